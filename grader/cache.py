@@ -1,0 +1,58 @@
+"""Compiled templates kept on disk, so only the first run of a template pays for sympy.
+
+The key is the template file's hash, the package version and a fingerprint of the solver's
+source: editing either recompiles. The folder is ``$GRADER_CACHE_DIR``, else
+``$XDG_CACHE_HOME/grader``, else ``~/.cache/grader``; if it cannot be written, templates are
+compiled each run and nothing fails.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+from functools import lru_cache
+from pathlib import Path
+
+from grader import __version__
+from grader.bank import Template
+from grader.compiled import FORMAT, Compiled
+from grader.files import write_atomic
+
+_SOLVER_SOURCES = ("solver.py", "symbolic.py", "compiled.py", "expr.py", "units.py", "scene.py", "bank.py",
+                   "effects/base.py", "effects/flight.py", "effects/impact.py", "effects/velocity.py")
+
+
+def cache_dir() -> Path:
+    """Where compiled templates are kept."""
+    if os.environ.get("GRADER_CACHE_DIR"):
+        return Path(os.environ["GRADER_CACHE_DIR"])
+    base = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
+    return Path(base) / "grader"
+
+
+@lru_cache(maxsize=1)
+def _fingerprint() -> str:
+    digest = hashlib.sha256(f"{__version__}/{FORMAT}".encode())
+    package = Path(__file__).resolve().parent
+    for name in _SOLVER_SOURCES:
+        digest.update((package / name).read_bytes())
+    return digest.hexdigest()
+
+
+def compiled_for(template: Template) -> Compiled:
+    """The compiled form of a template: from the cache, or compiled now and cached."""
+    key = hashlib.sha256(f"{template.source_hash}/{_fingerprint()}".encode()).hexdigest()[:20]
+    path = cache_dir() / f"{template.id}-{key}.json"
+    try:
+        return Compiled.from_json(json.loads(path.read_text(encoding="utf-8")))
+    except (OSError, ValueError, KeyError, TypeError, IndexError):
+        pass
+    from grader.solver import compile_template
+
+    compiled = compile_template(template)
+    try:
+        write_atomic(path, json.dumps(compiled.to_json()))
+    except OSError:
+        pass  # a read-only home folder only costs time
+    return compiled

@@ -1,0 +1,270 @@
+"""The ``grader`` command: one subcommand per stage of the pipeline.
+
+Exit codes: 0 ok; 1 runtime error (a bug: it keeps its traceback); 2 usage or invalid input;
+3 finished, with some rows refused.
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import difflib
+import io
+import json
+import re
+import sys
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+from grader import __version__
+from grader.bank import Parameter, Template, load_bank
+from grader.errors import GraderError, UsageError
+from grader.units import parse_unit
+
+EXIT_OK, EXIT_USAGE, EXIT_REFUSED = 0, 2, 3
+_VALUE = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*(.*?)\s*$")
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The argument parser, with one subparser per command."""
+    parser = argparse.ArgumentParser(prog="grader", description="Impact-problem generator and auto-grader.")
+    parser.add_argument("--version", action="version", version=f"grader {__version__}")
+    parser.add_argument("--bank", type=Path, help="folder of problem templates (default: the shipped bank)")
+    commands = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+
+    listing = commands.add_parser("list", help="list the templates in the bank")
+    listing.add_argument("--json", action="store_true", help="one JSON object per template")
+
+    show = commands.add_parser("show", help="one template: scene, parameters, derived step chain")
+    show.add_argument("template", metavar="ID")
+    show.add_argument("--json", action="store_true", help="print JSON")
+
+    solve = commands.add_parser("solve", help="answers for one parameter set or a CSV of them")
+    solve.add_argument("template", metavar="ID")
+    given = solve.add_mutually_exclusive_group(required=True)
+    given.add_argument("--set", action="append", metavar="NAME=VALUE", dest="assignments",
+                       help="a parameter value in the template's unit, or with its own unit (2.1m)")
+    given.add_argument("--batch", type=Path, metavar="FILE.csv", help="CSV with a header of parameter names")
+    solve.add_argument("--json", action="store_true", help="JSON output (one object per line for --batch)")
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run the command line; returns the exit code."""
+    arguments = build_parser().parse_args(argv)
+    try:
+        return _COMMANDS[arguments.command](arguments)
+    except GraderError as error:
+        print(f"grader: error: {error}", file=sys.stderr)
+        return EXIT_USAGE
+    except BrokenPipeError:
+        return EXIT_OK
+
+
+def _bank(arguments: argparse.Namespace) -> dict[str, Template]:
+    return load_bank(arguments.bank)
+
+
+def _template(arguments: argparse.Namespace) -> Template:
+    bank = _bank(arguments)
+    if arguments.template not in bank:
+        close = difflib.get_close_matches(arguments.template, list(bank), n=3, cutoff=0.5)
+        hint = f"; did you mean {' or '.join(close)}?" if close else f"; the bank has {', '.join(sorted(bank))}"
+        raise UsageError(f"unknown template '{arguments.template}'{hint}")
+    return bank[arguments.template]
+
+
+def _list(arguments: argparse.Namespace) -> int:
+    bank = _bank(arguments)
+    if arguments.json:
+        for template in bank.values():
+            print(json.dumps({"id": template.id, "title": template.title, "version": template.version,
+                              "parameters": list(template.parameters), "answers": list(template.answers)}))
+        return EXIT_OK
+    rows = [(t.id, t.title, ", ".join(t.parameters), ", ".join(t.answers)) for t in bank.values()]
+    print(_table(("id", "title", "parameters", "answers"), rows))
+    return EXIT_OK
+
+
+def _show(arguments: argparse.Namespace) -> int:
+    from grader.cache import compiled_for
+    from grader.expr import to_text
+
+    template = _template(arguments)
+    compiled = compiled_for(template)
+    if arguments.json:
+        print(json.dumps({
+            "id": template.id, "title": template.title, "version": template.version,
+            "parameters": {n: {"unit": p.unit.text, "domain": str(p.domain), "description": p.description}
+                           for n, p in template.parameters.items()},
+            "answers": {n: {"unit": a.unit.text, "description": a.description, "symbolic": list(a.symbolic)}
+                        for n, a in template.answers.items()},
+            "steps": [{"unknown": s.unknown, "relation": s.relation, "solved": to_text(s.solved)}
+                      for s in compiled.steps]}))
+        return EXIT_OK
+    scene = template.scene
+    lines = [f"{template.id} (version {template.version}): {template.title}", "", "Bodies:"]
+    lines += [f"  {b.name}: {'fixed surface' if b.mass is None else 'mass ' + to_text(b.mass)}"
+              for b in scene.bodies.values()]
+    lines += ["", "Stages:"]
+    lines += [f"  {s.index + 1}. {s.effect}: " + ", ".join(f"{k}={v}" for k, v in s.source.items())
+              for s in scene.stages]
+    lines += ["", "Parameters:"]
+    lines += [f"  {n:<10} {p.unit.text or '-':<6} {str(p.domain):<12} {p.description}"
+              for n, p in template.parameters.items()]
+    lines += ["", "Answers:"]
+    lines += [f"  {n:<10} {a.unit.text or '-':<6} {a.description}" for n, a in template.answers.items()]
+    lines += ["", "Step chain (one equation, one unknown):"]
+    for number, step in enumerate(compiled.steps, 1):
+        lhs, rhs = (to_text(side) for side in step.equation)
+        lines += [f"  {number}. {step.relation}", f"       {lhs} = {rhs}",
+                  f"       => {step.unknown} = {to_text(step.solved)}"]
+    print("\n".join(lines))
+    return EXIT_OK
+
+
+def _solve(arguments: argparse.Namespace) -> int:
+    from grader.cache import compiled_for
+    from grader.evaluate import solve_batch, solve_one
+
+    template = _template(arguments)
+    if arguments.batch is not None:
+        table, raw_rows, errors = _read_batch(arguments.batch, template)
+        compiled = compiled_for(template)
+        solutions = solve_batch(template, compiled, table)
+        refused = 0
+        for row, solution in enumerate(solutions):
+            error = errors[row] or solution.error
+            refused += error is not None
+            params = raw_rows[row] if errors[row] else solution.params
+            _print_solution(template, params, solution.answers if error is None else None, error, arguments.json,
+                            row + 1)
+        return EXIT_REFUSED if refused else EXIT_OK
+    params = _read_assignments(arguments.assignments, template)
+    solution = solve_one(template, compiled_for(template), params)
+    _print_solution(template, solution.params, solution.answers, solution.error, arguments.json, None)
+    return EXIT_REFUSED if solution.error else EXIT_OK
+
+
+def _print_solution(template: Template, params: Any, answers: Any, error: str | None, as_json: bool,
+                    row: int | None) -> None:
+    if as_json:
+        record: dict[str, Any] = {"template": template.id} if row is None else {"template": template.id, "row": row}
+        record["params"] = dict(params)
+        if error is None:
+            record["answers"] = {name: value.to_json() for name, value in answers.items()}
+        else:
+            record["error"] = error
+        print(json.dumps(record))
+        return
+    heading = f"{template.id}" + (f", row {row}" if row is not None else "") + ": " + ", ".join(
+        f"{name} = {_number(value)}{_unit(template.parameters[name])}" for name, value in params.items()
+        if name in template.parameters and isinstance(value, float))
+    print(heading)
+    if error is not None:
+        print(f"  refused: {error}")
+        return
+    for name, value in answers.items():
+        unit = f" {value.unit}" if value.unit and isinstance(value.value, float) else ""
+        shown = _number(value.value) if isinstance(value.value, float) else value.value
+        print(f"  {name:<12} {'undefined (' + value.undefined + ')' if value.undefined else str(shown) + unit}")
+
+
+def _number(value: float) -> str:
+    return f"{value:.5g}" if value == value else "nan"
+
+
+def _unit(parameter: Parameter) -> str:
+    return f" {parameter.unit.text}" if parameter.unit.text else ""
+
+
+def _check_names(given: Sequence[str], template: Template, where: str) -> None:
+    unknown = [n for n in given if n not in template.parameters]
+    missing = [n for n in template.parameters if n not in given]
+    problems = []
+    if unknown:
+        problems.append(f"unknown parameter(s) {', '.join(unknown)}")
+    if missing:
+        problems.append(f"missing parameter(s) {', '.join(missing)}")
+    if problems:
+        raise UsageError(f"{where}: {'; '.join(problems)} (template '{template.id}' takes "
+                         f"{', '.join(template.parameters)})")
+
+
+def _read_assignments(assignments: Sequence[str], template: Template) -> dict[str, float]:
+    params: dict[str, float] = {}
+    for text in assignments:
+        name, sep, value = text.partition("=")
+        name = name.strip()
+        if not sep or not name:
+            raise UsageError(f"--set {text}: expected NAME=VALUE, like h_drop=2.1")
+        if name in params:
+            raise UsageError(f"--set {text}: {name} is given twice")
+        if name in template.parameters:
+            params[name] = _read_value(value, template.parameters[name], f"--set {name}")
+        else:
+            params[name] = float("nan")
+    _check_names(list(params), template, "--set")
+    return params
+
+
+def _read_value(text: str, parameter: Parameter, where: str) -> float:
+    """A number in the parameter's unit, or with another unit of the same kind (``2.1 m``)."""
+    match = _VALUE.match(text)
+    expected = f"a number in {parameter.unit.text}" if parameter.unit.text else "a number"
+    if not match:
+        raise GraderError(f"{where}: expected {expected}, got '{text}'")
+    number, unit_text = float(match.group(1)), match.group(2)
+    if not unit_text:
+        return number
+    unit = parse_unit(unit_text)
+    if not unit.same_dimension(parameter.unit):
+        raise GraderError(f"{where}: '{unit_text}' cannot be converted to {parameter.unit.text or 'a pure number'}")
+    return number * unit.to_si / parameter.unit.to_si
+
+
+def _read_batch(path: Path, template: Template) -> tuple[dict[str, Any], list[dict[str, str]], list[str | None]]:
+    try:
+        text = path.read_text(encoding="utf-8-sig")
+    except OSError as error:
+        raise UsageError(f"{path}: cannot read ({error.strerror})") from None
+    except UnicodeDecodeError:
+        raise UsageError(f"{path}: expected UTF-8 text") from None
+    try:
+        dialect: Any = csv.Sniffer().sniff(text.split("\n", 1)[0], delimiters=",;\t")
+    except csv.Error:
+        dialect = csv.excel
+    reader = csv.DictReader(io.StringIO(text), dialect=dialect)
+    header = [h.strip() for h in (reader.fieldnames or [])]
+    if not header:
+        raise UsageError(f"{path}: empty file; expected a header of parameter names")
+    _check_names(header, template, str(path))
+    reader.fieldnames = header
+    table: dict[str, list[float]] = {name: [] for name in template.parameters}
+    raw_rows: list[dict[str, str]] = []
+    errors: list[str | None] = []
+    for line, row in enumerate(reader, 2):
+        raw = {k: (v or "").strip() for k, v in row.items() if k is not None}
+        raw_rows.append(raw)
+        error = None
+        for name, parameter in template.parameters.items():
+            try:
+                table[name].append(_read_value(raw.get(name, ""), parameter, f"line {line}, {name}"))
+            except GraderError as problem:
+                table[name].append(float("nan"))
+                error = error or str(problem)
+        if None in row:
+            error = error or f"line {line}: more cells than header columns"
+        errors.append(error)
+    return table, raw_rows, errors
+
+
+def _table(header: Sequence[str], rows: Sequence[Sequence[str]]) -> str:
+    widths = [max(len(str(r[i])) for r in [header, *rows]) for i in range(len(header))]
+    lines = ["  ".join(str(cell).ljust(w) for cell, w in zip(row, widths)).rstrip() for row in [header, *rows]]
+    lines.insert(1, "  ".join("-" * w for w in widths))
+    return "\n".join(lines)
+
+
+_COMMANDS = {"list": _list, "show": _show, "solve": _solve}

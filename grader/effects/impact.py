@@ -1,0 +1,107 @@
+"""Direct and oblique central impact of two bodies, or of a body against a fixed surface.
+
+Axes: n along the line of impact, pointing from the first body into the second; t along the
+common tangent. Surfaces are smooth: no impulse along t. Numbers follow DESIGN.md: impulse form
+with inverse masses ``w = 1/m`` (``w = 0`` for a fixed surface); after-impact velocities in the
+mass-centre form ``v1' = v_c - e w1 (v1 - v2)/(w1 + w2)``, which equals ``v1 - J w1`` but keeps its
+accuracy when ``e`` is small or the masses are very unequal; energy lost as
+``1/2 mu (1 - e)(1 + e) v_rel^2``, or ``1/2 mu (v_rel^2 - v_sep^2)`` when ``e`` itself is derived.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Any
+
+from grader.effects.base import Condition, Effect, Field, Relation, Stable
+
+if TYPE_CHECKING:
+    from grader.symbolic import Context
+    from grader.scene import Stage
+
+
+def _impact(stage: Stage, ctx: Context) -> list[Relation]:
+    import sympy as sp
+
+    first, second = stage.fields["bodies"]
+    w1, w2 = ctx.inverse_mass(first), ctx.inverse_mass(second)
+    e = ctx.sym(stage.fields["restitution"])
+    J = ctx.quantity(stage, "impulse")
+    u1, u2 = ctx.velocity(stage, first, "before", "n"), ctx.velocity(stage, second, "before", "n")
+    a1, a2 = ctx.velocity(stage, first, "after", "n"), ctx.velocity(stage, second, "after", "n")
+    approach, separation = u1 - u2, a2 - a1
+    centre = (w2 * u1 + w1 * u2) / (w1 + w2)
+    e_text = stage.text("restitution")
+
+    relations = [
+        Relation(f"impulse along n in the impact of {first} and {second}, with restitution {e_text}",
+                 J, (1 + e) * approach / (w1 + w2), solutions={J: (1 + e) * approach / (w1 + w2)},
+                 general=False),
+        Relation(f"impulse-momentum for {first} along n", a1, u1 - J * w1,
+                 solutions={a1: u1 - J * w1, J: (u1 - a1) / w1},
+                 stable={a1: (Stable(centre - e * w1 * approach / (w1 + w2)),)}),
+    ]
+    if w2 != 0:
+        relations.append(Relation(
+            f"impulse-momentum for {second} along n", a2, u2 + J * w2,
+            solutions={a2: u2 + J * w2, J: (a2 - u2) / w2},
+            stable={a2: (Stable(centre + e * w2 * approach / (w1 + w2)),)}))
+    relations.append(Relation(
+        f"coefficient of restitution: separation over approach along n", e, separation / approach,
+        solutions=_only_symbols({e: separation / approach, a1: a2 - e * approach, a2: a1 + e * approach}),
+        requires=(
+            Condition(sp.Gt(approach, 0), f"{first} and {second} are not approaching along the line of "
+                      "impact (relative normal velocity <= 0), so they do not collide"),
+            Condition(sp.Ge(e, 0), "the coefficient of restitution is {value}; it cannot be negative "
+                      "(the bodies would pass through each other)", subject=e),
+            Condition(sp.Le(e, 1), "the coefficient of restitution is {value}; above 1 the impact "
+                      "would create energy", subject=e),
+        )))
+    for body in (first, second):
+        if ctx.inverse_mass(body) != 0 and stage.is_oblique:
+            before, after = ctx.velocity(stage, body, "before", "t"), ctx.velocity(stage, body, "after", "t")
+            relations.append(Relation(f"smooth surfaces: no impulse along t, so {body}'s t-velocity is "
+                                      "unchanged", after, before, solutions=_only_symbols({after: before})))
+    return relations + _energy(stage, ctx, e, approach, separation, w1, w2)
+
+
+def _energy(stage: Stage, ctx: Context, e: Any, approach: Any, separation: Any, w1: Any, w2: Any) -> list[Relation]:
+    before, after = ctx.quantity(stage, "energy_before"), ctx.quantity(stage, "energy_after")
+    lost, fraction = ctx.quantity(stage, "energy_lost"), ctx.quantity(stage, "loss_fraction")
+    totals = {when: ctx.kinetic_energy(stage, when) for when in ("before", "after")}
+    lost_form = (1 - e) * (1 + e) * approach**2 / (2 * (w1 + w2))
+    return [
+        Relation("kinetic energy just before the impact", before, totals["before"],
+                 solutions={before: totals["before"]}, general=False),
+        Relation("kinetic energy just after the impact", after, totals["after"],
+                 solutions={after: totals["after"]}, general=False),
+        Relation("energy lost in the impact", lost, lost_form, solutions={lost: lost_form}, general=False,
+                 stable={lost: (Stable(lost_form, given=(e,)),
+                                Stable((approach**2 - separation**2) / (2 * (w1 + w2))))}),
+        Relation("fraction of the kinetic energy lost", fraction, lost / before,
+                 solutions={fraction: lost / before}, general=False),
+    ]
+
+
+def _only_symbols(solutions: dict[Any, Any]) -> dict[Any, Any]:
+    """Keep the solutions whose unknown is a quantity (a fixed body's velocity is just 0)."""
+    import sympy as sp
+
+    return {k: v for k, v in solutions.items() if isinstance(k, sp.Symbol)}
+
+
+IMPACT = Effect(
+    "impact",
+    "direct or oblique central impact with restitution e; smooth surfaces; a body may be fixed",
+    (
+        Field("bodies", "bodies", doc="[first, second]: n points from the first into the second"),
+        Field("restitution", "expr", doc="coefficient of restitution e, 0..1"),
+        Field("before", "velocities", doc="per body: n-velocity, or {n: .., t: ..}; omitted = at rest"),
+        Field("after", "velocities", required=False, doc="per body: names for the velocities after"),
+        Field("impulse", "name", required=False, doc="name for the normal impulse J"),
+        Field("energy_before", "name", required=False, doc="name for the kinetic energy before"),
+        Field("energy_after", "name", required=False, doc="name for the kinetic energy after"),
+        Field("energy_lost", "name", required=False, doc="name for the energy lost"),
+        Field("loss_fraction", "name", required=False, doc="name for the fraction of energy lost"),
+    ),
+    _impact,
+)

@@ -1,0 +1,154 @@
+"""Answers for parameter sets: domain and physics checks, then the compiled kernels.
+
+Every set is answered or refused with a reason; one bad set never stops the others, and no NaN
+or infinity reaches an answer.
+
+>>> from grader.bank import load_bank
+>>> from grader.cache import compiled_for
+>>> template = load_bank()["drop-rebound"]
+>>> solution = solve_one(template, compiled_for(template), {"h_drop": 2100, "h_rebound": 1100})
+>>> round(solution.answers["e"].value, 3), round(solution.answers["loss_pct"].value, 1)
+(0.724, 47.6)
+>>> solve_one(template, compiled_for(template), {"h_drop": 1000, "h_rebound": 1100}).error
+'constraint h_rebound <= h_drop fails: the ball cannot bounce higher than it was dropped from'
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+from fractions import Fraction
+from typing import Any
+
+import numpy as np
+
+from grader.bank import Template
+from grader.compiled import Compiled
+from grader.expr import Num, fold, format_number, substitute, to_text
+from grader.kernel import evaluate
+
+
+@dataclass(frozen=True)
+class AnswerValue:
+    """One answer: a number, an expression (text) for a symbolic answer, or undefined."""
+
+    name: str
+    unit: str
+    value: float | str | None
+    undefined: str | None = None
+
+    def to_json(self) -> dict[str, Any]:
+        """``{"value", "unit"}``, plus ``"undefined": reason`` where there is no value."""
+        data: dict[str, Any] = {"value": self.value, "unit": self.unit}
+        if self.undefined is not None:
+            data["undefined"] = self.undefined
+        return data
+
+
+@dataclass(frozen=True)
+class Solution:
+    """The answers for one parameter set, or the reason it was refused."""
+
+    template: str
+    params: Mapping[str, float]
+    answers: Mapping[str, AnswerValue] | None
+    error: str | None = None
+
+
+def solve_one(template: Template, compiled: Compiled, params: Mapping[str, float]) -> Solution:
+    """Answers for one parameter set."""
+    table = {name: np.array([float(value)]) for name, value in params.items()}
+    return solve_batch(template, compiled, table)[0]
+
+
+def solve_batch(template: Template, compiled: Compiled, table: Mapping[str, Any]) -> list[Solution]:
+    """Answers for many parameter sets at once: ``table`` maps each parameter to a float array."""
+    columns = {name: np.asarray(table[name], dtype=float) for name in template.parameters}
+    count = len(next(iter(columns.values()))) if columns else 0
+    refusals: list[str | None] = [None] * count
+    env: dict[str, Any] = {**columns, **compiled.constants}
+    with np.errstate(all="ignore"):
+        _check_domains(template, columns, refusals)
+        _check_constraints(template, env, refusals)
+        _check_physics(compiled, env, refusals)
+        values, undefined = _numeric_answers(compiled, env, refusals, count)
+    return [_solution(template, compiled, columns, values, undefined, refusals, row) for row in range(count)]
+
+
+def _refuse(refusals: list[str | None], failing: Any, message: Any) -> None:
+    for row in np.flatnonzero(failing):
+        if refusals[row] is None:
+            refusals[row] = message(row) if callable(message) else message
+
+
+def _check_domains(template: Template, columns: Mapping[str, Any], refusals: list[str | None]) -> None:
+    for name, parameter in template.parameters.items():
+        values = columns[name]
+        unit = f" {parameter.unit.text}" if parameter.unit.text else ""
+        _refuse(refusals, ~np.isfinite(values), f"{name} is not a finite number")
+        _refuse(refusals, ~parameter.domain.contains(values),
+                lambda row, v=values, n=name, p=parameter, u=unit:
+                f"{n} = {_show(v[row])}{u} is outside its domain {p.domain}")
+
+
+def _check_constraints(template: Template, env: Mapping[str, Any], refusals: list[str | None]) -> None:
+    for constraint in template.constraints:
+        holds = evaluate(constraint.holds, env)
+        _refuse(refusals, ~np.asarray(holds, dtype=bool),
+                f"constraint {constraint.text} fails: {constraint.message}")
+
+
+def _check_physics(compiled: Compiled, env: Mapping[str, Any], refusals: list[str | None]) -> None:
+    for check in compiled.checks:
+        holds = np.asarray(evaluate(check.holds, env), dtype=bool)
+        if check.subject is not None and "{value}" in check.message:
+            subject = np.broadcast_to(evaluate(check.subject, env), holds.shape)
+            _refuse(refusals, ~holds, lambda row, s=subject, m=check.message: m.replace("{value}", _show(s[row])))
+        else:
+            _refuse(refusals, ~holds, check.message)
+
+
+def _numeric_answers(compiled: Compiled, env: Mapping[str, Any], refusals: list[str | None],
+                     count: int) -> tuple[dict[str, Any], dict[str, list[str | None]]]:
+    values: dict[str, Any] = {}
+    undefined: dict[str, list[str | None]] = {}
+    for name, answer in compiled.answers.items():
+        missing: list[str | None] = [None] * count
+        for rule in answer.undefined:
+            for row in np.flatnonzero(np.broadcast_to(evaluate(rule.when, env), (count,))):
+                missing[row] = missing[row] or rule.reason
+        undefined[name] = missing
+        if answer.numeric is None:
+            continue
+        value = np.broadcast_to(np.asarray(evaluate(answer.numeric, env), dtype=float), (count,))
+        values[name] = value
+        bad = ~np.isfinite(value) & np.array([m is None for m in missing])
+        _refuse(refusals, bad, f"answer {name} is not a finite number for these values "
+                               "(they are beyond what float64 can represent)")
+    return values, undefined
+
+
+def _solution(template: Template, compiled: Compiled, columns: Mapping[str, Any], values: Mapping[str, Any],
+              undefined: Mapping[str, list[str | None]], refusals: list[str | None], row: int) -> Solution:
+    params = {name: float(column[row]) for name, column in columns.items()}
+    if refusals[row] is not None:
+        return Solution(template.id, params, None, refusals[row])
+    answers = {}
+    for name, answer in compiled.answers.items():
+        reason = undefined[name][row]
+        if reason is not None:
+            answers[name] = AnswerValue(name, answer.unit, None, reason)
+        elif answer.symbolic is not None:
+            keep = set(template.answers[name].symbolic)
+            numbers = {p: Num(Fraction(repr(v))) for p, v in params.items() if p not in keep}
+            answers[name] = AnswerValue(name, answer.unit, to_text(fold(substitute(answer.symbolic, numbers))))
+        else:
+            answers[name] = AnswerValue(name, answer.unit, float(values[name][row]))
+    return Solution(template.id, params, answers)
+
+
+def _show(value: float) -> str:
+    """A number for a message: short, exact decimals where they are short."""
+    if not np.isfinite(value):
+        return str(value)
+    return format_number(Fraction(f"{float(value):.6g}"))

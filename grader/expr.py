@@ -1,0 +1,281 @@
+"""Expressions as small frozen trees: parsed safely, printed, substituted, folded.
+
+One representation serves templates (stage fields, constraints, answers), the compiled
+kernels of the solver (stored as JSON in the cache) and, later, students' answers. Text is
+parsed with Python's ``ast`` and an allow-list; nothing is ever passed to ``eval``.
+
+>>> tree = parse("v*(1 - e*p)/(p + 1)")
+>>> to_text(tree)
+'v*(1 - e*p)/(p + 1)'
+>>> to_text(fold(substitute(tree, {"e": Num(Fraction(1, 10))})))
+'v*(1 - 0.1*p)/(p + 1)'
+>>> sorted(names(tree))
+['e', 'p', 'v']
+>>> parse("__import__('os')")
+Traceback (most recent call last):
+...
+grader.errors.ExpressionError: '__import__' is not an allowed function (allowed: abs, atan2, cos, cosd, exp, hypot, log, sin, sind, sqrt, tan)
+"""
+
+from __future__ import annotations
+
+import ast
+from dataclasses import dataclass
+from fractions import Fraction
+from typing import Any, Union
+
+from grader.errors import ExpressionError
+
+MAX_LENGTH = 500
+MAX_DEPTH = 40
+MAX_EXPONENT = 64
+
+FUNCTIONS = {
+    "sqrt": 1, "sin": 1, "cos": 1, "tan": 1, "sind": 1, "cosd": 1,
+    "exp": 1, "log": 1, "abs": 1, "atan2": 2, "hypot": 2,
+}
+"""Functions an expression may call, with their number of arguments."""
+
+CONSTANTS = {"pi"}
+
+_BINARY = {ast.Add: "add", ast.Sub: "sub", ast.Mult: "mul", ast.Div: "div", ast.Pow: "pow"}
+_COMPARE = {ast.Lt: "lt", ast.LtE: "le", ast.Gt: "gt", ast.GtE: "ge"}
+_BOOLEAN = {ast.And: "and", ast.Or: "or"}
+
+
+@dataclass(frozen=True)
+class Num:
+    """A number: exact (``Fraction``) where it can be, else a float."""
+
+    value: Fraction | float
+
+    def __post_init__(self) -> None:
+        if isinstance(self.value, float) and self.value != self.value:
+            raise ExpressionError("a number in an expression is NaN")
+
+
+@dataclass(frozen=True)
+class Sym:
+    """A named quantity."""
+
+    name: str
+
+
+@dataclass(frozen=True)
+class Op:
+    """An operation: arithmetic (add, sub, mul, div, pow, neg), a function, or a comparison."""
+
+    op: str
+    args: tuple[Node, ...]
+
+
+Node = Union[Num, Sym, Op]
+
+
+def parse(text: str, *, allow_compare: bool = False) -> Node:
+    """Parse ``text`` into a tree, refusing anything outside the allow-list.
+
+    ``^`` means power, as students write it. Comparisons (``h_r <= h``) and ``and``/``or``
+    are allowed only with ``allow_compare`` (template constraints).
+
+    >>> to_text(parse("2^3 + x"))
+    '2**3 + x'
+    >>> parse("h <= 2", allow_compare=True)
+    Op(op='le', args=(Sym(name='h'), Num(value=Fraction(2, 1))))
+    """
+    if not isinstance(text, str):
+        raise ExpressionError(f"expected an expression as text, got {type(text).__name__}")
+    if len(text) > MAX_LENGTH:
+        raise ExpressionError(f"expression is {len(text)} characters long; at most {MAX_LENGTH} are allowed")
+    if not text.strip():
+        raise ExpressionError("expression is empty")
+    try:
+        # '^' is power as students write it; Python would read it as xor, with the wrong precedence.
+        tree = ast.parse(text.strip().replace("^", "**"), mode="eval")
+    except SyntaxError as error:
+        raise ExpressionError(f"'{text}' is not a valid expression ({error.msg})") from None
+    return _convert(tree.body, allow_compare, 0)
+
+
+def _convert(node: ast.AST, allow_compare: bool, depth: int) -> Node:
+    if depth > MAX_DEPTH:
+        raise ExpressionError(f"expression is nested more than {MAX_DEPTH} levels deep")
+    deeper = depth + 1
+    if isinstance(node, ast.Constant):
+        return _number(node.value)
+    if isinstance(node, ast.Name):
+        return Sym(node.id)
+    if isinstance(node, ast.UnaryOp) and isinstance(node.op, (ast.USub, ast.UAdd)):
+        operand = _convert(node.operand, allow_compare, deeper)
+        return Op("neg", (operand,)) if isinstance(node.op, ast.USub) else operand
+    if isinstance(node, ast.BinOp) and type(node.op) in _BINARY:
+        left = _convert(node.left, allow_compare, deeper)
+        right = _convert(node.right, allow_compare, deeper)
+        op = _BINARY[type(node.op)]
+        if op == "pow":
+            _check_exponent(right)
+        return Op(op, (left, right))
+    if isinstance(node, ast.Call):
+        return _call(node, allow_compare, deeper)
+    if allow_compare and isinstance(node, ast.Compare) and len(node.ops) == 1 and type(node.ops[0]) in _COMPARE:
+        left = _convert(node.left, allow_compare, deeper)
+        right = _convert(node.comparators[0], allow_compare, deeper)
+        return Op(_COMPARE[type(node.ops[0])], (left, right))
+    if allow_compare and isinstance(node, ast.BoolOp) and type(node.op) in _BOOLEAN:
+        return Op(_BOOLEAN[type(node.op)], tuple(_convert(v, allow_compare, deeper) for v in node.values))
+    raise ExpressionError(f"'{ast.unparse(node)}' is not allowed in an expression "
+                          "(numbers, names, + - * / ** and the listed functions only)")
+
+
+def _number(value: Any) -> Num:
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise ExpressionError(f"{value!r} is not a number")
+    if isinstance(value, float):
+        if value != value or value in (float("inf"), float("-inf")):
+            raise ExpressionError(f"{value!r} is not a finite number")
+        return Num(Fraction(repr(value)))
+    return Num(Fraction(value))
+
+
+def _call(node: ast.Call, allow_compare: bool, depth: int) -> Node:
+    name = node.func.id if isinstance(node.func, ast.Name) else ast.unparse(node.func)
+    if name not in FUNCTIONS:
+        raise ExpressionError(f"'{name}' is not an allowed function (allowed: {', '.join(sorted(FUNCTIONS))})")
+    if node.keywords or len(node.args) != FUNCTIONS[name]:
+        raise ExpressionError(f"{name}() takes {FUNCTIONS[name]} argument(s)")
+    return Op(name, tuple(_convert(a, allow_compare, depth) for a in node.args))
+
+
+def _check_exponent(exponent: Node) -> None:
+    if isinstance(exponent, Num) and abs(exponent.value) > MAX_EXPONENT:
+        raise ExpressionError(f"exponent {to_text(exponent)} is larger than {MAX_EXPONENT}")
+
+
+def names(node: Node) -> set[str]:
+    """The names an expression uses (``pi`` excluded)."""
+    if isinstance(node, Sym):
+        return set() if node.name in CONSTANTS else {node.name}
+    if isinstance(node, Op):
+        return set().union(*(names(a) for a in node.args))
+    return set()
+
+
+def substitute(node: Node, values: dict[str, Node]) -> Node:
+    """Replace names by trees."""
+    if isinstance(node, Sym):
+        return values.get(node.name, node)
+    if isinstance(node, Op):
+        return Op(node.op, tuple(substitute(a, values) for a in node.args))
+    return node
+
+
+_EXACT = {
+    "add": lambda a, b: a + b, "sub": lambda a, b: a - b, "mul": lambda a, b: a * b,
+    "div": lambda a, b: a / b if b != 0 else None, "neg": lambda a: -a,
+    "pow": lambda a, b: a ** b if b.denominator == 1 and (a != 0 or b >= 0) else None,
+}
+
+
+def fold(node: Node) -> Node:
+    """Fold arithmetic on exact numbers, so ``1 + 0.1`` prints as ``1.1``."""
+    if not isinstance(node, Op):
+        return node
+    args = tuple(fold(a) for a in node.args)
+    rule = _EXACT.get(node.op)
+    if rule and all(isinstance(a, Num) and isinstance(a.value, Fraction) for a in args):
+        value = rule(*(a.value for a in args))  # type: ignore[union-attr]
+        if value is not None:
+            return Num(Fraction(value))
+    if node.op == "mul" and isinstance(args[1], Num) and not isinstance(args[0], Num):
+        args = (args[1], args[0])
+    if node.op == "mul" and isinstance(args[0], Num) and args[0].value == 1:
+        return args[1]
+    if node.op == "mul" and isinstance(args[1], Num) and args[1].value == 1:
+        return args[0]
+    return Op(node.op, args)
+
+
+_PRECEDENCE = {"or": 1, "and": 2, "lt": 3, "le": 3, "gt": 3, "ge": 3,
+               "add": 4, "sub": 4, "mul": 5, "div": 5, "neg": 6, "pow": 7}
+_SYMBOL = {"add": " + ", "sub": " - ", "mul": "*", "div": "/", "pow": "**",
+           "lt": " < ", "le": " <= ", "gt": " > ", "ge": " >= ", "and": " and ", "or": " or "}
+
+
+def to_text(node: Node) -> str:
+    """Python/sympy-parseable text of an expression, with as few parentheses as needed."""
+    return _text(node)[0]
+
+
+def _text(node: Node) -> tuple[str, int]:
+    if isinstance(node, Sym):
+        return node.name, 9
+    if isinstance(node, Num):
+        text = format_number(node.value)
+        return text, (6 if text.startswith("-") else 9) if "/" not in text else 5
+    if node.op in FUNCTIONS:
+        return f"{node.op}({', '.join(_text(a)[0] for a in node.args)})", 9
+    level = _PRECEDENCE[node.op]
+    if node.op == "neg":
+        inner, inner_level = _text(node.args[0])
+        # -(a*b) and (-a)*b are the same number, so a product needs no parentheses.
+        bare = inner_level > level or (isinstance(node.args[0], Op) and node.args[0].op in ("mul", "div"))
+        return "-" + (inner if bare else f"({inner})"), level
+    parts = []
+    for index, arg in enumerate(node.args):
+        inner, inner_level = _text(arg)
+        # Left-associative operators keep a right operand of equal level in parentheses,
+        # power is right-associative and does the opposite.
+        right_side = index > 0
+        needs = inner_level < level or (inner_level == level and (
+            (right_side and node.op in ("sub", "div", "mul")) or (not right_side and node.op == "pow")))
+        parts.append(f"({inner})" if needs else inner)
+    return _SYMBOL[node.op].join(parts), level
+
+
+def format_number(value: Fraction | float) -> str:
+    """Shortest faithful text of a number: exact decimals stay exact.
+
+    >>> format_number(Fraction(11, 10)), format_number(Fraction(1, 3)), format_number(2.5)
+    ('1.1', '1/3', '2.5')
+    """
+    if isinstance(value, float):
+        return repr(value)
+    if value.denominator == 1:
+        return str(value.numerator)
+    denominator, twos, fives = value.denominator, 0, 0
+    while denominator % 2 == 0:
+        denominator, twos = denominator // 2, twos + 1
+    while denominator % 5 == 0:
+        denominator, fives = denominator // 5, fives + 1
+    if denominator != 1:
+        return f"{value.numerator}/{value.denominator}"
+    places = max(twos, fives)
+    scaled = value * 10**places
+    sign = "-" if scaled < 0 else ""
+    digits = str(abs(scaled.numerator)).rjust(places + 1, "0")
+    return f"{sign}{digits[:-places]}.{digits[-places:]}"
+
+
+def to_json(node: Node) -> Any:
+    """A JSON-ready form of a tree (for the compiled-template cache)."""
+    if isinstance(node, Sym):
+        return node.name
+    if isinstance(node, Num):
+        if isinstance(node.value, Fraction):
+            return {"q": [node.value.numerator, node.value.denominator]}
+        return {"f": node.value}
+    return [node.op, *(to_json(a) for a in node.args)]
+
+
+def from_json(data: Any) -> Node:
+    """Inverse of :func:`to_json`.
+
+    >>> tree = parse("hypot(a, -2.5*b)")
+    >>> from_json(to_json(tree)) == tree
+    True
+    """
+    if isinstance(data, str):
+        return Sym(data)
+    if isinstance(data, dict):
+        return Num(Fraction(*data["q"])) if "q" in data else Num(float(data["f"]))
+    return Op(data[0], tuple(from_json(a) for a in data[1:]))

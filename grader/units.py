@@ -1,0 +1,105 @@
+"""Units: parse a unit string, convert to SI exactly, compare dimensions.
+
+Factors are exact (a ``Fraction`` times a power of pi), so unit conversions folded into the
+solver's expressions cancel exactly.
+
+>>> parse_unit("ft/s").factor, parse_unit("ft/s").dimension
+(Fraction(381, 1250), (1, 0, -1, 0))
+>>> parse_unit("deg").pi_power
+1
+>>> parse_unit("m/s^2") == parse_unit("m*s^-2")
+True
+>>> parse_unit("furlong")
+Traceback (most recent call last):
+...
+grader.errors.GraderError: unknown unit 'furlong' in 'furlong' (known: %, J, N, deg, ft, ft*lbf, ...)
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+from fractions import Fraction
+
+from grader.errors import GraderError
+
+# dimension exponents: (length, mass, time, angle)
+_BASE: dict[str, tuple[Fraction, int, tuple[int, int, int, int]]] = {
+    "m": (Fraction(1), 0, (1, 0, 0, 0)),
+    "mm": (Fraction(1, 1000), 0, (1, 0, 0, 0)),
+    "cm": (Fraction(1, 100), 0, (1, 0, 0, 0)),
+    "km": (Fraction(1000), 0, (1, 0, 0, 0)),
+    "ft": (Fraction("0.3048"), 0, (1, 0, 0, 0)),
+    "in": (Fraction("0.0254"), 0, (1, 0, 0, 0)),
+    "mi": (Fraction("1609.344"), 0, (1, 0, 0, 0)),
+    "kg": (Fraction(1), 0, (0, 1, 0, 0)),
+    "g": (Fraction(1, 1000), 0, (0, 1, 0, 0)),
+    "Mg": (Fraction(1000), 0, (0, 1, 0, 0)),
+    "t": (Fraction(1000), 0, (0, 1, 0, 0)),
+    "lbm": (Fraction("0.45359237"), 0, (0, 1, 0, 0)),
+    "slug": (Fraction("0.45359237") * Fraction("9.80665") / Fraction("0.3048"), 0, (0, 1, 0, 0)),
+    "s": (Fraction(1), 0, (0, 0, 1, 0)),
+    "ms": (Fraction(1, 1000), 0, (0, 0, 1, 0)),
+    "min": (Fraction(60), 0, (0, 0, 1, 0)),
+    "h": (Fraction(3600), 0, (0, 0, 1, 0)),
+    "N": (Fraction(1), 0, (1, 1, -2, 0)),
+    "kN": (Fraction(1000), 0, (1, 1, -2, 0)),
+    "lbf": (Fraction("0.45359237") * Fraction("9.80665"), 0, (1, 1, -2, 0)),
+    "lb": (Fraction("0.45359237") * Fraction("9.80665"), 0, (1, 1, -2, 0)),
+    "J": (Fraction(1), 0, (2, 1, -2, 0)),
+    "kJ": (Fraction(1000), 0, (2, 1, -2, 0)),
+    "rad": (Fraction(1), 0, (0, 0, 0, 1)),
+    "deg": (Fraction(1, 180), 1, (0, 0, 0, 1)),
+    "%": (Fraction(1, 100), 0, (0, 0, 0, 0)),
+    "1": (Fraction(1), 0, (0, 0, 0, 0)),
+}
+_ALIASES = {"°": "deg", "mph": "mi/h", "km/hr": "km/h", "sec": "s", "ft-lb": "ft*lbf", "ft*lb": "ft*lbf"}
+_TOKEN = re.compile(r"\s*([*/])?\s*([A-Za-z%°]+|1)\s*(?:(?:\^|\*\*)\s*(-?\d+))?\s*")
+
+
+@dataclass(frozen=True)
+class Unit:
+    """A unit: ``value_SI = value * factor * pi**pi_power``; ``text`` as the template wrote it."""
+
+    text: str
+    factor: Fraction
+    pi_power: int
+    dimension: tuple[int, int, int, int]
+
+    @property
+    def to_si(self) -> float:
+        """The conversion factor to SI as a float (deg -> rad included)."""
+        import math
+        return float(self.factor) * math.pi ** self.pi_power
+
+    def same_dimension(self, other: Unit) -> bool:
+        """Whether values in the two units can be converted into each other."""
+        return self.dimension == other.dimension
+
+
+def parse_unit(text: str) -> Unit:
+    """Parse ``m``, ``m/s``, ``m/s^2``, ``kg*m/s``, ``deg``, ``%``; empty means dimensionless."""
+    cleaned = _ALIASES.get(text.strip(), text.strip())
+    if cleaned in ("", "-"):
+        cleaned = "1"
+    factor, pi_power, dimension = Fraction(1), 0, [0, 0, 0, 0]
+    position = 0
+    while position < len(cleaned):
+        match = _TOKEN.match(cleaned, position)
+        if not match or match.end() == position or (position == 0 and match.group(1)):
+            raise GraderError(f"cannot read unit '{text}' (write units like m, m/s, m/s^2, kg, deg, %)")
+        operator, name, power_text = match.groups()
+        name = _ALIASES.get(name, name)
+        if name not in _BASE:
+            known = ", ".join(sorted(set(_BASE) | {"ft*lbf"}, key=str.lower)[:6])
+            raise GraderError(f"unknown unit '{name}' in '{text}' (known: {known}, ...)")
+        base_factor, base_pi, base_dimension = _BASE[name]
+        power = int(power_text or 1) * (-1 if operator == "/" else 1)
+        factor *= base_factor ** power
+        pi_power += base_pi * power
+        dimension = [d + b * power for d, b in zip(dimension, base_dimension)]
+        position = match.end()
+    return Unit(text.strip(), factor, pi_power, (dimension[0], dimension[1], dimension[2], dimension[3]))
+
+
+DIMENSIONLESS = parse_unit("")

@@ -1,0 +1,37 @@
+"""Shared fixtures: the bank, compiled templates, and a private compile cache for the run."""
+
+from __future__ import annotations
+
+import os
+import tempfile
+from collections.abc import Iterator
+
+import pytest
+
+# Tests never read or write the user's cache; the first compile of each template happens here.
+os.environ["GRADER_CACHE_DIR"] = tempfile.mkdtemp(prefix="grader-test-cache-")
+
+from grader.bank import Template, load_bank  # noqa: E402
+from grader.cache import compiled_for  # noqa: E402
+from grader.compiled import Compiled  # noqa: E402
+
+
+@pytest.fixture(scope="session")
+def bank() -> dict[str, Template]:
+    """The shipped problem bank."""
+    return load_bank()
+
+
+@pytest.fixture(scope="session")
+def compiled(bank: dict[str, Template]) -> dict[str, Compiled]:
+    """Every shipped template, compiled once per test session."""
+    return {template_id: compiled_for(template) for template_id, template in bank.items()}
+
+
+@pytest.fixture
+def workdir(tmp_path: pytest.TempPathFactory) -> Iterator[str]:
+    """A temporary current folder."""
+    old = os.getcwd()
+    os.chdir(tmp_path)  # type: ignore[arg-type]
+    yield str(tmp_path)
+    os.chdir(old)

@@ -176,8 +176,8 @@ def parse_template(raw: Mapping[str, Any], where: str, source_hash: str, stem: s
     """Validate a template's YAML mapping and freeze it."""
     unknown = set(raw) - _TOP_KEYS
     if unknown:
-        raise TemplateError(where, ", ".join(sorted(map(str, unknown))), f"only the keys {', '.join(sorted(_TOP_KEYS))}",
-                            "unknown key(s)")
+        raise TemplateError(where, ", ".join(sorted(map(str, unknown))),
+                            f"only the keys {', '.join(sorted(_TOP_KEYS))}", "unknown key(s)")
     template_id = _text(raw, "id", where)
     if not re.match(r"^[a-z0-9][a-z0-9-]*$", template_id):
         raise TemplateError(where, "id", "lower-case letters, digits and -", repr(template_id))
@@ -240,7 +240,7 @@ def _check_statement(template: Template, given: set[str]) -> None:
     import jinja2.meta
 
     try:
-        syntax = jinja2.Environment().parse(template.statement)
+        syntax = jinja2.Environment(autoescape=True).parse(template.statement)
     except jinja2.TemplateSyntaxError as error:
         raise TemplateError(template.where, "statement", "a valid Jinja2 snippet", error.message) from None
     unknown = jinja2.meta.find_undeclared_variables(syntax) - given - {"g"}

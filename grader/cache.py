@@ -8,6 +8,7 @@ compiled each run and nothing fails.
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import json
 import os
@@ -51,8 +52,6 @@ def compiled_for(template: Template) -> Compiled:
     from grader.solver import compile_template
 
     compiled = compile_template(template)
-    try:
+    with contextlib.suppress(OSError):  # a read-only home folder only costs time
         write_atomic(path, json.dumps(compiled.to_json()))
-    except OSError:
-        pass  # a read-only home folder only costs time
     return compiled

@@ -111,7 +111,7 @@ def _show(arguments: argparse.Namespace) -> int:
     lines += [f"  {s.index + 1}. {s.effect}: " + ", ".join(f"{k}={v}" for k, v in s.source.items())
               for s in scene.stages]
     lines += ["", "Parameters:"]
-    lines += [f"  {n:<10} {p.unit.text or '-':<6} {str(p.domain):<12} {p.description}"
+    lines += [f"  {n:<10} {p.unit.text or '-':<6} {p.domain!s:<12} {p.description}"
               for n, p in template.parameters.items()]
     lines += ["", "Answers:"]
     lines += [f"  {n:<10} {a.unit.text or '-':<6} {a.description}" for n, a in template.answers.items()]
@@ -218,7 +218,10 @@ def _read_value(text: str, parameter: Parameter, where: str) -> float:
     number, unit_text = float(match.group(1)), match.group(2)
     if not unit_text:
         return number
-    unit = parse_unit(unit_text)
+    try:
+        unit = parse_unit(unit_text)
+    except GraderError:
+        raise GraderError(f"{where}: expected {expected}, got '{text}'") from None
     if not unit.same_dimension(parameter.unit):
         raise GraderError(f"{where}: '{unit_text}' cannot be converted to {parameter.unit.text or 'a pure number'}")
     return number * unit.to_si / parameter.unit.to_si
@@ -247,22 +250,23 @@ def _read_batch(path: Path, template: Template) -> tuple[dict[str, Any], list[di
     for line, row in enumerate(reader, 2):
         raw = {k: (v or "").strip() for k, v in row.items() if k is not None}
         raw_rows.append(raw)
-        error = None
+        reason = None
         for name, parameter in template.parameters.items():
             try:
                 table[name].append(_read_value(raw.get(name, ""), parameter, f"line {line}, {name}"))
             except GraderError as problem:
                 table[name].append(float("nan"))
-                error = error or str(problem)
+                reason = reason or str(problem)
         if None in row:
-            error = error or f"line {line}: more cells than header columns"
-        errors.append(error)
+            reason = reason or f"line {line}: more cells than header columns"
+        errors.append(reason)
     return table, raw_rows, errors
 
 
 def _table(header: Sequence[str], rows: Sequence[Sequence[str]]) -> str:
     widths = [max(len(str(r[i])) for r in [header, *rows]) for i in range(len(header))]
-    lines = ["  ".join(str(cell).ljust(w) for cell, w in zip(row, widths)).rstrip() for row in [header, *rows]]
+    lines = ["  ".join(str(cell).ljust(width) for cell, width in zip(row, widths, strict=True)).rstrip()
+             for row in [header, *rows]]
     lines.insert(1, "  ".join("-" * w for w in widths))
     return "\n".join(lines)
 

@@ -11,18 +11,19 @@ parsed with Python's ``ast`` and an allow-list; nothing is ever passed to ``eval
 'v*(1 - 0.1*p)/(p + 1)'
 >>> sorted(names(tree))
 ['e', 'p', 'v']
->>> parse("__import__('os')")
+>>> parse("__import__('os')")  # doctest: +ELLIPSIS
 Traceback (most recent call last):
 ...
-grader.errors.ExpressionError: '__import__' is not an allowed function (allowed: abs, atan2, cos, cosd, exp, hypot, log, sin, sind, sqrt, tan)
+grader.errors.ExpressionError: '__import__' is not an allowed function (allowed: abs, atan2, ...)
 """
 
 from __future__ import annotations
 
 import ast
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from fractions import Fraction
-from typing import Any, Union
+from typing import Any
 
 from grader.errors import ExpressionError
 
@@ -69,7 +70,7 @@ class Op:
     args: tuple[Node, ...]
 
 
-Node = Union[Num, Sym, Op]
+Node = Num | Sym | Op
 
 
 def parse(text: str, *, allow_compare: bool = False) -> Node:
@@ -94,6 +95,8 @@ def parse(text: str, *, allow_compare: bool = False) -> Node:
         tree = ast.parse(text.strip().replace("^", "**"), mode="eval")
     except SyntaxError as error:
         raise ExpressionError(f"'{text}' is not a valid expression ({error.msg})") from None
+    except (RecursionError, MemoryError):
+        raise ExpressionError(f"expression is nested more than {MAX_DEPTH} levels deep") from None
     return _convert(tree.body, allow_compare, 0)
 
 
@@ -147,7 +150,7 @@ def _call(node: ast.Call, allow_compare: bool, depth: int) -> Node:
 
 
 def _check_exponent(exponent: Node) -> None:
-    if isinstance(exponent, Num) and abs(exponent.value) > MAX_EXPONENT:
+    if isinstance(exponent, Num) and abs(float(exponent.value)) > MAX_EXPONENT:
         raise ExpressionError(f"exponent {to_text(exponent)} is larger than {MAX_EXPONENT}")
 
 
@@ -160,7 +163,7 @@ def names(node: Node) -> set[str]:
     return set()
 
 
-def substitute(node: Node, values: dict[str, Node]) -> Node:
+def substitute(node: Node, values: Mapping[str, Node]) -> Node:
     """Replace names by trees."""
     if isinstance(node, Sym):
         return values.get(node.name, node)
@@ -169,7 +172,7 @@ def substitute(node: Node, values: dict[str, Node]) -> Node:
     return node
 
 
-_EXACT = {
+_EXACT: dict[str, Callable[..., Fraction | None]] = {
     "add": lambda a, b: a + b, "sub": lambda a, b: a - b, "mul": lambda a, b: a * b,
     "div": lambda a, b: a / b if b != 0 else None, "neg": lambda a: -a,
     "pow": lambda a, b: a ** b if b.denominator == 1 and (a != 0 or b >= 0) else None,
@@ -182,8 +185,9 @@ def fold(node: Node) -> Node:
         return node
     args = tuple(fold(a) for a in node.args)
     rule = _EXACT.get(node.op)
-    if rule and all(isinstance(a, Num) and isinstance(a.value, Fraction) for a in args):
-        value = rule(*(a.value for a in args))  # type: ignore[union-attr]
+    exact = [a.value for a in args if isinstance(a, Num) and isinstance(a.value, Fraction)]
+    if rule and len(exact) == len(args):
+        value = rule(*exact)
         if value is not None:
             return Num(Fraction(value))
     if node.op == "mul" and isinstance(args[1], Num) and not isinstance(args[0], Num):

@@ -67,5 +67,5 @@ def evaluate(node: Node, env: Mapping[str, Any]) -> Any:
         if node.name == "pi":
             return np.pi
         return env[node.name]
-    assert isinstance(node, Op)  # noqa: S101  (Node is a closed union; mypy narrowing only)
+    assert isinstance(node, Op)
     return OPERATIONS[node.op](*(evaluate(arg, env) for arg in node.args))

@@ -7,7 +7,7 @@ needs neither sympy nor this module.
 >>> from grader.bank import load_bank
 >>> compiled = compile_template(load_bank()["drop-rebound"])
 >>> [step.unknown for step in compiled.steps]
-['v_impact', 'v_after', 'e', '_1_energy_before', '_1_energy_lost', 'f_loss']
+['v_impact', 'T', 'v_after', 'e', 'E_lost', 'f_loss']
 >>> from grader.expr import to_text
 >>> to_text(compiled.answers["loss_pct"].numeric)
 '100*(h_drop - h_rebound)/h_drop'

@@ -24,7 +24,7 @@ from grader.expr import FUNCTIONS, Node, Num, Op, Sym, parse  # noqa: F401  (par
 from grader.scene import Scene, Stage
 
 
-class hypot(sp.Function):  # noqa: N801  (named like the numpy function it becomes)
+class hypot(sp.Function):  # type: ignore[misc]  # noqa: N801  (named like the numpy function it becomes)
     """``sqrt(x**2 + y**2)`` without overflow; the sign of either argument does not matter."""
 
     nargs = 2
@@ -69,7 +69,7 @@ def drop_common_factors(expr: Any) -> Any:
     return expr.replace(lambda e: isinstance(e, sp.atan2), simpler)
 
 
-class sind(sp.Function):  # noqa: N801
+class sind(sp.Function):  # type: ignore[misc]  # noqa: N801
     """Sine of an angle in degrees, exact at multiples of 90 (reduced in degrees first)."""
 
     nargs = 1
@@ -83,7 +83,7 @@ class sind(sp.Function):  # noqa: N801
         return None
 
 
-class cosd(sp.Function):  # noqa: N801
+class cosd(sp.Function):  # type: ignore[misc]  # noqa: N801
     """Cosine of an angle in degrees, exact at multiples of 90."""
 
     nargs = 1

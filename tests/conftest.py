@@ -11,9 +11,9 @@ import pytest
 # Tests never read or write the user's cache; the first compile of each template happens here.
 os.environ["GRADER_CACHE_DIR"] = tempfile.mkdtemp(prefix="grader-test-cache-")
 
-from grader.bank import Template, load_bank  # noqa: E402
-from grader.cache import compiled_for  # noqa: E402
-from grader.compiled import Compiled  # noqa: E402
+from grader.bank import Template, load_bank
+from grader.cache import compiled_for
+from grader.compiled import Compiled
 
 
 @pytest.fixture(scope="session")

@@ -15,8 +15,8 @@ from typing import TYPE_CHECKING, Any
 from grader.effects.base import Condition, Effect, Field, Relation, Stable
 
 if TYPE_CHECKING:
-    from grader.symbolic import Context
     from grader.scene import Stage
+    from grader.symbolic import Context
 
 
 def _impact(stage: Stage, ctx: Context) -> list[Relation]:
@@ -25,7 +25,7 @@ def _impact(stage: Stage, ctx: Context) -> list[Relation]:
     first, second = stage.fields["bodies"]
     w1, w2 = ctx.inverse_mass(first), ctx.inverse_mass(second)
     e = ctx.sym(stage.fields["restitution"])
-    J = ctx.quantity(stage, "impulse")
+    impulse = ctx.quantity(stage, "impulse")
     u1, u2 = ctx.velocity(stage, first, "before", "n"), ctx.velocity(stage, second, "before", "n")
     a1, a2 = ctx.velocity(stage, first, "after", "n"), ctx.velocity(stage, second, "after", "n")
     approach, separation = u1 - u2, a2 - a1
@@ -34,19 +34,19 @@ def _impact(stage: Stage, ctx: Context) -> list[Relation]:
 
     relations = [
         Relation(f"impulse along n in the impact of {first} and {second}, with restitution {e_text}",
-                 J, (1 + e) * approach / (w1 + w2), solutions={J: (1 + e) * approach / (w1 + w2)},
+                 impulse, (1 + e) * approach / (w1 + w2), solutions={impulse: (1 + e) * approach / (w1 + w2)},
                  general=False),
-        Relation(f"impulse-momentum for {first} along n", a1, u1 - J * w1,
-                 solutions={a1: u1 - J * w1, J: (u1 - a1) / w1},
+        Relation(f"impulse-momentum for {first} along n", a1, u1 - impulse * w1,
+                 solutions={a1: u1 - impulse * w1, impulse: (u1 - a1) / w1},
                  stable={a1: (Stable(centre - e * w1 * approach / (w1 + w2)),)}),
     ]
     if w2 != 0:
         relations.append(Relation(
-            f"impulse-momentum for {second} along n", a2, u2 + J * w2,
-            solutions={a2: u2 + J * w2, J: (a2 - u2) / w2},
+            f"impulse-momentum for {second} along n", a2, u2 + impulse * w2,
+            solutions={a2: u2 + impulse * w2, impulse: (a2 - u2) / w2},
             stable={a2: (Stable(centre + e * w2 * approach / (w1 + w2)),)}))
     relations.append(Relation(
-        f"coefficient of restitution: separation over approach along n", e, separation / approach,
+        "coefficient of restitution: separation over approach along n", e, separation / approach,
         solutions=_only_symbols({e: separation / approach, a1: a2 - e * approach, a2: a1 + e * approach}),
         requires=(
             Condition(sp.Gt(approach, 0), f"{first} and {second} are not approaching along the line of "

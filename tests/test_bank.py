@@ -1,0 +1,130 @@
+"""Template loading: every mistake is refused with `file: key: expected …, got …`."""
+
+from __future__ import annotations
+
+import copy
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import pytest
+import yaml
+
+from grader.bank import load_bank, load_template, parse_template
+from grader.errors import GraderError, TemplateError
+from grader.resources import bank_dir
+from grader.solver import compile_template
+
+BASE = yaml.safe_load((bank_dir() / "drop-rebound.yaml").read_text(encoding="utf-8"))
+
+
+def mutated(change: Callable[[dict[str, Any]], Any]) -> dict[str, Any]:
+    raw = copy.deepcopy(BASE)
+    change(raw)
+    return raw
+
+
+def set_in(path: str, value: Any) -> Callable[[dict[str, Any]], None]:
+    def change(raw: dict[str, Any]) -> None:
+        *parents, last = path.split("/")
+        node: Any = raw
+        for part in parents:
+            node = node[int(part)] if part.isdigit() else node[part]
+        node[int(last) if last.isdigit() else last] = value
+    return change
+
+
+INVALID = [
+    ("domain", set_in("parameters/h_drop/domain", "[1 2]"), "parameters.h_drop.domain: expected an interval"),
+    ("domain-order", set_in("parameters/h_drop/domain", "[3, 1]"), "expected an interval with low < high"),
+    ("unit", set_in("parameters/h_drop/unit", "furlongs"), "parameters.h_drop.unit: expected a unit"),
+    ("sample-outside", set_in("parameters/h_rebound/sample", {"uniform": [-5, 10]}),
+     "parameters.h_rebound.sample.uniform: expected values inside the domain [0, inf), got -5"),
+    ("sample-kind", set_in("parameters/h_drop/sample", {"normal": [1, 2]}),
+     "parameters.h_drop.sample: expected one of"),
+    ("precision-both", set_in("parameters/h_drop/sig_figs", 3), "expected exactly one of decimals or sig_figs"),
+    ("effect", set_in("stages/0/effect", "teleport"), "stages[0].effect: expected one of free_fall, impact, rise"),
+    ("field", set_in("stages/0/colour", "red"), "stages[0]: expected only the fields of 'free_fall'"),
+    ("missing-field", lambda raw: raw["stages"][0].pop("height"), "stages[0].height: expected a value"),
+    ("body", set_in("stages/0/body", "bat"), "stages[0].body: expected one of the bodies (ball, floor)"),
+    ("fixed-first", set_in("stages/1/bodies", ["floor", "ball"]), "expected the first body to be movable"),
+    ("expression", set_in("stages/0/height", "__import__('os')"), "'__import__' is not an allowed function"),
+    ("answer-name", set_in("answers/e/value", "e_typo"), "answers.e.value: expected names of the scene's quantities"),
+    ("constraint", set_in("constraints/0/require", "h_rebound <= height"), "constraints[0].require: expected an"),
+    ("constraint-not-comparison", set_in("constraints/0/require", "h_rebound"), "expected a comparison"),
+    ("statement", set_in("statement", "Dropped from {{ height }} mm"), "statement: expected only parameters"),
+    ("statement-syntax", set_in("statement", "Dropped from {{ h_drop mm"), "statement: expected a valid Jinja2"),
+    ("id", set_in("id", "Drop Rebound"), "id: expected lower-case letters"),
+    ("version", set_in("version", "one"), "version: expected a whole number"),
+    ("gravity", set_in("gravity", "9.81 m/s"), "gravity: expected a positive acceleration"),
+    ("top-key", set_in("colour", "red"), "colour: expected only the keys"),
+    ("reserved", set_in("parameters/g", BASE["parameters"]["h_drop"]),
+     "expected a name of letters, digits and _, not g"),
+    ("mass", set_in("bodies/ball/mass", "m_unknown"), "bodies.ball.mass: expected parameters or symbols only"),
+    ("body-spec", set_in("bodies/floor", {"fixed": True, "mass": "m"}), "either a mass or fixed: true"),
+    ("tolerance", set_in("answers/e/tolerance", {"rtol": -1}), "answers.e.tolerance.rtol: expected a number >= 0"),
+]
+
+
+@pytest.mark.parametrize(("change", "message"), [(c, m) for _, c, m in INVALID], ids=[i for i, _, _ in INVALID])
+def test_invalid_template_is_refused_with_where_and_what(change: Callable[[dict[str, Any]], Any],
+                                                         message: str) -> None:
+    """The message names the file and the key, and says what was expected."""
+    with pytest.raises(TemplateError) as error:
+        parse_template(mutated(change), "bank/drop-rebound.yaml", "hash", "drop-rebound")
+    assert str(error.value).startswith("bank/drop-rebound.yaml: ")
+    assert message in str(error.value)
+
+
+def test_shipped_template_passes_validation_unchanged() -> None:
+    """The base of the table above is itself valid (so each row tests one mistake)."""
+    assert parse_template(mutated(lambda raw: None), "x.yaml", "hash", "drop-rebound").id == "drop-rebound"
+
+
+def test_answer_the_scene_cannot_determine_is_refused_at_compile_time() -> None:
+    """A scene without the rebound stage cannot give e: the message names what is missing."""
+    raw = mutated(lambda raw: raw["stages"].pop(2))
+    raw.pop("constraints")
+    template = parse_template(raw, "x.yaml", "hash")
+    with pytest.raises(TemplateError, match=r"answers.e: expected an answer the scene determines .* nothing fixes"):
+        compile_template(template)
+
+
+def test_numeric_answer_that_depends_on_a_symbol_is_refused() -> None:
+    """An answer still in terms of the ball's mass m has no number: say so."""
+    raw = mutated(set_in("answers/e", {"value": "m*e", "unit": ""}))
+    with pytest.raises(TemplateError, match=r"answers.e: expected a number once the parameters are given, .* on m"):
+        compile_template(parse_template(raw, "x.yaml", "hash"))
+
+
+def test_file_level_problems_name_the_file(tmp_path: Path) -> None:
+    """Bad YAML, a non-mapping, an id that is not the file name, duplicate ids."""
+    cases = {"broken.yaml": "id: [unclosed", "list.yaml": "- a\n- b\n",
+             "renamed.yaml": (bank_dir() / "drop-rebound.yaml").read_text(encoding="utf-8")}
+    expected = {"broken.yaml": "(file): expected valid YAML", "list.yaml": "(file): expected a mapping",
+                "renamed.yaml": "id: expected the file name's stem 'renamed'"}
+    for name, text in cases.items():
+        (tmp_path / name).write_text(text, encoding="utf-8")
+        with pytest.raises(TemplateError) as error:
+            load_template(tmp_path / name)
+        assert str(error.value).startswith(str(tmp_path / name))
+        assert expected[name] in str(error.value)
+
+
+def test_missing_bank_folder_is_a_clear_error(tmp_path: Path) -> None:
+    """Pointing --bank at nothing says which folder."""
+    with pytest.raises(GraderError, match="problem bank folder not found"):
+        load_bank(tmp_path / "nowhere")
+
+
+def test_shipped_bank_has_the_five_seed_templates_with_their_names() -> None:
+    """Ids, parameters and answers exactly as the foundation issue names them."""
+    bank = load_bank()
+    expected = {
+        "drop-rebound": (["h_drop", "h_rebound"], ["e", "loss_pct"]),
+        "car-collision": (["p", "e"], ["vA", "vB", "vA_ratio", "vB_ratio"]),
+        "pile-driver": (["m_ram", "m_pile", "h_drop", "h_rebound"], ["v_pile", "e", "loss_pct"]),
+        "ball-plate": (["v", "theta", "e"], ["v_out", "theta_out"]),
+        "oblique-spheres": (["v1", "theta", "e", "m1", "m2"], ["v1_out", "v2_out", "theta1_out", "loss_pct"]),
+    }
+    assert {t: (list(bank[t].parameters), list(bank[t].answers)) for t in expected} == expected

@@ -1,0 +1,44 @@
+"""A regular (non-editable) install finds the shipped bank: wheel -> fresh venv -> grader from elsewhere."""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+import venv
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parent.parent
+
+
+@pytest.mark.slow
+def test_wheel_installed_in_a_fresh_venv_runs_from_another_folder(tmp_path: Path) -> None:
+    """Build the wheel, install it (with its dependencies) into a new venv, run `grader list` and
+    `grader solve` from an unrelated folder: the problem bank must come from the wheel."""
+    wheels = tmp_path / "wheels"
+    subprocess.run([sys.executable, "-m", "pip", "wheel", "--no-deps", "--quiet", "-w", str(wheels), str(ROOT)],
+                   check=True, capture_output=True, timeout=300)
+    wheel = next(wheels.glob("grader-*.whl"))
+    environment = tmp_path / "venv"
+    venv.create(environment, with_pip=True)
+    python = environment / "bin" / "python"
+    subprocess.run([str(python), "-m", "pip", "install", "--quiet", str(wheel)], check=True, capture_output=True,
+                   timeout=600)
+    elsewhere = tmp_path / "elsewhere"
+    elsewhere.mkdir()
+    env = {**os.environ, "GRADER_CACHE_DIR": str(tmp_path / "cache")}
+    env.pop("PYTHONPATH", None)
+    listing = subprocess.run([str(environment / "bin" / "grader"), "list"], cwd=elsewhere, env=env,
+                             capture_output=True, text=True, timeout=120)
+    assert listing.returncode == 0, listing.stderr
+    assert "pile-driver" in listing.stdout and "oblique-spheres" in listing.stdout
+    location = subprocess.run([str(python), "-c", "import grader.resources as r; print(r.bank_dir())"],
+                              cwd=elsewhere, env=env, capture_output=True, text=True, timeout=60)
+    assert str(environment) in location.stdout, "the bank must be found inside the installed package"
+    solved = subprocess.run([str(python), "-m", "grader", "solve", "drop-rebound", "--set", "h_drop=2100",
+                             "--set", "h_rebound=1100", "--json"], cwd=elsewhere, env=env, capture_output=True,
+                            text=True, timeout=120)
+    assert json.loads(solved.stdout)["answers"]["e"]["value"] == pytest.approx(0.7237, abs=1e-4)

@@ -24,7 +24,7 @@ import numpy as np
 
 from grader.bank import Template
 from grader.compiled import Compiled
-from grader.expr import Num, fold, format_number, substitute, to_text
+from grader.expr import Num, fold, substitute, to_text
 from grader.kernel import evaluate
 
 
@@ -149,6 +149,4 @@ def _solution(template: Template, compiled: Compiled, columns: Mapping[str, Any]
 
 def _show(value: float) -> str:
     """A number for a message: short, exact decimals where they are short."""
-    if not np.isfinite(value):
-        return str(value)
-    return format_number(Fraction(f"{float(value):.6g}"))
+    return f"{float(value):.6g}"

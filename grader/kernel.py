@@ -25,11 +25,14 @@ from grader.expr import Node, Num, Op, Sym
 
 def _quadrant(degrees: Any) -> tuple[Any, Any, Any]:
     x = np.asarray(degrees, dtype=float)
-    reduced = np.fmod(x, 360.0)  # exact
+    finite = np.isfinite(x)
+    reduced = np.fmod(np.where(finite, x, 0.0), 360.0)  # exact
     quarter = np.round(reduced / 90.0)
     rest = reduced - 90.0 * quarter  # exact: |rest| <= 45 and the operands are close
     radians = rest * (np.pi / 180.0)
-    return np.mod(quarter, 4).astype(int), np.sin(radians), np.cos(radians)
+    # A non-finite angle has no sine: NaN, which the caller refuses (never an index error).
+    return np.mod(quarter, 4).astype(int), np.where(finite, np.sin(radians), np.nan), np.where(
+        finite, np.cos(radians), np.nan)
 
 
 def sind(degrees: Any) -> Any:
@@ -54,7 +57,7 @@ OPERATIONS: dict[str, Callable[..., Any]] = {
     "add": np.add, "sub": np.subtract, "mul": np.multiply, "div": np.divide, "neg": np.negative,
     "pow": _power, "sqrt": np.sqrt, "sin": np.sin, "cos": np.cos, "tan": np.tan, "exp": np.exp,
     "log": np.log, "abs": np.abs, "atan2": np.arctan2, "hypot": np.hypot, "sind": sind, "cosd": cosd,
-    "lt": np.less, "le": np.less_equal, "gt": np.greater, "ge": np.greater_equal,
+    "Max": np.maximum, "Min": np.minimum, "lt": np.less, "le": np.less_equal, "gt": np.greater, "ge": np.greater_equal,
     "and": np.logical_and, "or": np.logical_or,
 }
 

@@ -26,7 +26,8 @@ from grader.compiled import Check, Compiled, CompiledAnswer, Step, Undefined
 from grader.effects import CATALOGUE, Relation
 from grader.errors import TemplateError
 from grader.expr import to_text
-from grader.symbolic import Context, cosd, drop_common_factors, from_node, sind, to_node
+from grader.stable import stabilize
+from grader.symbolic import Context, cosd, from_node, sind, to_node
 
 
 @dataclass(frozen=True)
@@ -75,7 +76,14 @@ def _solve(relation: Relation, unknown: Any) -> Any:
         return relation.solutions[unknown]
     if not relation.general:
         return None
-    roots = [r for r in sp.solve(sp.Eq(relation.lhs, relation.rhs), unknown) if r.is_real is not False]
+    # The side without the unknown is solved for as a whole, so sqrt(2*g*h) stays as the
+    # effect wrote it (sympy would split it into sqrt(2)*sqrt(g)*sqrt(h)).
+    lhs, rhs = sp.sympify(relation.lhs), sp.sympify(relation.rhs)
+    if unknown in rhs.free_symbols and unknown not in lhs.free_symbols:
+        lhs, rhs = rhs, lhs
+    whole = sp.Dummy("whole", real=True) if unknown not in rhs.free_symbols else rhs
+    roots = [r.xreplace({whole: rhs}) for r in sp.solve(sp.Eq(lhs, whole), unknown)]
+    roots = [r for r in roots if r.is_real is not False]
     if len(roots) > 1:
         roots = [r for r in roots if all(
             c.holds.subs(unknown, r) is not sp.false for c in relation.requires)]
@@ -123,7 +131,8 @@ class _Compiler:
         chain = _needed(chain, wanted.values())
         composed: dict[Any, Any] = {}
         for solved in chain:
-            composed[solved.unknown] = solved.numeric.xreplace(composed)
+            # doit(): display forms keep sqrt(2*g*h) whole; the numeric composition wants it evaluated.
+            composed[solved.unknown] = solved.numeric.doit().xreplace(composed)
         answers = {name: self._answer(name, expr, chain, composed) for name, expr in wanted.items()}
         return Compiled(
             template_id=self.template.id, source_hash=self.template.source_hash,
@@ -152,13 +161,11 @@ class _Compiler:
 
     def _tree(self, expr: Any, name: str) -> Any:
         """A numeric expression over parameters only, stabilised, as a tree."""
-        stable = drop_common_factors(sp.factor_terms(expr))
-        for angle in self.degree_angles:
-            stable = stable.subs(sind(angle) ** 2 + cosd(angle) ** 2, 1)
+        stable = stabilize(expr, self.degree_angles)
         stray = stable.free_symbols - {self.ctx.symbols[p] for p in self.template.parameters} - {
             self.ctx.symbols.get("g")}
         if stray:
-            stable = sp.factor_terms(sp.cancel(stable))
+            stable = stabilize(sp.cancel(stable), self.degree_angles)
             stray = stable.free_symbols - {self.ctx.symbols[p] for p in self.template.parameters} - {
                 self.ctx.symbols.get("g")}
         if stray:
@@ -202,7 +209,7 @@ class _Compiler:
         return tuple(checks)
 
     def _tree_condition(self, holds: Any) -> Any:
-        difference = drop_common_factors(sp.factor_terms(holds.lhs - holds.rhs))
+        difference = stabilize(holds.lhs - holds.rhs, self.degree_angles)
         # Against zero, a positive factor changes nothing: 381*v*x/1250 > 0 is x > 0.
         kept = [f for f in sp.Mul.make_args(difference) if not f.is_positive]
         return to_node(type(holds)(sp.Mul(*kept), 0))

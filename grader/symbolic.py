@@ -61,14 +61,6 @@ def common_positive_factor(x: Any, y: Any) -> Any:
     return common * sp.Mul(*shared)
 
 
-def drop_common_factors(expr: Any) -> Any:
-    """``atan2(k*y, k*x)`` is ``atan2(y, x)`` for ``k > 0``: write it so."""
-    def simpler(node: Any) -> Any:
-        common = common_positive_factor(*node.args)
-        return sp.atan2(node.args[0] / common, node.args[1] / common) if common != 1 else node
-    return expr.replace(lambda e: isinstance(e, sp.atan2), simpler)
-
-
 class sind(sp.Function):  # type: ignore[misc]  # noqa: N801
     """Sine of an angle in degrees, exact at multiples of 90 (reduced in degrees first)."""
 
@@ -99,7 +91,7 @@ class cosd(sp.Function):  # type: ignore[misc]  # noqa: N801
 
 _SYMPY_FUNCTIONS: dict[str, Any] = {
     "sqrt": sp.sqrt, "sin": sp.sin, "cos": sp.cos, "tan": sp.tan, "exp": sp.exp, "log": sp.log,
-    "abs": sp.Abs, "atan2": sp.atan2, "hypot": hypot, "sind": sind, "cosd": cosd,
+    "abs": sp.Abs, "atan2": sp.atan2, "hypot": hypot, "sind": sind, "cosd": cosd, "Max": sp.Max, "Min": sp.Min,
 }
 _BINARY = {"add": lambda a, b: a + b, "sub": lambda a, b: a - b, "mul": lambda a, b: a * b,
            "div": lambda a, b: a / b, "pow": lambda a, b: a**b,
@@ -160,7 +152,10 @@ def to_node(expr: Any) -> Node:
     name = {sp.Abs: "abs", sp.atan2: "atan2"}.get(type(expr), type(expr).__name__)
     if name not in FUNCTIONS:
         raise TemplateError("(compiled expression)", str(expr), "only functions the kernels know", name)
-    return Op(name, tuple(to_node(a) for a in expr.args))
+    args = tuple(to_node(a) for a in expr.args)
+    if name in ("Max", "Min") and len(args) > 2:  # sympy's Max takes any number of arguments
+        return Op(name, (args[0], to_node(type(expr)(*expr.args[1:]))))
+    return Op(name, args)
 
 
 def _add(expr: sp.Add) -> Node:

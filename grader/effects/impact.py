@@ -65,10 +65,15 @@ def _impact(stage: Stage, ctx: Context) -> list[Relation]:
 
 
 def _energy(stage: Stage, ctx: Context, e: Any, approach: Any, separation: Any, w1: Any, w2: Any) -> list[Relation]:
+    import sympy as sp
+
     before, after = ctx.quantity(stage, "energy_before"), ctx.quantity(stage, "energy_after")
     lost, fraction = ctx.quantity(stage, "energy_lost"), ctx.quantity(stage, "loss_fraction")
     totals = {when: ctx.kinetic_energy(stage, when) for when in ("before", "after")}
     lost_form = (1 - e) * (1 + e) * approach**2 / (2 * (w1 + w2))
+    # With e derived, (v_rel - v_sep) is a difference of measured quantities; once e <= 1 is
+    # checked the true loss is >= 0, so a negative result is rounding of an exact 0.
+    derived_form = sp.Max(0, (approach - separation) * (approach + separation) / (2 * (w1 + w2)))
     return [
         Relation("kinetic energy just before the impact", before, totals["before"],
                  solutions={before: totals["before"]}, general=False),
@@ -76,7 +81,7 @@ def _energy(stage: Stage, ctx: Context, e: Any, approach: Any, separation: Any, 
                  solutions={after: totals["after"]}, general=False),
         Relation("energy lost in the impact", lost, lost_form, solutions={lost: lost_form}, general=False,
                  stable={lost: (Stable(lost_form, given=(e,)),
-                                Stable((approach**2 - separation**2) / (2 * (w1 + w2))))}),
+                                Stable(derived_form))}),
         Relation("fraction of the kinetic energy lost", fraction, lost / before,
                  solutions={fraction: lost / before}, general=False),
     ]

@@ -38,7 +38,7 @@ import sympy as sp
 from grader.bank import Parameter, Template, load_bank
 from grader.cache import compiled_for
 from grader.compiled import Compiled
-from grader.evaluate import Solution, solve_batch
+from grader.evaluate import Solution, solve_batch, solve_columns
 from grader.kernel import evaluate
 from grader.symbolic import from_node
 
@@ -61,6 +61,7 @@ class Row:
     sets: int
     refused: int
     kernel_s: float
+    columns_s: float
     solve_batch_s: float
     baseline_sets: int
     sympy_s_per_set: float
@@ -71,6 +72,11 @@ class Row:
     def kernel_rate(self) -> float:
         """Parameter sets per second through the raw kernels."""
         return self.sets / self.kernel_s
+
+    @property
+    def columns_rate(self) -> float:
+        """Parameter sets per second through ``solve_columns`` (checks and answers, as arrays)."""
+        return self.sets / self.columns_s
 
     @property
     def solve_batch_rate(self) -> float:
@@ -214,12 +220,13 @@ def bench_template(template: Template, arguments: argparse.Namespace, rng: np.ra
     env = {**table, **compiled.constants}
     trees = numeric_answers(compiled)
     kernel_s, kernel = best_of(lambda: run_kernels(trees, env, arguments.sets), arguments.repeat)
+    columns_s, _ = best_of(lambda: solve_columns(template, compiled, table), arguments.repeat)
     batch_s, solutions = best_of(lambda: solve_batch(template, compiled, table), SOLVE_BATCH_REPEAT)
     check_solve_batch(kernel, solutions)
     per_set, baseline = sympy_baseline(compiled, trees, table, template.example, arguments.baseline_sets)
     worst, bad = compare(kernel, baseline, solutions)
     refused = sum(solution.error is not None for solution in solutions)
-    return Row(template.id, len(trees), arguments.sets, refused, kernel_s, batch_s,
+    return Row(template.id, len(trees), arguments.sets, refused, kernel_s, columns_s, batch_s,
                arguments.baseline_sets, per_set, worst, bad)
 
 
@@ -267,12 +274,13 @@ def verdict(ok: bool) -> str:
 def throughput_table(rows: Sequence[Row]) -> str:
     """The per-template Markdown table."""
     first = rows[0]
-    lines = [f"| template | answers | kernel sets/s | solve_batch sets/s | sympy sets/s ({first.baseline_sets}-set "
-             f"subset) | sympy, {first.sets:,} sets (extrapolated) | speed-up (kernel / sympy) | speed-up "
-             "(solve_batch / sympy) | refused rows | max rel. diff vs sympy |",
-             "|---|--:|--:|--:|--:|--:|--:|--:|--:|--:|"]
+    lines = [f"| template | answers | kernel sets/s | solve_columns sets/s | solve_batch sets/s | sympy sets/s "
+             f"({first.baseline_sets}-set subset) | sympy, {first.sets:,} sets (extrapolated) | speed-up (kernel / "
+             "sympy) | speed-up (solve_batch / sympy) | refused rows | max rel. diff vs sympy |",
+             "|---|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|"]
     for row in rows:
-        lines.append(f"| {row.template} | {row.answers} | {rate(row.kernel_rate)} | {rate(row.solve_batch_rate)} "
+        lines.append(f"| {row.template} | {row.answers} | {rate(row.kernel_rate)} | {rate(row.columns_rate)} "
+                     f"| {rate(row.solve_batch_rate)} "
                      f"| {rate(row.sympy_rate)} | {row.sympy_s_per_set * row.sets:,.0f} s "
                      f"| {rate(row.kernel_rate / row.sympy_rate)}× | {rate(row.solve_batch_rate / row.sympy_rate)}× "
                      f"| {row.refused} / {row.sets:,} | {row.max_rel_diff:.1e} |")
@@ -321,8 +329,8 @@ def report(rows: Sequence[Row], startup: Startup, arguments: argparse.Namespace)
         f"# Solve benchmark: {arguments.sets:,} parameter sets per template", environment(arguments),
         "## Throughput", throughput_table(rows),
         "A set is all of a template's numeric answers for one parameter set. The kernel column evaluates the "
-        "answer trees only; solve_batch also checks domains, "
-        "constraints and physics and builds one Python result per row (car-collision's two symbolic answers "
+        "answer trees only; solve_columns also checks domains, constraints and physics and returns arrays; "
+        "solve_batch adds one Python result per row (car-collision's two symbolic answers "
         "are written out as text per row, which dominates its time).",
         "## Startup", startup_table(startup), "## Targets", targets(rows, startup),
     ]) + "\n"
@@ -333,10 +341,12 @@ def write_csv(rows: Sequence[Row], startup: Startup, folder: Path) -> None:
     with (folder / "solve.csv").open("w", newline="", encoding="utf-8") as handle:
         writer = csv.writer(handle)
         fields = list(asdict(rows[0]))
-        writer.writerow([*fields, "kernel_sets_per_s", "solve_batch_sets_per_s", "sympy_sets_per_s",
+        writer.writerow([*fields, "kernel_sets_per_s", "solve_columns_sets_per_s", "solve_batch_sets_per_s",
+                         "sympy_sets_per_s",
                          "speedup_kernel", "speedup_solve_batch"])
         for row in rows:
-            writer.writerow([*asdict(row).values(), row.kernel_rate, row.solve_batch_rate, row.sympy_rate,
+            writer.writerow([*asdict(row).values(), row.kernel_rate, row.columns_rate, row.solve_batch_rate,
+                             row.sympy_rate,
                              row.kernel_rate / row.sympy_rate, row.solve_batch_rate / row.sympy_rate])
     with (folder / "solve_startup.csv").open("w", newline="", encoding="utf-8") as handle:
         writer = csv.writer(handle)
@@ -361,13 +371,14 @@ def plot(rows: Sequence[Row], path: Path) -> str:
         import matplotlib.pyplot as plt
     except ImportError:
         return "matplotlib is not installed: skipped the plot (pip install matplotlib)"
-    series = (("kernel", "kernel_rate", "#1f77b4"), ("solve_batch", "solve_batch_rate", "#ff7f0e"),
+    series = (("kernel", "kernel_rate", "#1f77b4"), ("solve_columns", "columns_rate", "#2ca02c"),
+              ("solve_batch", "solve_batch_rate", "#ff7f0e"),
               (f"sympy baseline ({rows[0].baseline_sets} sets)", "sympy_rate", "#7f7f7f"))
-    x, width = np.arange(len(rows)), 0.27
+    x, width = np.arange(len(rows)), 0.2
     figure, axes = plt.subplots(figsize=(11, 5.5), dpi=120)
     for index, (label, field, colour) in enumerate(series):
         values = [getattr(row, field) for row in rows]
-        bars = axes.bar(x + (index - 1) * width, values, width, label=label, color=colour)
+        bars = axes.bar(x + (index - 1.5) * width, values, width, label=label, color=colour)
         axes.bar_label(bars, labels=[short(v) for v in values], fontsize=8, padding=2)
     axes.axhline(TARGET_RATE, color="#d62728", linestyle="--", linewidth=1, label="target: $10^6$ sets/s")
     axes.set_yscale("log")

@@ -61,8 +61,20 @@ def solve_one(template: Template, compiled: Compiled, params: Mapping[str, float
     return solve_batch(template, compiled, table)[0]
 
 
-def solve_batch(template: Template, compiled: Compiled, table: Mapping[str, Any]) -> list[Solution]:
-    """Answers for many parameter sets at once: ``table`` maps each parameter to a float array."""
+@dataclass(frozen=True)
+class Columns:
+    """Answers for many parameter sets as arrays: ``values[name][row]`` (numeric answers only),
+    ``undefined[name][row]`` a reason or None, ``refusals[row]`` a reason or None. Values of
+    refused or undefined rows are meaningless and must be read through ``refusals``/``undefined``."""
+
+    params: Mapping[str, Any]
+    values: Mapping[str, Any]
+    undefined: Mapping[str, list[str | None]]
+    refusals: list[str | None]
+
+
+def solve_columns(template: Template, compiled: Compiled, table: Mapping[str, Any]) -> Columns:
+    """Answers for many parameter sets at once, as arrays: ``table`` maps parameters to float arrays."""
     columns = {name: np.asarray(table[name], dtype=float) for name in template.parameters}
     count = len(next(iter(columns.values()))) if columns else 0
     refusals: list[str | None] = [None] * count
@@ -72,7 +84,13 @@ def solve_batch(template: Template, compiled: Compiled, table: Mapping[str, Any]
         _check_constraints(template, env, refusals)
         _check_physics(compiled, env, refusals)
         values, undefined = _numeric_answers(compiled, env, refusals, count)
-    return [_solution(template, compiled, columns, values, undefined, refusals, row) for row in range(count)]
+    return Columns(columns, values, undefined, refusals)
+
+
+def solve_batch(template: Template, compiled: Compiled, table: Mapping[str, Any]) -> list[Solution]:
+    """Answers for many parameter sets, one :class:`Solution` per set, in order."""
+    result = solve_columns(template, compiled, table)
+    return [_solution(template, compiled, result, row) for row in range(len(result.refusals))]
 
 
 def _refuse(refusals: list[str | None], failing: Any, message: Any) -> None:
@@ -128,14 +146,13 @@ def _numeric_answers(compiled: Compiled, env: Mapping[str, Any], refusals: list[
     return values, undefined
 
 
-def _solution(template: Template, compiled: Compiled, columns: Mapping[str, Any], values: Mapping[str, Any],
-              undefined: Mapping[str, list[str | None]], refusals: list[str | None], row: int) -> Solution:
-    params = {name: float(column[row]) for name, column in columns.items()}
-    if refusals[row] is not None:
-        return Solution(template.id, params, None, refusals[row])
+def _solution(template: Template, compiled: Compiled, result: Columns, row: int) -> Solution:
+    params = {name: float(column[row]) for name, column in result.params.items()}
+    if result.refusals[row] is not None:
+        return Solution(template.id, params, None, result.refusals[row])
     answers = {}
     for name, answer in compiled.answers.items():
-        reason = undefined[name][row]
+        reason = result.undefined[name][row]
         if reason is not None:
             answers[name] = AnswerValue(name, answer.unit, None, reason)
         elif answer.symbolic is not None:
@@ -143,10 +160,15 @@ def _solution(template: Template, compiled: Compiled, columns: Mapping[str, Any]
             numbers = {p: Num(Fraction(repr(v))) for p, v in params.items() if p not in keep}
             answers[name] = AnswerValue(name, answer.unit, to_text(fold(substitute(answer.symbolic, numbers))))
         else:
-            answers[name] = AnswerValue(name, answer.unit, float(values[name][row]))
+            answers[name] = AnswerValue(name, answer.unit, float(result.values[name][row]))
     return Solution(template.id, params, answers)
 
 
 def _show(value: float) -> str:
-    """A number for a message: short, exact decimals where they are short."""
-    return f"{float(value):.6g}"
+    """A number for a message: 6 significant figures, but never a rounded whole number (a limit
+    like 1 or 90) for a value that is not exactly that: 1.0000000000000002 stays visible."""
+    value = float(value)
+    short = f"{value:.6g}"
+    if float(short) != value and float(short).is_integer():
+        short = repr(value)
+    return short

@@ -10,7 +10,7 @@ needs neither sympy nor this module.
 ['v_impact', 'T', 'v_after', 'e', 'E_lost', 'f_loss']
 >>> from grader.expr import to_text
 >>> to_text(compiled.answers["loss_pct"].numeric)
-'100*(h_drop - h_rebound)/h_drop'
+'100*Max(0, h_drop - h_rebound)/h_drop'
 """
 
 from __future__ import annotations

@@ -176,7 +176,11 @@ def _mul(expr: sp.Mul) -> Node:
     coefficient, rest = expr.as_coeff_Mul()
     if coefficient == -1:
         return Op("neg", (to_node(rest),))
-    factors = [to_node(f) for f in sp.Mul.make_args(expr)]
+    # c*x**2 as (c*x)*x: the square alone may under- or overflow where the product does not.
+    factors = []
+    for factor in sorted(sp.Mul.make_args(expr), key=lambda f: isinstance(f, sp.Pow) and f.exp == 2):
+        base_twice = isinstance(factor, sp.Pow) and factor.exp == 2 and len(sp.Mul.make_args(expr)) > 1
+        factors += [to_node(factor.base)] * 2 if base_twice else [to_node(factor)]
     result = factors[0]
     for factor in factors[1:]:
         result = Op("mul", (result, factor))
@@ -257,5 +261,5 @@ class Context:
             w = self.inverse_mass(body)
             if w != 0:
                 n, t = self.velocity(stage, body, when, "n"), self.velocity(stage, body, when, "t")
-                total += (n**2 + t**2) / (2 * w)
+                total += hypot(n, t) ** 2 / (2 * w)  # no square of a component under- or overflows
         return total

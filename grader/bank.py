@@ -289,7 +289,7 @@ def _parameter(name: str, spec: Any, where: str) -> Parameter:
     allowed = {"unit", "domain", "sample", "decimals", "sig_figs", "description"}
     if set(spec) - allowed:
         raise TemplateError(where, key, f"only {', '.join(sorted(allowed))}",
-                            ", ".join(sorted(set(spec) - allowed)))
+                            f"unknown key(s) {', '.join(sorted(set(spec) - allowed))}")
     domain = Interval.parse(spec.get("domain"), where, f"{key}.domain")
     sample = _sampling(spec.get("sample"), where, f"{key}.sample", domain)
     decimals, sig_figs = spec.get("decimals"), spec.get("sig_figs")

@@ -25,7 +25,6 @@ from grader.bank import Template
 from grader.compiled import Check, Compiled, CompiledAnswer, Step, Undefined
 from grader.effects import CATALOGUE, Relation
 from grader.errors import TemplateError
-from grader.expr import to_text
 from grader.stable import stabilize
 from grader.symbolic import Context, cosd, from_node, sind, to_node
 
@@ -127,7 +126,7 @@ class _Compiler:
             if missing:
                 raise TemplateError(self.template.where, f"answers.{name}",
                                     "an answer the scene determines from the parameters",
-                                    f"nothing fixes {', '.join(sorted(map(str, missing)))}")
+                                    f"nothing fixes {', '.join(sorted(map(str, missing)))}{self._coupled(known)}")
         chain = _needed(chain, wanted.values())
         composed: dict[Any, Any] = {}
         for solved in chain:
@@ -139,6 +138,25 @@ class _Compiler:
             parameters=tuple(self.template.parameters),
             constants={"g": float(self.template.scene.gravity.si)} if self.template.scene.gravity else {},
             steps=tuple(self._step(s) for s in chain), checks=self._checks(chain, composed), answers=answers)
+
+    def _coupled(self, known: set[Any]) -> str:
+        """Why the chain stopped: the unknowns the unused equations still tie together."""
+        left = [r.symbols() - known for r in self.relations if len(r.symbols() - known) > 1]
+        # An equation with an unknown no other equation has only ties that one up: drop it, repeat.
+        while True:
+            counts: dict[Any, int] = {}
+            for unknowns in left:
+                for symbol in unknowns:
+                    counts[symbol] = counts.get(symbol, 0) + 1
+            core = [u for u in left if all(counts[s] > 1 for s in u)]
+            if len(core) == len(left):
+                break
+            left = core
+        tied = sorted({str(s) for unknowns in left for s in unknowns})
+        if not tied:
+            return "; no stage involves it"
+        return (f"; the equations left tie {', '.join(tied)} together (two or more unknowns each) and the "
+                "solver takes one equation and one unknown at a time: give one of them as a parameter")
 
     def _step(self, solved: _Solved) -> Step:
         unknown_text = solved.unknown.name
@@ -243,8 +261,3 @@ def _tidy(expr: Any) -> Any:
 def compile_template(template: Template) -> Compiled:
     """Derive and compile a template's answers (sympy; slow the first time, then cached)."""
     return _Compiler(template).compile()
-
-
-def describe(expr: Any) -> str:
-    """Plain text of a sympy expression through our printer."""
-    return to_text(to_node(expr))

@@ -206,7 +206,7 @@ class Context:
 
     scene: Scene
     symbols: dict[str, sp.Symbol] = field(default_factory=dict)
-    defaults: dict[str, set[int]] = field(default_factory=dict)
+    defaults: dict[str, int] = field(default_factory=dict)  # default name -> the stage that owns it
 
     def sym(self, node: Node) -> Any:
         """A stage field as a sympy expression over the scene's symbols."""
@@ -236,12 +236,12 @@ class Context:
         return self.symbol(name if isinstance(name, str) else self.unused_name(_DEFAULT_NAMES[key], stage))
 
     def unused_name(self, base: str, stage: Stage) -> str:
-        """``base`` if the scene does not use it otherwise, else ``base_<stage index>``."""
-        taken = self.scene.names() | set(self.symbols) - set(self.defaults.get(base, ()))
-        name = base if base not in taken or stage.index in self.defaults.get(base, ()) else f"{base}_{stage.index}"
-        if name == base:
-            self.defaults.setdefault(base, set()).add(stage.index)
-        return name
+        """``base``, unless the template or another stage uses it: then ``base_<stage index>``."""
+        taken_by_template = base in self.scene.names() or (base in self.symbols and base not in self.defaults)
+        if taken_by_template or self.defaults.get(base, stage.index) != stage.index:
+            return f"{base}_{stage.index}"
+        self.defaults[base] = stage.index
+        return base
 
     def velocity(self, stage: Stage, body: str, when: str, axis: str) -> Any:
         """A velocity component of a body in an impact: 0 for a fixed body or one at rest."""

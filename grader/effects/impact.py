@@ -47,7 +47,7 @@ def _impact(stage: Stage, ctx: Context) -> list[Relation]:
             stable={a2: (Stable(centre + e * w2 * approach / (w1 + w2)),)}))
     relations.append(Relation(
         "coefficient of restitution: separation over approach along n", e, separation / approach,
-        solutions=_only_symbols({e: separation / approach, a1: a2 - e * approach, a2: a1 + e * approach}),
+        solutions={e: separation / approach, a1: a2 - e * approach, a2: a1 + e * approach},
         requires=(
             Condition(sp.Gt(approach, 0), f"{first} and {second} are not approaching along the line of "
                       "impact (relative normal velocity <= 0), so they do not collide"),
@@ -62,7 +62,7 @@ def _impact(stage: Stage, ctx: Context) -> list[Relation]:
         if ctx.inverse_mass(body) != 0 and stage.is_oblique:
             before, after = ctx.velocity(stage, body, "before", "t"), ctx.velocity(stage, body, "after", "t")
             relations.append(Relation(f"smooth surfaces: no impulse along t, so {body}'s t-velocity is "
-                                      "unchanged", after, before, solutions=_only_symbols({after: before})))
+                                      "unchanged", after, before, solutions={after: before}))
     return relations + _energy(stage, ctx, e, approach, separation, w1, w2)
 
 
@@ -87,13 +87,6 @@ def _energy(stage: Stage, ctx: Context, e: Any, approach: Any, separation: Any, 
         Relation("fraction of the kinetic energy lost", fraction, lost / before,
                  solutions={fraction: lost / before}, general=False),
     ]
-
-
-def _only_symbols(solutions: dict[Any, Any]) -> dict[Any, Any]:
-    """Keep the solutions whose unknown is a quantity (a fixed body's velocity is just 0)."""
-    import sympy as sp
-
-    return {k: v for k, v in solutions.items() if isinstance(k, sp.Symbol)}
 
 
 IMPACT = Effect(

@@ -1,0 +1,112 @@
+"""The step chain: one equation and one new unknown per step, across stages, forward and inverse."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+import yaml
+
+from grader.bank import Template, parse_template
+from grader.compiled import Compiled
+from grader.errors import TemplateError
+from grader.evaluate import solve_one
+from grader.expr import names
+from grader.solver import compile_template
+
+TWO_BOUNCES = """
+id: two-bounces
+title: A ball bounces twice
+version: 1
+gravity: 9.81 m/s^2
+bodies: {ball: {mass: m}, floor: {fixed: true}}
+symbols: {m: {unit: kg}}
+parameters:
+  h_drop: {unit: m, domain: "(0, inf)", sample: {uniform: [1, 2]}, decimals: 2}
+  e: {unit: "", domain: "[0, 1]", sample: {uniform: [0.5, 0.9]}, decimals: 2}
+  J: {unit: "", domain: "[0, 1]", sample: {uniform: [0, 1]}, decimals: 2, description: "named like an impulse"}
+stages:
+  - {effect: free_fall, body: ball, height: h_drop, speed: v1}
+  - {effect: impact, bodies: [ball, floor], restitution: e, before: {ball: v1}, after: {ball: w1}}
+  - {effect: rise, body: ball, speed: -w1, height: h1}
+  - {effect: free_fall, body: ball, height: h1, speed: v2}
+  - {effect: impact, bodies: [ball, floor], restitution: e, before: {ball: v2}, after: {ball: w2}, loss_fraction: f2}
+  - {effect: rise, body: ball, speed: -w2, height: h2}
+answers:
+  h2: {value: h2, unit: m}
+  f2: {value: f2, unit: ""}
+  J_plus_h2: {value: J + h2, unit: m}
+statement: Dropped from {{ h_drop }} m with e = {{ e }}.
+"""
+
+
+@pytest.fixture(scope="module")
+def two_bounces() -> tuple[Template, Compiled]:
+    template = parse_template(yaml.safe_load(TWO_BOUNCES), "test:two-bounces", "two-bounces")
+    return template, compile_template(template)
+
+
+def test_second_bounce_height_is_e_to_the_fourth_times_the_drop(two_bounces: tuple[Template, Compiled]) -> None:
+    """Each bounce keeps e**2 of the height: h2 = e**4 h_drop; each impact loses 1 - e**2."""
+    template, compiled = two_bounces
+    solution = solve_one(template, compiled, {"h_drop": 2.0, "e": 0.8, "J": 0.25})
+    assert solution.answers is not None, solution.error
+    assert solution.answers["h2"].value == pytest.approx(0.8**4 * 2.0, rel=1e-14)
+    assert solution.answers["f2"].value == pytest.approx(1 - 0.8**2, rel=1e-14)
+    assert solution.answers["J_plus_h2"].value == pytest.approx(0.25 + 0.8**4 * 2.0, rel=1e-14)
+
+
+def test_default_names_never_collide_with_the_templates_or_each_other(
+        two_bounces: tuple[Template, Compiled]) -> None:
+    """A parameter named J keeps its name; the two impacts' impulses get distinct names."""
+    _, compiled = two_bounces
+    unknowns = [step.unknown for step in compiled.steps]
+    assert "J" not in unknowns
+    assert len(unknowns) == len(set(unknowns))
+
+
+def test_each_step_solves_one_equation_for_one_new_unknown(two_bounces: tuple[Template, Compiled],
+                                                           compiled: dict[str, Compiled],
+                                                           bank: dict[str, Template]) -> None:
+    """A step's equation uses only what is known by then, plus the one unknown it solves for."""
+    cases = [two_bounces, *((bank[t], compiled[t]) for t in bank)]
+    for template, chain in cases:
+        known = set(template.parameters) | set(template.symbols) | {"g"}
+        for step in chain.steps:
+            used = names(step.equation[0]) | names(step.equation[1])
+            assert step.unknown in used, (template.id, step)
+            assert used - known == {step.unknown}, (template.id, step)
+            assert names(step.solved) <= known, (template.id, step)
+            known.add(step.unknown)
+
+
+def test_inverse_template_derives_e_from_the_heights(compiled: dict[str, Compiled]) -> None:
+    """drop-rebound gives e = sqrt(h_rebound/h_drop) through the rebound velocity, as a student would."""
+    steps = {step.unknown: step for step in compiled["drop-rebound"].steps}
+    assert steps["e"].relation.startswith("coefficient of restitution")
+    assert names(steps["e"].solved) == {"v_after", "v_impact"}
+
+
+def test_forward_and_inverse_from_one_scene() -> None:
+    """Swapping which quantities are given turns the same scene around (no formula is rewritten):
+    from the first bounce's height, e and then the second bounce follow."""
+    raw = yaml.safe_load(TWO_BOUNCES)
+    raw["parameters"]["h1"] = raw["parameters"].pop("e") | {"domain": "(0, inf)"}
+    raw["answers"] = {"e": {"value": "e", "unit": ""}, "h2": {"value": "h2", "unit": "m"}}
+    raw["statement"] = "Dropped from {{ h_drop }} m, the first bounce reaches {{ h1 }} m."
+    inverse = parse_template(raw, "test:inverse", "inverse")
+    solution = solve_one(inverse, compile_template(inverse), {"h_drop": 2.0, "h1": 0.8**2 * 2.0, "J": 0.0})
+    assert solution.answers is not None, solution.error
+    assert math.isclose(solution.answers["e"].value, 0.8, rel_tol=1e-14)
+    assert math.isclose(solution.answers["h2"].value, 0.8**4 * 2.0, rel_tol=1e-14)
+
+
+def test_coupled_unknowns_are_refused_with_what_ties_them() -> None:
+    """Given only the second bounce, e appears in both impacts with h1 between them: a chain of
+    one-unknown steps cannot untangle that, and the message says which unknowns are tied."""
+    raw = yaml.safe_load(TWO_BOUNCES)
+    raw["parameters"]["h2"] = raw["parameters"].pop("e") | {"domain": "(0, inf)"}
+    raw["answers"] = {"e": {"value": "e", "unit": ""}}
+    raw["statement"] = "Dropped from {{ h_drop }} m, the second bounce reaches {{ h2 }} m."
+    with pytest.raises(TemplateError, match=r"nothing fixes e; the equations left tie .*e, h1.* together"):
+        compile_template(parse_template(raw, "test:coupled", "coupled"))

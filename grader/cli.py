@@ -47,6 +47,21 @@ def build_parser() -> argparse.ArgumentParser:
                        help="a parameter value in the template's unit, or with its own unit (2.1m)")
     given.add_argument("--batch", type=Path, metavar="FILE.csv", help="CSV with a header of parameter names")
     solve.add_argument("--json", action="store_true", help="JSON output (one object per line for --batch)")
+
+    simulate = commands.add_parser("simulate", help="re-derive the answers in the time domain, beside the closed form")
+    simulate.add_argument("template", metavar="ID")
+    simulate.add_argument("--set", action="append", metavar="NAME=VALUE", dest="assignments", required=True,
+                          help="a parameter value in the template's unit, or with its own unit")
+    simulate.add_argument("--method", default="adaptive", help="euler, rk4 or adaptive (default)")
+    step = simulate.add_mutually_exclusive_group()
+    step.add_argument("--steps-per-contact", type=int, metavar="N", help="fixed steps per contact (euler, rk4)")
+    step.add_argument("--rtol", type=float, metavar="X", help="relative tolerance (adaptive; default 1e-10)")
+    simulate.add_argument("--contact-duration", type=float, default=1e-3, metavar="S",
+                          help="duration of a contact in seconds; sets the stiffness (default 0.001)")
+    simulate.add_argument("--weight-during-contact", action="store_true",
+                          help="let gravity act during contact too (the closed form neglects it)")
+    simulate.add_argument("--json", action="store_true", help="print one JSON object")
+    simulate.add_argument("--plot", type=Path, metavar="FILE.png", help="draw position, velocity and force")
     return parser
 
 
@@ -271,4 +286,65 @@ def _table(header: Sequence[str], rows: Sequence[Sequence[str]]) -> str:
     return "\n".join(lines)
 
 
-_COMMANDS = {"list": _list, "show": _show, "solve": _solve}
+def _simulate(arguments: argparse.Namespace) -> int:
+    from grader.cache import compiled_for
+    from grader.evaluate import solve_one
+    from grader.integrate import Settings
+    from grader.simulate import Options, simulate
+
+    template = _template(arguments)
+    params = _read_assignments(arguments.assignments, template)
+    if arguments.method == "adaptive" and arguments.steps_per_contact is not None:
+        raise UsageError("--steps-per-contact is for the fixed-step methods (euler, rk4); use --rtol with adaptive")
+    if arguments.method != "adaptive" and arguments.rtol is not None:
+        raise UsageError("--rtol is for the adaptive method; use --steps-per-contact with euler or rk4")
+    settings = Settings(arguments.method, arguments.steps_per_contact or 100, arguments.rtol or 1e-10,
+                        dense=arguments.plot is not None)
+    options = Options(settings, arguments.contact_duration, arguments.weight_during_contact)
+    closed = solve_one(template, compiled_for(template), params)
+    if closed.error is not None:
+        _print_solution(template, closed.params, None, closed.error, arguments.json, None)
+        return EXIT_REFUSED
+    result = simulate(template, params, options)
+    rows = {}
+    for name, simulated in result.answers.items():
+        exact = closed.answers[name].value if closed.answers else None
+        differs = None
+        if isinstance(exact, float) and simulated is not None:
+            differs = abs(simulated - exact) / abs(exact) if exact else abs(simulated - exact)
+        rows[name] = {"simulated": simulated, "closed_form": exact, "rel_diff": differs}
+    if arguments.plot is not None:
+        from grader.plots import plot_simulation
+
+        plot_simulation(result, arguments.plot)
+    record = {"template": template.id, "params": result.params, "method": settings.method,
+              "effects": list(result.effects), "steps": result.steps, "seconds": result.seconds, "answers": rows,
+              "fitted": dict(result.fitted), "nominal": dict(result.nominal),
+              "settings": {"steps_per_contact": settings.steps, "rtol": settings.rtol,
+                           "contact_duration": options.contact_duration,
+                           "weight_during_contact": options.weight_during_contact}}
+    if arguments.json:
+        print(json.dumps(record))
+        return EXIT_OK
+    _print_simulation(template, record)
+    return EXIT_OK
+
+
+def _print_simulation(template: Template, record: dict[str, Any]) -> None:
+    method = record["method"] + (f" (rtol {record['settings']['rtol']:g})" if record["method"] == "adaptive"
+                                 else f" ({record['settings']['steps_per_contact']} steps per contact)")
+    print(f"{template.id}: " + ", ".join(f"{n} = {_number(v)}{_unit(template.parameters[n])}"
+                                         for n, v in record["params"].items()))
+    print(f"simulated: {', '.join(record['effects'])}; {method}; {record['steps']} steps in "
+          f"{record['seconds'] * 1e3:.1f} ms")
+    for name, value in record["fitted"].items():
+        print(f"{name} found by matching the simulated outcome to the given one: {value:.10g}")
+    if record["nominal"]:
+        print("symbols set to 1 for the simulation: " + ", ".join(record["nominal"]))
+    print(_table(("answer", "simulated", "closed form", "rel. diff"), [
+        (name, "undefined" if row["simulated"] is None else f"{row['simulated']:.10g}",
+         "undefined" if row["closed_form"] is None else f"{row['closed_form']:.10g}",
+         "-" if row["rel_diff"] is None else f"{row['rel_diff']:.2g}") for name, row in record["answers"].items()]))
+
+
+_COMMANDS = {"list": _list, "show": _show, "solve": _solve, "simulate": _simulate}

@@ -90,7 +90,7 @@ def _stage_names(stage: Stage) -> set[str]:
     used: set[str] = set()
     for spec in CATALOGUE[stage.effect].fields:
         value = stage.fields.get(spec.name)
-        if value is None or spec.kind in ("body", "bodies") or spec.kind.startswith("choice:"):
+        if value is None or spec.kind in ("body", "bodies", "flag") or spec.kind.startswith("choice:"):
             continue
         if spec.kind == "name":
             used.add(value)
@@ -180,6 +180,10 @@ def _parse_field(spec: Field, value: Any, where: str, key: str, bodies: Mapping[
         options = spec.kind.split(":", 1)[1].split("|")
         if value not in options:
             raise TemplateError(where, key, f"one of {', '.join(options)}", repr(value))
+        return value
+    if spec.kind == "flag":
+        if not isinstance(value, bool):
+            raise TemplateError(where, key, "true or false", repr(value))
         return value
     if spec.kind == "velocities":
         return _parse_velocities(value, where, key, bodies)

@@ -16,6 +16,7 @@ if TYPE_CHECKING:
     import sympy as sp
 
     from grader.scene import Stage
+    from grader.simulate import Run
     from grader.symbolic import Context
 
 
@@ -25,7 +26,7 @@ class Field:
 
     kinds: ``body`` (a body's name), ``bodies`` (two names), ``expr`` (an expression),
     ``name`` (a new quantity's name), ``velocities`` (per body: an expression, or ``{n:, t:}``),
-    ``choice:a|b`` (one of the listed words).
+    ``choice:a|b`` (one of the listed words), ``flag`` (true or false).
     """
 
     name: str
@@ -77,9 +78,11 @@ class Relation:
 
 @dataclass(frozen=True)
 class Effect:
-    """An entry of the catalogue: its name, what it means, its fields and its relations."""
+    """An entry of the catalogue: its name, what it means, its fields, its relations (the
+    closed form) and how to simulate it (its force law in the time domain; None: it has none)."""
 
     name: str
     summary: str
     fields: tuple[Field, ...]
     relations: Callable[[Stage, Context], list[Relation]]
+    simulate: Callable[[Stage, Run], None] | None = None

@@ -1,13 +1,22 @@
-"""Free fall from rest and rise to a height: ``v = sqrt(2 g h)`` under gravity alone."""
+"""Free fall from rest and rise to a height: ``v = sqrt(2 g h)`` under gravity alone.
+
+Force law: gravity, ``a = -g`` upward. The simulation starts the body at the height (fall) or at
+the bottom with the speed (rise) and ends at the located event: reaching the bottom, or the apex.
+"""
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+import math
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
 
 from grader.effects.base import Condition, Effect, Field, Relation
+from grader.integrate import Mode, integrate
 
 if TYPE_CHECKING:
     from grader.scene import Stage
+    from grader.simulate import Run
     from grader.symbolic import Context
 
 _FIELDS = (
@@ -48,5 +57,44 @@ def _rise(stage: Stage, ctx: Context) -> list[Relation]:
     return _energy(stage, ctx, "rises")
 
 
-FREE_FALL = Effect("free_fall", "a body falls from rest through a height: v = sqrt(2 g h)", _FIELDS, _free_fall)
-RISE = Effect("rise", "a body moving up at a speed rises to a height where it stops: h = v^2/(2 g)", _FIELDS, _rise)
+def gravity(g: float) -> Any:
+    """The force law of flight, per unit mass, on a state ``[height, velocity]`` (up positive)."""
+    def rhs(_: float, y: Any) -> Any:
+        return np.array([y[1], -g])
+    return rhs
+
+
+def _simulate_fall(stage: Stage, run: Run) -> None:
+    height, g, body = run.value(stage.fields["height"]), run.gravity(), stage.fields["body"]
+    run.uses("gravity")
+    if height <= 0:
+        if height < 0:
+            run.problems.append(f"{body} cannot fall through a negative height")
+        run.output(stage.fields["speed"], 0.0)
+        return
+    # The time scale only sets fixed step sizes; the motion itself is integrated.
+    landing = Mode("free fall", gravity(g), lambda y: y[0], -1, scale=math.sqrt(2 * height / g))
+    path = integrate([landing], np.array([height, 0.0]), run.options.settings)
+    run.record(f"{body} falls", ("height", "velocity"), path)
+    run.output(stage.fields["speed"], -float(path.y[-1][1]))
+
+
+def _simulate_rise(stage: Stage, run: Run) -> None:
+    speed, g, body = run.value(stage.fields["speed"]), run.gravity(), stage.fields["body"]
+    run.uses("gravity")
+    if speed <= 0:
+        if speed < 0:
+            run.problems.append(f"{body} does not move up after the previous stage, so it cannot rise to "
+                                f"{stage.text('height')}")
+        run.output(stage.fields["height"], 0.0)  # continuous in speed, so a search for e can cross it
+        return
+    apex = Mode("rise", gravity(g), lambda y: y[1], -1, scale=speed / g)
+    path = integrate([apex], np.array([0.0, speed]), run.options.settings)
+    run.record(f"{body} rises", ("height", "velocity"), path)
+    run.output(stage.fields["height"], float(path.y[-1][0]))
+
+
+FREE_FALL = Effect("free_fall", "a body falls from rest through a height: v = sqrt(2 g h)", _FIELDS, _free_fall,
+                   _simulate_fall)
+RISE = Effect("rise", "a body moving up at a speed rises to a height where it stops: h = v^2/(2 g)", _FIELDS, _rise,
+              _simulate_rise)

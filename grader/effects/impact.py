@@ -5,17 +5,27 @@ common tangent. Surfaces are smooth: no impulse along t. Numbers follow DESIGN.m
 with inverse masses ``w = 1/m`` (``w = 0`` for a fixed surface); after-impact velocities in the
 mass-centre form ``v1' = v_c - e w1 (v1 - v2)/(w1 + w2)``, which equals ``v1 - J w1`` but keeps its
 accuracy when ``e`` is small or the masses are very unequal; energy lost as
-``1/2 mu (1 - e)(1 + e) v_rel^2``, or ``1/2 mu (v_rel^2 - v_sep^2)`` when ``e`` itself is derived.
+``1/2 mu (1 - e)(1 + e) v_rel^2``, or ``1/2 mu (v_rel - v_sep)(v_rel + v_sep)`` when ``e`` itself is derived.
+
+Force law (simulation): a Kelvin-Voigt contact calibrated to ``e`` (:class:`ContactLaw`), plus the
+weight during contact only where asked for.
 """
 
 from __future__ import annotations
 
+import math
+from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
+import numpy as np
+
 from grader.effects.base import Condition, Effect, Field, Relation, Stable
+from grader.expr import Sym
+from grader.integrate import Mode, integrate
 
 if TYPE_CHECKING:
     from grader.scene import Stage
+    from grader.simulate import Run
     from grader.symbolic import Context
 
 
@@ -89,6 +99,126 @@ def _energy(stage: Stage, ctx: Context, e: Any, approach: Any, separation: Any, 
     ]
 
 
+@dataclass(frozen=True)
+class ContactLaw:
+    """Kelvin-Voigt contact (linear spring and dashpot, tension allowed until the overlap is 0
+    again), calibrated so that it reproduces ``e`` exactly:
+    ``zeta = -ln e / sqrt(pi^2 + ln^2 e)``, natural frequency from the contact duration
+    ``omega_n = pi / (duration sqrt(1 - zeta^2))``. Stiffness and damping per unit reduced mass
+    (``k = mu omega_n^2``, ``c = 2 zeta mu omega_n``), so extreme mass ratios change nothing.
+    ``e = 0`` never separates on its own: the contact ends at maximum compression (``sticks``).
+
+    >>> law = ContactLaw.calibrated(0.5, 1e-3)
+    >>> round(law.zeta, 6), round(math.exp(-law.zeta * math.pi / math.sqrt(1 - law.zeta**2)), 12)
+    (0.215425, 0.5)
+    """
+
+    zeta: float
+    omega: float
+    sticks: bool
+
+    @classmethod
+    def calibrated(cls, e: float, duration: float) -> ContactLaw:
+        """The law for restitution ``e`` and a contact lasting ``duration`` seconds."""
+        if e <= 0:
+            return cls(1.0, math.pi / duration, True)
+        log_e = math.log1p(e - 1) if e > 0.5 else math.log(e)  # e - 1 is exact for e in [0.5, 1]
+        zeta = -log_e / math.hypot(math.pi, log_e)
+        return cls(zeta, math.pi / (duration * math.sqrt((1 - zeta) * (1 + zeta))), False)
+
+    def specific_force(self, overlap: float, rate: float) -> float:
+        """Contact force per unit reduced mass, pushing the bodies apart."""
+        return self.omega * (self.omega * overlap + 2 * self.zeta * rate)
+
+
+def _simulate_impact(stage: Stage, run: Run) -> None:
+    first, second = stage.fields["bodies"]
+    w1, w2 = _inverse_mass(run, first), _inverse_mass(run, second)
+    e = run.value(stage.fields["restitution"])
+    before = [_component(run, stage, body, "before", axis) for body in (first, second) for axis in ("n", "t")]
+    approach = before[0] - before[2]
+    if approach <= 0 or not 0 <= e <= 1:
+        run.problems.append(f"{first} and {second} do not collide (relative normal velocity {approach:g}) "
+                            if approach <= 0 else f"the coefficient of restitution {e:g} is outside [0, 1]")
+        after = before
+    else:
+        after = _contact(stage, run, (first, second), (w1, w2), e, before)
+    for index, body in enumerate((first, second)):
+        given = stage.fields.get("after", {}).get(body)
+        if given is not None:
+            run.output(given.n, after[2 * index])
+            if given.t is not None:
+                run.output(given.t, after[2 * index + 1])
+    _output_energies(stage, run, (w1, w2), before, after)
+
+
+def _contact(stage: Stage, run: Run, bodies: tuple[str, str], inverse: tuple[float, float], e: float,
+             before: list[float]) -> list[float]:
+    w1, w2 = inverse
+    share1, share2 = w1 / (w1 + w2), w2 / (w1 + w2)
+    law = ContactLaw.calibrated(e, run.options.contact_duration)
+    weight = _weight(stage, run)
+    run.uses("contact (Kelvin-Voigt)")
+
+    def free(_: float, y: Any) -> Any:
+        return np.concatenate([y[4:], np.zeros(4)])
+
+    def pressed(_: float, y: Any) -> Any:
+        f = law.specific_force(y[0] - y[2], y[4] - y[6])
+        return np.concatenate([y[4:], [weight - share1 * f, 0.0, (weight if w2 else 0.0) + share2 * f, 0.0]])
+
+    approach = before[0] - before[2]
+    gap = approach * run.options.contact_duration / 4
+    y0 = np.array([-gap, 0.0, 0.0, 0.0, *before])
+    entry = Mode("approach", free, lambda y: y[0] - y[2], +1, scale=gap / approach)
+    # e = 0: the spring would hold the bodies together for ever; they part at maximum compression.
+    exit_event = (lambda y: y[4] - y[6]) if law.sticks else (lambda y: y[0] - y[2])
+    contact = Mode("contact", pressed, exit_event, -1, scale=run.options.contact_duration, omega=law.omega,
+                   force=lambda y: law.specific_force(y[0] - y[2], y[4] - y[6]) / (w1 + w2))
+    path = integrate([entry, contact], y0, run.options.settings)
+    run.record(f"impact of {bodies[0]} and {bodies[1]}",
+               ("x1n", "x1t", "x2n", "x2t", "v1n", "v1t", "v2n", "v2t"), path)
+    return [float(v) for v in path.y[-1][4:]]
+
+
+def _weight(stage: Stage, run: Run) -> float:
+    """Gravity along n during contact: only if asked for, and only where the first body fell onto
+    the second (n is then downward)."""
+    if not (run.options.weight_during_contact or stage.fields.get("weight_during_contact", False)):
+        return 0.0
+    fell = any(s.effect == "free_fall" and s.fields["body"] == stage.fields["bodies"][0]
+               for s in run.template.scene.stages[:stage.index])
+    if not fell:
+        return 0.0
+    run.uses("weight during contact")
+    return run.gravity()
+
+
+def _inverse_mass(run: Run, body: str) -> float:
+    mass = run.template.scene.bodies[body].mass
+    return 0.0 if mass is None else 1.0 / run.value(mass)
+
+
+def _component(run: Run, stage: Stage, body: str, when: str, axis: str) -> float:
+    given = stage.fields.get(when, {}).get(body)
+    part = None if given is None else getattr(given, axis)
+    return 0.0 if part is None or run.template.scene.bodies[body].mass is None else run.value(part)
+
+
+def _output_energies(stage: Stage, run: Run, inverse: tuple[float, float], before: list[float],
+                     after: list[float]) -> None:
+    def kinetic(v: list[float]) -> float:
+        return sum(math.hypot(v[2 * i], v[2 * i + 1]) ** 2 / (2 * w) for i, w in enumerate(inverse) if w)
+    energy_before, energy_after = kinetic(before), kinetic(after)
+    measured = {"energy_before": energy_before, "energy_after": energy_after,
+                "energy_lost": energy_before - energy_after,
+                "loss_fraction": (energy_before - energy_after) / energy_before if energy_before else math.nan,
+                "impulse": (before[0] - after[0]) / inverse[0]}
+    for key, value in measured.items():
+        if key in stage.fields:
+            run.output(Sym(stage.fields[key]), value)
+
+
 IMPACT = Effect(
     "impact",
     "direct or oblique central impact with restitution e; smooth surfaces; a body may be fixed",
@@ -102,6 +232,9 @@ IMPACT = Effect(
         Field("energy_after", "name", required=False, doc="name for the kinetic energy after"),
         Field("energy_lost", "name", required=False, doc="name for the energy lost"),
         Field("loss_fraction", "name", required=False, doc="name for the fraction of energy lost"),
+        Field("weight_during_contact", "flag", required=False,
+              doc="simulate the weight during contact (the closed form neglects it); default false"),
     ),
     _impact,
+    _simulate_impact,
 )

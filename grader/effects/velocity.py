@@ -6,12 +6,14 @@ The angle is measured from the axis named in ``from`` toward the other one. Spee
 
 from __future__ import annotations
 
+import math
 from typing import TYPE_CHECKING
 
 from grader.effects.base import Condition, Effect, Field, Relation
 
 if TYPE_CHECKING:
     from grader.scene import Stage
+    from grader.simulate import Run
     from grader.symbolic import Context
 
 
@@ -42,6 +44,21 @@ def _components(stage: Stage, ctx: Context) -> list[Relation]:
     return relations
 
 
+def _simulate_components(stage: Stage, run: Run) -> None:
+    """Kinematics, not a force: split a known velocity into components, or combine them."""
+    fields = stage.fields
+    along_key, across_key = ("t", "n") if fields.get("from", "t") == "t" else ("n", "t")
+    if run.known(fields["speed"]) and run.known(fields["angle"]):
+        speed, angle = run.value(fields["speed"]), run.value(fields["angle"])
+        run.output(fields[along_key], speed * math.cos(angle))
+        run.output(fields[across_key], speed * math.sin(angle))
+        return
+    along, across = run.value(fields[along_key]), run.value(fields[across_key])
+    speed = math.hypot(along, across)
+    run.output(fields["speed"], speed)
+    run.output(fields["angle"], math.atan2(across, along) if speed > 0 else math.nan)
+
+
 VELOCITY = Effect(
     "velocity",
     "a velocity given by speed and angle, related to its n and t components",
@@ -53,4 +70,5 @@ VELOCITY = Effect(
         Field("t", "expr", doc="component along the tangent"),
     ),
     _components,
+    _simulate_components,
 )

@@ -110,7 +110,7 @@ class ContactLaw:
 
     >>> law = ContactLaw.calibrated(0.5, 1e-3)
     >>> round(law.zeta, 6), round(math.exp(-law.zeta * math.pi / math.sqrt(1 - law.zeta**2)), 12)
-    (0.215425, 0.5)
+    (0.215454, 0.5)
     """
 
     zeta: float

@@ -298,8 +298,9 @@ def _simulate(arguments: argparse.Namespace) -> int:
         raise UsageError("--steps-per-contact is for the fixed-step methods (euler, rk4); use --rtol with adaptive")
     if arguments.method != "adaptive" and arguments.rtol is not None:
         raise UsageError("--rtol is for the adaptive method; use --steps-per-contact with euler or rk4")
-    settings = Settings(arguments.method, arguments.steps_per_contact or 100, arguments.rtol or 1e-10,
-                        dense=arguments.plot is not None)
+    settings = Settings(arguments.method,
+                        100 if arguments.steps_per_contact is None else arguments.steps_per_contact,
+                        1e-10 if arguments.rtol is None else arguments.rtol, dense=arguments.plot is not None)
     options = Options(settings, arguments.contact_duration, arguments.weight_during_contact)
     closed = solve_one(template, compiled_for(template), params)
     if closed.error is not None:

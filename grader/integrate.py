@@ -45,7 +45,8 @@ class Mode:
     """One regime of motion: ``rhs(t, y)``, ended where ``event(y)`` crosses zero in ``direction``.
 
     ``scale`` is the mode's time scale (a fixed step is ``scale/steps``); ``omega`` its highest
-    natural angular frequency (0 for free motion); ``force(y)`` what a plot shows.
+    natural angular frequency (0 for free motion); ``force(y)`` what a plot shows; ``sizes(y)``
+    the size each state component is measured against (absolute tolerance = rtol * size).
     """
 
     name: str
@@ -55,6 +56,7 @@ class Mode:
     scale: float
     omega: float = 0.0
     force: Callable[[Any], float] | None = None
+    sizes: Callable[[Any], Any] | None = None
 
 
 @dataclass(frozen=True)
@@ -143,6 +145,17 @@ def _fixed(mode: Mode, t: float, y: Any, settings: Settings, path: Path) -> tupl
     raise SimulationError(f"the {mode.name} mode did not end within {MAX_STEPS} steps")
 
 
+def _sizes(mode: Mode, t: float, y: Any) -> Any:
+    """What each component's error is measured against: the mode's own sizes, or else the largest
+    position and the largest velocity (per component, one that starts at 0 would get none)."""
+    if mode.sizes is not None:
+        return np.asarray(mode.sizes(y), dtype=float)
+    half, slope = len(y) // 2, np.abs(mode.rhs(t, y))
+    positions = max(np.abs(y[:half]).max(), slope[:half].max() * mode.scale)
+    velocities = max(np.abs(y[half:]).max(), slope[half:].max() * mode.scale)
+    return np.repeat([positions, velocities], half)
+
+
 def _locate(mode: Mode, method: str, t: float, y: Any, dt: float) -> float:
     """The fraction of the step at which the event crosses zero, on the method's own partial step."""
     return float(brentq(lambda f: mode.event(_step(method, mode.rhs, t, y, f * dt)), 0.0, 1.0,
@@ -155,28 +168,32 @@ def _adaptive(mode: Mode, t: float, y: Any, rtol: float, path: Path, dense: bool
 
     event.terminal = True  # type: ignore[attr-defined]
     event.direction = mode.direction  # type: ignore[attr-defined]
-    # Absolute tolerance on the scale of the positions and of the velocities (not per component:
-    # one that starts at 0 would get none), so magnitudes from 1e-150 to 1e170 work alike.
-    half, slope = len(y) // 2, np.abs(mode.rhs(t, y))
-    positions = max(np.abs(y[:half]).max(), slope[:half].max() * mode.scale)
-    velocities = max(np.abs(y[half:]).max(), slope[half:].max() * mode.scale)
-    atol = np.maximum(rtol * np.repeat([positions, velocities], half), 1e-300)
-    horizon = t
+    atol = np.maximum(rtol * _sizes(mode, t, y), 1e-300)
+    # Time in units of the mode's own scale: the event is located to a tolerance relative to the
+    # contact's duration, not to an absolute 1e-15 s (which a 1 ns contact would not survive).
+    start, unit = t, mode.scale
+
+    def scaled(s: float, state: Any) -> Any:
+        return unit * mode.rhs(start + s * unit, state)
+
+    horizon = 0.0
     for _ in range(60):
-        horizon += 10 * mode.scale
-        solution = solve_ivp(mode.rhs, (t, horizon), y, method="DOP853", rtol=rtol, atol=atol, events=event,
+        origin, horizon = horizon, horizon + 10
+        solution = solve_ivp(scaled, (origin, horizon), y, method="DOP853", rtol=rtol, atol=atol, events=event,
                              dense_output=dense)
         path.steps += len(solution.t) - 1
         if solution.status < 0:
             raise SimulationError(f"the {mode.name} mode could not be integrated: {solution.message}")
-        interior = (((time, solution.sol(time)) for time in np.linspace(t, solution.t[-1], 50)[1:-1]) if dense
+        interior = (((s, solution.sol(s)) for s in np.linspace(origin, solution.t[-1], 50)[1:-1]) if dense
                     else zip(solution.t[1:-1], solution.y.T[1:-1], strict=True))
-        for time, state in interior:
-            path.add(float(time), state, mode)
-        t, y = float(solution.t[-1]), solution.y[:, -1]
+        for s, state in interior:
+            path.add(start + float(s) * unit, state, mode)
+        end, y = float(solution.t[-1]), solution.y[:, -1]
         if solution.status == 1:
-            t, y = float(solution.t_events[0][0]), solution.y_events[0][0]
+            end, y = float(solution.t_events[0][0]), solution.y_events[0][0]
+        t = start + end * unit
         path.add(t, y, mode)
         if solution.status == 1:
             return t, y
+        horizon = end
     raise SimulationError(f"the {mode.name} mode did not end within {600 * mode.scale:.3g} s")

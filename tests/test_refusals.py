@@ -9,6 +9,7 @@ from grader.bank import Template, parse_template
 from grader.compiled import Compiled
 from grader.evaluate import solve_one
 from grader.solver import compile_template
+from tests.scenes import TWO_BODIES
 
 REFUSALS = [
     ("ball-plate", {"v": 50, "theta": 30, "e": 1.2}, "e = 1.2 is outside its domain [0, 1]"),
@@ -43,29 +44,13 @@ def test_invalid_parameters_are_refused_with_the_reason(template_id: str, params
     assert solution.error is not None and solution.error.startswith(reason)
 
 
-TWO_BODIES = """
-id: two-bodies
-title: Two bodies on a line
-version: 1
-bodies: {a: {mass: m1}, b: {mass: m2}}
-parameters:
-  m1: {unit: kg, domain: "(0, inf)", sample: {uniform: [1, 2]}, decimals: 1}
-  m2: {unit: kg, domain: "(0, inf)", sample: {uniform: [1, 2]}, decimals: 1}
-  u1: {unit: m/s, domain: "(-inf, inf)", sample: {uniform: [1, 2]}, decimals: 1}
-  u2: {unit: m/s, domain: "(-inf, inf)", sample: {uniform: [-2, -1]}, decimals: 1}
-  e: {unit: "", domain: "[0, 1]", sample: {uniform: [0.2, 0.8]}, decimals: 2}
-stages:
-  - {effect: impact, bodies: [a, b], restitution: e, before: {a: u1, b: u2}, after: {a: a1, b: a2}}
-answers:
-  a1: {value: a1, unit: m/s}
-  square: {value: u1*u1*a2, unit: ""}
-statement: Two bodies collide.
-"""
 
 
 @pytest.fixture(scope="module")
 def two_bodies() -> tuple[Template, Compiled]:
-    template = parse_template(yaml.safe_load(TWO_BODIES), "test:two-bodies", "two-bodies")
+    raw = yaml.safe_load(TWO_BODIES)
+    raw["answers"]["square"] = {"value": "u1*u1*a2", "unit": ""}  # overflows where a1, a2 do not
+    template = parse_template(raw, "test:two-bodies", "two-bodies")
     return template, compile_template(template)
 
 

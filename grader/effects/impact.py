@@ -157,8 +157,8 @@ def _contact(stage: Stage, run: Run, bodies: tuple[str, str], inverse: tuple[flo
     w1, w2 = inverse
     share1, share2 = w1 / (w1 + w2), w2 / (w1 + w2)
     law = ContactLaw.calibrated(e, run.options.contact_duration)
-    weight = _weight(stage, run)
     run.uses("contact (Kelvin-Voigt)")
+    weight = _weight(stage, run)
 
     def free(_: float, y: Any) -> Any:
         return np.concatenate([y[4:], np.zeros(4)])
@@ -168,13 +168,19 @@ def _contact(stage: Stage, run: Run, bodies: tuple[str, str], inverse: tuple[flo
         return np.concatenate([y[4:], [weight - share1 * f, 0.0, (weight if w2 else 0.0) + share2 * f, 0.0]])
 
     approach = before[0] - before[2]
-    gap = approach * run.options.contact_duration / 4
+    duration = run.options.contact_duration
+    gap = approach * duration / 4
     y0 = np.array([-gap, 0.0, 0.0, 0.0, *before])
-    entry = Mode("approach", free, lambda y: y[0] - y[2], +1, scale=gap / approach)
+    # Errors along n are measured against the overlap and the approach speed, along t against the
+    # tangential motion: a grazing impact's tiny normal motion is not drowned by its t-motion.
+    normal_speed = max(approach, abs(before[0]), abs(before[2]))
+    tangent_speed = max(abs(before[1]), abs(before[3])) or normal_speed
+    sizes = np.array([approach * duration, tangent_speed * duration] * 2 + [normal_speed, tangent_speed] * 2)
+    entry = Mode("approach", free, lambda y: y[0] - y[2], +1, scale=gap / approach, sizes=lambda y: sizes)
     # e = 0: the spring would hold the bodies together for ever; they part at maximum compression.
     exit_event = (lambda y: y[4] - y[6]) if law.sticks else (lambda y: y[0] - y[2])
-    contact = Mode("contact", pressed, exit_event, -1, scale=run.options.contact_duration, omega=law.omega,
-                   force=lambda y: law.specific_force(y[0] - y[2], y[4] - y[6]) / (w1 + w2))
+    contact = Mode("contact", pressed, exit_event, -1, scale=duration, omega=law.omega,
+                   force=lambda y: law.specific_force(y[0] - y[2], y[4] - y[6]) / (w1 + w2), sizes=lambda y: sizes)
     path = integrate([entry, contact], y0, run.options.settings)
     run.record(f"impact of {bodies[0]} and {bodies[1]}",
                ("x1n", "x1t", "x2n", "x2t", "v1n", "v1t", "v2n", "v2t"), path)
@@ -207,12 +213,17 @@ def _component(run: Run, stage: Stage, body: str, when: str, axis: str) -> float
 
 def _output_energies(stage: Stage, run: Run, inverse: tuple[float, float], before: list[float],
                      after: list[float]) -> None:
+    # Energies in units of the largest speed squared: 1e170 m/s overflows only the energy itself,
+    # never the fraction lost.
+    unit = max(abs(v) for v in before + after) or 1.0
+
     def kinetic(v: list[float]) -> float:
-        return sum(math.hypot(v[2 * i], v[2 * i + 1]) ** 2 / (2 * w) for i, w in enumerate(inverse) if w)
-    energy_before, energy_after = kinetic(before), kinetic(after)
-    measured = {"energy_before": energy_before, "energy_after": energy_after,
-                "energy_lost": energy_before - energy_after,
-                "loss_fraction": (energy_before - energy_after) / energy_before if energy_before else math.nan,
+        return sum((math.hypot(v[2 * i], v[2 * i + 1]) / unit) ** 2 / (2 * w) for i, w in enumerate(inverse) if w)
+
+    scaled_before, scaled_after = kinetic(before), kinetic(after)
+    measured = {"energy_before": scaled_before * unit * unit, "energy_after": scaled_after * unit * unit,
+                "energy_lost": (scaled_before - scaled_after) * unit * unit,
+                "loss_fraction": (scaled_before - scaled_after) / scaled_before if scaled_before else math.nan,
                 "impulse": (before[0] - after[0]) / inverse[0]}
     for key, value in measured.items():
         if key in stage.fields:

@@ -1,0 +1,212 @@
+"""The time-domain simulation re-derives every template's answers; only declared effects are simulated."""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+
+from grader.bank import Template, parse_template
+from grader.cli import main
+from grader.compiled import Compiled
+from grader.effects import CATALOGUE
+from grader.evaluate import solve_one
+from grader.integrate import Settings, SimulationError
+from grader.simulate import Options, simulate
+from grader.solver import compile_template
+from tests.scenes import TWO_BODIES
+
+ADAPTIVE = Options(Settings("adaptive", rtol=1e-10))
+
+
+def _variants(template: Template, count: int, seed: int) -> list[dict[str, float]]:
+    """Parameter sets drawn from the template's sampling, rounded as they would be printed."""
+    rng = np.random.default_rng(seed)
+    sets = []
+    for _ in range(count):
+        params = {}
+        for name, parameter in template.parameters.items():
+            low, high = parameter.sample.values[0], parameter.sample.values[-1]
+            value = float(rng.choice(parameter.sample.values)) if parameter.sample.kind == "choice" else float(
+                rng.uniform(low, high))
+            params[name] = round(value, parameter.decimals) if parameter.decimals is not None else float(
+                f"{value:.{parameter.sig_figs}g}")
+        sets.append(params)
+    return sets
+
+
+def _compare(template: Template, compiled: Compiled, params: dict[str, float], options: Options) -> dict[str, float]:
+    closed = solve_one(template, compiled, params)
+    assert closed.answers is not None, closed.error
+    simulated = simulate(template, params, options)
+    differences = {}
+    for name, value in simulated.answers.items():
+        exact = closed.answers[name].value
+        if exact is None or value is None:
+            assert exact is None and value is None, (name, exact, value)
+            continue
+        assert isinstance(exact, float)
+        differences[name] = abs(value - exact) / abs(exact) if exact else abs(value)
+    return differences
+
+
+def test_every_bank_template_is_cross_checked_by_simulation(bank: dict[str, Template],
+                                                            compiled: dict[str, Compiled]) -> None:
+    """Each template of problem_bank/, on sampled variants, agrees with its closed form to 1e-6."""
+    for template_id, template in bank.items():
+        for params in _variants(template, 4, seed=len(template_id)):
+            differences = _compare(template, compiled[template_id], params, ADAPTIVE)
+            assert differences, template_id
+            assert max(differences.values()) <= 1e-6, (template_id, params, differences)
+
+
+@pytest.mark.parametrize(("template_id", "params", "effects"), [
+    ("car-collision", {"p": 0.5, "e": 0.1}, ("contact (Kelvin-Voigt)",)),
+    ("ball-plate", {"v": 50, "theta": 30, "e": 0.5}, ("contact (Kelvin-Voigt)",)),
+    ("drop-rebound", {"h_drop": 2100, "h_rebound": 1100}, ("gravity", "contact (Kelvin-Voigt)")),
+])
+def test_only_the_effects_a_scene_declares_are_simulated(template_id: str, params: dict[str, float],
+                                                         effects: tuple[str, ...],
+                                                         bank: dict[str, Template]) -> None:
+    """A car collision integrates no gravity, even when the weight during contact is asked for."""
+    asked = dataclasses.replace(ADAPTIVE, weight_during_contact=True)
+    assert simulate(bank[template_id], params).effects == effects
+    with_weight = simulate(bank[template_id], params, asked).effects
+    assert with_weight == ((*effects, "weight during contact") if "gravity" in effects else effects)
+
+
+@pytest.fixture(scope="module")
+def two_bodies() -> tuple[Template, Compiled]:
+    template = parse_template(yaml.safe_load(TWO_BODIES), "test:two-bodies", "two-bodies")
+    return template, compile_template(template)
+
+
+@pytest.mark.parametrize("e", [0.0, 0.01, 0.5, 0.99, 1 - 1e-9, 1.0])
+def test_the_contact_reproduces_e(e: float, two_bodies: tuple[Template, Compiled]) -> None:
+    """Separation over approach equals e (e = 0: the bodies part at maximum compression)."""
+    template, compiled = two_bodies
+    params = {"m1": 1.0, "m2": 2.0, "u1": 3.0, "u2": -1.0, "e": e}
+    result = simulate(template, params, Options(Settings("adaptive", rtol=1e-12)))
+    separation = result.answers["a2"] - result.answers["a1"]  # type: ignore[operator]
+    assert separation == pytest.approx(e * 4.0, rel=1e-10, abs=1e-12)
+    assert max(_compare(template, compiled, params, Options(Settings("adaptive", rtol=1e-12))).values()) < 1e-10
+
+
+@pytest.mark.parametrize("ratio", [1e-6, 1e-3, 1.0, 1e3, 1e6])
+def test_extreme_mass_ratios_stay_accurate(ratio: float, two_bodies: tuple[Template, Compiled]) -> None:
+    """Stiffness follows the reduced mass, so the relative motion is the same at any mass ratio."""
+    template, compiled = two_bodies
+    params = {"m1": ratio, "m2": 1.0, "u1": 3.0, "u2": -1.0, "e": 0.7}
+    assert max(_compare(template, compiled, params, Options(Settings("adaptive", rtol=1e-12))).values()) < 1e-10
+
+
+@pytest.mark.parametrize("theta", [1e-3, 1.0, 89.999, 90.0])
+def test_grazing_and_head_on_impacts_on_a_plate(theta: float, bank: dict[str, Template],
+                                                compiled: dict[str, Compiled]) -> None:
+    """A grazing impact's small normal motion is integrated on its own scale."""
+    params = {"v": 50.0, "theta": theta, "e": 0.5}
+    assert max(_compare(bank["ball-plate"], compiled["ball-plate"], params, ADAPTIVE).values()) < 1e-8
+
+
+@pytest.mark.parametrize("duration", [1e-1, 1e-3, 1e-6, 1e-9])
+def test_stiff_contacts_are_integrated_on_their_own_time_scale(duration: float,
+                                                               two_bodies: tuple[Template, Compiled]) -> None:
+    """The error does not depend on how short (stiff) the contact is."""
+    template, compiled = two_bodies
+    params = {"m1": 1.0, "m2": 2.0, "u1": 3.0, "u2": -1.0, "e": 0.7}
+    options = dataclasses.replace(ADAPTIVE, contact_duration=duration)
+    assert max(_compare(template, compiled, params, options).values()) < 1e-8
+
+
+@pytest.mark.parametrize(("method", "steps", "bound"), [("euler", 100, 2e-3), ("euler", 1000, 2e-4),
+                                                        ("rk4", 30, 5e-6), ("rk4", 300, 1e-9)])
+def test_fixed_step_methods_converge_within_their_bounds(method: str, steps: int, bound: float,
+                                                         two_bodies: tuple[Template, Compiled]) -> None:
+    """Semi-implicit Euler is first order, RK4 fourth: errors within what benchmarks/accuracy.py shows."""
+    template, compiled = two_bodies
+    params = {"m1": 1.0, "m2": 2.0, "u1": 3.0, "u2": -1.0, "e": 0.7}
+    error = max(_compare(template, compiled, params, Options(Settings(method, steps=steps))).values())
+    assert error < bound
+    coarse = max(_compare(template, compiled, params, Options(Settings(method, steps=steps // 2))).values())
+    assert coarse / error > (1.6 if method == "euler" else 10)
+
+
+@pytest.mark.parametrize("magnitude", [1e-150, 1e170])
+def test_extreme_magnitudes_neither_blow_up_nor_lose_accuracy(magnitude: float,
+                                                              two_bodies: tuple[Template, Compiled]) -> None:
+    """Speeds near 1e-150 and 1e170 simulate like ordinary ones."""
+    template, compiled = two_bodies
+    params = {"m1": 1.0, "m2": 2.0, "u1": 3 * magnitude, "u2": -magnitude, "e": 0.7}
+    closed = solve_one(template, compiled, params)
+    result = simulate(template, params, ADAPTIVE)
+    for name in ("a1", "a2"):
+        exact = closed.answers[name].value if closed.answers else None  # type: ignore[union-attr]
+        assert isinstance(exact, float) and math.isfinite(exact)
+        assert result.answers[name] == pytest.approx(exact, rel=1e-9)
+
+
+def test_inverse_template_finds_e_by_matching_the_simulated_rebound(bank: dict[str, Template]) -> None:
+    """The rebound height is given; e is what makes the simulated rebound reach it."""
+    result = simulate(bank["drop-rebound"], {"h_drop": 2100, "h_rebound": 1100}, ADAPTIVE)
+    assert result.fitted["e"] == pytest.approx(math.sqrt(1100 / 2100), rel=1e-8)
+
+
+@pytest.mark.parametrize(("settings", "message"), [
+    (lambda: Settings("leapfrog"), "unknown method 'leapfrog' (use one of euler, rk4, adaptive)"),
+    (lambda: Settings("rk4", steps=-3), "steps per contact must be a whole number >= 1"),
+    (lambda: Settings("adaptive", rtol=0.0), "rtol must be between 1e-14 and 1"),
+    (lambda: Options(contact_duration=-1.0), "the contact duration must be a positive number of seconds"),
+])
+def test_bad_settings_are_refused_with_a_message(settings: object, message: str) -> None:
+    """Unknown methods, negative steps, tolerances and durations out of range."""
+    with pytest.raises(SimulationError, match=message.replace("(", r"\(").replace(")", r"\)")):
+        settings()  # type: ignore[operator]
+
+
+def test_a_step_above_the_stability_limit_is_refused(two_bodies: tuple[Template, Compiled]) -> None:
+    """Euler with one step per contact would blow up: refused with the limit and what to use."""
+    template, _ = two_bodies
+    with pytest.raises(SimulationError, match=r"stability limit 2/omega .* use at least 2 steps per contact"):
+        simulate(template, {"m1": 1.0, "m2": 2.0, "u1": 3.0, "u2": -1.0, "e": 0.7}, Options(Settings("euler", 1)))
+
+
+def test_a_scene_with_an_effect_without_force_law_is_refused(monkeypatch: pytest.MonkeyPatch,
+                                                             bank: dict[str, Template]) -> None:
+    """An effect that cannot be simulated is named, with the stage it is in."""
+    monkeypatch.setitem(CATALOGUE, "rise", dataclasses.replace(CATALOGUE["rise"], simulate=None))
+    with pytest.raises(SimulationError, match=r"stages\[2\]: the effect 'rise' has no force law"):
+        simulate(bank["drop-rebound"], {"h_drop": 2100, "h_rebound": 1100})
+
+
+def test_simulate_cli_json_has_the_documented_shape(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
+    """One object: template, params, method, effects, steps, seconds, answers with both values; a plot file."""
+    plot = tmp_path / "run.png"
+    code = main(["simulate", "ball-plate", "--set", "v=50", "--set", "theta=30", "--set", "e=0.5", "--json",
+                 "--plot", str(plot)])
+    record = json.loads(capsys.readouterr().out)
+    assert code == 0
+    assert {"template", "params", "method", "effects", "steps", "seconds", "answers"} <= set(record)
+    assert record["effects"] == ["contact (Kelvin-Voigt)"]
+    assert record["answers"]["v_out"]["rel_diff"] < 1e-8
+    assert record["answers"]["v_out"]["closed_form"] == pytest.approx(45.0694, abs=1e-4)
+    assert plot.stat().st_size > 10_000
+
+
+@pytest.mark.parametrize(("argv", "message"), [
+    (["--method", "rk4", "--steps-per-contact", "0"], "steps per contact must be a whole number >= 1"),
+    (["--method", "euler", "--steps-per-contact", "1"], "stability limit"),
+    (["--method", "magic"], "unknown method 'magic'"),
+    (["--steps-per-contact", "50"], "--steps-per-contact is for the fixed-step methods"),
+    (["--method", "rk4", "--rtol", "1e-6"], "--rtol is for the adaptive method"),
+    (["--contact-duration", "0"], "the contact duration must be a positive number"),
+])
+def test_simulate_cli_bad_input_exits_2(capsys: pytest.CaptureFixture[str], argv: list[str], message: str) -> None:
+    """Bad steps, methods and durations: exit 2 with the reason on stderr."""
+    code = main(["simulate", "ball-plate", "--set", "v=50", "--set", "theta=30", "--set", "e=0.5", *argv])
+    assert code == 2
+    assert message in capsys.readouterr().err

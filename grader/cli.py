@@ -321,6 +321,8 @@ def _simulate(arguments: argparse.Namespace) -> int:
     record = {"template": template.id, "params": result.params, "method": settings.method,
               "effects": list(result.effects), "steps": result.steps, "seconds": result.seconds, "answers": rows,
               "fitted": dict(result.fitted), "nominal": dict(result.nominal),
+              "contacts": [{"impact": c.label, "e": c.e, "measured_e": c.measured_e, "zeta": c.zeta,
+                            "duration": c.duration} for c in result.contacts],
               "settings": {"steps_per_contact": settings.steps, "rtol": settings.rtol,
                            "contact_duration": options.contact_duration,
                            "weight_during_contact": options.weight_during_contact}}
@@ -338,8 +340,12 @@ def _print_simulation(template: Template, record: dict[str, Any]) -> None:
                                          for n, v in record["params"].items()))
     print(f"simulated: {', '.join(record['effects'])}; {method}; {record['steps']} steps in "
           f"{record['seconds'] * 1e3:.1f} ms")
+    for contact in record["contacts"]:
+        print(f"{contact['impact']}: Kelvin-Voigt contact of {contact['duration'] * 1e3:g} ms, zeta = "
+              f"{contact['zeta']:.4f}, measured e = separation/approach = {contact['measured_e']:.10g}")
     for name, value in record["fitted"].items():
-        print(f"{name} found by matching the simulated outcome to the given one: {value:.10g}")
+        print(f"{name} not given: contact law calibrated to {name} = {value:.10g}, found so that the simulated "
+              "outcome matches the given one")
     if record["nominal"]:
         print("symbols set to 1 for the simulation: " + ", ".join(record["nominal"]))
     print(_table(("answer", "simulated", "closed form", "rel. diff"), [

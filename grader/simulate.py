@@ -60,6 +60,18 @@ class PhaseRecord:
     path: Path
 
 
+@dataclass(frozen=True)
+class ContactRecord:
+    """One simulated contact: the e the law was calibrated to and the e it produced."""
+
+    stage: int
+    label: str
+    e: float
+    measured_e: float
+    zeta: float
+    duration: float
+
+
 @dataclass
 class Run:
     """The state of one pass through the stages: known quantities (SI), what was simulated."""
@@ -71,6 +83,7 @@ class Run:
     phases: list[PhaseRecord] = field(default_factory=list)
     observed: dict[str, tuple[float, float]] = field(default_factory=dict)
     problems: list[str] = field(default_factory=list)
+    contacts: list[ContactRecord] = field(default_factory=list)
     steps: int = 0
 
     def value(self, node: Node) -> float:
@@ -130,6 +143,7 @@ class Simulation:
     fitted: Mapping[str, float]
     nominal: Mapping[str, float]
     phases: tuple[PhaseRecord, ...]
+    contacts: tuple[ContactRecord, ...] = ()
 
 
 def simulate(template: Template, params: Mapping[str, float], options: Options | None = None) -> Simulation:
@@ -139,11 +153,18 @@ def simulate(template: Template, params: Mapping[str, float], options: Options |
     started = time.perf_counter()
     base = _si_values(template, params)
     run, fitted = _solve_for_unknowns(template, options, base)
+    # A found e is reported as the contact produced it (separation over approach), not as the
+    # value the contact law was calibrated to: that is the time-domain answer.
+    for contact in run.contacts:
+        restitution = template.scene.stages[contact.stage].fields["restitution"]
+        if isinstance(restitution, Sym) and restitution.name in fitted:
+            run.values[restitution.name] = contact.measured_e
     if run.problems:
         raise SimulationError(f"{template.id}: {run.problems[0]}")
     answers = {name: _answer(run, name) for name, spec in template.answers.items() if not spec.symbolic}
     return Simulation(template.id, dict(params), answers, tuple(run.effects), run.steps,
-                      time.perf_counter() - started, fitted, {n: 1.0 for n in template.symbols}, tuple(run.phases))
+                      time.perf_counter() - started, fitted, {n: 1.0 for n in template.symbols}, tuple(run.phases),
+                      tuple(run.contacts))
 
 
 def _check_force_laws(template: Template) -> None:

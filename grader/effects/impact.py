@@ -182,9 +182,13 @@ def _contact(stage: Stage, run: Run, bodies: tuple[str, str], inverse: tuple[flo
     contact = Mode("contact", pressed, exit_event, -1, scale=duration, omega=law.omega,
                    force=lambda y: law.specific_force(y[0] - y[2], y[4] - y[6]) / (w1 + w2), sizes=lambda y: sizes)
     path = integrate([entry, contact], y0, run.options.settings)
-    run.record(f"impact of {bodies[0]} and {bodies[1]}",
-               ("x1n", "x1t", "x2n", "x2t", "v1n", "v1t", "v2n", "v2t"), path)
-    return [float(v) for v in path.y[-1][4:]]
+    label = f"impact of {bodies[0]} and {bodies[1]}"
+    run.record(label, ("x1n", "x1t", "x2n", "x2t", "v1n", "v1t", "v2n", "v2t"), path)
+    after = [float(v) for v in path.y[-1][4:]]
+    from grader.simulate import ContactRecord  # the simulator imports the effects, not the other way
+
+    run.contacts.append(ContactRecord(stage.index, label, e, (after[2] - after[0]) / approach, law.zeta, duration))
+    return after
 
 
 def _weight(stage: Stage, run: Run) -> float:

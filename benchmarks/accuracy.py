@@ -1,0 +1,508 @@
+"""Benchmark: what accuracy costs in time, simulation against closed form (a work-precision diagram).
+
+As DifferentialEquations.jl's ``WorkPrecisionSet``: for four forward scenes (``e`` given) and each method,
+the error of the simulated answers against a reference simulation (adaptive, rtol 1e-13) versus the
+median wall time of ``simulate``: ``euler`` and ``rk4`` over a geometric sweep of steps per contact N,
+``adaptive`` over rtol 1e-3..1e-13. Each point runs at ``--shifts`` contact durations
+``tau (1 + k/(shifts N))`` (N = 16 for adaptive), moving the step grid against the contact; the errors
+are averaged. Corners: the closed-form kernels, and a 50-digit mpmath evaluation of formulas written
+here. Second panel: the drop's rebound with the weight acting during contact, against contact
+stiffness (modelling error) beside the same without weight (integration error). A small table times
+the inverse templates (e found by root search). Run: ``python benchmarks/accuracy.py [--quick]``;
+writes ``benchmarks/results/accuracy.md``, ``accuracy.csv`` and ``accuracy.png``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import itertools
+import math
+import os
+import platform
+import statistics
+import sys
+import time
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import asdict, dataclass
+from functools import partial
+from pathlib import Path
+from typing import Any
+
+import mpmath as mp
+import numpy as np
+import yaml
+
+from grader.bank import Template, load_bank, parse_template
+from grader.cache import compiled_for
+from grader.compiled import Compiled
+from grader.effects.impact import ContactLaw
+from grader.evaluate import solve_one
+from grader.integrate import Settings
+from grader.kernel import evaluate
+from grader.resources import bank_dir
+from grader.simulate import DEFAULT_CONTACT_DURATION, Options, simulate
+from grader.solver import compile_template
+
+RESULTS = Path(__file__).resolve().parent / "results"
+REFERENCE_RTOL = 1e-13
+PANEL_RTOL = 1e-12
+TARGET_ERROR = 1e-8
+TARGET_SECONDS = 5e-3
+FLOOR = 1e-17  # an error of exactly 0 is drawn here on the log axis
+DIGITS = 50
+ADAPTIVE_GRID = 16  # the "steps per contact" used to shift the onset for the adaptive method
+KERNEL_REPEAT = 301
+Exact = Callable[[Mapping[str, Any]], dict[str, Any]]
+
+
+@dataclass(frozen=True)
+class Scene:
+    """A forward scene: template, one parameter set, its compiled form and its exact answers."""
+
+    name: str
+    template: Template
+    compiled: Compiled
+    params: Mapping[str, float]
+    exact: Exact
+
+
+@dataclass(frozen=True)
+class Point:
+    """One point of the diagram: errors (mean and max over the onset shifts) and median time."""
+
+    scene: str
+    method: str
+    setting: str
+    value: float  # steps per contact, rtol, or NaN for a corner
+    error_mean: float  # vs the reference simulation (corners: vs the exact value)
+    error_max: float
+    closed_mean: float  # vs the closed form
+    closed_max: float
+    spread: float  # max - min of the error over the onset shifts
+    seconds: float
+    steps: float
+
+
+@dataclass(frozen=True)
+class Stiffness:
+    """The drop's rebound at one contact duration, with and without the weight during contact."""
+
+    duration: float
+    k_per_m: float
+    modelling: float
+    integration: float
+
+
+@dataclass(frozen=True)
+class Inverse:
+    """An inverse template (e found by root search): median time and error against the closed form."""
+
+    template: str
+    rtol: float
+    fitted_e: float
+    seconds: float
+    error: float
+
+
+def parse_args(argv: Sequence[str] | None = None) -> argparse.Namespace:
+    """The command-line options."""
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0] if __doc__ else None)
+    parser.add_argument("--quick", action="store_true", help="a coarse sweep (about 15 s)")
+    parser.add_argument("--max-steps", type=int, default=1000, help="largest steps per contact (default 1000)")
+    parser.add_argument("--points", type=int, default=11, help="fixed-step sweep points (default 11)")
+    parser.add_argument("--shifts", type=int, default=8, help="onset positions per point (default 8)")
+    parser.add_argument("--repeat", type=int, default=2, help="timed runs per onset position (default 2)")
+    parser.add_argument("--out", type=Path, default=RESULTS, help=f"output folder (default {RESULTS})")
+    args = parser.parse_args(argv)
+    if args.quick:
+        args.max_steps, args.points, args.shifts, args.repeat = 400, 6, 2, 1
+    if args.max_steps < 4 or args.points < 2 or args.shifts < 1 or args.repeat < 1:
+        parser.error("need --max-steps >= 4, --points >= 2, --shifts >= 1 and --repeat >= 1")
+    args.steps = sorted({round(n) for n in np.geomspace(4, args.max_steps, args.points)})
+    args.rtols = [10.0 ** -p for p in range(3, 14, 2 if args.quick else 1)]
+    args.durations = np.geomspace(1e-1, 1e-6, 6 if args.quick else 11)
+    return args
+
+
+def _exact_ball_plate(p: Mapping[str, Any]) -> dict[str, Any]:
+    """n = v sin(theta) is reversed and scaled by e, t = v cos(theta) is kept."""
+    n, t = p["e"] * p["v"] * mp.sin(mp.radians(p["theta"])), p["v"] * mp.cos(mp.radians(p["theta"]))
+    return {"v_out": mp.hypot(n, t), "theta_out": mp.degrees(mp.atan2(n, t))}
+
+
+def _exact_oblique(p: Mapping[str, Any]) -> dict[str, Any]:
+    """Momentum and restitution along n (sphere 2 at rest), t-velocities unchanged."""
+    m1, m2, e = p["m1"], p["m2"], p["e"]
+    n, t = p["v1"] * mp.cos(mp.radians(p["theta"])), p["v1"] * mp.sin(mp.radians(p["theta"]))
+    n1, n2 = n * (m1 - e * m2) / (m1 + m2), n * m1 * (1 + e) / (m1 + m2)
+    lost = (1 - e**2) * m1 * m2 / (m1 + m2) * n**2 / 2
+    return {"v1_out": mp.hypot(n1, t), "v2_out": abs(n2), "theta1_out": mp.degrees(mp.atan2(n1, t)),
+            "loss_pct": 100 * lost / (m1 * p["v1"] ** 2 / 2)}
+
+
+def _exact_car(p: Mapping[str, Any]) -> dict[str, Any]:
+    """vA'/v = (1 - e p)/(1 + p), vB'/v = (1 + e)/(1 + p)."""
+    return {"vA_ratio": (1 - p["e"] * p["p"]) / (1 + p["p"]), "vB_ratio": (1 + p["e"]) / (1 + p["p"])}
+
+
+def _exact_drop(p: Mapping[str, Any]) -> dict[str, Any]:
+    """v = sqrt(2 g h), rebound speed e v, so h' = e^2 h (g cancels)."""
+    return {"h_rebound": p["e"] ** 2 * p["h_drop"]}
+
+
+def drop_forward() -> Template:
+    """The drop-rebound scene asked forward: e given, the rebound height found."""
+    raw = yaml.safe_load((bank_dir() / "drop-rebound.yaml").read_text(encoding="utf-8"))
+    for key in ("constraints", "example"):
+        raw.pop(key, None)
+    raw["id"] = "drop-rebound-forward"
+    raw["parameters"] = {"h_drop": raw["parameters"]["h_drop"], "e": {
+        "unit": "", "domain": "[0, 1]", "sample": {"uniform": [0.3, 0.9]}, "decimals": 2}}
+    raw["answers"] = {"h_rebound": {"value": "h_rebound", "unit": "mm", "description": "rebound height"}}
+    raw["statement"] = "Dropped from {{ h_drop }} mm with e = {{ e }}."
+    return parse_template(raw, "benchmarks/accuracy.py (drop-rebound, forward)", "benchmark-drop-forward")
+
+
+def scenes() -> list[Scene]:
+    """The four forward scenes."""
+    bank, drop = load_bank(), drop_forward()
+    specs: list[tuple[Template, Compiled, dict[str, float], Exact]] = [
+        (bank["ball-plate"], compiled_for(bank["ball-plate"]), {"v": 50, "theta": 30, "e": 0.5}, _exact_ball_plate),
+        (bank["oblique-spheres"], compiled_for(bank["oblique-spheres"]),
+         {"v1": 6, "theta": 30, "e": 0.6, "m1": 1, "m2": 1}, _exact_oblique),
+        (bank["car-collision"], compiled_for(bank["car-collision"]), {"p": 0.5, "e": 0.1}, _exact_car),
+        (drop, compile_template(drop), {"h_drop": 2000, "e": 0.6}, _exact_drop),
+    ]
+    return [Scene(t.id, t, c, {k: float(v) for k, v in p.items()}, x) for t, c, p, x in specs]
+
+
+def relative(got: Mapping[str, Any], want: Mapping[str, Any]) -> float:
+    """Largest relative difference over ``want``'s answers, computed at 50 digits."""
+    with mp.workdps(DIGITS):
+        return max(float(abs(mp.mpf(got[k]) - mp.mpf(want[k])) / abs(mp.mpf(want[k]))) for k in want)
+
+
+def closed_form(template: Template, compiled: Compiled, params: Mapping[str, float]) -> dict[str, float]:
+    """The closed-form numeric answers."""
+    solution = solve_one(template, compiled, params)
+    assert solution.answers is not None, solution.error
+    return {k: a.value for k, a in solution.answers.items() if isinstance(a.value, float)}
+
+
+def median_time(call: Callable[[], Any], repeat: int) -> tuple[float, Any]:
+    """Median wall time of ``repeat`` calls, and the last call's result."""
+    times, result = [], None
+    for _ in range(repeat):
+        start = time.perf_counter()
+        result = call()
+        times.append(time.perf_counter() - start)
+    return statistics.median(times), result
+
+
+_REFERENCES: dict[tuple[str, float], Mapping[str, Any]] = {}
+
+
+def reference(scene: Scene, duration: float) -> Mapping[str, Any]:
+    """The reference answers (adaptive, rtol 1e-13) at one contact duration, computed once."""
+    key = (scene.name, duration)
+    if key not in _REFERENCES:
+        options = Options(Settings("adaptive", rtol=REFERENCE_RTOL), contact_duration=duration)
+        _REFERENCES[key] = simulate(scene.template, scene.params, options).answers
+    return _REFERENCES[key]
+
+
+def sweep_point(scene: Scene, settings: Settings, args: argparse.Namespace) -> Point:
+    """One method and setting, over the onset shifts: errors and the median time of ``simulate``."""
+    closed = closed_form(scene.template, scene.compiled, scene.params)
+    grid = ADAPTIVE_GRID if settings.method == "adaptive" else settings.steps
+    errors, closes, times, steps = [], [], [], []
+    for k in range(args.shifts):
+        options = Options(settings, contact_duration=DEFAULT_CONTACT_DURATION * (1 + k / (args.shifts * grid)))
+        for _ in range(args.repeat):
+            start = time.perf_counter()
+            sim = simulate(scene.template, scene.params, options)
+            times.append(time.perf_counter() - start)
+        want = reference(scene, options.contact_duration)
+        errors.append(relative(sim.answers, want))
+        closes.append(relative(sim.answers, {name: closed[name] for name in want}))
+        steps.append(sim.steps)
+    mean = statistics.fmean(errors)
+    label, value = ((f"rtol={settings.rtol:.0e}", settings.rtol) if settings.method == "adaptive"
+                    else (f"N={settings.steps}", float(settings.steps)))
+    return Point(scene.name, settings.method, label, value, mean, max(errors), statistics.fmean(closes),
+                 max(closes), max(errors) - min(errors),
+                 statistics.median(times), statistics.fmean(steps))
+
+
+def work_precision(scene: Scene, args: argparse.Namespace) -> list[Point]:
+    """The sweep of every method for one scene."""
+    configs = [Settings(m, steps=n) for m in ("euler", "rk4") for n in args.steps]
+    configs += [Settings("adaptive", rtol=r) for r in args.rtols]
+    return [sweep_point(scene, settings, args) for settings in configs]
+
+
+def corners(scene: Scene, repeat: int) -> list[Point]:
+    """Closed form (raw kernels, and solve_one), exact mpmath, and the reference simulation."""
+    names = list(reference(scene, DEFAULT_CONTACT_DURATION))
+    env = {**scene.params, **scene.compiled.constants}
+    trees = {n: scene.compiled.answers[n].numeric for n in names}
+    kernel_s, kernel = median_time(lambda: {n: float(evaluate(t, env)) for n, t in trees.items()}, KERNEL_REPEAT)
+    solve_s, _ = median_time(partial(closed_form, scene.template, scene.compiled, scene.params), KERNEL_REPEAT)
+
+    def exact() -> dict[str, Any]:
+        with mp.workdps(DIGITS):
+            return scene.exact({k: mp.mpf(v) for k, v in scene.params.items()})  # the float inputs, exactly
+
+    exact_s, truth = median_time(exact, KERNEL_REPEAT)
+    options = Options(Settings("adaptive", rtol=REFERENCE_RTOL))
+    sim_s, sim = median_time(partial(simulate, scene.template, scene.params, options), 3 * repeat)
+    nan = math.nan
+    return [Point(scene.name, "closed form (kernels)", "", nan, relative(kernel, truth), relative(kernel, truth),
+                  0.0, 0.0, 0.0, kernel_s, 0.0),
+            Point(scene.name, "closed form (solve_one)", "", nan, relative(kernel, truth), relative(kernel, truth),
+                  0.0, 0.0, 0.0, solve_s, 0.0),
+            Point(scene.name, "exact (mpmath, 50 digits)", "", nan, 0.0, 0.0, relative(truth, kernel),
+                  relative(truth, kernel), 0.0, exact_s, 0.0),
+            Point(scene.name, "reference (adaptive, rtol 1e-13)", "", REFERENCE_RTOL, relative(sim.answers, truth),
+                  relative(sim.answers, truth), relative(sim.answers, kernel), relative(sim.answers, kernel), 0.0,
+                  sim_s, float(sim.steps))]
+
+
+def stiffness(scene: Scene, durations: Sequence[float]) -> list[Stiffness]:
+    """The drop's rebound height against contact duration, with and without the weight during contact."""
+    want = closed_form(scene.template, scene.compiled, scene.params)
+    settings, rows = Settings("adaptive", rtol=PANEL_RTOL), []
+    for duration in durations:
+        def height(weight: bool, d: float = float(duration)) -> float:
+            options = Options(settings, contact_duration=d, weight_during_contact=weight)
+            return float(simulate(scene.template, scene.params, options).answers["h_rebound"] or math.nan)
+        k_per_m = ContactLaw.calibrated(scene.params["e"], float(duration)).omega ** 2  # k = mu omega_n^2, mu = m
+        rows.append(Stiffness(float(duration), k_per_m, relative({"h": height(True)}, {"h": want["h_rebound"]}),
+                              relative({"h": height(False)}, {"h": want["h_rebound"]})))
+    return rows
+
+
+def inverse(repeat: int) -> list[Inverse]:
+    """The shipped inverse templates at their example parameters, at three tolerances."""
+    bank, rows = load_bank(), []
+    for name in ("drop-rebound", "pile-driver"):
+        template = bank[name]
+        want = closed_form(template, compiled_for(template), template.example)
+        for rtol in (1e-8, 1e-10, 1e-12):
+            options = Options(Settings("adaptive", rtol=rtol))
+            seconds, sim = median_time(partial(simulate, template, template.example, options), repeat)
+            rows.append(Inverse(name, rtol, sim.fitted["e"], seconds, relative(sim.answers, want)))
+    return rows
+
+
+def target(points: Sequence[Point], scene: str) -> Point | None:
+    """The loosest rtol whose error, and that of every tighter rtol, is within 1e-8 of the closed form."""
+    found = None
+    for point in sorted((p for p in points if p.scene == scene and p.method == "adaptive"), key=lambda p: p.value):
+        if point.closed_max > TARGET_ERROR:
+            break
+        found = point
+    return found
+
+
+def met(point: Point | None) -> bool:
+    """Whether a target point exists and is fast enough."""
+    return point is not None and point.seconds <= TARGET_SECONDS
+
+
+def table(header: Sequence[str], rows: Sequence[Sequence[str]]) -> str:
+    """A Markdown table; columns after the first two are right-aligned."""
+    align = ["---" if i < 2 else "--:" for i in range(len(header))]
+    return "\n".join("| " + " | ".join(r) + " |" for r in [header, align, *rows])
+
+
+def targets_table(points: Sequence[Point], names: Sequence[str]) -> str:
+    """Per scene: the loosest adaptive rtol meeting 1e-8 and its median time."""
+    rows = []
+    for name in names:
+        best = target(points, name)
+        rows.append([name, "none"] if best is None else
+                    [name, f"{best.value:.0e}", f"{best.closed_max:.1e}", f"{best.seconds * 1e3:.2f}"])
+        rows[-1] += ["-", "-"] * (best is None) + ["met" if met(best) else "**NOT met**"]
+    return table(["scene", "loosest rtol", "error vs closed form (max)", "median ms/scene", "target"], rows)
+
+
+def sweep_table(points: Sequence[Point], names: Sequence[str]) -> str:
+    """Method × setting rows; per scene the mean error vs the reference and the median time."""
+    settings = list(dict.fromkeys((p.method, p.setting) for p in points))
+    cells = {(p.scene, p.method, p.setting): f"{p.error_mean:.1e} / {p.seconds * 1e3:.2f}" for p in points}
+    rows = [[method, setting, *(cells[(n, method, setting)] for n in names)] for method, setting in settings]
+    return table(["method", "setting", *(f"{n}: error / ms" for n in names)], rows)
+
+
+def onset_table(points: Sequence[Point], names: Sequence[str]) -> str:
+    """How much the error moves with where the contact starts in the step grid (worst over the sweep)."""
+    rows = []
+    for method in ("euler", "rk4", "adaptive"):
+        cells = []
+        for name in names:
+            mine = [p for p in points if p.scene == name and p.method == method and p.error_mean > 0]
+            cells.append(f"{max(p.spread for p in mine):.0e} ({max(p.spread / p.error_mean for p in mine):.0e})")
+        rows.append([method, "max − min (÷ error)", *cells])
+    return table(["method", "worst over the sweep", *names], rows)
+
+
+def corner_table(points: Sequence[Point]) -> str:
+    """The corners and the reference: time per scene and errors."""
+    rows = [[p.scene, p.method, f"{p.seconds * 1e6:,.1f}", f"{p.error_max:.1e}",
+             "-" if p.method.startswith("closed") else f"{p.closed_max:.1e}"] for p in points]
+    return table(["scene", "evaluation", "µs per scene", "error vs exact", "difference vs closed form"], rows)
+
+
+def stiffness_table(rows: Sequence[Stiffness]) -> tuple[str, float]:
+    """The stiffness table and the least-squares slope of log(modelling error) against log(duration)."""
+    slope = float(np.polyfit(np.log([r.duration for r in rows]), np.log([r.modelling for r in rows]), 1)[0])
+    return table(["contact duration (s)", "k/m (1/s²)", "with weight: modelling error", "without: integration"],
+                 [[f"{r.duration:.1e}", f"{r.k_per_m:.2e}", f"{r.modelling:.2e}", f"{r.integration:.1e}"]
+                  for r in rows]), slope
+
+
+def inverse_table(rows: Sequence[Inverse]) -> str:
+    """Time and error of the inverse templates."""
+    return table(["template", "rtol", "e found", "median ms/scene", "max error vs closed form"],
+                 [[r.template, f"{r.rtol:.0e}", f"{r.fitted_e:.12f}", f"{r.seconds * 1e3:.1f}", f"{r.error:.1e}"]
+                  for r in rows])
+
+
+def report(points: Sequence[Point], rows: Sequence[Stiffness], inverse_rows: Sequence[Inverse],
+           args: argparse.Namespace, names: Sequence[str]) -> str:
+    """The whole Markdown report."""
+    sweep = [p for p in points if p.method in COLOURS]
+    gap = max(abs(p.closed_max - p.error_max) for p in sweep)
+    stiff, slope = stiffness_table(rows)
+    return "\n\n".join([
+        "# Accuracy benchmark: simulation against closed form",
+        f"Python {platform.python_version()}, numpy {np.__version__}, mpmath {mp.__version__}, {os.cpu_count()} "
+        f"CPUs ({platform.machine()}). Contact duration {DEFAULT_CONTACT_DURATION:g} s. Time: median wall time of "
+        f"`simulate` over {args.shifts} onset shifts × {args.repeat} runs. Error: largest relative error over the "
+        "scene's numeric answers.",
+        "## Target: adaptive within 1e-8 of the closed form in ≤ 5 ms per scene", targets_table(points, names),
+        "## Work-precision: error vs the adaptive rtol 1e-13 reference (mean over onset shifts) / median ms",
+        sweep_table(sweep, names),
+        f"Against the closed form instead of the reference every error differs by at most {gap:.1e} (the "
+        "reference's own error); 0 means the run is the reference itself. N = steps per time scale of each "
+        "mode (contact, approach, fall, rise).",
+        "## Onset position: spread of the error over the onset shifts", onset_table(sweep, names),
+        "Every mode restarts at its located event and the Kelvin-Voigt contact is linear, so moving the onset "
+        "against the step grid changes the error only by rounding (about 1e-15 and never above 1e-12 absolute).",
+        "## Corners: closed form and exact evaluation", corner_table([p for p in points if p not in sweep]),
+        "Exact: answers written from first principles, evaluated by mpmath at 50 digits from the float inputs' "
+        "exact binary values. The kernels are built for arrays: one set pays numpy's per-call overhead.",
+        "## Modelling vs integration error: drop-rebound (h_drop 2000 mm, e 0.6), adaptive rtol 1e-12", stiff,
+        f"Modelling error ∝ duration^{slope:.2f} (least-squares slope); the integration error stays at the floor.",
+        "## Inverse templates (e found by root search, example parameters)", inverse_table(inverse_rows),
+    ]) + "\n"
+
+
+def write_csv(points: Sequence[Point], rows: Sequence[Stiffness], inverse_rows: Sequence[Inverse],
+              path: Path) -> None:
+    """One table, one ``kind`` per measurement; empty cells where a column does not apply."""
+    fields = list(dict.fromkeys(["kind", *asdict(points[0]), *asdict(rows[0]), *asdict(inverse_rows[0])]))
+    with path.open("w", newline="", encoding="utf-8") as handle:
+        writer = csv.DictWriter(handle, fields, restval="")
+        writer.writeheader()
+        writer.writerows({"kind": "sweep" if p.method in COLOURS else "corner", **asdict(p)} for p in points)
+        writer.writerows({"kind": "stiffness", **asdict(r)} for r in rows)
+        writer.writerows({"kind": "inverse", **asdict(r)} for r in inverse_rows)
+
+
+COLOURS = {"euler": "#1f77b4", "rk4": "#ff7f0e", "adaptive": "#2ca02c"}
+MARKERS = ("o", "s", "^", "D")
+CORNERS = (("closed form (kernels)", "*", "black", ""),
+           ("exact (mpmath, 50 digits)", "P", "purple", "; error 0, drawn at 1e-17"))
+
+
+def draw_sweep(axes: Any, points: Sequence[Point], names: Sequence[str]) -> None:
+    """Panel 1: error vs time per method and scene, the two corners, the target box."""
+    for (method, colour), (name, marker) in itertools.product(COLOURS.items(), zip(names, MARKERS, strict=True)):
+        line = [p for p in points if p.method == method and p.scene == name and p.error_mean > 0]
+        axes.plot([p.seconds * 1e3 for p in line], [p.error_mean for p in line], color=colour, marker=marker,
+                  markersize=4, linewidth=1, alpha=0.85)
+    for method, marker, colour, note in CORNERS:
+        group = [p for p in points if p.method == method]
+        seconds = statistics.median(p.seconds for p in group)
+        axes.plot(seconds * 1e3, max(max(p.error_max for p in group), FLOOR), marker=marker, color=colour,
+                  markersize=14, linestyle="none", label=f"{method}: median {seconds * 1e6:.0f} µs{note}")
+    own = max(p.closed_max for p in points if p.method.startswith("reference"))
+    axes.axhline(own, color="grey", linestyle=":", linewidth=1, label=f"reference's own error ({own:.0e})")
+    axes.axhline(TARGET_ERROR, color="#d62728", linestyle="--", linewidth=1)
+    axes.axvline(TARGET_SECONDS * 1e3, color="#d62728", linestyle="--", linewidth=1)
+    axes.fill_between([1e-4, TARGET_SECONDS * 1e3], FLOOR / 3, TARGET_ERROR, color="#d62728", alpha=0.06,
+                      label="target: ≤ 1e-8 in ≤ 5 ms")
+    for method, colour in COLOURS.items():
+        axes.plot([], [], color=colour, linewidth=2, label=method)
+    for name, marker in zip(names, MARKERS, strict=True):
+        axes.plot([], [], color="grey", marker=marker, linestyle="none", label=name)
+    axes.set(xscale="log", yscale="log", xlabel="median wall time per scene (ms)", ylim=(FLOOR / 3, 3),
+             ylabel="max relative error of the answers", xlim=(1e-3, None),
+             title="Work-precision: simulation error vs the rtol 1e-13 reference, corners vs exact")
+    axes.legend(fontsize=8, loc="upper left")
+    axes.grid(which="major", alpha=0.3)
+
+
+def draw_stiffness(axes: Any, rows: Sequence[Stiffness], zeta: float) -> None:
+    """Panel 2: modelling and integration error of the drop's rebound against stiffness."""
+    x, scale = [r.k_per_m for r in rows], math.pi / math.sqrt(1 - zeta**2)  # duration = scale / sqrt(k/m)
+    axes.plot(x, [r.modelling for r in rows], "o-", color="#9467bd", label="weight during contact: modelling error")
+    axes.plot(x, [max(r.integration, FLOOR) for r in rows], "s-", color="#2ca02c",
+              label=f"no weight: integration error only (rtol {PANEL_RTOL:g})")
+    axes.axhline(TARGET_ERROR, color="#d62728", linestyle="--", linewidth=1, label="1e-8 (the target's accuracy)")
+    axes.set(xscale="log", yscale="log", xlabel="contact stiffness per unit mass k/m (1/s²)",
+             ylabel="relative error of h_rebound vs the closed form e² h_drop",
+             title="Drop-rebound: modelling error vs integration error")
+    with np.errstate(all="ignore"):
+        top = axes.secondary_xaxis("top", functions=(lambda k: scale / np.sqrt(k), lambda d: (scale / d) ** 2))
+    top.set_xlabel("contact duration (s)")
+    axes.legend(fontsize=8, loc="upper right")
+    axes.grid(which="major", alpha=0.3)
+
+
+def plot(points: Sequence[Point], rows: Sequence[Stiffness], names: Sequence[str], zeta: float, path: Path) -> str:
+    """Both panels side by side; a note when matplotlib is missing."""
+    try:
+        import matplotlib
+
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+    except ImportError:
+        return "matplotlib is not installed: skipped the plot (pip install matplotlib)"
+    figure, (left, right) = plt.subplots(1, 2, figsize=(15, 6.5), dpi=110)
+    draw_sweep(left, points, names)
+    draw_stiffness(right, rows, zeta)
+    figure.tight_layout()
+    figure.savefig(path)
+    plt.close(figure)
+    return f"plot written to {path}"
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run every measurement, print the report and write the result files; 1 if a target is missed."""
+    args = parse_args(argv)
+    started, forward, points = time.perf_counter(), scenes(), []
+    names = [s.name for s in forward]
+    for scene in forward:
+        print(f"sweeping {scene.name} ...", file=sys.stderr, flush=True)
+        points += work_precision(scene, args)
+    for scene in forward:
+        points += corners(scene, args.repeat)
+    print("stiffness sweep and inverse templates ...", file=sys.stderr, flush=True)
+    rows, inverse_rows = stiffness(forward[-1], args.durations), inverse(3 * args.repeat)
+    text = report(points, rows, inverse_rows, args, names)
+    args.out.mkdir(parents=True, exist_ok=True)
+    (args.out / "accuracy.md").write_text(text, encoding="utf-8")
+    write_csv(points, rows, inverse_rows, args.out / "accuracy.csv")
+    print(text)
+    zeta = ContactLaw.calibrated(forward[-1].params["e"], DEFAULT_CONTACT_DURATION).zeta
+    print(plot(points, rows, names, zeta, args.out / "accuracy.png"), file=sys.stderr)
+    print(f"total {time.perf_counter() - started:.0f} s", file=sys.stderr)
+    return 0 if all(met(target(points, n)) for n in names) else 1
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

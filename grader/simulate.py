@@ -19,10 +19,8 @@ from __future__ import annotations
 import math
 import time
 from collections.abc import Mapping
-from dataclasses import dataclass, field, replace
-from typing import Any
+from dataclasses import dataclass, field
 
-import numpy as np
 from scipy.optimize import brentq
 
 from grader.bank import Template
@@ -206,7 +204,7 @@ def _solve_for_unknowns(template: Template, options: Options, base: dict[str, fl
 
     def mismatch(e: float) -> float:
         run = _walk(template, options, {**base, name: e})
-        observed = [pair for key, pair in run.observed.items()]
+        observed = list(run.observed.values())
         if len(observed) != 1:
             raise SimulationError(f"{template.where}: cannot simulate: finding {name} needs exactly one "
                                   f"measured outcome, the scene has {len(observed)}")
@@ -241,12 +239,3 @@ def _answer(run: Run, name: str) -> float | None:
                               f"'{missing.name}'") from None
     return value / spec.unit.to_si if math.isfinite(value) else None
 
-
-def with_settings(options: Options, **changes: Any) -> Options:
-    """A copy of ``options`` with other integration settings."""
-    return replace(options, settings=replace(options.settings, **changes))
-
-
-def state_array(path: Path) -> np.ndarray:
-    """A phase path's states as a (steps, components) array."""
-    return np.array(path.y)

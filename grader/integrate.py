@@ -130,9 +130,15 @@ def _fixed(mode: Mode, t: float, y: Any, settings: Settings, path: Path) -> tupl
             f"{settings.method}: a step of {dt:.3g} s is at or above the stability limit 2/omega = "
             f"{2 / mode.omega:.3g} s of the {mode.name} mode; use at least "
             f"{math.floor(mode.scale * mode.omega / 2) + 1} steps per contact")
-    for _ in range(MAX_STEPS):
+    for count in range(MAX_STEPS):
         following = _step(settings.method, mode.rhs, t, y, dt)
         path.steps += 1
+        if count == 0 and mode.omega > 0 and mode.event(following) * mode.direction >= 0:
+            # A contact starts at zero overlap, on its own end; ending it within the first step
+            # means the step cannot resolve it (and whether a crossing is seen would hang on rounding).
+            raise SimulationError(
+                f"{settings.method}: {settings.steps} steps per contact do not resolve the {mode.name} mode "
+                "(it reverses within the first step); use more steps per contact")
         if _crossed(mode, mode.event(y), mode.event(following)):
             # The crossing, located on the method's own partial step (same order as a full step).
             fraction = _locate(mode, settings.method, t, y, dt)
@@ -142,7 +148,7 @@ def _fixed(mode: Mode, t: float, y: Any, settings: Settings, path: Path) -> tupl
             return t, y
         t, y = t + dt, following
         path.add(t, y, mode)
-    raise SimulationError(f"the {mode.name} mode did not end within {MAX_STEPS} steps")
+    raise SimulationError(f"the {mode.name} mode did not end within {MAX_STEPS} steps{_never_ends(mode)}")
 
 
 def _sizes(mode: Mode, t: float, y: Any) -> Any:
@@ -196,4 +202,11 @@ def _adaptive(mode: Mode, t: float, y: Any, rtol: float, path: Path, dense: bool
         if solution.status == 1:
             return t, y
         horizon = end
-    raise SimulationError(f"the {mode.name} mode did not end within {600 * mode.scale:.3g} s")
+    raise SimulationError(f"the {mode.name} mode did not end within {600 * mode.scale:.3g} s{_never_ends(mode)}")
+
+
+def _never_ends(mode: Mode) -> str:
+    if mode.omega > 0:
+        return (": the bodies stay in contact (with the weight acting on a soft contact they come to rest "
+                "pressed together); try a shorter contact duration")
+    return ""

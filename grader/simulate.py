@@ -150,7 +150,10 @@ def simulate(template: Template, params: Mapping[str, float], options: Options |
     _check_force_laws(template)
     started = time.perf_counter()
     base = _si_values(template, params)
-    run, fitted = _solve_for_unknowns(template, options, base)
+    try:
+        run, fitted = _solve_for_unknowns(template, options, base)
+    except SimulationError as error:
+        raise SimulationError(f"{template.id}: {error}") from None
     # A found e is reported as the contact produced it (separation over approach), not as the
     # value the contact law was calibrated to: that is the time-domain answer.
     for contact in run.contacts:

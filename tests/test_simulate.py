@@ -210,3 +210,27 @@ def test_simulate_cli_bad_input_exits_2(capsys: pytest.CaptureFixture[str], argv
     code = main(["simulate", "ball-plate", "--set", "v=50", "--set", "theta=30", "--set", "e=0.5", *argv])
     assert code == 2
     assert message in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("duration", [1e-3, 1.15625e-3])
+def test_coarse_euler_is_refused_whatever_the_onset_rounding(duration: float, bank: dict[str, Template]) -> None:
+    """Regression: with 4 Euler steps a heavily damped contact reverses within one step; whether that
+    counted as an exit hung on a 1e-20 overlap at onset. Now it is refused either way."""
+    options = Options(Settings("euler", steps=4), contact_duration=duration)
+    with pytest.raises(SimulationError, match="4 steps per contact do not resolve the contact mode"):
+        simulate(bank["car-collision"], {"p": 0.5, "e": 0.1}, options)
+
+
+def test_a_contact_that_never_ends_says_why(bank: dict[str, Template]) -> None:
+    """Regression: a soft contact with the weight on leaves the ball resting on the floor."""
+    raw = yaml.safe_load((Path(bank["drop-rebound"].where)).read_text(encoding="utf-8"))
+    raw["parameters"]["e"] = {"unit": "", "domain": "[0, 1]", "sample": {"uniform": [0.3, 0.9]}, "decimals": 2}
+    raw["answers"] = {"h_rebound": {"value": "h_rebound", "unit": "mm"}}
+    raw["parameters"].pop("h_rebound")
+    for key in ("constraints", "example"):
+        raw.pop(key)
+    raw["statement"] = "Dropped from {{ h_drop }} mm with e = {{ e }}."
+    forward = parse_template(raw, "test:forward", "forward")
+    options = Options(contact_duration=0.1, weight_during_contact=True)
+    with pytest.raises(SimulationError, match="drop-rebound: the contact mode did not end .* the bodies stay in"):
+        simulate(forward, {"h_drop": 2000.0, "e": 0.05}, options)

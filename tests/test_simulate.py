@@ -232,5 +232,5 @@ def test_a_contact_that_never_ends_says_why(bank: dict[str, Template]) -> None:
     raw["statement"] = "Dropped from {{ h_drop }} mm with e = {{ e }}."
     forward = parse_template(raw, "test:forward", "forward")
     options = Options(contact_duration=0.1, weight_during_contact=True)
-    with pytest.raises(SimulationError, match="drop-rebound: the contact mode did not end .* the bodies stay in"):
+    with pytest.raises(SimulationError, match=r"drop-rebound: the contact mode did not end .* the bodies stay in"):
         simulate(forward, {"h_drop": 2000.0, "e": 0.05}, options)

@@ -54,7 +54,8 @@ def build_parser() -> argparse.ArgumentParser:
                           help="a parameter value in the template's unit, or with its own unit")
     simulate.add_argument("--method", default="adaptive", help="euler, rk4 or adaptive (default)")
     step = simulate.add_mutually_exclusive_group()
-    step.add_argument("--steps-per-contact", type=int, metavar="N", help="fixed steps per contact (euler, rk4)")
+    step.add_argument("--steps-per-contact", type=int, metavar="N",
+                      help="fixed steps per contact (euler, rk4; a fall or rise takes N steps over its duration)")
     step.add_argument("--rtol", type=float, metavar="X", help="relative tolerance (adaptive; default 1e-10)")
     simulate.add_argument("--contact-duration", type=float, default=1e-3, metavar="S",
                           help="duration of a contact in seconds; sets the stiffness (default 0.001)")

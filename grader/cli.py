@@ -63,7 +63,26 @@ def build_parser() -> argparse.ArgumentParser:
                           help="let gravity act during contact too (the closed form neglects it)")
     simulate.add_argument("--json", action="store_true", help="print one JSON object")
     simulate.add_argument("--plot", type=Path, metavar="FILE.png", help="draw position, velocity and force")
+
+    generate = commands.add_parser("generate", help="per-student variants, key and PDFs for an assignment")
+    generate.add_argument("assignment", type=Path, metavar="ASSIGNMENT.yaml")
+    generate.add_argument("--roster", type=Path, required=True, metavar="ROSTER.csv",
+                          help="columns id, name, email, section")
+    generate.add_argument("--out", type=Path, required=True, metavar="DIR", help="output folder (new or empty)")
+    _output_options(generate)
+    generate.add_argument("--no-pdf", action="store_true", help="write key.json and key.csv only")
+    generate.add_argument("--keep-source", action="store_true", help="also keep the Typst sources")
+
+    demo = commands.add_parser("demo", help="the whole job on shipped sample data (5 problems, 30 students)")
+    demo.add_argument("--out", type=Path, default=Path("grader-demo"), metavar="DIR",
+                      help="output folder (default: ./grader-demo)")
+    _output_options(demo)
     return parser
+
+
+def _output_options(command: argparse.ArgumentParser) -> None:
+    command.add_argument("--jobs", type=int, default=1, metavar="N", help="render PDFs in N parallel jobs")
+    command.add_argument("--force", action="store_true", help="replace a non-empty output folder")
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -355,4 +374,40 @@ def _print_simulation(template: Template, record: dict[str, Any]) -> None:
          "-" if row["rel_diff"] is None else f"{row['rel_diff']:.2g}") for name, row in record["answers"].items()]))
 
 
-_COMMANDS = {"list": _list, "show": _show, "solve": _solve, "simulate": _simulate}
+def _generate(arguments: argparse.Namespace) -> int:
+    from grader.generate import Job, run
+
+    _check_jobs(arguments.jobs)
+    job = Job(arguments.assignment, arguments.roster, arguments.out, pdf=not arguments.no_pdf,
+              jobs=arguments.jobs, keep_source=arguments.keep_source, force=arguments.force)
+    _print_summary(run(job, _bank(arguments)))
+    return EXIT_OK
+
+
+def _demo(arguments: argparse.Namespace) -> int:
+    from grader.generate import demo
+
+    _check_jobs(arguments.jobs)
+    summary = demo(arguments.out, _bank(arguments), jobs=arguments.jobs, force=arguments.force)
+    _print_summary(summary)
+    print(f"The assignment and roster it used are in {summary.out}: edit them and run\n"
+          f"  grader generate {summary.out / 'assignment.yaml'} --roster {summary.out / 'roster.csv'} --out OTHER")
+    return EXIT_OK
+
+
+def _check_jobs(jobs: int) -> None:
+    if jobs < 1:
+        raise UsageError(f"--jobs must be 1 or more, got {jobs}")
+
+
+def _print_summary(summary: Any) -> None:
+    collided = {key: n for key, n in summary.collisions.items() if n}
+    print(f"{summary.students} students x {summary.problems} problems -> {summary.out} "
+          f"({summary.files} files, {summary.seconds:.1f} s)")
+    if collided:
+        print("students sharing their numbers with another (the parameter space is small): " +
+              ", ".join(f"problem {key}: {n}" for key, n in collided.items()))
+
+
+_COMMANDS = {"list": _list, "show": _show, "solve": _solve, "simulate": _simulate, "generate": _generate,
+             "demo": _demo}

@@ -15,7 +15,7 @@ or infinity reaches an answer.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from fractions import Fraction
 from typing import Any
@@ -24,7 +24,7 @@ import numpy as np
 
 from grader.bank import Template
 from grader.compiled import Compiled
-from grader.expr import Num, fold, substitute, to_text
+from grader.expr import Node, Num, fold, substitute, to_text
 from grader.kernel import evaluate
 
 
@@ -156,12 +156,22 @@ def _solution(template: Template, compiled: Compiled, result: Columns, row: int)
         if reason is not None:
             answers[name] = AnswerValue(name, answer.unit, None, reason)
         elif answer.symbolic is not None:
-            keep = set(template.answers[name].symbolic)
-            numbers = {p: Num(Fraction(repr(v))) for p, v in params.items() if p not in keep}
-            answers[name] = AnswerValue(name, answer.unit, to_text(fold(substitute(answer.symbolic, numbers))))
+            text = symbolic_text(answer.symbolic, params, template.answers[name].symbolic)
+            answers[name] = AnswerValue(name, answer.unit, text)
         else:
             answers[name] = AnswerValue(name, answer.unit, float(result.values[name][row]))
     return Solution(template.id, params, answers)
+
+
+def symbolic_text(tree: Node, params: Mapping[str, float], keep: Sequence[str]) -> str:
+    """A symbolic answer as text: the parameters not kept symbolic substituted as exact decimals.
+
+    >>> from grader.expr import parse
+    >>> symbolic_text(parse("v*(1 - e*p)/(p + 1)"), {"e": 0.1, "p": 0.5}, ["p", "v"])
+    'v*(1 - 0.1*p)/(p + 1)'
+    """
+    numbers: dict[str, Node] = {p: Num(Fraction(repr(v))) for p, v in params.items() if p not in keep}
+    return to_text(fold(substitute(tree, numbers)))
 
 
 def _show(value: float) -> str:

@@ -21,6 +21,11 @@ def bank_dir() -> Path:
     return _find("problem_bank")
 
 
+def sample_dir() -> Path:
+    """The folder of the sample assignment and roster ``grader demo`` uses."""
+    return _PACKAGE / "sample"
+
+
 def templates_dir() -> Path:
     """The folder of the shipped Jinja2 document templates."""
     return _find("templates")

@@ -1,0 +1,116 @@
+"""Benchmark: generating an assignment's key and PDFs.
+
+- key only (variants, answers, key.json and key.csv) for 2,000 students x the sample's 5 problems;
+- baseline in the same run: the same variants' answers by sympy substitution, one variant at a
+  time (timed on a subset and extrapolated, as a full run would take minutes);
+- PDFs for 200 students with ``--jobs 1`` and ``--jobs 2``: time per student PDF.
+
+Targets: key for 2,000 x 5 in under 1 s; PDFs at <= 50 ms per student (2 cores, --jobs 2).
+
+Run: ``python benchmarks/generate.py [--students 2000] [--pdf-students 200] [--baseline 100]``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import statistics
+import tempfile
+import time
+from collections.abc import Sequence
+from pathlib import Path
+
+from grader.assignment import Student, load_assignment
+from grader.bank import load_bank
+from grader.cache import compiled_for
+from grader.generate import Job, run
+from grader.keyfile import key_csv, key_document, key_json
+from grader.resources import sample_dir
+from grader.symbolic import from_node
+from grader.variants import generate
+
+RESULTS = Path(__file__).resolve().parent / "results"
+
+
+def roster(count: int, folder: Path) -> Path:
+    """A synthetic roster of ``count`` students."""
+    lines = ["id,name,email,section"] + [f"{9000000 + i},Student {i},s{i}@example.edu,L0{i % 4}" for i in range(count)]
+    path = folder / f"roster-{count}.csv"
+    path.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    return path
+
+
+def time_key(count: int, folder: Path, repeat: int = 3) -> tuple[float, object]:
+    """Best wall time of variants + answers + key.json + key.csv for ``count`` students."""
+    bank, assignment = load_bank(), load_assignment(sample_dir() / "assignment.yaml")
+    students = tuple(Student(f"{9000000 + i}", f"Student {i}", f"s{i}@example.edu", "L01") for i in range(count))
+    for template in bank.values():
+        compiled_for(template)  # compile once, outside the timing, as a warm cache would
+    best, generation = float("inf"), None
+    for _ in range(repeat):
+        started = time.perf_counter()
+        generation = generate(assignment, students, bank)
+        key_json(key_document(assignment, generation, bank))
+        key_csv(generation)
+        best = min(best, time.perf_counter() - started)
+    return best, generation
+
+
+def time_baseline(generation: object, subset: int) -> float:
+    """Seconds per variant when every numeric answer is substituted into the sympy solution."""
+    bank = load_bank()
+    trees = {t: {n: from_node(a.numeric, {}) for n, a in compiled_for(bank[t]).answers.items()
+                 if a.numeric is not None} for t in bank}
+    variants = [v for s in generation.students for v in s.problems][:subset]  # type: ignore[attr-defined]
+    started = time.perf_counter()
+    for variant in variants:
+        constants = compiled_for(bank[variant.template]).constants
+        values = {**variant.params, **constants}
+        for expr in trees[variant.template].values():
+            float(expr.subs({symbol: values[symbol.name] for symbol in expr.free_symbols}).evalf())
+    return (time.perf_counter() - started) / len(variants)
+
+
+def time_pdfs(count: int, folder: Path, jobs: int) -> float:
+    """Seconds per student PDF (the class PDF and the key included in the total) with ``jobs`` jobs."""
+    path = roster(count, folder)
+    out = folder / f"pdf-{count}-{jobs}"
+    started = time.perf_counter()
+    run(Job(sample_dir() / "assignment.yaml", path, out, jobs=jobs), load_bank())
+    return (time.perf_counter() - started) / count
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--students", type=int, default=2000)
+    parser.add_argument("--pdf-students", type=int, default=200)
+    parser.add_argument("--baseline", type=int, default=100, help="variants timed for the sympy baseline")
+    arguments = parser.parse_args(argv)
+    with tempfile.TemporaryDirectory() as scratch:
+        folder = Path(scratch)
+        key_s, generation = time_key(arguments.students, folder)
+        variants = arguments.students * 5
+        per_variant = time_baseline(generation, arguments.baseline)
+        pdf = {jobs: statistics.median(time_pdfs(arguments.pdf_students, folder, jobs) for _ in range(1))
+               for jobs in (1, 2)}
+    rows = [
+        ("key: variants + answers + key.json + key.csv", f"{arguments.students:,} students x 5 problems",
+         f"{key_s:.3f} s", f"{key_s / variants * 1e6:.1f} µs per variant", "< 1 s", key_s < 1),
+        ("baseline: sympy substitution per variant", f"{arguments.baseline} variants, extrapolated",
+         f"{per_variant * variants:.1f} s", f"{per_variant * 1e3:.2f} ms per variant",
+         f"{per_variant * variants / key_s:,.0f}x slower", True),
+        ("PDFs, --jobs 1", f"{arguments.pdf_students} students", f"{pdf[1] * arguments.pdf_students:.2f} s",
+         f"{pdf[1] * 1e3:.1f} ms per student", "-", True),
+        ("PDFs, --jobs 2", f"{arguments.pdf_students} students", f"{pdf[2] * arguments.pdf_students:.2f} s",
+         f"{pdf[2] * 1e3:.1f} ms per student", "<= 50 ms per student", pdf[2] <= 0.05),
+    ]
+    table = ["| what | size | total | per item | target | |", "|---|---|--:|--:|---|---|"]
+    table += [f"| {w} | {s} | {t} | {p} | {g} | {'met' if ok else '**NOT met**'} |" for w, s, t, p, g, ok in rows]
+    report = "# Generate benchmark\n\n" + "\n".join(table) + "\n"
+    print(report)
+    RESULTS.mkdir(exist_ok=True)
+    (RESULTS / "generate.md").write_text(report, encoding="utf-8")
+    return 0 if all(ok for *_, ok in rows) else 1
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,0 +1,174 @@
+"""Assignments: seeded, stable variants; a key that equals `grader solve`; every bad input refused."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+import yaml
+
+from grader.assignment import load_assignment, load_roster
+from grader.bank import Template
+from grader.cli import main
+from grader.compiled import Compiled
+from grader.evaluate import solve_one
+from grader.resources import sample_dir
+from grader.variants import generate
+
+ASSIGNMENT = sample_dir() / "assignment.yaml"
+ROSTER = sample_dir() / "roster.csv"
+
+
+def run(capsys: pytest.CaptureFixture[str], *argv: str) -> tuple[int, str, str]:
+    code = main([str(a) for a in argv])
+    captured = capsys.readouterr()
+    return code, captured.out, captured.err
+
+
+def test_same_inputs_give_byte_identical_keys(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """Two runs, same assignment and roster: key.json and key.csv are identical to the byte."""
+    for name in ("one", "two"):
+        assert run(capsys, "generate", ASSIGNMENT, "--roster", ROSTER, "--out", tmp_path / name, "--no-pdf")[0] == 0
+    for file in ("key.json", "key.csv"):
+        assert (tmp_path / "one" / file).read_bytes() == (tmp_path / "two" / file).read_bytes()
+
+
+def test_removing_a_student_changes_nobody_elses_numbers(bank: dict[str, Template]) -> None:
+    """Variants are keyed on (seed, problem key, student id), not on positions in the roster."""
+    assignment, roster = load_assignment(ASSIGNMENT), load_roster(ROSTER)
+    everyone = {s.student.id: s.problems for s in generate(assignment, roster, bank).students}
+    fewer = generate(assignment, roster[:3] + roster[4:], bank)
+    assert len(fewer.students) == len(roster) - 1
+    for entry in fewer.students:
+        assert entry.problems == everyone[entry.student.id]
+
+
+def test_a_different_seed_changes_the_numbers(bank: dict[str, Template]) -> None:
+    """The assignment seed is part of every variant's key."""
+    assignment, roster = load_assignment(ASSIGNMENT), load_roster(ROSTER)
+    other = type(assignment)(**{**assignment.__dict__, "seed": "another"})
+    first, second = generate(assignment, roster, bank), generate(other, roster, bank)
+    assert first.students[0].problems[0].printed != second.students[0].problems[0].printed
+
+
+def test_every_answer_in_the_key_equals_solving_the_printed_parameters(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str], bank: dict[str, Template],
+        compiled: dict[str, Compiled]) -> None:
+    """The key's answers are the solver's answers for the numbers on the student's page."""
+    run(capsys, "generate", ASSIGNMENT, "--roster", ROSTER, "--out", tmp_path / "out", "--no-pdf")
+    key = json.loads((tmp_path / "out" / "key.json").read_text(encoding="utf-8"))
+    assert key["schema"] == "grader-key" and key["version"] == 1
+    for student in key["students"]:
+        for problem in student["problems"]:
+            assert {n: float(t) for n, t in problem["printed"].items()} == problem["params"]
+            solution = solve_one(bank[problem["template"]], compiled[problem["template"]], problem["params"])
+            assert solution.answers is not None
+            for name, answer in problem["answers"].items():
+                assert answer["value"] == solution.answers[name].value
+    student, problem = key["students"][7], key["students"][7]["problems"][2]
+    sets = [f"--set={n}={t}" for n, t in problem["printed"].items()]
+    code, out, _ = run(capsys, "solve", problem["template"], *sets, "--json")
+    assert code == 0 and student["id"]
+    for name, answer in json.loads(out)["answers"].items():
+        assert answer["value"] == problem["answers"][name]["value"]
+
+
+def test_printed_values_keep_their_precision_and_labels_follow_the_problem_keys(bank: dict[str, Template]) -> None:
+    """h_drop has 2 decimals on the page ("2.10", not "2.1"); answers are labelled 3a, 3b, 3c."""
+    variants = generate(load_assignment(ASSIGNMENT), load_roster(ROSTER), bank).students[0].problems
+    pile = variants[2]
+    assert all(len(pile.printed[n].split(".")[1]) == 2 for n in ("h_drop", "h_rebound"))
+    assert [a.label for a in pile.answers] == ["3a", "3b", "3c"]
+    assert [a.points for a in variants[0].answers] == [2.0, 2.0]
+    assert pile.answers[2].tolerance.rtol == 0.02
+
+
+def _write(path: Path, text: str) -> Path:
+    path.write_text(text, encoding="utf-8")
+    return path
+
+
+def _assignment(tmp_path: Path, change: dict[str, object]) -> Path:
+    raw = yaml.safe_load(ASSIGNMENT.read_text(encoding="utf-8"))
+    raw["problems"][0].update(change)
+    return _write(tmp_path / "assignment.yaml", yaml.safe_dump(raw))
+
+
+ROSTER_TEXT = ROSTER.read_text(encoding="utf-8")
+
+
+@pytest.mark.parametrize(("change", "roster", "message"), [
+    ({"template": "drop-rebond"}, None, "problems[0].template: expected a template id of the bank (did you mean "
+                                        "drop-rebound?)"),
+    ({"fixed": {"h_drop": -5}}, None, "problems[0].fixed.h_drop: expected a value in the parameter's domain (0, inf)"),
+    ({"fixed": {"height": 5}}, None, "problems[0].fixed: expected parameters of drop-rebound"),
+    ({"fixed": {"h_drop": 1000, "h_rebound": 1500}}, None, "problem 1 (drop-rebound): no valid variant for student "),
+    ({}, "id,name,email,section\n1,A,a@x,L1\n1,B,b@x,L1\n", "line 3: student id '1' appears twice"),
+    ({}, "id,name,email,section\n1,A,a@x,L1\n,B,b@x,L1\n", "line 3: empty student id"),
+    ({}, "id,name,email,section\n", "the roster has no students"),
+    ({}, "id,name\n1,A\n", "missing column(s) email, section"),
+], ids=["unknown-template", "fixed-outside-domain", "unknown-parameter", "infeasible-constraint", "duplicate-id",
+        "empty-id", "empty-roster", "missing-columns"])
+def test_bad_input_exits_2_and_leaves_nothing_behind(tmp_path: Path, capsys: pytest.CaptureFixture[str],
+                                                     change: dict[str, object], roster: str | None,
+                                                     message: str) -> None:
+    """A clear message naming where the problem is; no output folder, no half-written files."""
+    assignment = _assignment(tmp_path, change)
+    roster_path = _write(tmp_path / "roster.csv", roster if roster is not None else ROSTER_TEXT)
+    code, out, err = run(capsys, "generate", assignment, "--roster", roster_path, "--out", tmp_path / "out",
+                         "--no-pdf")
+    assert (code, out) == (2, "")
+    assert message in err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["assignment.yaml", "roster.csv"]
+
+
+def test_infeasible_constraint_names_the_template_and_the_constraint(tmp_path: Path,
+                                                                     capsys: pytest.CaptureFixture[str]) -> None:
+    """The refusal says which constraint every draw broke."""
+    assignment = _assignment(tmp_path, {"fixed": {"h_drop": 1000, "h_rebound": 1500}})
+    _, _, err = run(capsys, "generate", assignment, "--roster", ROSTER, "--out", tmp_path / "out", "--no-pdf")
+    assert "constraint h_rebound <= h_drop fails" in err
+
+
+def test_an_existing_output_folder_is_kept_unless_forced(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """A non-empty --out is refused (exit 2) and untouched; --force replaces it whole."""
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "notes.txt").write_text("mine", encoding="utf-8")
+    code, _, err = run(capsys, "generate", ASSIGNMENT, "--roster", ROSTER, "--out", out, "--no-pdf")
+    assert code == 2 and "exists and is not empty" in err
+    assert (out / "notes.txt").read_text(encoding="utf-8") == "mine"
+    assert run(capsys, "generate", ASSIGNMENT, "--roster", ROSTER, "--out", out, "--no-pdf", "--force")[0] == 0
+    assert sorted(p.name for p in out.iterdir()) == ["key.csv", "key.json"]
+    assert [p.name for p in tmp_path.iterdir()] == ["out"]
+
+
+@pytest.mark.parametrize("delimiter", [",", ";", "\t"])
+def test_rosters_with_bom_and_any_of_three_delimiters_read_alike(tmp_path: Path, delimiter: str) -> None:
+    """UTF-8 with a byte-order mark, comma, semicolon or tab: the same students."""
+    text = ROSTER_TEXT.replace(",", delimiter) if delimiter != "," else ROSTER_TEXT
+    if delimiter != ",":
+        text = "\n".join(line.replace(",", delimiter) for line in ROSTER_TEXT.splitlines())
+    path = tmp_path / "roster.csv"
+    path.write_bytes(b"\xef\xbb\xbf" + text.encode("utf-8"))
+    assert load_roster(path) == load_roster(ROSTER)
+
+
+def test_collisions_are_reported_when_the_parameter_space_is_too_small(tmp_path: Path,
+                                                                       capsys: pytest.CaptureFixture[str]) -> None:
+    """With every parameter fixed, all students share their numbers, and the run says so."""
+    assignment = _assignment(tmp_path, {"fixed": {"h_drop": 2000, "h_rebound": 1000}})
+    code, out, _ = run(capsys, "generate", assignment, "--roster", ROSTER, "--out", tmp_path / "out", "--no-pdf")
+    assert code == 0
+    assert "problem 1: 30" in out
+    assert json.loads((tmp_path / "out" / "key.json").read_text(encoding="utf-8"))["collisions"]["1"] == 30
+
+
+def test_key_csv_neutralizes_formulas_in_text_cells(tmp_path: Path, bank: dict[str, Template]) -> None:
+    """A name starting with '=' is written so that a spreadsheet shows it as text."""
+    from grader.keyfile import key_csv
+
+    roster = _write(tmp_path / "roster.csv", "id,name,email,section\n7,=cmd|' /C calc'!A0,x@y,L1\n")
+    csv_text = key_csv(generate(load_assignment(ASSIGNMENT), load_roster(roster), bank))
+    assert "'=cmd|' /C calc'!A0" in csv_text

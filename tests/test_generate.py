@@ -172,3 +172,33 @@ def test_key_csv_neutralizes_formulas_in_text_cells(tmp_path: Path, bank: dict[s
     roster = _write(tmp_path / "roster.csv", "id,name,email,section\n7,=cmd|' /C calc'!A0,x@y,L1\n")
     csv_text = key_csv(generate(load_assignment(ASSIGNMENT), load_roster(roster), bank))
     assert "'=cmd|' /C calc'!A0" in csv_text
+
+
+def test_demo_writes_its_inputs_and_generate_from_them_reproduces_it(tmp_path: Path,
+                                                                     capsys: pytest.CaptureFixture[str]) -> None:
+    """`grader demo --out DIR` then `grader generate DIR/assignment.yaml --roster DIR/roster.csv --out OTHER`
+    give the same key and the same PDFs, byte for byte."""
+    demo, other = tmp_path / "demo", tmp_path / "other"
+    code, out, _ = run(capsys, "demo", "--out", demo)
+    assert code == 0 and "30 students x 5 problems" in out
+    assert run(capsys, "generate", demo / "assignment.yaml", "--roster", demo / "roster.csv", "--out", other)[0] == 0
+    produced = sorted(p.relative_to(demo) for p in demo.rglob("*") if p.is_file())
+    assert {"key.json", "key.csv", "class.pdf", "answer-key.pdf"} <= {str(p) for p in produced}
+    assert len([p for p in produced if str(p).startswith("students")]) == 30
+    for path in produced:
+        if path.name not in ("assignment.yaml", "roster.csv"):
+            assert (demo / path).read_bytes() == (other / path).read_bytes(), path
+
+
+def test_a_failure_while_rendering_leaves_nothing_behind(tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
+                                                         capsys: pytest.CaptureFixture[str]) -> None:
+    """Key files already written to the staging folder are removed with it; --out never appears."""
+    import grader.render
+
+    def broken(*args: object, **kwargs: object) -> list[Path]:
+        raise RuntimeError("disk full")
+
+    monkeypatch.setattr(grader.render, "render_all", broken)
+    with pytest.raises(RuntimeError, match="disk full"):
+        main(["generate", str(ASSIGNMENT), "--roster", str(ROSTER), "--out", str(tmp_path / "out")])
+    assert list(tmp_path.iterdir()) == []

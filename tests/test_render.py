@@ -1,0 +1,336 @@
+"""PDFs: reproducible to the byte, every student's own numbers and labels, names shown literally,
+worked solutions in the key, figures that fit; PNGs of each template's page in tests/artifacts/."""
+
+from __future__ import annotations
+
+import dataclasses
+import re
+import struct
+from pathlib import Path
+
+import pytest
+import yaml
+from pypdf import PdfReader
+
+from grader.assignment import Assignment, ProblemSpec, Student, load_assignment, load_roster
+from grader.bank import Template, parse_template
+from grader.cache import compiled_for
+from grader.errors import GraderError
+from grader.evaluate import solve_one
+from grader.expr import parse
+from grader.figures import figure
+from grader.render import file_names, render_all, render_page_png, safe_file_name
+from grader.resources import sample_dir
+from grader.variants import AnswerPart, Generation, ProblemVariant, StudentVariants, generate
+from grader.worked import Typ, dimension, math, unit_of, worked
+
+ARTIFACTS = Path(__file__).parent / "artifacts"
+TRICKY = "Farah #1 Haddad [TA's pick] $x$"
+
+
+@pytest.fixture(scope="module")
+def assignment() -> Assignment:
+    return load_assignment(sample_dir() / "assignment.yaml")
+
+
+@pytest.fixture(scope="module")
+def generation(assignment: Assignment, bank: dict[str, Template]) -> Generation:
+    return generate(assignment, load_roster(sample_dir() / "roster.csv"), bank)
+
+
+@pytest.fixture(scope="module")
+def few(generation: Generation) -> Generation:
+    """Four students, the tricky name among them: enough for every check, quick to typeset."""
+    return Generation(generation.students[3:7], generation.collisions)
+
+
+@pytest.fixture(scope="module")
+def rendered(tmp_path_factory: pytest.TempPathFactory, assignment: Assignment, bank: dict[str, Template],
+             few: Generation) -> tuple[Path, list[Path], list[int]]:
+    out = tmp_path_factory.mktemp("render")
+    progress: list[int] = []
+    return out, render_all(assignment, few, bank, out, jobs=2, keep_source=True, progress=progress.append), progress
+
+
+def pdf_text(path: Path) -> str:
+    return "\n".join(page.extract_text() for page in PdfReader(path).pages)
+
+
+def tricky_entry(generation: Generation) -> StudentVariants:
+    return next(s for s in generation.students if s.student.name == TRICKY)
+
+
+def test_render_all_writes_every_document_and_reports_progress(rendered: tuple[Path, list[Path], list[int]],
+                                                                few: Generation) -> None:
+    """One PDF per student, the class file, the key, the sources; progress once per document."""
+    out, paths, progress = rendered
+    students = [out / "students" / f"{s.student.id}.pdf" for s in few.students]
+    assert paths[:len(students) + 2] == [*students, out / "class.pdf", out / "answer-key.pdf"]
+    assert all(p.is_file() and p.read_bytes().startswith(b"%PDF-") for p in paths[:len(students) + 2])
+    assert (out / "source" / "answer-key.typ").is_file() and (out / "source" / "students").is_dir()
+    assert sum(progress) == len(students) + 2
+
+
+def test_two_renders_are_byte_identical(tmp_path: Path, rendered: tuple[Path, list[Path], list[int]],
+                                        assignment: Assignment, bank: dict[str, Template], few: Generation) -> None:
+    """Embedded fonts and a fixed timestamp: the same inputs give the same bytes, in one thread or two."""
+    first, _, _ = rendered
+    again = render_all(assignment, few, bank, tmp_path, jobs=1)
+    for path in again:
+        assert path.read_bytes() == (first / path.relative_to(tmp_path)).read_bytes(), path.name
+
+
+def test_a_sheet_shows_the_students_name_id_numbers_and_answer_labels(
+        rendered: tuple[Path, list[Path], list[int]], few: Generation) -> None:
+    """Name and id in the header, every printed parameter value, every label the CSV expects."""
+    out, _, _ = rendered
+    for entry in few.students:
+        text = pdf_text(out / "students" / f"{entry.student.id}.pdf")
+        assert entry.student.name in text and entry.student.id in text
+        for problem in entry.problems:
+            for value in problem.printed.values():
+                assert value in text, (problem.template, value)
+            for part in problem.answers:
+                assert part.label in text
+
+
+def test_the_tricky_name_is_shown_literally_everywhere(rendered: tuple[Path, list[Path], list[int]],
+                                                       few: Generation) -> None:
+    """# [ ] ' and $ in a name are text: not a heading, a link, a smart quote or math."""
+    out, _, _ = rendered
+    entry = tricky_entry(few)
+    for path in (out / "students" / f"{entry.student.id}.pdf", out / "class.pdf", out / "answer-key.pdf"):
+        assert TRICKY in pdf_text(path), path.name
+
+
+def test_the_class_file_starts_each_student_on_a_new_page(rendered: tuple[Path, list[Path], list[int]],
+                                                          few: Generation) -> None:
+    out, _, _ = rendered
+    pages = [page.extract_text() for page in PdfReader(out / "class.pdf").pages]
+    starts = [index for index, text in enumerate(pages) if text.lstrip().startswith("Homework 7")]
+    assert len(starts) == len(few.students)
+    for start, entry in zip(starts, few.students, strict=True):
+        assert entry.student.id in pages[start]
+
+
+def test_the_key_has_worked_steps_with_each_students_numbers(rendered: tuple[Path, list[Path], list[int]],
+                                                             few: Generation) -> None:
+    """Relation labels, substituted numbers (g, the printed values in SI), answers to 4 figures."""
+    out, _, _ = rendered
+    text = pdf_text(out / "answer-key.pdf")
+    assert "conservation of energy, ball falls through" in text
+    assert "impulse-momentum for" in text and "9.81" in text
+    entry = tricky_entry(few)
+    drop = entry.problems[0]
+    assert f"{float(drop.printed['h_drop']) / 1000:.3f}" in text  # mm shown converted to m
+    assert f"{drop.answers[0].value:.4f}" in text  # e to 4 significant figures
+
+
+def test_a_step_that_depends_on_a_cancelling_mass_is_shown_as_a_multiple_of_it(
+        bank: dict[str, Template], few: Generation) -> None:
+    """T = m v^2/2 in drop-rebound has no number of its own: it is shown as 'number times m'."""
+    variant = few.students[0].problems[0]
+    solution = worked(bank[variant.template], variant)
+    energy = next(s for s in solution.steps if s.chain[0] == "T")
+    assert energy.chain[-1].endswith(" m") and "in kg" in energy.note
+    ratio = next(s for s in solution.steps if s.chain[0] == 'f_"loss"')
+    assert not ratio.chain[-1].endswith("m") and not ratio.note
+
+
+@pytest.mark.parametrize(("expression", "dimensions", "unit"), [
+    ("sqrt(2*g*h)", {"g": (1, 0, -2, 0), "h": (1, 0, 0, 0)}, "m/s"),
+    ("m*v*v/2", {"m": (0, 1, 0, 0), "v": (1, 0, -1, 0)}, "J"),
+    ("v*(e + 1)/(1/m + 1/(m*p))", {"v": (1, 0, -1, 0), "m": (0, 1, 0, 0), "e": (0, 0, 0, 0), "p": (0, 0, 0, 0)},
+     "N·s"),
+    ("atan2(-a, b)", {"a": (1, 0, -1, 0), "b": (1, 0, -1, 0)}, "rad"),
+    ("hypot(a, b)*cos(t)", {"a": (1, 0, -1, 0), "b": (1, 0, -1, 0), "t": (0, 0, 0, 1)}, "m/s"),
+    ("Max(0, h - k)/h", {"h": (1, 0, 0, 0), "k": (1, 0, 0, 0)}, ""),
+    ("m*v*h", {"m": (0, 2, 0, 0), "v": (1, 0, -1, 0), "h": (1, 0, 0, 0)}, "kg²·m²/s"),
+])
+def test_step_units_follow_from_the_parameters_units(expression: str, dimensions: dict[str, tuple[int, ...]],
+                                                     unit: str) -> None:
+    assert unit_of(dimension(parse(expression), dimensions)) == unit
+
+
+@pytest.mark.parametrize(("expression", "typst"), [
+    ("sqrt(2*g*h_drop)", 'sqrt(2 g h_"drop")'),
+    ("-v_after/v_impact", "(-v')/v_\"impact\""),
+    ("m*v_impact*v_impact/2", '(m v_"impact"^2)/2'),
+    ("hypot(v1_n_after, v1_t_after)", "sqrt(v'_(1, n)^2 + v'_(1, t)^2)"),
+    ("atan2(-v_n_after, v_t_after)", "op(\"atan2\")(-v'_n, v'_t)"),
+    ("vA_after - theta1_out", "v'_A - theta_(1, \"out\")"),
+])
+def test_expressions_become_typst_math(expression: str, typst: str) -> None:
+    assert math(parse(expression)) == typst
+
+
+@pytest.mark.parametrize(("student_id", "name"), [
+    ("2026100", "2026100"), ("a.b_c-9", "a.b_c-9"),
+    ("../../etc/passwd", "etc_passwd-" + safe_file_name("../../etc/passwd")[-10:]),
+    ("Ünïcode id", "n_code_id-" + safe_file_name("Ünïcode id")[-10:]),
+])
+def test_student_ids_map_to_safe_file_names(student_id: str, name: str) -> None:
+    assert safe_file_name(student_id) == name
+    assert all(c.isascii() and (c.isalnum() or c in "._-") for c in safe_file_name(student_id))
+
+
+def test_ids_that_differ_only_in_case_get_different_file_names() -> None:
+    """On macOS and Windows 'A1.pdf' and 'a1.pdf' are one file: neither may overwrite the other."""
+    names = file_names(["A1", "a1", "b2"])
+    assert len({n.casefold() for n in names}) == 3 and names[2] == "b2"
+
+
+def test_markup_in_names_and_ids_is_shown_literally(tmp_path: Path, assignment: Assignment,
+                                                    bank: dict[str, Template], few: Generation) -> None:
+    """Every Typst special character, a string-literal break-out attempt, an unsafe id."""
+    name = 'Zed "quoted" \\ back #let x = 1; // not a comment *bold* _it_ <l> @r = h'
+    student = Student("x/y z", name, "zed@example.edu", "L#1")
+    odd = Generation((StudentVariants(student, few.students[0].problems),), few.collisions)
+    paths = render_all(assignment, odd, bank, tmp_path)
+    sheet = tmp_path / "students" / f"{safe_file_name('x/y z')}.pdf"
+    assert sheet in paths
+    text = pdf_text(sheet)
+    assert name in text and "x/y z" in text and "L#1" in text
+
+
+def test_an_undefined_answer_is_given_with_its_reason(tmp_path: Path, assignment: Assignment,
+                                                      bank: dict[str, Template], few: Generation) -> None:
+    """A ball that hits head-on with e = 0 stops: its rebound angle is undefined, step and answer."""
+    template = bank["ball-plate"]
+    solution = solve_one(template, compiled_for(template), {"v": 40.0, "theta": 90.0, "e": 0.0})
+    assert solution.answers is not None
+    parts = tuple(AnswerPart(a.name, f"4{'ab'[i]}", a.value, a.unit, 2.0, template.answers[a.name].tolerance,
+                             template.answers[a.name].description, a.undefined)
+                  for i, a in enumerate(solution.answers.values()))
+    variant = ProblemVariant("4", template.id, "0" * 16, {"v": 40.0, "theta": 90.0, "e": 0.0},
+                             {"v": "40", "theta": "90", "e": "0.00"}, parts)
+    steps = worked(template, variant).steps
+    assert "undefined" in steps[-1].note and "degree" not in steps[-1].chain[-1]
+    single = dataclasses.replace(assignment, problems=(assignment.problems[3],))
+    one = Generation((StudentVariants(few.students[0].student, (variant,)),), few.collisions)
+    render_all(single, one, bank, tmp_path)
+    assert "undefined: v_out is zero" in pdf_text(tmp_path / "answer-key.pdf").replace("\n", " ")
+
+
+def test_a_statement_typst_cannot_read_is_reported_with_its_template(
+        tmp_path: Path, assignment: Assignment, bank: dict[str, Template], few: Generation) -> None:
+    broken = {**bank, "drop-rebound": dataclasses.replace(bank["drop-rebound"], statement="Unclosed $e = {{ h_drop }}")}
+    with pytest.raises(GraderError, match=r"drop-rebound\.yaml: statement"):
+        render_all(assignment, few, broken, tmp_path)
+
+
+def png_size(data: bytes) -> tuple[int, int]:
+    assert data.startswith(b"\x89PNG\r\n\x1a\n") and data[12:16] == b"IHDR"
+    width, height = struct.unpack(">II", data[16:24])
+    return width, height
+
+
+@pytest.mark.parametrize("position", range(5))
+def test_each_templates_page_renders_to_a_png(position: int, assignment: Assignment, few: Generation,
+                                              bank: dict[str, Template]) -> None:
+    """The header and one problem (statement, figure, blanks) on a letter page, written to
+    tests/artifacts/<template>.png to look at."""
+    single = dataclasses.replace(assignment, problems=(assignment.problems[position],))
+    one = Generation(tuple(StudentVariants(s.student, (s.problems[position],)) for s in few.students), {})
+    index = few.students.index(tricky_entry(few))
+    png = render_page_png(single, one, bank, index, ppi=110)
+    width, height = png_size(png)
+    assert (width, height) == (935, 1210) and len(png) > 30_000
+    ARTIFACTS.mkdir(exist_ok=True)
+    (ARTIFACTS / f"{assignment.problems[position].template}.png").write_bytes(png)
+
+
+def test_a_key_page_renders_to_a_png(assignment: Assignment, few: Generation, bank: dict[str, Template]) -> None:
+    index = few.students.index(tricky_entry(few))
+    for page in (0, 1):
+        png = render_page_png(assignment, few, bank, index, key=True, page=page)
+        assert png_size(png) == (935, 1210)
+        ARTIFACTS.mkdir(exist_ok=True)
+        (ARTIFACTS / f"answer-key-page-{page}.png").write_bytes(png)
+    with pytest.raises(GraderError, match="page 99 does not exist"):
+        render_page_png(assignment, few, bank, index, page=99)
+
+
+def test_figures_fit_their_column(assignment: Assignment, generation: Generation, bank: dict[str, Template]) -> None:
+    """No figure of any student is wider than 7.7 cm or taller than 8 cm."""
+    for entry in generation.students:
+        for variant in entry.problems:
+            template = bank[variant.template]
+            drawn = figure(template, variant, worked(template, variant).values)
+            assert isinstance(drawn, Typ)
+            match = re.match(r"fig-canvas\(([0-9.]+), ([0-9.]+),", drawn)
+            assert match, drawn[:80]
+            assert float(match.group(1)) <= 7.7 and float(match.group(2)) <= 8.0, (variant.template, match.groups())
+
+
+
+WALL = """
+id: wall
+title: A puck strikes a wall head-on
+version: 1
+bodies: {puck: {mass: m}, wall: {fixed: true}}
+symbols: {m: {unit: kg}}
+parameters:
+  v: {unit: m/s, domain: "(0, inf)", sample: {uniform: [1, 5]}, decimals: 1}
+  e: {unit: "", domain: "[0, 1]", sample: {uniform: [0.2, 0.9]}, decimals: 2}
+stages:
+  - {effect: impact, bodies: [puck, wall], restitution: e, before: {puck: v}, after: {puck: v_after}}
+answers:
+  v_after: {value: v_after, unit: m/s}
+statement: A puck at {{ v }} m/s strikes a wall; $e = {{ e }}$.
+"""
+
+FALL = """
+id: fall
+title: A stone falls
+version: 1
+gravity: 9.81 m/s^2
+bodies: {stone: {mass: m}}
+symbols: {m: {unit: kg}}
+parameters:
+  h: {unit: ft, domain: "(0, inf)", sample: {uniform: [1, 5]}, decimals: 1}
+stages:
+  - {effect: free_fall, body: stone, height: h, speed: v}
+answers:
+  v: {value: v, unit: ft/s}
+statement: A stone falls {{ h }} ft from rest; g is {{ g }} m/s².
+"""
+
+
+COMPONENTS = """
+id: components
+title: Components of a velocity
+version: 1
+bodies: {ball: {mass: m}}
+symbols: {m: {unit: kg}}
+parameters:
+  v: {unit: m/s, domain: "(0, inf)", sample: {uniform: [1, 5]}, decimals: 1}
+  theta: {unit: deg, domain: "[0, 90]", sample: {uniform: [10, 80]}, decimals: 0}
+stages:
+  - {effect: velocity, speed: v, angle: theta, n: v_n, t: v_t}
+answers:
+  v_n: {value: v_n, unit: m/s}
+statement: A ball moves at {{ v }} m/s, {{ theta }}° from the t axis.
+"""
+
+
+@pytest.mark.parametrize("source", [WALL, FALL, COMPONENTS], ids=["wall", "fall-only", "no-known-shape"])
+def test_scenes_of_other_shapes_get_a_figure_and_a_worked_solution(source: str, tmp_path: Path,
+                                                                   assignment: Assignment) -> None:
+    """A direct impact on a fixed body (a wall); a fall without an impact (the ground); a scene of no
+    known shape (its bodies in a row)."""
+    raw = yaml.safe_load(source)
+    template = parse_template(raw, f"test:{raw['id']}", f"hash-{raw['id']}")
+    spec = ProblemSpec("1", template.id, {"*": 1.0}, {}, {}, {})
+    one = dataclasses.replace(assignment, problems=(spec,))
+    student = Student("s1", "Sam", "", "")
+    generated = generate(one, (student,), {template.id: template})
+    paths = render_all(one, generated, {template.id: template}, tmp_path)
+    text = pdf_text(tmp_path / "students" / "s1.pdf")
+    assert all(value in text for value in generated.students[0].problems[0].printed.values())
+    assert "1a" in text and len(paths) == 3
+    key = pdf_text(tmp_path / "answer-key.pdf")
+    assert "conservation of energy" in key or "impulse" in key or "component along" in key
+    png = render_page_png(one, generated, {template.id: template}, 0)
+    ARTIFACTS.mkdir(exist_ok=True)
+    (ARTIFACTS / f"extra-{template.id}.png").write_bytes(png)

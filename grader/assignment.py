@@ -10,8 +10,6 @@
 
 from __future__ import annotations
 
-import csv
-import io
 import re
 from collections.abc import Mapping
 from dataclasses import dataclass
@@ -22,6 +20,7 @@ import yaml
 
 from grader.bank import Interval, Template, Tolerance
 from grader.errors import GraderError, TemplateError
+from grader.files import open_csv
 
 _KEY = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_-]{0,15}$")
 _ROSTER_COLUMNS = ("id", "name", "email", "section")
@@ -174,15 +173,7 @@ def _inside(domain: Interval, value: float, where: str, key: str) -> None:
 
 def load_roster(path: Path) -> tuple[Student, ...]:
     """Read a roster: columns id, name, email, section (UTF-8 with or without BOM; , ; or tab)."""
-    try:
-        text = path.read_text(encoding="utf-8-sig")
-    except OSError as error:
-        raise GraderError(f"{path}: cannot read ({error.strerror})") from None
-    except UnicodeDecodeError:
-        raise GraderError(f"{path}: expected UTF-8 text") from None
-    first = text.split("\n", 1)[0]
-    delimiter = max(",;\t", key=first.count)
-    reader = csv.DictReader(io.StringIO(text), delimiter=delimiter)
+    reader = open_csv(path)
     header = [(h or "").strip().lower() for h in (reader.fieldnames or [])]
     missing = [c for c in _ROSTER_COLUMNS if c not in header]
     if missing:

@@ -7,9 +7,7 @@ Exit codes: 0 ok; 1 runtime error (a bug: it keeps its traceback); 2 usage or in
 from __future__ import annotations
 
 import argparse
-import csv
 import difflib
-import io
 import json
 import re
 import sys
@@ -20,6 +18,7 @@ from typing import Any
 from grader import __version__
 from grader.bank import Parameter, Template, load_bank
 from grader.errors import GraderError, UsageError
+from grader.files import open_csv
 from grader.units import parse_unit
 
 EXIT_OK, EXIT_USAGE, EXIT_REFUSED = 0, 2, 3
@@ -263,17 +262,7 @@ def _read_value(text: str, parameter: Parameter, where: str) -> float:
 
 
 def _read_batch(path: Path, template: Template) -> tuple[dict[str, Any], list[dict[str, str]], list[str | None]]:
-    try:
-        text = path.read_text(encoding="utf-8-sig")
-    except OSError as error:
-        raise UsageError(f"{path}: cannot read ({error.strerror})") from None
-    except UnicodeDecodeError:
-        raise UsageError(f"{path}: expected UTF-8 text") from None
-    try:
-        dialect: Any = csv.Sniffer().sniff(text.split("\n", 1)[0], delimiters=",;\t")
-    except csv.Error:
-        dialect = csv.excel
-    reader = csv.DictReader(io.StringIO(text), dialect=dialect)
+    reader = open_csv(path)
     header = [h.strip() for h in (reader.fieldnames or [])]
     if not header:
         raise UsageError(f"{path}: empty file; expected a header of parameter names")

@@ -16,8 +16,9 @@ ROOT = Path(__file__).resolve().parent.parent
 
 @pytest.mark.slow
 def test_wheel_installed_in_a_fresh_venv_runs_from_another_folder(tmp_path: Path) -> None:
-    """Build the wheel, install it (with its dependencies) into a new venv, run `grader list` and
-    `grader solve` from an unrelated folder: the problem bank must come from the wheel."""
+    """Build the wheel, install it (with its dependencies) into a new venv, run `grader list`,
+    `grader solve` and `grader demo` from an unrelated folder: the problem bank, the sample data and
+    the document templates must come from the wheel."""
     wheels = tmp_path / "wheels"
     subprocess.run([sys.executable, "-m", "pip", "wheel", "--no-deps", "--quiet", "-w", str(wheels), str(ROOT)],
                    check=True, capture_output=True, timeout=300)
@@ -42,3 +43,10 @@ def test_wheel_installed_in_a_fresh_venv_runs_from_another_folder(tmp_path: Path
                              "--set", "h_rebound=1100", "--json"], cwd=elsewhere, env=env, capture_output=True,
                             text=True, timeout=120)
     assert json.loads(solved.stdout)["answers"]["e"]["value"] == pytest.approx(0.7237, abs=1e-4)
+    # The demo needs the shipped sample data and the Typst templates too.
+    demo = subprocess.run([str(environment / "bin" / "grader"), "demo", "--out", "demo"], cwd=elsewhere, env=env,
+                          capture_output=True, text=True, timeout=300)
+    assert demo.returncode == 0, demo.stderr
+    assert (elsewhere / "demo" / "answer-key.pdf").stat().st_size > 10_000
+    assert len(list((elsewhere / "demo" / "students").glob("*.pdf"))) == 30
+    assert (elsewhere / "demo" / "assignment.yaml").is_file() and (elsewhere / "demo" / "roster.csv").is_file()

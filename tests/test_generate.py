@@ -202,3 +202,13 @@ def test_a_failure_while_rendering_leaves_nothing_behind(tmp_path: Path, monkeyp
     with pytest.raises(RuntimeError, match="disk full"):
         main(["generate", str(ASSIGNMENT), "--roster", str(ROSTER), "--out", str(tmp_path / "out")])
     assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("command", ["generate", "demo"])
+def test_jobs_below_one_exits_2(tmp_path: Path, capsys: pytest.CaptureFixture[str], command: str) -> None:
+    """--jobs 0 is refused before anything is written."""
+    inputs = [ASSIGNMENT, "--roster", ROSTER] if command == "generate" else []
+    code, out, err = run(capsys, command, *inputs, "--out", tmp_path / "out", "--jobs", "0")
+    assert (code, out) == (2, "")
+    assert "--jobs must be 1 or more, got 0" in err
+    assert list(tmp_path.iterdir()) == []

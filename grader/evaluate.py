@@ -150,17 +150,23 @@ def _solution(template: Template, compiled: Compiled, result: Columns, row: int)
     params = {name: float(column[row]) for name, column in result.params.items()}
     if result.refusals[row] is not None:
         return Solution(template.id, params, None, result.refusals[row])
-    answers = {}
-    for name, answer in compiled.answers.items():
-        reason = result.undefined[name][row]
-        if reason is not None:
-            answers[name] = AnswerValue(name, answer.unit, None, reason)
-        elif answer.symbolic is not None:
-            text = symbolic_text(answer.symbolic, params, template.answers[name].symbolic)
-            answers[name] = AnswerValue(name, answer.unit, text)
-        else:
-            answers[name] = AnswerValue(name, answer.unit, float(result.values[name][row]))
+    answers = {name: AnswerValue(name, answer.unit, *answer_at(template, compiled, result, name, row))
+               for name, answer in compiled.answers.items()}
     return Solution(template.id, params, answers)
+
+
+def answer_at(template: Template, compiled: Compiled, result: Columns, name: str,
+              row: int) -> tuple[float | str | None, str | None]:
+    """One answer of one row of a result: ``(value, None)``, where the value is a number or, for a
+    symbolic answer, its text; or ``(None, reason)`` where it is undefined."""
+    reason = result.undefined[name][row]
+    if reason is not None:
+        return None, reason
+    symbolic = compiled.answers[name].symbolic
+    if symbolic is None:
+        return float(result.values[name][row]), None
+    params = {parameter: float(column[row]) for parameter, column in result.params.items()}
+    return symbolic_text(symbolic, params, template.answers[name].symbolic), None
 
 
 def symbolic_text(tree: Node, params: Mapping[str, float], keep: Sequence[str]) -> str:

@@ -27,6 +27,7 @@ from grader.effects import CATALOGUE, Relation
 from grader.errors import TemplateError
 from grader.stable import stabilize
 from grader.symbolic import Context, cosd, from_node, sind, to_node
+from grader.units import Unit
 
 
 @dataclass(frozen=True)
@@ -137,7 +138,7 @@ class _Compiler:
             template_id=self.template.id, source_hash=self.template.source_hash,
             parameters=tuple(self.template.parameters),
             constants={"g": float(self.template.scene.gravity.si)} if self.template.scene.gravity else {},
-            steps=tuple(self._step(s) for s in chain), checks=self._checks(chain, composed), answers=answers)
+            steps=tuple(self._step(s) for s in chain), checks=self._checks(composed), answers=answers)
 
     def _coupled(self, known: set[Any]) -> str:
         """Why the chain stopped: the unknowns the unused equations still tie together."""
@@ -159,15 +160,13 @@ class _Compiler:
                 "solver takes one equation and one unknown at a time: give one of them as a parameter")
 
     def _step(self, solved: _Solved) -> Step:
-        unknown_text = solved.unknown.name
-        return Step(unknown_text, solved.relation.label,
+        return Step(solved.unknown.name, solved.relation.label,
                     (to_node(solved.relation.lhs), to_node(solved.relation.rhs)), to_node(solved.display))
 
     def _answer(self, name: str, expr: Any, chain: list[_Solved], composed: Mapping[Any, Any]) -> CompiledAnswer:
         spec = self.template.answers[name]
         si = expr.xreplace(dict(composed))
-        factor = sp.Rational(spec.unit.factor.numerator, spec.unit.factor.denominator) * sp.pi**spec.unit.pi_power
-        in_units = self._user_units(si) / factor
+        in_units = self._user_units(si) / _si_factor(spec.unit)
         undefined = tuple(
             Undefined(self._tree_condition(self._user_units(cond.xreplace(dict(composed)))), reason)
             for solved in _needed(chain, [expr]) for unknown, (cond, reason) in solved.relation.undefined.items()
@@ -179,13 +178,11 @@ class _Compiler:
 
     def _tree(self, expr: Any, name: str) -> Any:
         """A numeric expression over parameters only, stabilised, as a tree."""
+        allowed = {self.ctx.symbols[p] for p in self.template.parameters} | {self.ctx.symbols.get("g")}
         stable = stabilize(expr, self.degree_angles)
-        stray = stable.free_symbols - {self.ctx.symbols[p] for p in self.template.parameters} - {
-            self.ctx.symbols.get("g")}
-        if stray:
+        if stable.free_symbols - allowed:
             stable = stabilize(sp.cancel(stable), self.degree_angles)
-            stray = stable.free_symbols - {self.ctx.symbols[p] for p in self.template.parameters} - {
-                self.ctx.symbols.get("g")}
+        stray = stable.free_symbols - allowed
         if stray:
             raise TemplateError(self.template.where, f"answers.{name}", "a number once the parameters are given",
                                 f"an expression that still depends on {', '.join(sorted(map(str, stray)))}")
@@ -196,7 +193,7 @@ class _Compiler:
         scale = {}
         for name, unit in [(n, p.unit) for n, p in self.template.parameters.items()] + [
                 (n, s.unit) for n, s in self.template.symbols.items()]:
-            factor = sp.Rational(unit.factor.numerator, unit.factor.denominator) * sp.pi**unit.pi_power
+            factor = _si_factor(unit)
             if factor != 1:
                 scale[self.ctx.symbols[name]] = self.ctx.symbols[name] * factor
         converted = expr.xreplace(scale)
@@ -204,7 +201,7 @@ class _Compiler:
         converted = converted.replace(lambda e: isinstance(e, sp.sin), lambda e: sind(e.args[0] * 180 / sp.pi))
         return converted.replace(lambda e: isinstance(e, sp.cos), lambda e: cosd(e.args[0] * 180 / sp.pi))
 
-    def _checks(self, chain: list[_Solved], composed: Mapping[Any, Any]) -> tuple[Check, ...]:
+    def _checks(self, composed: Mapping[Any, Any]) -> tuple[Check, ...]:
         known = self.inputs | set(composed)
         checks = []
         for relation in self.relations:
@@ -231,6 +228,11 @@ class _Compiler:
         # Against zero, a positive factor changes nothing: 381*v*x/1250 > 0 is x > 0.
         kept = [f for f in sp.Mul.make_args(difference) if not f.is_positive]
         return to_node(type(holds)(sp.Mul(*kept), 0))
+
+
+def _si_factor(unit: Unit) -> Any:
+    """A unit's factor to SI as an exact sympy number (deg: pi/180), so conversions cancel exactly."""
+    return sp.Rational(unit.factor.numerator, unit.factor.denominator) * sp.pi**unit.pi_power
 
 
 def _needed(chain: list[_Solved], wanted: Iterable[Any]) -> list[_Solved]:

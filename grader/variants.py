@@ -28,7 +28,7 @@ from grader.bank import Parameter, Template, Tolerance
 from grader.cache import compiled_for
 from grader.compiled import Compiled
 from grader.errors import GraderError
-from grader.evaluate import Columns, solve_columns, symbolic_text
+from grader.evaluate import Columns, answer_at, solve_columns
 from grader.expr import Sym
 
 MAX_DRAWS = 25
@@ -223,14 +223,6 @@ def _answer_parts(blanks: Sequence[AnswerPart], template: Template, compiled: Co
                   row: int) -> tuple[AnswerPart, ...]:
     parts = []
     for blank in blanks:
-        undefined = result.undefined[blank.name][row]
-        value: float | str | None = None
-        if undefined is None:
-            symbolic = compiled.answers[blank.name].symbolic
-            if symbolic is None:
-                value = float(result.values[blank.name][row])
-            else:
-                params = {name: float(column[row]) for name, column in result.params.items()}
-                value = symbolic_text(symbolic, params, template.answers[blank.name].symbolic)
+        value, undefined = answer_at(template, compiled, result, blank.name, row)
         parts.append(replace(blank, value=value, undefined=undefined))
     return tuple(parts)

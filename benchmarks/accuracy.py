@@ -33,16 +33,17 @@ import mpmath as mp
 import numpy as np
 import yaml
 
-from grader.bank import Template, load_bank, parse_template
-from grader.cache import compiled_for
-from grader.compiled import Compiled
-from grader.effects.impact import ContactLaw
-from grader.evaluate import solve_one
-from grader.integrate import Settings, SimulationError
-from grader.kernel import evaluate
+from grader.bank.template import Template, load_bank, parse_template
+from grader.model.kernel import evaluate
+from grader.physics.effects.impact import ContactLaw
+from grader.physics.integrate import Settings, SimulationError
+from grader.physics.run import DEFAULT_CONTACT_DURATION, Options
 from grader.resources import bank_dir
-from grader.simulate import DEFAULT_CONTACT_DURATION, Options, simulate
-from grader.solver import compile_template
+from grader.simulate.walker import simulate
+from grader.solve.cache import compiled_for
+from grader.solve.compiled import Compiled
+from grader.solve.evaluate import solve_one
+from grader.solve.solver import compile_template
 
 RESULTS = Path(__file__).resolve().parent / "results"
 REFERENCE_RTOL = 1e-13

@@ -20,13 +20,13 @@ import time
 from collections.abc import Sequence
 from pathlib import Path
 
-from grader.assignment import Student, load_assignment
-from grader.bank import load_bank
-from grader.cache import compiled_for
-from grader.keyfile import key_csv, key_document, key_json
+from grader.assign.assignment import Student, load_assignment
+from grader.assign.keyfile import key_csv, key_document, key_json
+from grader.assign.variants import generate
+from grader.bank.template import load_bank
+from grader.physics.symbolic import from_node
 from grader.resources import sample_dir
-from grader.symbolic import from_node
-from grader.variants import generate
+from grader.solve.cache import compiled_for
 
 RESULTS = Path(__file__).resolve().parent / "results"
 
@@ -89,9 +89,9 @@ def time_pdfs(count: int, folder: Path, jobs: int) -> tuple[float, float]:
 _SHEETS = """
 import sys, time, concurrent.futures as cf
 from pathlib import Path
-from grader.assignment import load_assignment, load_roster
-from grader.bank import load_bank
-from grader.variants import generate
+from grader.assign.assignment import load_assignment, load_roster
+from grader.bank.template import load_bank
+from grader.assign.variants import generate
 from grader import render
 assignment, roster, jobs = load_assignment(Path(sys.argv[1])), load_roster(Path(sys.argv[2])), int(sys.argv[3])
 bank = load_bank()

@@ -3,8 +3,8 @@
 For each template of the shipped bank this draws ``--sets`` parameter sets from the parameters'
 sampling specs and times
 
-* the raw kernels: :func:`grader.kernel.evaluate` on every numeric answer tree (best of ``--repeat``);
-* :func:`grader.evaluate.solve_batch`: checks plus one Python result object per row (best of 3);
+* the raw kernels: :func:`grader.model.kernel.evaluate` on every numeric answer tree (best of ``--repeat``);
+* :func:`grader.solve.evaluate.solve_batch`: checks plus one Python result object per row (best of 3);
 * the baseline: each numeric answer tree turned back into sympy and evaluated with
   ``expr.subs(values).evalf()``, one set at a time, on the first ``--baseline-sets`` sets only
   (the full run would take minutes); its 10^5-set time is extrapolated from the per-set time.
@@ -35,12 +35,12 @@ from typing import Any
 import numpy as np
 import sympy as sp
 
-from grader.bank import Parameter, Template, load_bank
-from grader.cache import compiled_for
-from grader.compiled import Compiled
-from grader.evaluate import Solution, solve_batch, solve_columns
-from grader.kernel import evaluate
-from grader.symbolic import from_node
+from grader.bank.template import Parameter, Template, load_bank
+from grader.model.kernel import evaluate
+from grader.physics.symbolic import from_node
+from grader.solve.cache import compiled_for
+from grader.solve.compiled import Compiled
+from grader.solve.evaluate import Solution, solve_batch, solve_columns
 
 RESULTS = Path(__file__).resolve().parent / "results"
 AGREEMENT_RTOL = 1e-9

@@ -16,10 +16,10 @@ from pathlib import Path
 from typing import Any
 
 from grader import __version__
-from grader.bank import Parameter, Template, load_bank
+from grader.bank.template import Parameter, Template, load_bank
 from grader.errors import GraderError, UsageError
 from grader.files import open_csv
-from grader.units import parse_unit
+from grader.model.units import parse_unit
 
 EXIT_OK, EXIT_USAGE, EXIT_REFUSED = 0, 2, 3
 _VALUE = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*(.*?)\s*$")
@@ -122,8 +122,8 @@ def _list(arguments: argparse.Namespace) -> int:
 
 
 def _show(arguments: argparse.Namespace) -> int:
-    from grader.cache import compiled_for
-    from grader.expr import to_text
+    from grader.model.expr import to_text
+    from grader.solve.cache import compiled_for
 
     template = _template(arguments)
     compiled = compiled_for(template)
@@ -159,8 +159,8 @@ def _show(arguments: argparse.Namespace) -> int:
 
 
 def _solve(arguments: argparse.Namespace) -> int:
-    from grader.cache import compiled_for
-    from grader.evaluate import solve_batch, solve_one
+    from grader.solve.cache import compiled_for
+    from grader.solve.evaluate import solve_batch, solve_one
 
     template = _template(arguments)
     if arguments.batch is not None:
@@ -296,10 +296,11 @@ def _table(header: Sequence[str], rows: Sequence[Sequence[str]]) -> str:
 
 
 def _simulate(arguments: argparse.Namespace) -> int:
-    from grader.cache import compiled_for
-    from grader.evaluate import solve_one
-    from grader.integrate import Settings
-    from grader.simulate import Options, simulate
+    from grader.physics.integrate import Settings
+    from grader.physics.run import Options
+    from grader.simulate.walker import simulate
+    from grader.solve.cache import compiled_for
+    from grader.solve.evaluate import solve_one
 
     template = _template(arguments)
     params = _read_assignments(arguments.assignments, template)
@@ -324,7 +325,7 @@ def _simulate(arguments: argparse.Namespace) -> int:
             differs = abs(simulated - exact) / abs(exact) if exact else abs(simulated - exact)
         rows[name] = {"simulated": simulated, "closed_form": exact, "rel_diff": differs}
     if arguments.plot is not None:
-        from grader.plots import plot_simulation
+        from grader.simulate.plots import plot_simulation
 
         plot_simulation(result, arguments.plot)
     record = {"template": template.id, "params": result.params, "method": settings.method,
@@ -364,7 +365,7 @@ def _print_simulation(template: Template, record: dict[str, Any]) -> None:
 
 
 def _generate(arguments: argparse.Namespace) -> int:
-    from grader.generate import Job, run
+    from grader.render.generate import Job, run
 
     _check_jobs(arguments.jobs)
     job = Job(arguments.assignment, arguments.roster, arguments.out, pdf=not arguments.no_pdf,
@@ -374,7 +375,7 @@ def _generate(arguments: argparse.Namespace) -> int:
 
 
 def _demo(arguments: argparse.Namespace) -> int:
-    from grader.generate import demo
+    from grader.render.generate import demo
 
     _check_jobs(arguments.jobs)
     summary = demo(arguments.out, _bank(arguments), jobs=arguments.jobs, force=arguments.force)

@@ -11,9 +11,9 @@ import pytest
 # Tests never read or write the user's cache; the first compile of each template happens here.
 os.environ["GRADER_CACHE_DIR"] = tempfile.mkdtemp(prefix="grader-test-cache-")
 
-from grader.bank import Template, load_bank
-from grader.cache import compiled_for
-from grader.compiled import Compiled
+from grader.bank.template import Template, load_bank
+from grader.solve.cache import compiled_for
+from grader.solve.compiled import Compiled
 
 
 @pytest.fixture(scope="session")

@@ -1,4 +1,4 @@
-"""Small scenes that tests share (YAML text; parse with grader.bank.parse_template)."""
+"""Small scenes that tests share (YAML text; parse with grader.bank.template.parse_template)."""
 
 TWO_BODIES = """
 id: two-bodies

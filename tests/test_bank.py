@@ -10,10 +10,10 @@ from typing import Any
 import pytest
 import yaml
 
-from grader.bank import load_bank, load_template, parse_template
+from grader.bank.template import load_bank, load_template, parse_template
 from grader.errors import GraderError, TemplateError
 from grader.resources import bank_dir
-from grader.solver import compile_template
+from grader.solve.solver import compile_template
 
 BASE = yaml.safe_load((bank_dir() / "drop-rebound.yaml").read_text(encoding="utf-8"))
 

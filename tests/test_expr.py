@@ -9,10 +9,10 @@ import pytest
 import sympy as sp
 
 from grader.errors import ExpressionError, GraderError
-from grader.expr import MAX_DEPTH, MAX_LENGTH, format_number, parse, to_text
-from grader.kernel import cosd, evaluate, sind
-from grader.symbolic import from_node
-from grader.units import parse_unit
+from grader.model.expr import MAX_DEPTH, MAX_LENGTH, format_number, parse, to_text
+from grader.model.kernel import cosd, evaluate, sind
+from grader.model.units import parse_unit
+from grader.physics.symbolic import from_node
 
 REFUSED = [
     ("__import__('os').system('ls')", "is not an allowed function"),

@@ -8,13 +8,13 @@ from pathlib import Path
 import pytest
 import yaml
 
-from grader.assignment import load_assignment, load_roster
-from grader.bank import Template
+from grader.assign.assignment import load_assignment, load_roster
+from grader.assign.variants import generate
+from grader.bank.template import Template
 from grader.cli import main
-from grader.compiled import Compiled
-from grader.evaluate import solve_one
 from grader.resources import sample_dir
-from grader.variants import generate
+from grader.solve.compiled import Compiled
+from grader.solve.evaluate import solve_one
 
 ASSIGNMENT = sample_dir() / "assignment.yaml"
 ROSTER = sample_dir() / "roster.csv"
@@ -167,7 +167,7 @@ def test_collisions_are_reported_when_the_parameter_space_is_too_small(tmp_path:
 
 def test_key_csv_neutralizes_formulas_in_text_cells(tmp_path: Path, bank: dict[str, Template]) -> None:
     """A name starting with '=' is written so that a spreadsheet shows it as text."""
-    from grader.keyfile import key_csv
+    from grader.assign.keyfile import key_csv
 
     roster = _write(tmp_path / "roster.csv", "id,name,email,section\n7,=cmd|' /C calc'!A0,x@y,L1\n")
     csv_text = key_csv(generate(load_assignment(ASSIGNMENT), load_roster(roster), bank))
@@ -193,12 +193,12 @@ def test_demo_writes_its_inputs_and_generate_from_them_reproduces_it(tmp_path: P
 def test_a_failure_while_rendering_leaves_nothing_behind(tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
                                                          capsys: pytest.CaptureFixture[str]) -> None:
     """Key files already written to the staging folder are removed with it; --out never appears."""
-    import grader.render
+    import grader.render.documents
 
     def broken(*args: object, **kwargs: object) -> list[Path]:
         raise RuntimeError("disk full")
 
-    monkeypatch.setattr(grader.render, "render_all", broken)
+    monkeypatch.setattr(grader.render.documents, "render_all", broken)
     with pytest.raises(RuntimeError, match="disk full"):
         main(["generate", str(ASSIGNMENT), "--roster", str(ROSTER), "--out", str(tmp_path / "out")])
     assert list(tmp_path.iterdir()) == []

@@ -8,9 +8,9 @@ import pytest
 import sympy as sp
 import yaml
 
-from grader.bank import Template
-from grader.compiled import Compiled
-from grader.evaluate import solve_one
+from grader.bank.template import Template
+from grader.solve.compiled import Compiled
+from grader.solve.evaluate import solve_one
 
 GOLDEN_FILE = Path(__file__).resolve().parents[2] / "shared" / "golden-answers.yaml"
 GOLDEN = yaml.safe_load(GOLDEN_FILE.read_text(encoding="utf-8"))

@@ -4,9 +4,11 @@ from __future__ import annotations
 
 import json
 import os
+import shutil
 import subprocess
 import sys
 import venv
+import zipfile
 from pathlib import Path
 
 import pytest
@@ -19,10 +21,18 @@ def test_wheel_installed_in_a_fresh_venv_runs_from_another_folder(tmp_path: Path
     """Build the wheel, install it (with its dependencies) into a new venv, run `grader list`,
     `grader solve` and `grader demo` from an unrelated folder: the problem bank, the sample data and
     the document templates must come from the wheel."""
+    # Built from a clean copy: setuptools reuses a checkout's build/ folder, whose stale files would
+    # hide a package missing from pyproject's list.
+    source = tmp_path / "source"
+    shutil.copytree(ROOT, source, ignore=shutil.ignore_patterns(".git", ".venv", "build", "dist", "*.egg-info",
+                                                                 "__pycache__", "artifacts", ".*_cache"))
     wheels = tmp_path / "wheels"
-    subprocess.run([sys.executable, "-m", "pip", "wheel", "--no-deps", "--quiet", "-w", str(wheels), str(ROOT)],
+    subprocess.run([sys.executable, "-m", "pip", "wheel", "--no-deps", "--quiet", "-w", str(wheels), str(source)],
                    check=True, capture_output=True, timeout=300)
     wheel = next(wheels.glob("grader-*.whl"))
+    shipped = set(zipfile.ZipFile(wheel).namelist())
+    sources = {p.relative_to(ROOT).as_posix() for p in (ROOT / "grader").rglob("*.py")}
+    assert sources <= shipped, f"modules missing from the wheel (pyproject packages?): {sorted(sources - shipped)}"
     environment = tmp_path / "venv"
     venv.create(environment, with_pip=True)
     python = environment / "bin" / "python"

@@ -14,7 +14,7 @@ import mpmath as mp
 import numpy as np
 import pytest
 
-from grader.evaluate import solve_batch, solve_one
+from grader.solve.evaluate import solve_batch, solve_one
 
 # 400 digits (not just 60): a sum like m1 + m2 with m2/m1 = 1e170 must keep m1, so that the
 # reference stays exact for mass ratios and magnitudes spanning 1e-150..1e170. Set locally

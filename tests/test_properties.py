@@ -11,11 +11,11 @@ import yaml
 from hypothesis import assume, example, given, settings
 from hypothesis import strategies as st
 
-from grader.bank import Template, load_bank, parse_template
-from grader.compiled import Compiled
-from grader.evaluate import solve_one
+from grader.bank.template import Template, load_bank, parse_template
 from grader.resources import bank_dir
-from grader.solver import compile_template
+from grader.solve.compiled import Compiled
+from grader.solve.evaluate import solve_one
+from grader.solve.solver import compile_template
 
 PROPERTY = settings(max_examples=200, deadline=None)
 

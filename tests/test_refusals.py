@@ -5,10 +5,10 @@ from __future__ import annotations
 import pytest
 import yaml
 
-from grader.bank import Template, parse_template
-from grader.compiled import Compiled
-from grader.evaluate import solve_one
-from grader.solver import compile_template
+from grader.bank.template import Template, parse_template
+from grader.solve.compiled import Compiled
+from grader.solve.evaluate import solve_one
+from grader.solve.solver import compile_template
 from tests.scenes import TWO_BODIES
 
 REFUSALS = [
@@ -74,7 +74,7 @@ def test_refused_rows_do_not_stop_the_others(two_bodies: tuple[Template, Compile
     """Between two refused rows, a good row is still answered."""
     import numpy as np
 
-    from grader.evaluate import solve_batch
+    from grader.solve.evaluate import solve_batch
 
     template, compiled = two_bodies
     table = {"m1": np.array([1.0, 1.0, 0.0]), "m2": np.ones(3), "u1": np.array([1.0, 3.0, 3.0]),

@@ -12,17 +12,17 @@ import pytest
 import yaml
 from pypdf import PdfReader
 
-from grader.assignment import Assignment, ProblemSpec, Student, load_assignment, load_roster
-from grader.bank import Template, parse_template
-from grader.cache import compiled_for
+from grader.assign.assignment import Assignment, ProblemSpec, Student, load_assignment, load_roster
+from grader.assign.variants import AnswerPart, Generation, ProblemVariant, StudentVariants, generate
+from grader.bank.template import Template, parse_template
 from grader.errors import GraderError
-from grader.evaluate import solve_one
-from grader.expr import parse
-from grader.figures import figure
-from grader.render import file_names, render_all, render_page_png, safe_file_name
+from grader.model.expr import parse
+from grader.render.documents import file_names, render_all, render_page_png, safe_file_name
+from grader.render.figures import figure
+from grader.render.worked import Typ, dimension, math, unit_of, worked
 from grader.resources import sample_dir
-from grader.variants import AnswerPart, Generation, ProblemVariant, StudentVariants, generate
-from grader.worked import Typ, dimension, math, unit_of, worked
+from grader.solve.cache import compiled_for
+from grader.solve.evaluate import solve_one
 
 ARTIFACTS = Path(__file__).parent / "artifacts"
 TRICKY = "Farah #1 Haddad [TA's pick] $x$"

@@ -11,14 +11,15 @@ import numpy as np
 import pytest
 import yaml
 
-from grader.bank import Template, parse_template
+from grader.bank.template import Template, parse_template
 from grader.cli import main
-from grader.compiled import Compiled
-from grader.effects import CATALOGUE
-from grader.evaluate import solve_one
-from grader.integrate import Settings, SimulationError
-from grader.simulate import Options, simulate
-from grader.solver import compile_template
+from grader.physics.effects import CATALOGUE
+from grader.physics.integrate import Settings, SimulationError
+from grader.physics.run import Options
+from grader.simulate.walker import simulate
+from grader.solve.compiled import Compiled
+from grader.solve.evaluate import solve_one
+from grader.solve.solver import compile_template
 from tests.scenes import TWO_BODIES
 
 ADAPTIVE = Options(Settings("adaptive", rtol=1e-10))

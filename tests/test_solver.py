@@ -7,12 +7,12 @@ import math
 import pytest
 import yaml
 
-from grader.bank import Template, parse_template
-from grader.compiled import Compiled
+from grader.bank.template import Template, parse_template
 from grader.errors import TemplateError
-from grader.evaluate import solve_one
-from grader.expr import names
-from grader.solver import compile_template
+from grader.model.expr import names
+from grader.solve.compiled import Compiled
+from grader.solve.evaluate import solve_one
+from grader.solve.solver import compile_template
 
 TWO_BOUNCES = """
 id: two-bounces

@@ -1,0 +1,2 @@
+"""Assignments: the assignment file and roster, one seeded variant per student rounded as printed, and
+the key files (key.json, key.csv) that grading reads."""

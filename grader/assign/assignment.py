@@ -1,0 +1,196 @@
+"""An assignment (YAML) and a class roster (CSV), parsed and validated into frozen objects.
+
+>>> from grader.resources import sample_dir
+>>> assignment = load_assignment(sample_dir() / "assignment.yaml")
+>>> [p.key for p in assignment.problems], assignment.problems[0].template
+(['1', '2', '3', '4', '5'], 'drop-rebound')
+>>> len(load_roster(sample_dir() / "roster.csv"))
+30
+"""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Mapping
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import yaml
+
+from grader.bank.template import Interval, Template, Tolerance
+from grader.errors import GraderError, TemplateError
+from grader.files import open_csv
+
+_KEY = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_-]{0,15}$")
+_ROSTER_COLUMNS = ("id", "name", "email", "section")
+
+
+@dataclass(frozen=True)
+class ProblemSpec:
+    """One problem of an assignment: a template, its key (``1``), points per answer part, and
+    parameters fixed or narrowed for everyone, tolerance overrides per answer."""
+
+    key: str
+    template: str
+    points: Mapping[str, float]
+    fixed: Mapping[str, float]
+    narrowed: Mapping[str, tuple[float, float]]
+    tolerances: Mapping[str, Tolerance]
+
+
+@dataclass(frozen=True)
+class Assignment:
+    """An assignment: what every student gets, and the seed their variants come from."""
+
+    where: str
+    title: str
+    course: str
+    seed: str
+    due: str
+    instructions: str
+    problems: tuple[ProblemSpec, ...]
+
+
+@dataclass(frozen=True)
+class Student:
+    """A roster row."""
+
+    id: str
+    name: str
+    email: str
+    section: str
+
+
+def load_assignment(path: Path) -> Assignment:
+    """Read and validate an assignment file (problems are checked against the bank separately)."""
+    where = str(path)
+    try:
+        raw = yaml.safe_load(path.read_text(encoding="utf-8-sig"))
+    except OSError as error:
+        raise GraderError(f"{where}: cannot read ({error.strerror})") from None
+    except yaml.YAMLError as error:
+        raise TemplateError(where, "(file)", "valid YAML", str(error).replace("\n", " ")) from None
+    if not isinstance(raw, Mapping):
+        raise TemplateError(where, "(file)", "a mapping with title, course, seed, problems", type(raw).__name__)
+    allowed = {"title", "course", "seed", "due", "instructions", "problems"}
+    if set(raw) - allowed:
+        raise TemplateError(where, ", ".join(sorted(map(str, set(raw) - allowed))),
+                            f"only {', '.join(sorted(allowed))}", "unknown key(s)")
+    problems_raw = raw.get("problems")
+    if not isinstance(problems_raw, list) or not problems_raw:
+        raise TemplateError(where, "problems", "a non-empty list of problems", repr(problems_raw))
+    problems = tuple(_problem(item, index, where) for index, item in enumerate(problems_raw))
+    keys = [p.key for p in problems]
+    duplicated = sorted({k for k in keys if keys.count(k) > 1})
+    if duplicated:
+        raise TemplateError(where, "problems", "a different key for each problem", f"{', '.join(duplicated)} twice")
+    seed = raw.get("seed")
+    if isinstance(seed, bool) or not isinstance(seed, (int, str)) or not str(seed).strip():
+        raise TemplateError(where, "seed", "a number or text (the assignment seed)", repr(seed))
+    return Assignment(where, _text(raw, "title", where), _text(raw, "course", where), str(seed).strip(),
+                      _text(raw, "due", where, required=False), _text(raw, "instructions", where, required=False),
+                      problems)
+
+
+def _text(raw: Mapping[str, Any], key: str, where: str, required: bool = True) -> str:
+    value = raw.get(key, "" if not required else None)
+    if not isinstance(value, (str, int, float)) or isinstance(value, bool) or (required and not str(value).strip()):
+        raise TemplateError(where, key, "text", repr(value))
+    return str(value).strip()
+
+
+def _problem(raw: Any, index: int, where: str) -> ProblemSpec:
+    key = f"problems[{index}]"
+    allowed = {"key", "template", "points", "fixed", "narrow", "tolerance"}
+    if not isinstance(raw, Mapping) or "template" not in raw or set(raw) - allowed:
+        raise TemplateError(where, key, f"a mapping with template and only {', '.join(sorted(allowed))}", repr(raw))
+    problem_key = str(raw.get("key", index + 1))
+    if not _KEY.match(problem_key):
+        raise TemplateError(where, f"{key}.key", "a short label of letters and digits, like 1 or 2b", repr(problem_key))
+    points = raw.get("points", 1)
+    if isinstance(points, (int, float)) and not isinstance(points, bool):
+        points = {"*": points}
+    if not isinstance(points, Mapping) or not all(_number(v) and v >= 0 for v in points.values()):
+        raise TemplateError(where, f"{key}.points", "a number, or answer name -> number (>= 0)", repr(points))
+    fixed = raw.get("fixed") or {}
+    if not isinstance(fixed, Mapping) or not all(_number(v) for v in fixed.values()):
+        raise TemplateError(where, f"{key}.fixed", "parameter name -> number", repr(fixed))
+    narrowed = raw.get("narrow") or {}
+    if not isinstance(narrowed, Mapping) or not all(
+            isinstance(v, list) and len(v) == 2 and all(_number(x) for x in v) and v[0] <= v[1]
+            for v in narrowed.values()):
+        raise TemplateError(where, f"{key}.narrow", "parameter name -> [low, high] with low <= high", repr(narrowed))
+    tolerances = raw.get("tolerance") or {}
+    if not isinstance(tolerances, Mapping) or not all(
+            isinstance(v, Mapping) and set(v) <= {"rtol", "atol"} and all(_number(x) and x >= 0 for x in v.values())
+            for v in tolerances.values()):
+        raise TemplateError(where, f"{key}.tolerance", "answer name -> {rtol: X, atol: Y}", repr(tolerances))
+    return ProblemSpec(problem_key, str(raw["template"]), {str(k): float(v) for k, v in points.items()},
+                       {str(k): float(v) for k, v in fixed.items()},
+                       {str(k): (float(v[0]), float(v[1])) for k, v in narrowed.items()},
+                       {str(k): Tolerance(float(v.get("rtol", -1)), float(v.get("atol", -1)))
+                        for k, v in tolerances.items()})
+
+
+def _number(value: Any) -> bool:
+    return isinstance(value, (int, float)) and not isinstance(value, bool) and value == value and abs(value) != float(
+        "inf")
+
+
+def check_against_bank(assignment: Assignment, bank: Mapping[str, Template]) -> None:
+    """Every problem's template exists; fixed and narrowed parameters exist and lie in the domain."""
+    import difflib
+
+    for index, problem in enumerate(assignment.problems):
+        key = f"problems[{index}]"
+        if problem.template not in bank:
+            close = difflib.get_close_matches(problem.template, list(bank), n=3, cutoff=0.5)
+            raise TemplateError(assignment.where, f"{key}.template", f"a template id of the bank"
+                                f"{' (did you mean ' + ' or '.join(close) + '?)' if close else ''}",
+                                repr(problem.template))
+        template = bank[problem.template]
+        for label, names in (("fixed", problem.fixed), ("narrow", problem.narrowed)):
+            unknown = set(names) - set(template.parameters)
+            if unknown:
+                raise TemplateError(assignment.where, f"{key}.{label}", f"parameters of {template.id} "
+                                    f"({', '.join(template.parameters)})", ", ".join(sorted(unknown)))
+        for name, value in problem.fixed.items():
+            _inside(template.parameters[name].domain, value, assignment.where, f"{key}.fixed.{name}")
+        for name, (low, high) in problem.narrowed.items():
+            for value in (low, high):
+                _inside(template.parameters[name].domain, value, assignment.where, f"{key}.narrow.{name}")
+        unknown = (set(problem.points) - {"*"} | set(problem.tolerances)) - set(template.answers)
+        if unknown:
+            raise TemplateError(assignment.where, key, f"answer names of {template.id} ({', '.join(template.answers)})",
+                                ", ".join(sorted(unknown)))
+
+
+def _inside(domain: Interval, value: float, where: str, key: str) -> None:
+    if not domain.contains(value):
+        raise TemplateError(where, key, f"a value in the parameter's domain {domain}", f"{value:g}")
+
+
+def load_roster(path: Path) -> tuple[Student, ...]:
+    """Read a roster: columns id, name, email, section (UTF-8 with or without BOM; , ; or tab)."""
+    reader = open_csv(path)
+    header = [(h or "").strip().lower() for h in (reader.fieldnames or [])]
+    missing = [c for c in _ROSTER_COLUMNS if c not in header]
+    if missing:
+        raise GraderError(f"{path}: missing column(s) {', '.join(missing)}; expected a header with "
+                          f"{', '.join(_ROSTER_COLUMNS)} (got {', '.join(header) or 'nothing'})")
+    reader.fieldnames = header
+    students, seen = [], set()
+    for line, row in enumerate(reader, 2):
+        values = {c: (row.get(c) or "").strip() for c in _ROSTER_COLUMNS}
+        if not any(values.values()):
+            continue
+        if not values["id"]:
+            raise GraderError(f"{path}: line {line}: empty student id (every student needs one)")
+        if values["id"] in seen:
+            raise GraderError(f"{path}: line {line}: student id '{values['id']}' appears twice")
+        seen.add(values["id"])
+        students.append(Student(values["id"], values["name"], values["email"], values["section"]))
+    if not students:
+        raise GraderError(f"{path}: the roster has no students")
+    return tuple(students)

@@ -1,0 +1,228 @@
+"""One seeded variant per student and problem, with answers from the numbers as printed.
+
+A variant's generator is keyed on ``(assignment seed, problem key, student id)`` through SHA-256
+into ``numpy.random.SeedSequence``: adding or removing a student changes nobody else's numbers.
+Parameters are rounded to their printed precision before anything is computed. A draw that the
+solver refuses, or whose answer sits near a degenerate point (an answer near zero, where a
+relative tolerance breaks; a derived ``e`` at 0 or 1), is redrawn from the same generator, at
+most ``MAX_DRAWS`` times. Whether a draw is degenerate never depends on the rest of the class.
+
+>>> from decimal import Decimal
+>>> printed_text(2.345, decimals=2, sig_figs=None), printed_text(2398.7, decimals=None, sig_figs=3)
+('2.35', '2400')
+"""
+
+from __future__ import annotations
+
+import hashlib
+from collections import Counter
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, replace
+from decimal import ROUND_HALF_UP, Decimal
+from typing import Any
+
+import numpy as np
+
+from grader.assign.assignment import Assignment, ProblemSpec, Student
+from grader.bank.template import Parameter, Template, Tolerance
+from grader.errors import GraderError
+from grader.model.expr import Sym
+from grader.solve.cache import compiled_for
+from grader.solve.compiled import Compiled
+from grader.solve.evaluate import Columns, answer_at, solve_columns
+
+MAX_DRAWS = 25
+NEAR_ZERO = 0.02  # an answer below 2% of its typical size is too close to zero to grade relatively
+PILOT = 256  # draws that set an answer's typical size, from a generator of their own
+
+
+@dataclass(frozen=True)
+class AnswerPart:
+    """One answer of a variant, as the key stores it."""
+
+    name: str
+    label: str
+    value: float | str | None
+    unit: str
+    points: float
+    tolerance: Tolerance
+    description: str
+    undefined: str | None = None
+
+
+@dataclass(frozen=True)
+class ProblemVariant:
+    """One student's numbers for one problem: parameters as printed, and the answers they give."""
+
+    key: str
+    template: str
+    variant_seed: str
+    params: Mapping[str, float]
+    printed: Mapping[str, str]
+    answers: tuple[AnswerPart, ...]
+
+
+@dataclass(frozen=True)
+class StudentVariants:
+    """Everything one student gets."""
+
+    student: Student
+    problems: tuple[ProblemVariant, ...]
+
+
+@dataclass(frozen=True)
+class Generation:
+    """All students' variants, and how many students share their numbers with another, per problem."""
+
+    students: tuple[StudentVariants, ...]
+    collisions: Mapping[str, int]
+
+
+def variant_generator(seed: str, problem_key: str, student_id: str) -> tuple[np.random.Generator, str]:
+    """The generator of one variant, and its seed as hex (stored in the key).
+
+    >>> first, seed = variant_generator("s", "1", "42")
+    >>> again, same = variant_generator("s", "1", "42")
+    >>> seed == same and first.random() == again.random()
+    True
+    """
+    digest = hashlib.sha256("\x1f".join((seed, problem_key, student_id)).encode("utf-8")).digest()
+    return np.random.Generator(np.random.PCG64(np.random.SeedSequence(int.from_bytes(digest[:16], "big")))), \
+        digest[:8].hex()
+
+
+def printed_text(value: float, decimals: int | None, sig_figs: int | None) -> str:
+    """A value as printed on the page: fixed decimals, or significant figures (halves round up)."""
+    number = Decimal(repr(float(value)))
+    if decimals is not None:
+        return str(number.quantize(Decimal(1).scaleb(-decimals), ROUND_HALF_UP))
+    assert sig_figs is not None  # a Parameter always has one of the two (validated on load)
+    if number == 0:
+        return "0"
+    exponent = number.adjusted() - (sig_figs - 1)
+    rounded = number.quantize(Decimal(1).scaleb(exponent), ROUND_HALF_UP)
+    return f"{rounded:f}" if exponent < 0 else str(int(rounded))
+
+
+def _draw(parameter: Parameter, problem: ProblemSpec, rng: np.random.Generator) -> str:
+    name = parameter.name
+    if name in problem.fixed:
+        value = problem.fixed[name]
+    elif name in problem.narrowed:
+        low, high = problem.narrowed[name]
+        value = float(rng.uniform(low, high))
+    elif parameter.sample.kind == "choice":
+        value = float(rng.choice(parameter.sample.values))
+    elif parameter.sample.kind == "log_uniform":
+        low, high = np.log(parameter.sample.values)
+        value = float(np.exp(rng.uniform(low, high)))
+    else:
+        low, high = parameter.sample.values
+        value = float(rng.uniform(low, high))
+    return printed_text(value, parameter.decimals, parameter.sig_figs)
+
+
+def _restitution_answers(template: Template) -> set[str]:
+    """Answers that are a derived coefficient of restitution (kept off 0 and 1)."""
+    derived = {stage.fields["restitution"].name for stage in template.scene.stages
+               if stage.effect == "impact" and isinstance(stage.fields["restitution"], Sym)} - set(template.parameters)
+    return {name for name, spec in template.answers.items()
+            if isinstance(spec.value, Sym) and spec.value.name in derived}
+
+
+class _Problem:
+    """Draws and checks the variants of one problem."""
+
+    def __init__(self, assignment: Assignment, problem: ProblemSpec, template: Template) -> None:
+        self.assignment, self.problem, self.template = assignment, problem, template
+        self.compiled: Compiled = compiled_for(template)
+        self.restitution = _restitution_answers(template)
+        self.typical = self._typical_sizes()
+
+    def _typical_sizes(self) -> dict[str, float]:
+        rng, _ = variant_generator(self.assignment.seed, self.problem.key, "\x00pilot")
+        rows = [self._draw_row(rng) for _ in range(PILOT)]
+        result = solve_columns(self.template, self.compiled, self._table(rows))
+        ok = np.array([reason is None for reason in result.refusals])
+        return {name: float(np.median(np.abs(values[ok]))) if ok.any() else 0.0
+                for name, values in result.values.items()}
+
+    def _draw_row(self, rng: np.random.Generator) -> dict[str, str]:
+        return {name: _draw(p, self.problem, rng) for name, p in self.template.parameters.items()}
+
+    def _table(self, rows: Sequence[Mapping[str, str]]) -> dict[str, Any]:
+        return {name: np.array([float(row[name]) for row in rows]) for name in self.template.parameters}
+
+    def _flaws(self, rows: Sequence[Mapping[str, str]]) -> list[str | None]:
+        result = solve_columns(self.template, self.compiled, self._table(rows))
+        flaws = list(result.refusals)
+        for name, values in result.values.items():
+            for row, value in enumerate(values):
+                if flaws[row] is not None or result.undefined[name][row] is not None:
+                    continue
+                if abs(value) < NEAR_ZERO * self.typical.get(name, 0.0):
+                    flaws[row] = f"answer {name} = {value:.3g} is too close to zero to grade with a relative tolerance"
+                elif name in self.restitution and not 0.01 <= value <= 0.99:
+                    flaws[row] = f"the derived coefficient of restitution {name} = {value:.4g} is at 0 or 1"
+        return flaws
+
+    def draw(self, students: Sequence[Student]) -> tuple[list[dict[str, str]], list[str]]:
+        """Each student's parameters as printed, and each variant's seed."""
+        keyed = {s.id: variant_generator(self.assignment.seed, self.problem.key, s.id) for s in students}
+        generators = {student_id: pair[0] for student_id, pair in keyed.items()}
+        rows = {s.id: self._draw_row(generators[s.id]) for s in students}
+        pending = [s.id for s in students]
+        for _ in range(MAX_DRAWS):
+            flaws = self._flaws([rows[i] for i in pending])
+            pending = [i for i, flaw in zip(pending, flaws, strict=True) if flaw is not None]
+            if not pending:
+                return [rows[s.id] for s in students], [keyed[s.id][1] for s in students]
+            last = dict(zip(pending, [f for f in flaws if f is not None], strict=True))
+            for student_id in pending:
+                rows[student_id] = self._draw_row(generators[student_id])
+        first = pending[0]
+        raise GraderError(f"{self.assignment.where}: problem {self.problem.key} ({self.template.id}): no valid variant "
+                          f"for student {first} in {MAX_DRAWS} draws; the last was refused because {last[first]} "
+                          "(check fixed/narrowed parameters against the template's constraints)")
+
+
+def generate(assignment: Assignment, roster: Sequence[Student], bank: Mapping[str, Template]) -> Generation:
+    """Every student's variants for every problem, answers computed from the printed values."""
+    per_problem: list[list[ProblemVariant]] = []
+    collisions = {}
+    for problem in assignment.problems:
+        template = bank[problem.template]
+        maker = _Problem(assignment, problem, template)
+        rows, seeds = maker.draw(roster)
+        result = solve_columns(template, maker.compiled, maker._table(rows))
+        blanks = _blank_parts(problem, template)
+        variants = [ProblemVariant(problem.key, template.id, seed, {n: float(v) for n, v in row.items()}, dict(row),
+                                   _answer_parts(blanks, template, maker.compiled, result, index))
+                    for index, (row, seed) in enumerate(zip(rows, seeds, strict=True))]
+        shared = Counter(tuple(row.values()) for row in rows)
+        collisions[problem.key] = sum(shared[tuple(row.values())] > 1 for row in rows)
+        per_problem.append(variants)
+    students = tuple(StudentVariants(s, tuple(p[i] for p in per_problem)) for i, s in enumerate(roster))
+    return Generation(students, collisions)
+
+
+def _blank_parts(problem: ProblemSpec, template: Template) -> list[AnswerPart]:
+    """What every student's answer parts share: label, unit, points, tolerance (overrides applied)."""
+    parts = []
+    for index, (name, spec) in enumerate(template.answers.items()):
+        override = problem.tolerances.get(name)
+        tolerance = spec.tolerance if override is None else Tolerance(
+            override.rtol if override.rtol >= 0 else spec.tolerance.rtol,
+            override.atol if override.atol >= 0 else spec.tolerance.atol)
+        parts.append(AnswerPart(name, f"{problem.key}{chr(ord('a') + index)}", None, spec.unit.text,
+                                problem.points.get(name, problem.points.get("*", 1.0)), tolerance, spec.description))
+    return parts
+
+
+def _answer_parts(blanks: Sequence[AnswerPart], template: Template, compiled: Compiled, result: Columns,
+                  row: int) -> tuple[AnswerPart, ...]:
+    parts = []
+    for blank in blanks:
+        value, undefined = answer_at(template, compiled, result, blank.name, row)
+        parts.append(replace(blank, value=value, undefined=undefined))
+    return tuple(parts)

@@ -1,0 +1,153 @@
+"""Reads a template's scene from YAML: bodies, and stages validated against each effect's field schema.
+
+>>> scene = parse_scene({"bodies": {"ball": {"mass": "m"}, "floor": {"fixed": True}},
+...     "stages": [{"effect": "free_fall", "body": "ball", "height": "h", "speed": "v"}]},
+...     "demo.yaml", gravity=None)
+>>> scene.stages[0].text("height"), sorted(scene.names())
+('h', ['h', 'm', 'v'])
+"""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Mapping
+from typing import Any
+
+from grader.errors import ExpressionError, TemplateError
+from grader.model.expr import Node, names, parse
+from grader.model.scene import Body, Gravity, Scene, Stage, Velocity
+from grader.physics.effects import CATALOGUE, Effect, Field
+
+IDENTIFIER = re.compile(r"^[A-Za-z][A-Za-z0-9_]*$")
+
+
+def parse_scene(raw: Mapping[str, Any], where: str, gravity: Gravity | None) -> Scene:
+    """Read ``bodies`` and ``stages`` from a template's YAML mapping."""
+    bodies = _parse_bodies(raw.get("bodies"), where)
+    stages_raw = raw.get("stages")
+    if not isinstance(stages_raw, list) or not stages_raw:
+        raise TemplateError(where, "stages", "a non-empty list of stages", repr(stages_raw))
+    stages = tuple(_parse_stage(item, index, where, bodies) for index, item in enumerate(stages_raw))
+    return Scene(where, bodies, stages, gravity)
+
+
+def _parse_bodies(raw: Any, where: str) -> dict[str, Body]:
+    if not isinstance(raw, Mapping) or not raw:
+        raise TemplateError(where, "bodies", "a mapping of body names to {mass: ...} or {fixed: true}", repr(raw))
+    bodies = {}
+    for name, spec in raw.items():
+        key = f"bodies.{name}"
+        if not IDENTIFIER.match(str(name)):
+            raise TemplateError(where, key, "a name of letters, digits and _", repr(name))
+        if not isinstance(spec, Mapping) or set(spec) - {"mass", "fixed", "radius"}:
+            raise TemplateError(where, key, "{mass: EXPR} or {fixed: true}", repr(spec))
+        if spec.get("fixed") is True:
+            if "mass" in spec:
+                raise TemplateError(where, key, "either a mass or fixed: true, not both", repr(spec))
+            bodies[name] = Body(name, None)
+        elif "mass" in spec:
+            bodies[name] = Body(name, _expr(spec["mass"], where, f"{key}.mass"))
+        else:
+            raise TemplateError(where, key, "a mass or fixed: true", repr(spec))
+    return bodies
+
+
+def _parse_stage(raw: Any, index: int, where: str, bodies: Mapping[str, Body]) -> Stage:
+    key = f"stages[{index}]"
+    if not isinstance(raw, Mapping) or "effect" not in raw:
+        raise TemplateError(where, key, "a mapping with an 'effect' key", repr(raw))
+    effect = CATALOGUE.get(raw["effect"])
+    if effect is None:
+        raise TemplateError(where, f"{key}.effect", f"one of {', '.join(sorted(CATALOGUE))}", repr(raw["effect"]))
+    allowed = {f.name for f in effect.fields} | {"effect"}
+    unknown = set(raw) - allowed
+    if unknown:
+        raise TemplateError(where, f"{key}", f"only the fields of '{effect.name}' ({', '.join(sorted(allowed))})",
+                            f"unknown field(s) {', '.join(sorted(map(str, unknown)))}")
+    fields: dict[str, Any] = {}
+    source: dict[str, str] = {}
+    for spec in effect.fields:
+        if spec.name not in raw:
+            if spec.required:
+                raise TemplateError(where, f"{key}.{spec.name}", f"a value ({spec.doc})", "nothing")
+            continue
+        fields[spec.name] = _parse_field(spec, raw[spec.name], where, f"{key}.{spec.name}", bodies)
+        source[spec.name] = str(raw[spec.name])
+    stage = Stage(index, effect.name, fields, source, frozenset(_quantities(effect, fields)))
+    if "bodies" in fields and bodies[fields["bodies"][0]].mass is None:
+        raise TemplateError(where, f"{key}.bodies", "the first body to be movable (list the fixed one second)",
+                            repr(list(fields["bodies"])))
+    return stage
+
+
+def _parse_field(spec: Field, value: Any, where: str, key: str, bodies: Mapping[str, Body]) -> Any:
+    if spec.kind == "body":
+        if value not in bodies:
+            raise TemplateError(where, key, f"one of the bodies ({', '.join(bodies)})", repr(value))
+        return value
+    if spec.kind == "bodies":
+        if not (isinstance(value, list) and len(value) == 2 and all(v in bodies for v in value)
+                and value[0] != value[1]):
+            raise TemplateError(where, key, f"two different bodies from ({', '.join(bodies)})", repr(value))
+        return tuple(value)
+    if spec.kind == "name":
+        if not (isinstance(value, str) and IDENTIFIER.match(value)):
+            raise TemplateError(where, key, "a quantity name of letters, digits and _", repr(value))
+        return value
+    if spec.kind.startswith("choice:"):
+        options = spec.kind.split(":", 1)[1].split("|")
+        if value not in options:
+            raise TemplateError(where, key, f"one of {', '.join(options)}", repr(value))
+        return value
+    if spec.kind == "flag":
+        if not isinstance(value, bool):
+            raise TemplateError(where, key, "true or false", repr(value))
+        return value
+    if spec.kind == "velocities":
+        return _parse_velocities(value, where, key, bodies)
+    return _expr(value, where, key)
+
+
+def _parse_velocities(value: Any, where: str, key: str, bodies: Mapping[str, Body]) -> dict[str, Velocity]:
+    if not isinstance(value, Mapping):
+        raise TemplateError(where, key, "a mapping of body name to velocity", repr(value))
+    result = {}
+    for body, given in value.items():
+        if body not in bodies:
+            raise TemplateError(where, f"{key}.{body}", f"one of the bodies ({', '.join(bodies)})", repr(body))
+        if bodies[body].mass is None:
+            raise TemplateError(where, f"{key}.{body}", "no velocity for a fixed body (it stays at rest)", repr(given))
+        if isinstance(given, Mapping):
+            if set(given) - {"n", "t"} or "n" not in given:
+                raise TemplateError(where, f"{key}.{body}", "{n: EXPR, t: EXPR}", repr(given))
+            t = _expr(given["t"], where, f"{key}.{body}.t") if "t" in given else None
+            result[body] = Velocity(_expr(given["n"], where, f"{key}.{body}.n"), t)
+        else:
+            result[body] = Velocity(_expr(given, where, f"{key}.{body}"))
+    return result
+
+
+def _expr(value: Any, where: str, key: str) -> Node:
+    if isinstance(value, bool) or not isinstance(value, (str, int, float)):
+        raise TemplateError(where, key, "an expression (text or number)", repr(value))
+    try:
+        return parse(str(value))
+    except ExpressionError as error:
+        raise TemplateError(where, key, "a valid expression", f"{value!r} ({error})") from None
+
+
+def _quantities(effect: Effect, fields: Mapping[str, Any]) -> set[str]:
+    used: set[str] = set()
+    for spec in effect.fields:
+        value = fields.get(spec.name)
+        if value is None or spec.kind in ("body", "bodies", "flag") or spec.kind.startswith("choice:"):
+            continue
+        if spec.kind == "name":
+            used.add(value)
+        elif spec.kind == "velocities":
+            for velocity in value.values():
+                for part in (velocity.n, velocity.t):
+                    used |= names(part) if part is not None else set()
+        else:
+            used |= names(value)
+    return used

@@ -1,0 +1,377 @@
+"""The problem bank: YAML templates parsed into frozen, validated :class:`Template` objects.
+
+>>> bank = load_bank()
+>>> sorted(bank)
+['ball-plate', 'car-collision', 'drop-rebound', 'oblique-spheres', 'pile-driver']
+>>> bank["drop-rebound"].parameters["h_drop"].unit.text
+'mm'
+"""
+
+from __future__ import annotations
+
+import hashlib
+import re
+from collections.abc import Mapping
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import yaml
+
+from grader.bank.scene_parser import IDENTIFIER, parse_scene
+from grader.errors import ExpressionError, GraderError, TemplateError
+from grader.model.expr import Node, Op, names, parse
+from grader.model.scene import Gravity, Scene
+from grader.model.units import Unit, parse_unit
+from grader.resources import bank_dir
+
+RESERVED = {"g", "pi"}
+_INTERVAL = re.compile(r"^\s*([\[(])\s*(-?inf|[-+0-9.eE]+)\s*,\s*(inf|[-+0-9.eE]+)\s*([\])])\s*$")
+_TOP_KEYS = {"id", "title", "version", "gravity", "bodies", "stages", "symbols", "parameters",
+             "constraints", "answers", "tolerance", "statement", "example"}
+
+
+@dataclass(frozen=True)
+class Interval:
+    """A parameter's valid domain, e.g. ``[0, 1]`` or ``(0, inf)``.
+
+    >>> Interval.parse("[0, 90)", "x", "k").contains(90.0)
+    False
+    """
+
+    low: float
+    high: float
+    low_open: bool
+    high_open: bool
+
+    @classmethod
+    def parse(cls, text: Any, where: str, key: str) -> Interval:
+        """Read ``[a, b]``, ``(a, b)``, ``[a, inf)`` and mixed forms."""
+        match = _INTERVAL.match(str(text))
+        if not match:
+            raise TemplateError(where, key, "an interval like '[0, 1]' or '(0, inf)'", repr(text))
+        low, high = float(match.group(2)), float(match.group(3))
+        if not low < high:
+            raise TemplateError(where, key, "an interval with low < high", repr(text))
+        return cls(low, high, match.group(1) == "(", match.group(4) == ")")
+
+    def contains(self, value: Any) -> Any:
+        """Whether ``value`` (a number or numpy array) lies in the interval."""
+        above = value > self.low if self.low_open else value >= self.low
+        below = value < self.high if self.high_open else value <= self.high
+        return above & below
+
+    def __str__(self) -> str:
+        def show(x: float) -> str:
+            return "inf" if x == float("inf") else "-inf" if x == float("-inf") else f"{x:g}"
+        return f"{'(' if self.low_open else '['}{show(self.low)}, {show(self.high)}{')' if self.high_open else ']'}"
+
+
+@dataclass(frozen=True)
+class Sampling:
+    """How a variant draws a parameter: ``uniform``, ``log_uniform`` over a range, or ``choice``."""
+
+    kind: str
+    values: tuple[float, ...]
+
+
+@dataclass(frozen=True)
+class Parameter:
+    """A given quantity: unit, domain, sampling, the precision it is printed with."""
+
+    name: str
+    unit: Unit
+    domain: Interval
+    sample: Sampling
+    decimals: int | None
+    sig_figs: int | None
+    description: str
+
+
+@dataclass(frozen=True)
+class SymbolSpec:
+    """A name that stays symbolic: it has no value (a mass that cancels, the speed ``v``)."""
+
+    name: str
+    unit: Unit
+    description: str
+
+
+@dataclass(frozen=True)
+class Tolerance:
+    """Grading tolerance: ``|s - t| <= atol + rtol*|t|`` (atol in the answer's unit)."""
+
+    rtol: float
+    atol: float
+
+
+@dataclass(frozen=True)
+class AnswerSpec:
+    """An asked quantity: an expression of scene quantities, its unit, and whether it is symbolic."""
+
+    name: str
+    value: Node
+    unit: Unit
+    description: str
+    tolerance: Tolerance
+    symbolic: tuple[str, ...]
+
+
+@dataclass(frozen=True)
+class Constraint:
+    """A condition on the parameters, with the reason it must hold."""
+
+    holds: Node
+    text: str
+    message: str
+
+
+@dataclass(frozen=True)
+class Template:
+    """A loaded, validated problem template."""
+
+    id: str
+    title: str
+    version: int
+    where: str
+    source_hash: str
+    scene: Scene
+    parameters: Mapping[str, Parameter]
+    symbols: Mapping[str, SymbolSpec]
+    constraints: tuple[Constraint, ...]
+    answers: Mapping[str, AnswerSpec]
+    statement: str
+    example: Mapping[str, float]
+
+
+def load_bank(directory: Path | None = None) -> dict[str, Template]:
+    """Load every ``*.yaml`` template of a folder (the shipped bank by default), keyed by id."""
+    folder = directory or bank_dir()
+    if not folder.is_dir():
+        raise GraderError(f"{folder}: problem bank folder not found")
+    templates: dict[str, Template] = {}
+    for path in sorted(folder.glob("*.yaml")):
+        template = load_template(path)
+        if template.id in templates:
+            raise TemplateError(str(path), "id", "an id no other template uses", repr(template.id))
+        templates[template.id] = template
+    return templates
+
+
+def load_template(path: Path) -> Template:
+    """Read, parse and validate one template file."""
+    where = str(path)
+    try:
+        data = path.read_bytes()
+        raw = yaml.safe_load(data)
+    except OSError as error:
+        raise GraderError(f"{where}: cannot read ({error.strerror})") from None
+    except yaml.YAMLError as error:
+        raise TemplateError(where, "(file)", "valid YAML", str(error).replace("\n", " ")) from None
+    if not isinstance(raw, Mapping):
+        raise TemplateError(where, "(file)", "a mapping of template keys", type(raw).__name__)
+    return parse_template(raw, where, hashlib.sha256(data).hexdigest(), path.stem)
+
+
+def parse_template(raw: Mapping[str, Any], where: str, source_hash: str, stem: str | None = None) -> Template:
+    """Validate a template's YAML mapping and freeze it."""
+    unknown = set(raw) - _TOP_KEYS
+    if unknown:
+        raise TemplateError(where, ", ".join(sorted(map(str, unknown))),
+                            f"only the keys {', '.join(sorted(_TOP_KEYS))}", "unknown key(s)")
+    template_id = _text(raw, "id", where)
+    if not re.match(r"^[a-z0-9][a-z0-9-]*$", template_id):
+        raise TemplateError(where, "id", "lower-case letters, digits and -", repr(template_id))
+    if stem is not None and stem != template_id:
+        raise TemplateError(where, "id", f"the file name's stem '{stem}'", repr(template_id))
+    version = raw.get("version")
+    if not isinstance(version, int) or isinstance(version, bool) or version < 1:
+        raise TemplateError(where, "version", "a whole number >= 1", repr(version))
+    gravity = _gravity(raw.get("gravity"), where)
+    parameters = {name: _parameter(name, spec, where) for name, spec in _mapping(raw, "parameters", where).items()}
+    symbols = {name: _symbol(name, spec, where) for name, spec in (raw.get("symbols") or {}).items()}
+    for name in list(parameters) + list(symbols):
+        if not IDENTIFIER.match(name) or name in RESERVED:
+            raise TemplateError(where, name, "a name of letters, digits and _, not g or pi", repr(name))
+    both = set(parameters) & set(symbols)
+    if both:
+        raise TemplateError(where, "symbols", "names not also parameters", ", ".join(sorted(both)))
+    scene = parse_scene(raw, where, gravity)
+    default = _tolerance(raw.get("tolerance", {}), where, "tolerance", Tolerance(0.01, 0.0))
+    answers = {name: _answer(name, spec, where, default) for name, spec in _mapping(raw, "answers", where).items()}
+    template = Template(
+        id=template_id, title=_text(raw, "title", where), version=version, where=where,
+        source_hash=source_hash, scene=scene, parameters=parameters, symbols=symbols,
+        constraints=tuple(_constraint(i, c, where) for i, c in enumerate(raw.get("constraints") or [])),
+        answers=answers, statement=_text(raw, "statement", where),
+        example=_example(raw.get("example") or {}, parameters, where),
+    )
+    _check_names(template)
+    return template
+
+
+def _check_names(template: Template) -> None:
+    where = template.where
+    given = set(template.parameters) | set(template.symbols)
+    quantities = template.scene.names() | given
+    for body in template.scene.bodies.values():
+        missing = names(body.mass) - given if body.mass is not None else set()
+        if missing:
+            raise TemplateError(where, f"bodies.{body.name}.mass", "parameters or symbols only",
+                                ", ".join(sorted(missing)))
+    for answer in template.answers.values():
+        missing = names(answer.value) - quantities
+        if missing:
+            raise TemplateError(where, f"answers.{answer.name}.value", "names of the scene's quantities",
+                                f"unknown {', '.join(sorted(missing))}")
+        missing = set(answer.symbolic) - given
+        if missing:
+            raise TemplateError(where, f"answers.{answer.name}.symbolic", "parameters or symbols",
+                                ", ".join(sorted(missing)))
+    for index, constraint in enumerate(template.constraints):
+        missing = names(constraint.holds) - set(template.parameters)
+        if missing:
+            raise TemplateError(where, f"constraints[{index}].require", "an expression in the parameters",
+                                f"unknown {', '.join(sorted(missing))}")
+    _check_statement(template, given)
+
+
+def _check_statement(template: Template, given: set[str]) -> None:
+    import jinja2
+    import jinja2.meta
+
+    try:
+        syntax = jinja2.Environment(autoescape=True).parse(template.statement)
+    except jinja2.TemplateSyntaxError as error:
+        raise TemplateError(template.where, "statement", "a valid Jinja2 snippet", error.message) from None
+    unknown = jinja2.meta.find_undeclared_variables(syntax) - given - {"g"}
+    if unknown:
+        raise TemplateError(template.where, "statement", "only parameters, symbols and g",
+                            f"unknown {', '.join(sorted(unknown))}")
+
+
+def _text(raw: Mapping[str, Any], key: str, where: str) -> str:
+    value = raw.get(key)
+    if not isinstance(value, str) or not value.strip():
+        raise TemplateError(where, key, "non-empty text", repr(value))
+    return value.strip()
+
+
+def _mapping(raw: Mapping[str, Any], key: str, where: str) -> Mapping[str, Any]:
+    value = raw.get(key)
+    if not isinstance(value, Mapping) or not value:
+        raise TemplateError(where, key, "a non-empty mapping", repr(value))
+    return value
+
+
+def _unit(text: Any, where: str, key: str) -> Unit:
+    try:
+        return parse_unit("" if text is None else str(text))
+    except GraderError as error:
+        raise TemplateError(where, key, "a unit like m, m/s, kg, deg, %", str(error)) from None
+
+
+def _gravity(text: Any, where: str) -> Gravity | None:
+    if text is None:
+        return None
+    match = re.match(r"^\s*([0-9.]+(?:[eE][-+]?\d+)?)\s+(\S+)\s*$", str(text))
+    unit = _unit(match.group(2), where, "gravity") if match else None
+    if not match or unit is None or unit.dimension != (1, 0, -2, 0) or float(match.group(1)) <= 0:
+        raise TemplateError(where, "gravity", "a positive acceleration like '9.81 m/s^2' or '32.2 ft/s^2'",
+                            repr(text))
+    from fractions import Fraction
+    return Gravity(Fraction(match.group(1)) * unit.factor, str(text).strip())
+
+
+def _parameter(name: str, spec: Any, where: str) -> Parameter:
+    key = f"parameters.{name}"
+    if not isinstance(spec, Mapping):
+        raise TemplateError(where, key, "a mapping with unit, domain, sample and decimals or sig_figs", repr(spec))
+    allowed = {"unit", "domain", "sample", "decimals", "sig_figs", "description"}
+    if set(spec) - allowed:
+        raise TemplateError(where, key, f"only {', '.join(sorted(allowed))}",
+                            f"unknown key(s) {', '.join(sorted(set(spec) - allowed))}")
+    domain = Interval.parse(spec.get("domain"), where, f"{key}.domain")
+    sample = _sampling(spec.get("sample"), where, f"{key}.sample", domain)
+    decimals, sig_figs = spec.get("decimals"), spec.get("sig_figs")
+    if (decimals is None) == (sig_figs is None):
+        raise TemplateError(where, key, "exactly one of decimals or sig_figs (the printed precision)",
+                            f"decimals={decimals!r}, sig_figs={sig_figs!r}")
+    for label, value, least in (("decimals", decimals, 0), ("sig_figs", sig_figs, 1)):
+        if value is not None and (not isinstance(value, int) or isinstance(value, bool) or not least <= value <= 15):
+            raise TemplateError(where, f"{key}.{label}", f"a whole number from {least} to 15", repr(value))
+    return Parameter(name, _unit(spec.get("unit"), where, f"{key}.unit"), domain, sample, decimals, sig_figs,
+                     str(spec.get("description", name)))
+
+
+def _sampling(spec: Any, where: str, key: str, domain: Interval) -> Sampling:
+    kinds = ("uniform", "log_uniform", "choice")
+    if not isinstance(spec, Mapping) or len(spec) != 1 or next(iter(spec)) not in kinds:
+        raise TemplateError(where, key, "one of {uniform: [a, b]}, {log_uniform: [a, b]}, {choice: [x, ...]}",
+                            repr(spec))
+    kind, values = next(iter(spec.items()))
+    if not isinstance(values, list) or not values or not all(
+            isinstance(v, (int, float)) and not isinstance(v, bool) for v in values):
+        raise TemplateError(where, f"{key}.{kind}", "a list of numbers", repr(values))
+    if kind != "choice" and (len(values) != 2 or not values[0] < values[1]):
+        raise TemplateError(where, f"{key}.{kind}", "[low, high] with low < high", repr(values))
+    if kind == "log_uniform" and values[0] <= 0:
+        raise TemplateError(where, f"{key}.{kind}", "a positive range for log_uniform", repr(values))
+    outside = [v for v in values if not domain.contains(float(v))]
+    if outside:
+        raise TemplateError(where, f"{key}.{kind}", f"values inside the domain {domain}",
+                            ", ".join(map(str, outside)))
+    return Sampling(kind, tuple(float(v) for v in values))
+
+
+def _symbol(name: str, spec: Any, where: str) -> SymbolSpec:
+    if not isinstance(spec, Mapping) or set(spec) - {"unit", "description"}:
+        raise TemplateError(where, f"symbols.{name}", "{unit: ..., description: ...}", repr(spec))
+    return SymbolSpec(name, _unit(spec.get("unit"), where, f"symbols.{name}.unit"),
+                      str(spec.get("description", name)))
+
+
+def _tolerance(spec: Any, where: str, key: str, default: Tolerance) -> Tolerance:
+    if not isinstance(spec, Mapping) or set(spec) - {"rtol", "atol"}:
+        raise TemplateError(where, key, "{rtol: X, atol: Y}", repr(spec))
+    values = {k: spec.get(k, getattr(default, k)) for k in ("rtol", "atol")}
+    for k, value in values.items():
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or not 0 <= value < 1e300:
+            raise TemplateError(where, f"{key}.{k}", "a number >= 0", repr(value))
+    return Tolerance(float(values["rtol"]), float(values["atol"]))
+
+
+def _answer(name: str, spec: Any, where: str, default: Tolerance) -> AnswerSpec:
+    key = f"answers.{name}"
+    allowed = {"value", "unit", "description", "tolerance", "symbolic"}
+    if not isinstance(spec, Mapping) or "value" not in spec or set(spec) - allowed:
+        raise TemplateError(where, key, f"a mapping with value and only {', '.join(sorted(allowed))}", repr(spec))
+    symbolic = spec.get("symbolic") or []
+    if not isinstance(symbolic, list) or not all(isinstance(s, str) for s in symbolic):
+        raise TemplateError(where, f"{key}.symbolic", "a list of names", repr(symbolic))
+    return AnswerSpec(name, _parse(spec["value"], where, f"{key}.value"),
+                      _unit(spec.get("unit"), where, f"{key}.unit"), str(spec.get("description", name)),
+                      _tolerance(spec.get("tolerance", {}), where, f"{key}.tolerance", default), tuple(symbolic))
+
+
+def _constraint(index: int, spec: Any, where: str) -> Constraint:
+    key = f"constraints[{index}]"
+    if not isinstance(spec, Mapping) or set(spec) != {"require", "message"}:
+        raise TemplateError(where, key, "{require: EXPR, message: TEXT}", repr(spec))
+    holds = _parse(spec["require"], where, f"{key}.require", compare=True)
+    if not (isinstance(holds, Op) and holds.op in ("lt", "le", "gt", "ge", "and", "or")):
+        raise TemplateError(where, f"{key}.require", "a comparison like 'h_rebound <= h_drop'", repr(spec["require"]))
+    return Constraint(holds, str(spec["require"]), str(spec["message"]))
+
+
+def _parse(text: Any, where: str, key: str, compare: bool = False) -> Node:
+    try:
+        return parse(str(text), allow_compare=compare)
+    except ExpressionError as error:
+        raise TemplateError(where, key, "a valid expression", f"{text!r} ({error})") from None
+
+
+def _example(raw: Any, parameters: Mapping[str, Parameter], where: str) -> dict[str, float]:
+    if not isinstance(raw, Mapping) or set(raw) - set(parameters):
+        raise TemplateError(where, "example", "a mapping of parameter names to values", repr(raw))
+    return {k: float(v) for k, v in raw.items()}

@@ -1,0 +1,88 @@
+"""What every effect provides: field schema, relations with solved and stable forms, conditions.
+
+An effect turns one stage of a scene into :class:`Relation` objects. A relation is one
+equation as a student would write it (for the worked solution), the forms solved for each
+unknown it can give, and, per unknown, numerically stable forms the compiled kernel prefers.
+Sympy is imported lazily: loading and validating a template never needs it.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    import sympy as sp
+
+    from grader.model.scene import Stage
+    from grader.physics.run import Run
+    from grader.physics.symbolic import Context
+
+
+@dataclass(frozen=True)
+class Field:
+    """One key of a stage: its kind says how the YAML value is read.
+
+    kinds: ``body`` (a body's name), ``bodies`` (two names), ``expr`` (an expression),
+    ``name`` (a new quantity's name), ``velocities`` (per body: an expression, or ``{n:, t:}``),
+    ``choice:a|b`` (one of the listed words), ``flag`` (true or false).
+    """
+
+    name: str
+    kind: str
+    required: bool = True
+    doc: str = ""
+
+
+@dataclass(frozen=True)
+class Condition:
+    """A condition that must hold for the relation to describe the physics.
+
+    ``message`` is shown when it fails; ``{value}`` in it is replaced by ``subject``'s value.
+    """
+
+    holds: Any  # sympy relational
+    message: str
+    subject: Any = None  # sympy expression, dimensionless
+
+
+@dataclass(frozen=True)
+class Stable:
+    """A numerically preferred form of a solution; ``given`` symbols must be parameters,
+    not derived, for it to be used (it would otherwise inherit their rounding)."""
+
+    expr: Any
+    given: tuple[Any, ...] = ()
+
+
+@dataclass(frozen=True)
+class Relation:
+    """One equation of a stage, with what the solver may do with it."""
+
+    label: str
+    lhs: Any
+    rhs: Any
+    solutions: Mapping[Any, Any] = field(default_factory=dict)
+    stable: Mapping[Any, tuple[Stable, ...]] = field(default_factory=dict)
+    general: bool = True
+    requires: tuple[Condition, ...] = ()
+    undefined: Mapping[Any, tuple[Any, str]] = field(default_factory=dict)
+
+    def symbols(self) -> set[sp.Symbol]:
+        """Every quantity the equation involves."""
+        import sympy as sp
+
+        return {s for s in (sp.sympify(self.lhs) - sp.sympify(self.rhs)).free_symbols}
+
+
+@dataclass(frozen=True)
+class Effect:
+    """An entry of the catalogue: its name, what it means, its fields, its relations (the
+    closed form) and how to simulate it (its force law in the time domain; None: it has none)."""
+
+    name: str
+    summary: str
+    fields: tuple[Field, ...]
+    relations: Callable[[Stage, Context], list[Relation]]
+    simulate: Callable[[Stage, Run], None] | None = None

@@ -1,0 +1,254 @@
+"""Direct and oblique central impact of two bodies, or of a body against a fixed surface.
+
+Axes: n along the line of impact, pointing from the first body into the second; t along the
+common tangent. Surfaces are smooth: no impulse along t. Numbers follow DESIGN.md: impulse form
+with inverse masses ``w = 1/m`` (``w = 0`` for a fixed surface); after-impact velocities in the
+mass-centre form ``v1' = v_c - e w1 (v1 - v2)/(w1 + w2)``, which equals ``v1 - J w1`` but keeps its
+accuracy when ``e`` is small or the masses are very unequal; energy lost as
+``1/2 mu (1 - e)(1 + e) v_rel^2``, or ``1/2 mu (v_rel - v_sep)(v_rel + v_sep)`` when ``e`` itself is derived.
+
+Force law (simulation): a Kelvin-Voigt contact calibrated to ``e`` (:class:`ContactLaw`), plus the
+weight during contact only where asked for.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from grader.model.expr import Sym
+from grader.physics.effects.base import Condition, Effect, Field, Relation, Stable
+from grader.physics.integrate import Mode, integrate
+from grader.physics.run import ContactRecord
+
+if TYPE_CHECKING:
+    from grader.model.scene import Stage
+    from grader.physics.run import Run
+    from grader.physics.symbolic import Context
+
+
+def _impact(stage: Stage, ctx: Context) -> list[Relation]:
+    import sympy as sp
+
+    first, second = stage.fields["bodies"]
+    w1, w2 = ctx.inverse_mass(first), ctx.inverse_mass(second)
+    e = ctx.sym(stage.fields["restitution"])
+    impulse = ctx.quantity(stage, "impulse")
+    u1, u2 = ctx.velocity(stage, first, "before", "n"), ctx.velocity(stage, second, "before", "n")
+    a1, a2 = ctx.velocity(stage, first, "after", "n"), ctx.velocity(stage, second, "after", "n")
+    approach, separation = u1 - u2, a2 - a1
+    centre = (w2 * u1 + w1 * u2) / (w1 + w2)
+    e_text = stage.text("restitution")
+
+    relations = [
+        Relation(f"impulse along n in the impact of {first} and {second}, with restitution {e_text}",
+                 impulse, (1 + e) * approach / (w1 + w2), solutions={impulse: (1 + e) * approach / (w1 + w2)},
+                 general=False),
+        Relation(f"impulse-momentum for {first} along n", a1, u1 - impulse * w1,
+                 solutions={a1: u1 - impulse * w1, impulse: (u1 - a1) / w1},
+                 stable={a1: (Stable(centre - e * w1 * approach / (w1 + w2)),)}),
+    ]
+    if w2 != 0:
+        relations.append(Relation(
+            f"impulse-momentum for {second} along n", a2, u2 + impulse * w2,
+            solutions={a2: u2 + impulse * w2, impulse: (a2 - u2) / w2},
+            stable={a2: (Stable(centre + e * w2 * approach / (w1 + w2)),)}))
+    relations.append(Relation(
+        "coefficient of restitution: separation over approach along n", e, separation / approach,
+        solutions={e: separation / approach, a1: a2 - e * approach, a2: a1 + e * approach},
+        requires=(
+            Condition(sp.Gt(approach, 0), f"{first} and {second} are not approaching along the line of "
+                      "impact (relative normal velocity <= 0), so they do not collide"),
+            Condition(sp.Ge(e, 0), "the coefficient of restitution is {value}; it cannot be negative "
+                      "(the bodies would pass through each other)", subject=e),
+            # Slack of 1e-12: a derived e one rounding above 1 (an exactly elastic rebound, its
+            # height rounded) is 1, not a refusal; a real excess is far larger.
+            Condition(sp.Le(e, 1 + sp.Rational(1, 10**12)), "the coefficient of restitution is {value}; above 1 "
+                      "the impact would create energy", subject=e),
+        )))
+    for body in (first, second):
+        if ctx.inverse_mass(body) != 0 and stage.is_oblique:
+            before, after = ctx.velocity(stage, body, "before", "t"), ctx.velocity(stage, body, "after", "t")
+            relations.append(Relation(f"smooth surfaces: no impulse along t, so {body}'s t-velocity is "
+                                      "unchanged", after, before, solutions={after: before}))
+    return relations + _energy(stage, ctx, e, approach, separation, w1, w2)
+
+
+def _energy(stage: Stage, ctx: Context, e: Any, approach: Any, separation: Any, w1: Any, w2: Any) -> list[Relation]:
+    import sympy as sp
+
+    before, after = ctx.quantity(stage, "energy_before"), ctx.quantity(stage, "energy_after")
+    lost, fraction = ctx.quantity(stage, "energy_lost"), ctx.quantity(stage, "loss_fraction")
+    totals = {when: ctx.kinetic_energy(stage, when) for when in ("before", "after")}
+    lost_form = (1 - e) * (1 + e) * approach**2 / (2 * (w1 + w2))
+    # With e derived, (v_rel - v_sep) is a difference of measured quantities; once e <= 1 is
+    # checked the true loss is >= 0, so a negative result is rounding of an exact 0.
+    derived_form = sp.Max(0, (approach - separation) * (approach + separation) / (2 * (w1 + w2)))
+    return [
+        Relation("kinetic energy just before the impact", before, totals["before"],
+                 solutions={before: totals["before"]}, general=False),
+        Relation("kinetic energy just after the impact", after, totals["after"],
+                 solutions={after: totals["after"]}, general=False),
+        Relation("energy lost in the impact", lost, lost_form, solutions={lost: lost_form}, general=False,
+                 stable={lost: (Stable(lost_form, given=(e,)),
+                                Stable(derived_form))}),
+        Relation("fraction of the kinetic energy lost", fraction, lost / before,
+                 solutions={fraction: lost / before}, general=False),
+    ]
+
+
+@dataclass(frozen=True)
+class ContactLaw:
+    """Kelvin-Voigt contact (linear spring and dashpot, tension allowed until the overlap is 0
+    again), calibrated so that it reproduces ``e`` exactly:
+    ``zeta = -ln e / sqrt(pi^2 + ln^2 e)``, natural frequency from the contact duration
+    ``omega_n = pi / (duration sqrt(1 - zeta^2))``. Stiffness and damping per unit reduced mass
+    (``k = mu omega_n^2``, ``c = 2 zeta mu omega_n``), so extreme mass ratios change nothing.
+    ``e = 0`` never separates on its own: the contact ends at maximum compression (``sticks``).
+
+    >>> law = ContactLaw.calibrated(0.5, 1e-3)
+    >>> round(law.zeta, 6), round(math.exp(-law.zeta * math.pi / math.sqrt(1 - law.zeta**2)), 12)
+    (0.215454, 0.5)
+    """
+
+    zeta: float
+    omega: float
+    sticks: bool
+
+    @classmethod
+    def calibrated(cls, e: float, duration: float) -> ContactLaw:
+        """The law for restitution ``e`` and a contact lasting ``duration`` seconds."""
+        if e <= 0:
+            return cls(1.0, math.pi / duration, True)
+        log_e = math.log1p(e - 1) if e > 0.5 else math.log(e)  # e - 1 is exact for e in [0.5, 1]
+        zeta = -log_e / math.hypot(math.pi, log_e)
+        return cls(zeta, math.pi / (duration * math.sqrt((1 - zeta) * (1 + zeta))), False)
+
+    def specific_force(self, overlap: float, rate: float) -> float:
+        """Contact force per unit reduced mass, pushing the bodies apart."""
+        return self.omega * (self.omega * overlap + 2 * self.zeta * rate)
+
+
+def _simulate_impact(stage: Stage, run: Run) -> None:
+    first, second = stage.fields["bodies"]
+    w1, w2 = _inverse_mass(run, first), _inverse_mass(run, second)
+    e = run.value(stage.fields["restitution"])
+    before = [_component(run, stage, body, "before", axis) for body in (first, second) for axis in ("n", "t")]
+    approach = before[0] - before[2]
+    if approach <= 0 or not 0 <= e <= 1:
+        run.problems.append(f"{first} and {second} do not collide (relative normal velocity {approach:g}) "
+                            if approach <= 0 else f"the coefficient of restitution {e:g} is outside [0, 1]")
+        after = before
+    else:
+        after = _contact(stage, run, (first, second), (w1, w2), e, before)
+    for index, body in enumerate((first, second)):
+        given = stage.fields.get("after", {}).get(body)
+        if given is not None:
+            run.output(given.n, after[2 * index])
+            if given.t is not None:
+                run.output(given.t, after[2 * index + 1])
+    _output_energies(stage, run, (w1, w2), before, after)
+
+
+def _contact(stage: Stage, run: Run, bodies: tuple[str, str], inverse: tuple[float, float], e: float,
+             before: list[float]) -> list[float]:
+    w1, w2 = inverse
+    share1, share2 = w1 / (w1 + w2), w2 / (w1 + w2)
+    law = ContactLaw.calibrated(e, run.options.contact_duration)
+    run.uses("contact (Kelvin-Voigt)")
+    weight = _weight(stage, run)
+
+    def free(_: float, y: Any) -> Any:
+        return np.concatenate([y[4:], np.zeros(4)])
+
+    def pressed(_: float, y: Any) -> Any:
+        f = law.specific_force(y[0] - y[2], y[4] - y[6])
+        return np.concatenate([y[4:], [weight - share1 * f, 0.0, (weight if w2 else 0.0) + share2 * f, 0.0]])
+
+    approach = before[0] - before[2]
+    duration = run.options.contact_duration
+    gap = approach * duration / 4
+    y0 = np.array([-gap, 0.0, 0.0, 0.0, *before])
+    # Errors along n are measured against the overlap and the approach speed, along t against the
+    # tangential motion: a grazing impact's tiny normal motion is not drowned by its t-motion.
+    normal_speed = max(approach, abs(before[0]), abs(before[2]))
+    tangent_speed = max(abs(before[1]), abs(before[3])) or normal_speed
+    sizes = np.array([approach * duration, tangent_speed * duration] * 2 + [normal_speed, tangent_speed] * 2)
+    entry = Mode("approach", free, lambda y: y[0] - y[2], +1, scale=gap / approach, sizes=lambda y: sizes)
+    # e = 0: the spring would hold the bodies together for ever; they part at maximum compression.
+    exit_event = (lambda y: y[4] - y[6]) if law.sticks else (lambda y: y[0] - y[2])
+    contact = Mode("contact", pressed, exit_event, -1, scale=duration, omega=law.omega,
+                   force=lambda y: law.specific_force(y[0] - y[2], y[4] - y[6]) / (w1 + w2), sizes=lambda y: sizes)
+    path = integrate([entry, contact], y0, run.options.settings)
+    label = f"impact of {bodies[0]} and {bodies[1]}"
+    run.record(label, ("x1n", "x1t", "x2n", "x2t", "v1n", "v1t", "v2n", "v2t"), path)
+    after = [float(v) for v in path.y[-1][4:]]
+    run.contacts.append(ContactRecord(stage.index, label, e, (after[2] - after[0]) / approach, law.zeta, duration))
+    return after
+
+
+def _weight(stage: Stage, run: Run) -> float:
+    """Gravity along n during contact: only if asked for, and only where the first body fell onto
+    the second (n is then downward)."""
+    if not (run.options.weight_during_contact or stage.fields.get("weight_during_contact", False)):
+        return 0.0
+    fell = any(s.effect == "free_fall" and s.fields["body"] == stage.fields["bodies"][0]
+               for s in run.scene.stages[:stage.index])
+    if not fell:
+        return 0.0
+    run.uses("weight during contact")
+    return run.gravity()
+
+
+def _inverse_mass(run: Run, body: str) -> float:
+    mass = run.scene.bodies[body].mass
+    return 0.0 if mass is None else 1.0 / run.value(mass)
+
+
+def _component(run: Run, stage: Stage, body: str, when: str, axis: str) -> float:
+    given = stage.fields.get(when, {}).get(body)
+    part = None if given is None else getattr(given, axis)
+    return 0.0 if part is None or run.scene.bodies[body].mass is None else run.value(part)
+
+
+def _output_energies(stage: Stage, run: Run, inverse: tuple[float, float], before: list[float],
+                     after: list[float]) -> None:
+    # Energies in units of the largest speed squared: 1e170 m/s overflows only the energy itself,
+    # never the fraction lost.
+    unit = max(abs(v) for v in before + after) or 1.0
+
+    def kinetic(v: list[float]) -> float:
+        return sum((math.hypot(v[2 * i], v[2 * i + 1]) / unit) ** 2 / (2 * w) for i, w in enumerate(inverse) if w)
+
+    scaled_before, scaled_after = kinetic(before), kinetic(after)
+    measured = {"energy_before": scaled_before * unit * unit, "energy_after": scaled_after * unit * unit,
+                "energy_lost": (scaled_before - scaled_after) * unit * unit,
+                "loss_fraction": (scaled_before - scaled_after) / scaled_before if scaled_before else math.nan,
+                "impulse": (before[0] - after[0]) / inverse[0]}
+    for key, value in measured.items():
+        if key in stage.fields:
+            run.output(Sym(stage.fields[key]), value)
+
+
+IMPACT = Effect(
+    "impact",
+    "direct or oblique central impact with restitution e; smooth surfaces; a body may be fixed",
+    (
+        Field("bodies", "bodies", doc="[first, second]: n points from the first into the second"),
+        Field("restitution", "expr", doc="coefficient of restitution e, 0..1"),
+        Field("before", "velocities", doc="per body: n-velocity, or {n: .., t: ..}; omitted = at rest"),
+        Field("after", "velocities", required=False, doc="per body: names for the velocities after"),
+        Field("impulse", "name", required=False, doc="name for the normal impulse J"),
+        Field("energy_before", "name", required=False, doc="name for the kinetic energy before"),
+        Field("energy_after", "name", required=False, doc="name for the kinetic energy after"),
+        Field("energy_lost", "name", required=False, doc="name for the energy lost"),
+        Field("loss_fraction", "name", required=False, doc="name for the fraction of energy lost"),
+        Field("weight_during_contact", "flag", required=False,
+              doc="simulate the weight during contact (the closed form neglects it); default false"),
+    ),
+    _impact,
+    _simulate_impact,
+)

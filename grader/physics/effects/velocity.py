@@ -1,0 +1,74 @@
+"""A velocity as speed and angle, or as components along the n (impact) and t (tangent) axes.
+
+The angle is measured from the axis named in ``from`` toward the other one. Speeds come from
+``hypot`` and angles from ``atan2``; the angle of a zero velocity is undefined, not zero.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import TYPE_CHECKING
+
+from grader.physics.effects.base import Condition, Effect, Field, Relation
+
+if TYPE_CHECKING:
+    from grader.model.scene import Stage
+    from grader.physics.run import Run
+    from grader.physics.symbolic import Context
+
+
+def _components(stage: Stage, ctx: Context) -> list[Relation]:
+    import sympy as sp
+
+    from grader.physics.symbolic import hypot
+
+    speed, angle = ctx.sym(stage.fields["speed"]), ctx.sym(stage.fields["angle"])
+    n, t = ctx.sym(stage.fields["n"]), ctx.sym(stage.fields["t"])
+    along, across = (t, n) if stage.fields.get("from", "t") == "t" else (n, t)
+    along_name, across_name = ("t", "n") if stage.fields.get("from", "t") == "t" else ("n", "t")
+    what = stage.text("speed")
+    relations = [
+        Relation(f"{what}: component along {along_name}", along, speed * sp.cos(angle),
+                 requires=(Condition(sp.Ge(speed, 0), f"the speed {what} must not be negative"),)),
+        Relation(f"{what}: component along {across_name}", across, speed * sp.sin(angle)),
+    ]
+    if isinstance(speed, sp.Symbol):
+        relations.append(Relation(
+            f"{what}: magnitude from its components", speed, hypot(n, t),
+            solutions={speed: hypot(n, t)}, general=False))
+    if isinstance(angle, sp.Symbol):
+        relations.append(Relation(
+            f"{what}: direction, measured from the {along_name}-axis", sp.tan(angle), across / along,
+            solutions={angle: sp.atan2(across, along)}, general=False,
+            undefined={angle: (sp.Le(hypot(n, t), 0), f"{what} is zero, so it has no direction")}))
+    return relations
+
+
+def _simulate_components(stage: Stage, run: Run) -> None:
+    """Kinematics, not a force: split a known velocity into components, or combine them."""
+    fields = stage.fields
+    along_key, across_key = ("t", "n") if fields.get("from", "t") == "t" else ("n", "t")
+    if run.known(fields["speed"]) and run.known(fields["angle"]):
+        speed, angle = run.value(fields["speed"]), run.value(fields["angle"])
+        run.output(fields[along_key], speed * math.cos(angle))
+        run.output(fields[across_key], speed * math.sin(angle))
+        return
+    along, across = run.value(fields[along_key]), run.value(fields[across_key])
+    speed = math.hypot(along, across)
+    run.output(fields["speed"], speed)
+    run.output(fields["angle"], math.atan2(across, along) if speed > 0 else math.nan)
+
+
+VELOCITY = Effect(
+    "velocity",
+    "a velocity given by speed and angle, related to its n and t components",
+    (
+        Field("speed", "expr", doc="magnitude"),
+        Field("angle", "expr", doc="direction, measured from the `from` axis toward the other"),
+        Field("from", "choice:t|n", required=False, doc="axis the angle is measured from (default t)"),
+        Field("n", "expr", doc="component along the line of impact"),
+        Field("t", "expr", doc="component along the tangent"),
+    ),
+    _components,
+    _simulate_components,
+)

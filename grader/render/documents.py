@@ -1,0 +1,481 @@
+"""PDFs through Typst: a sheet per student, the class's sheets in one file, the instructor's key.
+
+Sources are made from the Jinja2 templates in ``templates/`` (``student.typ.j2``, ``key.typ.j2``,
+with ``figures.typ`` and ``preamble.typ`` inlined, so each source stands alone) and compiled with
+the ``typst`` package using only its embedded fonts and a fixed timestamp: two runs give
+byte-identical PDFs.
+
+Text from the roster and the assignment (names, ids, titles, descriptions) is never interpreted:
+every ``{{ }}`` of a document template is shown as a Typst string literal unless this module
+marked the value as Typst source (:class:`~grader.render.worked.Typ`). A template's ``statement`` is
+instructor-written Typst markup and is inserted as markup, with the printed values filled in.
+
+>>> safe_file_name("2026100"), safe_file_name("a/b c")
+('2026100', 'a_b_c-0af99a6091')
+"""
+
+from __future__ import annotations
+
+import concurrent.futures
+import hashlib
+import re
+import threading
+from collections.abc import Callable, Iterable, Mapping, Sequence
+from dataclasses import dataclass
+from functools import lru_cache
+from pathlib import Path
+from typing import Any, Literal
+
+import jinja2
+
+from grader.assign.assignment import Assignment
+from grader.assign.variants import AnswerPart, Generation, ProblemVariant
+from grader.bank.template import Template
+from grader.errors import GraderError
+from grader.model.expr import parse
+from grader.render.figures import figure
+from grader.render.worked import Typ, Worked, WorkedStep, answer_math, math, name, number, string, text, worked
+from grader.resources import templates_dir
+from grader.solve.cache import compiled_for
+from grader.solve.compiled import Compiled
+
+PAPER = "us-letter"
+TIMESTAMP = 0  # the PDFs' creation date: fixed, so that output is reproducible
+_SAFE = re.compile(r"[A-Za-z0-9._-]+")
+
+
+# --- file names ---------------------------------------------------------------------------------
+
+def safe_file_name(student_id: str) -> str:
+    """The file name (without ``.pdf``) for a student id.
+
+    An id made only of ASCII letters, digits, ``.``, ``_`` and ``-`` (at most 120 characters) is
+    kept as it is. Any other id becomes its safe characters, runs of others replaced by ``_``
+    (at most 60), then ``-`` and the first 10 hex digits of the SHA-256 of the id (UTF-8), so two
+    different ids never share a name.
+    """
+    if _SAFE.fullmatch(student_id) and len(student_id) <= 120:
+        return student_id
+    cleaned = re.sub(r"[^A-Za-z0-9._-]+", "_", student_id)[:60].strip("._") or "student"
+    return f"{cleaned}-{hashlib.sha256(student_id.encode('utf-8')).hexdigest()[:10]}"
+
+
+def file_names(student_ids: Sequence[str]) -> list[str]:
+    """:func:`safe_file_name` of each id; ids whose names differ only in case (one file on macOS and
+    Windows) all take the hash suffix too, so no PDF overwrites another.
+
+    >>> file_names(["AB1", "ab1", "x"])
+    ['AB1-2d2c442062', 'ab1-ca5ba87c93', 'x']
+    """
+    names = [safe_file_name(i) for i in student_ids]
+    folded = [n.casefold() for n in names]
+    return [f"{n}-{hashlib.sha256(i.encode('utf-8')).hexdigest()[:10]}" if folded.count(n.casefold()) > 1 else n
+            for n, i in zip(names, student_ids, strict=True)]
+
+
+# --- views: what the templates show -------------------------------------------------------------
+
+@dataclass(frozen=True)
+class Blank:
+    """An answer blank: label as the submission CSV expects it, what to give, unit, points."""
+
+    label: str
+    description: str
+    unit: str
+    points: str
+
+
+@dataclass(frozen=True)
+class ProblemSheet:
+    """One problem on a student's sheet."""
+
+    key: str
+    title: str
+    points: str
+    statement: Typ
+    figure: Typ
+    blanks: tuple[Blank, ...]
+
+
+@dataclass(frozen=True)
+class Sheet:
+    """A student's sheet."""
+
+    name: str
+    id: str
+    section: str
+    problems: tuple[ProblemSheet, ...]
+
+
+@dataclass(frozen=True)
+class KeyAnswer:
+    """An answer in the key: where it comes from and its value (math), or why it has none."""
+
+    label: str
+    description: str
+    value: Typ
+    points: str
+    tolerance: str
+
+
+@dataclass(frozen=True)
+class KeyStep:
+    """A worked step, as markup ready for the key."""
+
+    relation: Typ
+    equation: Typ
+    chain: Typ
+    note: Typ
+
+
+@dataclass(frozen=True)
+class KeyProblem:
+    """One student's problem in the key: given values, notes, steps, answers."""
+
+    key: str
+    title: str
+    seed: str
+    given: Typ
+    notes: tuple[Typ, ...]
+    steps: tuple[KeyStep, ...]
+    answers: tuple[KeyAnswer, ...]
+
+
+@dataclass(frozen=True)
+class KeyPerson:
+    """A student's section of the key."""
+
+    name: str
+    id: str
+    section: str
+    problems: tuple[KeyProblem, ...]
+
+
+@dataclass(frozen=True)
+class Glance:
+    """One problem's answers for every student, as a table."""
+
+    key: str
+    title: str
+    header: tuple[Typ, ...]
+    rows: tuple[tuple[Typ, ...], ...]
+
+
+def _math(source: str) -> Typ:
+    return Typ(f"${source}$") if source else Typ("")
+
+
+def _points(points: float) -> str:
+    return f"{points:g} point{'' if points == 1 else 's'}"
+
+
+def _unit_text(unit: str) -> str:
+    return {"deg": "degrees", "": "(no unit)"}.get(unit, unit.replace("^2", "²").replace("^3", "³").replace("*", "·"))
+
+
+def tolerance_text(part: AnswerPart) -> str:
+    """``±1%``, ``±0.05 m/s``, or both: ``±(0.05 m/s + 1%)``.
+
+    >>> from grader.bank.template import Tolerance
+    >>> tolerance_text(AnswerPart("e", "1a", 0.5, "", 1.0, Tolerance(0.01, 0.0), "e"))
+    '±1%'
+    """
+    relative = f"{part.tolerance.rtol * 100:.3g}%" if part.tolerance.rtol else ""
+    absolute = f"{part.tolerance.atol:g} {part.unit}".strip() if part.tolerance.atol else ""
+    if relative and absolute:
+        return f"±({absolute} + {relative})"
+    return f"±{relative or absolute}" if relative or absolute else "exact"
+
+
+def paragraphs(text_: str) -> list[str]:
+    """Text split at blank lines, each paragraph on one line."""
+    return [" ".join(p.split()) for p in re.split(r"\n\s*\n", text_) if p.strip()]
+
+
+class _Documents:
+    """Builds the views of one generation, computing each variant's worked solution once."""
+
+    def __init__(self, assignment: Assignment, generation: Generation, bank: Mapping[str, Template]) -> None:
+        self.assignment, self.generation, self.bank = assignment, generation, bank
+        self.compiled: dict[str, Compiled] = {}
+        self.worked: dict[tuple[int, int], Worked] = {}
+        self.sheets: dict[int, Sheet] = {}
+
+    def _compiled(self, template: Template) -> Compiled:
+        if template.id not in self.compiled:
+            self.compiled[template.id] = compiled_for(template)
+        return self.compiled[template.id]
+
+    def solution(self, student: int, problem: int) -> Worked:
+        """The worked solution of one student's problem."""
+        if (student, problem) not in self.worked:
+            variant = self.generation.students[student].problems[problem]
+            template = self.bank[variant.template]
+            self.worked[(student, problem)] = worked(template, variant, self._compiled(template))
+        return self.worked[(student, problem)]
+
+    def sheet(self, index: int) -> Sheet:
+        """A student's sheet."""
+        if index not in self.sheets:
+            entry = self.generation.students[index]
+            problems = tuple(self._problem_sheet(index, p, v) for p, v in enumerate(entry.problems))
+            student = entry.student
+            self.sheets[index] = Sheet(student.name, student.id, student.section, problems)
+        return self.sheets[index]
+
+    def _problem_sheet(self, student: int, problem: int, variant: ProblemVariant) -> ProblemSheet:
+        template = self.bank[variant.template]
+        blanks = tuple(Blank(part.label, part.description, self._blank_unit(template, part),
+                             _points(part.points)) for part in variant.answers)
+        return ProblemSheet(variant.key, template.title, _points(sum(p.points for p in variant.answers)),
+                            statement(template, variant),
+                            figure(template, variant, self.solution(student, problem).values), blanks)
+
+    @staticmethod
+    def _blank_unit(template: Template, part: AnswerPart) -> str:
+        symbolic = template.answers[part.name].symbolic
+        if symbolic:
+            unit = f" ({_unit_text(part.unit)})" if part.unit else ""
+            return f"an expression in {' and '.join(symbolic)}{unit}"
+        return _unit_text(part.unit)
+
+    def person(self, index: int) -> KeyPerson:
+        """A student's section of the key."""
+        entry = self.generation.students[index]
+        problems = tuple(self._key_problem(self.solution(index, p), v) for p, v in enumerate(entry.problems))
+        return KeyPerson(entry.student.name, entry.student.id, entry.student.section, problems)
+
+    def _key_problem(self, solution: Worked, variant: ProblemVariant) -> KeyProblem:
+        template = self.bank[variant.template]
+        given = Typ(", ".join(f"${g}$" for g in solution.given))
+        steps = tuple(_key_step(s) for s in solution.steps)
+        answers = tuple(_key_answer(template, part) for part in variant.answers)
+        return KeyProblem(variant.key, template.title, variant.variant_seed, given, solution.notes, steps, answers)
+
+    def glances(self, indices: Sequence[int]) -> list[Glance]:
+        """Per problem, a table of every listed student's numbers and answers."""
+        tables = []
+        for position, spec in enumerate(self.assignment.problems):
+            template = self.bank[spec.template]
+            first = self.generation.students[indices[0]].problems[position]
+            header = [Typ("ID"), Typ("Student")]
+            header += [_math(_given_header(n, p.unit.text)) for n, p in template.parameters.items()]
+            header += [Typ(f"*{part.label}*" + (f" {text(_unit_text(part.unit))}" if part.unit else ""))
+                       for part in first.answers]
+            rows = []
+            for index in indices:
+                entry = self.generation.students[index]
+                variant = entry.problems[position]
+                cells = [text(entry.student.id), text(entry.student.name)]
+                cells += [text(variant.printed[n]) for n in template.parameters]
+                cells += [_glance_value(part) for part in variant.answers]
+                rows.append(tuple(cells))
+            tables.append(Glance(spec.key, template.title, tuple(header), tuple(rows)))
+        return tables
+
+
+def _given_header(parameter: str, unit: str) -> str:
+    shown = {"deg": "degree", "": ""}.get(unit, f"thin ({string(unit)})")
+    return f"{name(parameter)} {shown}".strip()
+
+
+def _glance_value(part: AnswerPart) -> Typ:
+    if part.value is None:
+        return text("undefined")
+    if isinstance(part.value, str):
+        return _math(math(parse(part.value)))
+    return _math(number(part.value))
+
+
+def _key_step(step: WorkedStep) -> KeyStep:
+    chain = f"$display({step.chain[0]} = {step.chain[1]})$" + "".join(
+        f" $display(= {part})$" for part in step.chain[2:])
+    return KeyStep(step.relation, _math(f"display({step.equation})" if step.equation else ""), Typ(chain), step.note)
+
+
+def _key_answer(template: Template, part: AnswerPart) -> KeyAnswer:
+    source = math(template.answers[part.name].value)
+    if part.value is None:
+        value = Typ(f"${source}$ {text('undefined: ' + (part.undefined or 'no value'))}")
+    else:
+        value = _math(f"display({source} = {answer_math(part.value, part.unit)})")
+    return KeyAnswer(part.label, part.description, value, f"{part.points:g}", tolerance_text(part))
+
+
+# --- statements ---------------------------------------------------------------------------------
+
+@lru_cache(maxsize=64)
+def _statement_template(source: str) -> jinja2.Template:
+    environment = jinja2.Environment(undefined=jinja2.StrictUndefined, autoescape=False)  # noqa: S701 (Typst, not HTML)
+    return environment.from_string(source)
+
+
+def statement(template: Template, variant: ProblemVariant) -> Typ:
+    """The template's statement (trusted Typst markup) with the variant's printed values."""
+    values: dict[str, Any] = {n: n for n in template.symbols}
+    if template.scene.gravity is not None:
+        values["g"] = template.scene.gravity.text.split()[0]
+    values.update(variant.printed)
+    try:
+        return Typ(_statement_template(template.statement).render(values).strip())
+    except jinja2.TemplateError as error:
+        raise GraderError(f"{template.where}: statement: cannot fill in the values ({error})") from None
+
+
+# --- documents ----------------------------------------------------------------------------------
+
+def _finalize(value: Any) -> Any:
+    """Every ``{{ }}`` of a document template: shown as text unless marked as Typst source."""
+    return value if isinstance(value, Typ) else text("" if value is None else value)
+
+
+@lru_cache(maxsize=1)
+def _environment() -> jinja2.Environment:
+    # Not HTML, so no autoescape: _finalize shows every value as a Typst string instead.
+    environment = jinja2.Environment(
+        loader=jinja2.FileSystemLoader(str(templates_dir())), undefined=jinja2.StrictUndefined,
+        finalize=_finalize, trim_blocks=True, lstrip_blocks=True, keep_trailing_newline=True,
+        autoescape=False)  # noqa: S701
+    environment.filters["str"] = string
+    environment.filters["int"] = lambda value: Typ(str(int(value)))
+    return environment
+
+
+def _assignment_view(assignment: Assignment) -> dict[str, Any]:
+    return {"title": assignment.title, "course": assignment.course, "due": assignment.due,
+            "instructions": paragraphs(assignment.instructions)}
+
+
+def student_source(documents: _Documents, indices: Iterable[int]) -> str:
+    """The Typst source of the sheets of the listed students (roster positions), in order."""
+    sheets = [documents.sheet(i) for i in indices]
+    title = documents.assignment.title + (f": {sheets[0].name}" if len(sheets) == 1 else ": class")
+    return _environment().get_template("student.typ.j2").render(
+        assignment=_assignment_view(documents.assignment), sheets=sheets, paper=PAPER, document_title=title)
+
+
+def key_source(documents: _Documents, indices: Sequence[int], overview: bool = True) -> str:
+    """The Typst source of the answer key for the listed students; ``overview``: with the cover and
+    the tables of everyone's answers."""
+    assignment = documents.assignment
+    first = documents.generation.students[indices[0]]
+    summary = [(p.key, documents.bank[p.template].title,
+                [(a.label, a.description, _unit_text(a.unit), f"{a.points:g}", tolerance_text(a)) for a in p.answers])
+               for p in first.problems]
+    return _environment().get_template("key.typ.j2").render(
+        assignment=_assignment_view(assignment), paper=PAPER, overview=overview, summary=summary,
+        glances=documents.glances(indices) if overview else [], people=[documents.person(i) for i in indices],
+        count=f"{len(indices)} student{'' if len(indices) == 1 else 's'}",
+        document_title=f"{assignment.title}: answer key")
+
+
+_LOCAL = threading.local()
+
+
+def compile_typst(source: str, fmt: Literal["pdf", "png"] = "pdf", ppi: float | None = None,
+                  tagged: bool = True) -> bytes | list[bytes]:
+    """Compile a source with embedded fonts only and the fixed timestamp (one compiler per thread);
+    ``tagged``: with the PDF structure tags screen readers use."""
+    import typst
+
+    compiler = getattr(_LOCAL, "compiler", None)
+    if compiler is None:
+        compiler = _LOCAL.compiler = typst.Compiler(ignore_system_fonts=True)
+    try:
+        result = compiler.compile(source.encode("utf-8"), format=fmt, ppi=ppi, timestamp=TIMESTAMP, pdf_tags=tagged)
+    except typst.TypstError as error:
+        where = "\n".join(str(error.diagnostic).splitlines()[:6])
+        raise GraderError(f"Typst could not typeset a document: {error.message}\n{where}") from None
+    if result is None:
+        raise GraderError("Typst produced no output")
+    return result
+
+
+def check_statements(assignment: Assignment, generation: Generation, bank: Mapping[str, Template]) -> None:
+    """Typeset each problem's statement alone once, so that a statement Typst cannot read is
+    reported with its template's file, not as a failure of a whole document."""
+    if not generation.students:
+        return
+    for variant in generation.students[0].problems:
+        template = bank[variant.template]
+        try:
+            compile_typst(f"#set page(width: 12cm, height: auto)\n{statement(template, variant)}\n")
+        except GraderError as error:
+            raise GraderError(f"{template.where}: statement: {error}") from None
+
+
+def render_all(assignment: Assignment, generation: Generation, bank: Mapping[str, Template], out: Path, *,
+               jobs: int = 1, keep_source: bool = False,
+               progress: Callable[[int], None] | None = None) -> list[Path]:
+    """Write ``out/students/<file name>.pdf`` per student (names from :func:`file_names`),
+    ``out/class.pdf`` (every sheet, each student from a new page) and ``out/answer-key.pdf``;
+    with ``keep_source`` also their Typst sources under ``out/source/``.
+
+    ``progress(1)`` is called as each of the ``len(students) + 2`` documents is written. Student
+    sheets compile in ``jobs`` threads (Typst releases the GIL). The class PDF is the student PDFs
+    joined (typesetting them again would double the work). With ``jobs > 1`` the answer key, one
+    large document, compiles meanwhile in a process of its own: Typst's memo cache is process-wide
+    and only grows, and after a whole key has been through it a sheet compiles 3-5 times slower.
+    Returns the paths written: students in roster order, the class file, the key, then the sources.
+    """
+    if not generation.students:
+        raise GraderError("there are no students to make PDFs for")
+    check_statements(assignment, generation, bank)
+    documents = _Documents(assignment, generation, bank)
+    everyone = list(range(len(generation.students)))
+    names = file_names([s.student.id for s in generation.students])
+    sheets = [(out / "students" / f"{n}.pdf", student_source(documents, [i])) for i, n in enumerate(names)]
+    key_path, key = out / "answer-key.pdf", key_source(documents, everyone)
+    (out / "students").mkdir(parents=True, exist_ok=True)
+    with concurrent.futures.ThreadPoolExecutor(max_workers=max(1, jobs)) as pool:
+        futures = {pool.submit(compile_typst, source): path for path, source in sheets}
+        for future in concurrent.futures.as_completed(futures):
+            futures[future].write_bytes(_pdf(future.result()))
+            if progress is not None:
+                progress(1)
+        # The key typesets (without the GIL) while the class PDF is joined in this thread.
+        typesetting = pool.submit(compile_typst, key, tagged=False)
+        _join_pdfs([path for path, _ in sheets], out / "class.pdf")
+        if progress is not None:
+            progress(1)
+        key_path.write_bytes(_pdf(typesetting.result()))
+    if progress is not None:
+        progress(1)
+    written = [path for path, _ in sheets] + [out / "class.pdf", key_path]
+    if keep_source:
+        (out / "source" / "students").mkdir(parents=True, exist_ok=True)
+        for path, source in [*sheets, (out / "class.pdf", student_source(documents, everyone)), (key_path, key)]:
+            kept = out / "source" / path.relative_to(out).with_suffix(".typ")
+            kept.write_text(source, encoding="utf-8")
+            written.append(kept)
+    return written
+
+
+def _pdf(result: bytes | list[bytes]) -> bytes:
+    assert isinstance(result, bytes)  # a PDF compile returns one document
+    return result
+
+
+def _join_pdfs(parts: Sequence[Path], target: Path) -> None:
+    """One PDF of the given ones in order (deterministic: pypdf writes no dates or random ids)."""
+    from pypdf import PdfWriter
+
+    writer = PdfWriter()
+    for part in parts:
+        writer.append(str(part))
+    with target.open("wb") as stream:
+        writer.write(stream)
+
+
+def render_page_png(assignment: Assignment, generation: Generation, bank: Mapping[str, Template],
+                    student_index: int, *, key: bool = False, page: int = 0, ppi: int = 110) -> bytes:
+    """One page of a student's sheet as PNG, or with ``key`` of that student's worked solutions in
+    the answer key (without the class overview)."""
+    documents = _Documents(assignment, generation, bank)
+    source = key_source(documents, [student_index], overview=False) if key else \
+        student_source(documents, [student_index])
+    pages = compile_typst(source, "png", ppi)
+    pages = [pages] if isinstance(pages, bytes) else pages
+    if not 0 <= page < len(pages):
+        raise GraderError(f"page {page} does not exist: the document has {len(pages)} page(s)")
+    return pages[page]

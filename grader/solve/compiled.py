@@ -1,0 +1,102 @@
+"""A compiled template: the step chain and the answer and check trees, JSON-serialisable.
+
+This is what the cache stores and the kernels evaluate; it never needs sympy.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any
+
+from grader.model.expr import Node, from_json, to_json, to_text
+
+FORMAT = 1
+
+
+@dataclass(frozen=True)
+class Step:
+    """One step of the chain: from ``relation``'s equation ``lhs = rhs``, ``unknown = solved``."""
+
+    unknown: str
+    relation: str
+    equation: tuple[Node, Node]
+    solved: Node
+
+    def __str__(self) -> str:
+        lhs, rhs = (to_text(side) for side in self.equation)
+        return f"{self.unknown} = {to_text(self.solved)}    [{self.relation}: {lhs} = {rhs}]"
+
+
+@dataclass(frozen=True)
+class Check:
+    """A condition on the parameters (template units) that the physics needs."""
+
+    holds: Node
+    message: str
+    subject: Node | None = None
+
+
+@dataclass(frozen=True)
+class Undefined:
+    """When ``when`` holds, the answer has no value; ``reason`` says why."""
+
+    when: Node
+    reason: str
+
+
+@dataclass(frozen=True)
+class CompiledAnswer:
+    """An answer as a numeric tree over the parameters, or a symbolic tree."""
+
+    name: str
+    unit: str
+    numeric: Node | None
+    symbolic: Node | None
+    undefined: tuple[Undefined, ...] = ()
+
+
+@dataclass(frozen=True)
+class Compiled:
+    """Everything the kernels need for one template."""
+
+    template_id: str
+    source_hash: str
+    parameters: tuple[str, ...]
+    constants: Mapping[str, float]
+    steps: tuple[Step, ...]
+    checks: tuple[Check, ...]
+    answers: Mapping[str, CompiledAnswer]
+
+    def to_json(self) -> dict[str, Any]:
+        """A JSON-ready dictionary."""
+        def tree(node: Node | None) -> Any:
+            return None if node is None else to_json(node)
+        return {
+            "format": FORMAT, "template": self.template_id, "source_hash": self.source_hash,
+            "parameters": list(self.parameters), "constants": dict(self.constants),
+            "steps": [{"unknown": s.unknown, "relation": s.relation,
+                       "equation": [to_json(s.equation[0]), to_json(s.equation[1])],
+                       "solved": to_json(s.solved)} for s in self.steps],
+            "checks": [{"holds": to_json(c.holds), "message": c.message, "subject": tree(c.subject)}
+                       for c in self.checks],
+            "answers": {name: {"unit": a.unit, "numeric": tree(a.numeric), "symbolic": tree(a.symbolic),
+                               "undefined": [{"when": to_json(u.when), "reason": u.reason} for u in a.undefined]}
+                        for name, a in self.answers.items()},
+        }
+
+    @classmethod
+    def from_json(cls, data: Mapping[str, Any]) -> Compiled:
+        """Inverse of :meth:`to_json`."""
+        def tree(value: Any) -> Node | None:
+            return None if value is None else from_json(value)
+        return cls(
+            template_id=data["template"], source_hash=data["source_hash"],
+            parameters=tuple(data["parameters"]), constants=dict(data["constants"]),
+            steps=tuple(Step(s["unknown"], s["relation"], (from_json(s["equation"][0]), from_json(s["equation"][1])),
+                             from_json(s["solved"])) for s in data["steps"]),
+            checks=tuple(Check(from_json(c["holds"]), c["message"], tree(c["subject"])) for c in data["checks"]),
+            answers={name: CompiledAnswer(name, a["unit"], tree(a["numeric"]), tree(a["symbolic"]),
+                                          tuple(Undefined(from_json(u["when"]), u["reason"]) for u in a["undefined"]))
+                     for name, a in data["answers"].items()},
+        )

@@ -1,0 +1,265 @@
+"""From a scene and what is known, a chain of steps (one equation, one unknown each), compiled
+into expression trees over the parameters that the numpy kernels evaluate.
+
+Sympy does the algebra once per template; :mod:`grader.solve.cache` keeps the result, so a later run
+needs neither sympy nor this module.
+
+>>> from grader.bank.template import load_bank
+>>> compiled = compile_template(load_bank()["drop-rebound"])
+>>> [step.unknown for step in compiled.steps]
+['v_impact', 'T', 'v_after', 'e', 'E_lost', 'f_loss']
+>>> from grader.model.expr import to_text
+>>> to_text(compiled.answers["loss_pct"].numeric)
+'100*Max(0, h_drop - h_rebound)/h_drop'
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass
+from typing import Any
+
+import sympy as sp
+
+from grader.bank.template import Template
+from grader.errors import TemplateError
+from grader.model.units import Unit
+from grader.physics.effects import CATALOGUE, Relation
+from grader.physics.symbolic import Context, cosd, from_node, sind, to_node
+from grader.solve.compiled import Check, Compiled, CompiledAnswer, Step, Undefined
+from grader.solve.stable import stabilize
+
+
+@dataclass(frozen=True)
+class _Solved:
+    unknown: Any
+    relation: Relation
+    display: Any
+    numeric: Any
+
+
+def derive(relations: list[Relation], knowns: Iterable[Any], given: Iterable[Any]) -> list[_Solved]:
+    """Solve relations one unknown at a time, earliest relation first, as far as they go.
+
+    ``given`` are the knowns that are inputs (not derived): a stable form that asks for its
+    symbols to be given is used only then.
+    """
+    known, given_set = set(knowns), set(given)
+    used: set[int] = set()
+    chain: list[_Solved] = []
+    progress = True
+    while progress:
+        progress = False
+        for index, relation in enumerate(relations):
+            if index in used:
+                continue
+            unknowns = relation.symbols() - known
+            if not unknowns:
+                used.add(index)
+                continue
+            if len(unknowns) != 1:
+                continue
+            unknown = unknowns.pop()
+            display = _solve(relation, unknown)
+            if display is None:
+                continue
+            chain.append(_Solved(unknown, relation, display, _stable(relation, unknown, display, known, given_set)))
+            known.add(unknown)
+            used.add(index)
+            progress = True
+            break
+    return chain
+
+
+def _solve(relation: Relation, unknown: Any) -> Any:
+    if unknown in relation.solutions:
+        return relation.solutions[unknown]
+    if not relation.general:
+        return None
+    # The side without the unknown is solved for as a whole, so sqrt(2*g*h) stays as the
+    # effect wrote it (sympy would split it into sqrt(2)*sqrt(g)*sqrt(h)).
+    lhs, rhs = sp.sympify(relation.lhs), sp.sympify(relation.rhs)
+    if unknown in rhs.free_symbols and unknown not in lhs.free_symbols:
+        lhs, rhs = rhs, lhs
+    whole = sp.Dummy("whole", real=True) if unknown not in rhs.free_symbols else rhs
+    roots = [r.xreplace({whole: rhs}) for r in sp.solve(sp.Eq(lhs, whole), unknown)]
+    roots = [r for r in roots if r.is_real is not False]
+    if len(roots) > 1:
+        roots = [r for r in roots if all(
+            c.holds.subs(unknown, r) is not sp.false for c in relation.requires)]
+    return roots[0] if len(roots) == 1 else None
+
+
+def _stable(relation: Relation, unknown: Any, display: Any, known: set[Any], given: set[Any]) -> Any:
+    for form in relation.stable.get(unknown, ()):
+        needs_given = set().union(*(sp.sympify(g).free_symbols for g in form.given)) if form.given else set()
+        if sp.sympify(form.expr).free_symbols <= known and needs_given <= given:
+            return form.expr
+    return display
+
+
+class _Compiler:
+    """Compiles one template; holds its context and the unit substitutions."""
+
+    def __init__(self, template: Template) -> None:
+        self.template = template
+        self.ctx = Context(template.scene)
+        for name, parameter in template.parameters.items():
+            low = parameter.domain.low
+            positive = low > 0 or (low == 0 and parameter.domain.low_open)
+            assumptions = {"positive": True} if positive else {"nonnegative": True} if low >= 0 else {}
+            self.ctx.symbols[name] = sp.Symbol(name, real=True, **assumptions)
+        for name in template.symbols:
+            self.ctx.symbols[name] = sp.Symbol(name, positive=True)
+        self.relations = [r for stage in template.scene.stages
+                          for r in CATALOGUE[stage.effect].relations(stage, self.ctx)]
+        self.degree_angles = [self.ctx.symbols[n] for n, p in template.parameters.items() if p.unit.pi_power]
+        self.inputs = {self.ctx.symbols[n] for n in list(template.parameters) + list(template.symbols)}
+        if "g" in self.ctx.symbols:
+            self.inputs.add(self.ctx.symbols["g"])
+
+    def compile(self) -> Compiled:
+        chain = derive(self.relations, self.inputs, self.inputs)
+        wanted = {name: from_node(spec.value, self.ctx.symbols) for name, spec in self.template.answers.items()}
+        known = self.inputs | {s.unknown for s in chain}
+        for name, expr in wanted.items():
+            missing = expr.free_symbols - known
+            if missing:
+                raise TemplateError(self.template.where, f"answers.{name}",
+                                    "an answer the scene determines from the parameters",
+                                    f"nothing fixes {', '.join(sorted(map(str, missing)))}{self._coupled(known)}")
+        chain = _needed(chain, wanted.values())
+        composed: dict[Any, Any] = {}
+        for solved in chain:
+            # doit(): display forms keep sqrt(2*g*h) whole; the numeric composition wants it evaluated.
+            composed[solved.unknown] = solved.numeric.doit().xreplace(composed)
+        answers = {name: self._answer(name, expr, chain, composed) for name, expr in wanted.items()}
+        return Compiled(
+            template_id=self.template.id, source_hash=self.template.source_hash,
+            parameters=tuple(self.template.parameters),
+            constants={"g": float(self.template.scene.gravity.si)} if self.template.scene.gravity else {},
+            steps=tuple(self._step(s) for s in chain), checks=self._checks(composed), answers=answers)
+
+    def _coupled(self, known: set[Any]) -> str:
+        """Why the chain stopped: the unknowns the unused equations still tie together."""
+        left = [r.symbols() - known for r in self.relations if len(r.symbols() - known) > 1]
+        # An equation with an unknown no other equation has only ties that one up: drop it, repeat.
+        while True:
+            counts: dict[Any, int] = {}
+            for unknowns in left:
+                for symbol in unknowns:
+                    counts[symbol] = counts.get(symbol, 0) + 1
+            core = [u for u in left if all(counts[s] > 1 for s in u)]
+            if len(core) == len(left):
+                break
+            left = core
+        tied = sorted({str(s) for unknowns in left for s in unknowns})
+        if not tied:
+            return "; no stage involves it"
+        return (f"; the equations left tie {', '.join(tied)} together (two or more unknowns each) and the "
+                "solver takes one equation and one unknown at a time: give one of them as a parameter")
+
+    def _step(self, solved: _Solved) -> Step:
+        return Step(solved.unknown.name, solved.relation.label,
+                    (to_node(solved.relation.lhs), to_node(solved.relation.rhs)), to_node(solved.display))
+
+    def _answer(self, name: str, expr: Any, chain: list[_Solved], composed: Mapping[Any, Any]) -> CompiledAnswer:
+        spec = self.template.answers[name]
+        si = expr.xreplace(dict(composed))
+        in_units = self._user_units(si) / _si_factor(spec.unit)
+        undefined = tuple(
+            Undefined(self._tree_condition(self._user_units(cond.xreplace(dict(composed)))), reason)
+            for solved in _needed(chain, [expr]) for unknown, (cond, reason) in solved.relation.undefined.items()
+            if unknown == solved.unknown)
+        if spec.symbolic:
+            return CompiledAnswer(name, spec.unit.text, None, to_node(_tidy(sp.factor(sp.simplify(in_units)))),
+                                  undefined)
+        return CompiledAnswer(name, spec.unit.text, self._tree(in_units, name), None, undefined)
+
+    def _tree(self, expr: Any, name: str) -> Any:
+        """A numeric expression over parameters only, stabilised, as a tree."""
+        allowed = {self.ctx.symbols[p] for p in self.template.parameters} | {self.ctx.symbols.get("g")}
+        stable = stabilize(expr, self.degree_angles)
+        if stable.free_symbols - allowed:
+            stable = stabilize(sp.cancel(stable), self.degree_angles)
+        stray = stable.free_symbols - allowed
+        if stray:
+            raise TemplateError(self.template.where, f"answers.{name}", "a number once the parameters are given",
+                                f"an expression that still depends on {', '.join(sorted(map(str, stray)))}")
+        return to_node(stable)
+
+    def _user_units(self, expr: Any) -> Any:
+        """Rewrite an SI expression over SI-valued names into one over values in template units."""
+        scale = {}
+        for name, unit in [(n, p.unit) for n, p in self.template.parameters.items()] + [
+                (n, s.unit) for n, s in self.template.symbols.items()]:
+            factor = _si_factor(unit)
+            if factor != 1:
+                scale[self.ctx.symbols[name]] = self.ctx.symbols[name] * factor
+        converted = expr.xreplace(scale)
+        # Angles given in degrees stay in degrees inside sine and cosine: sind(90 - x) is exact.
+        converted = converted.replace(lambda e: isinstance(e, sp.sin), lambda e: sind(e.args[0] * 180 / sp.pi))
+        return converted.replace(lambda e: isinstance(e, sp.cos), lambda e: cosd(e.args[0] * 180 / sp.pi))
+
+    def _checks(self, composed: Mapping[Any, Any]) -> tuple[Check, ...]:
+        known = self.inputs | set(composed)
+        checks = []
+        for relation in self.relations:
+            if not relation.symbols() <= known:
+                continue
+            for condition in relation.requires:
+                holds = self._user_units(sp.sympify(condition.holds).xreplace(dict(composed)))
+                if holds is sp.true:
+                    continue
+                if holds is sp.false:
+                    raise TemplateError(self.template.where, "stages", "a scene that can hold",
+                                        f"a condition that never holds: {condition.message}")
+                subject = None
+                if condition.subject is not None:
+                    subject = self._tree(self._user_units(sp.sympify(condition.subject).xreplace(dict(composed))),
+                                         "(check)")
+                check = Check(self._tree_condition(holds), condition.message, subject)
+                if check not in checks:
+                    checks.append(check)
+        return tuple(checks)
+
+    def _tree_condition(self, holds: Any) -> Any:
+        difference = stabilize(holds.lhs - holds.rhs, self.degree_angles)
+        # Against zero, a positive factor changes nothing: 381*v*x/1250 > 0 is x > 0.
+        kept = [f for f in sp.Mul.make_args(difference) if not f.is_positive]
+        return to_node(type(holds)(sp.Mul(*kept), 0))
+
+
+def _si_factor(unit: Unit) -> Any:
+    """A unit's factor to SI as an exact sympy number (deg: pi/180), so conversions cancel exactly."""
+    return sp.Rational(unit.factor.numerator, unit.factor.denominator) * sp.pi**unit.pi_power
+
+
+def _needed(chain: list[_Solved], wanted: Iterable[Any]) -> list[_Solved]:
+    """The steps the wanted expressions depend on, in chain order."""
+    producer = {s.unknown: s for s in chain}
+    needed: set[Any] = set()
+    frontier = set().union(*(sp.sympify(w).free_symbols for w in wanted))
+    while frontier:
+        symbol = frontier.pop()
+        if symbol in producer and symbol not in needed:
+            needed.add(symbol)
+            step = producer[symbol]
+            frontier |= step.display.free_symbols | step.numeric.free_symbols
+    return [s for s in chain if s.unknown in needed]
+
+
+def _tidy(expr: Any) -> Any:
+    """Write ``-v*(e*p - 1)/(p + 1)`` as ``v*(1 - e*p)/(p + 1)``."""
+    if isinstance(expr, sp.Mul) and expr.could_extract_minus_sign():
+        factors = list(sp.Mul.make_args(-expr))
+        for index, factor in enumerate(factors):
+            if isinstance(factor, sp.Add):
+                factors[index] = sp.Add(*[-t for t in factor.args], evaluate=False)
+                return sp.Mul(*factors, evaluate=False)
+    return expr
+
+
+def compile_template(template: Template) -> Compiled:
+    """Derive and compile a template's answers (sympy; slow the first time, then cached)."""
+    return _Compiler(template).compile()

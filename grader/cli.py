@@ -9,7 +9,7 @@ from __future__ import annotations
 import argparse
 import difflib
 import json
-import re
+import math
 import sys
 from collections.abc import Sequence
 from pathlib import Path
@@ -17,12 +17,11 @@ from typing import Any
 
 from grader import __version__
 from grader.bank.template import Parameter, Template, load_bank
-from grader.errors import GraderError, UsageError
-from grader.files import open_csv
-from grader.model.units import parse_unit
+from grader.errors import GraderError, UsageError, shown
+from grader.inputs import read_csv
+from grader.model.units import parse_unit, split_quantity
 
 EXIT_OK, EXIT_USAGE, EXIT_REFUSED = 0, 2, 3
-_VALUE = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*(.*?)\s*$")
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -245,46 +244,42 @@ def _read_assignments(assignments: Sequence[str], template: Template) -> dict[st
 
 def _read_value(text: str, parameter: Parameter, where: str) -> float:
     """A number in the parameter's unit, or with another unit of the same kind (``2.1 m``)."""
-    match = _VALUE.match(text)
-    expected = f"a number in {parameter.unit.text}" if parameter.unit.text else "a number"
-    if not match:
-        raise GraderError(f"{where}: expected {expected}, got '{text}'")
-    number, unit_text = float(match.group(1)), match.group(2)
+    quantity = split_quantity(text)
+    expected = f"a finite number in {parameter.unit.text}" if parameter.unit.text else "a finite number"
+    if quantity is None:
+        raise GraderError(f"{where}: expected {expected}, got {shown(text.strip(), 40)}")
+    number, unit_text = quantity
     if not unit_text:
-        return number
+        return number + 0.0  # -0 is 0
     try:
         unit = parse_unit(unit_text)
-    except GraderError:
-        raise GraderError(f"{where}: expected {expected}, got '{text}'") from None
+    except GraderError as error:
+        raise GraderError(f"{where}: expected {expected}, got {shown(text.strip(), 40)} ({error})") from None
     if not unit.same_dimension(parameter.unit):
         raise GraderError(f"{where}: '{unit_text}' cannot be converted to {parameter.unit.text or 'a pure number'}")
-    return number * unit.to_si / parameter.unit.to_si
+    converted = number * unit.to_si / parameter.unit.to_si
+    if not math.isfinite(converted):
+        raise GraderError(f"{where}: expected {expected}, got {shown(text.strip(), 40)}")
+    return converted + 0.0
 
 
 def _read_batch(path: Path, template: Template) -> tuple[dict[str, Any], list[dict[str, str]], list[str | None]]:
-    reader = open_csv(path)
-    header = [h.strip() for h in (reader.fieldnames or [])]
-    if not header:
-        raise UsageError(f"{path}: empty file; expected a header of parameter names")
-    _check_names(header, template, str(path))
-    reader.fieldnames = header
-    table: dict[str, list[float]] = {name: [] for name in template.parameters}
-    raw_rows: list[dict[str, str]] = []
+    table = read_csv(path)
+    _check_names(table.header, template, str(path))
+    if not table.rows:
+        raise UsageError(f"{path}: no data rows; expected the header line, then one row of values per line")
+    columns: dict[str, list[float]] = {name: [] for name in template.parameters}
     errors: list[str | None] = []
-    for line, row in enumerate(reader, 2):
-        raw = {k: (v or "").strip() for k, v in row.items() if k is not None}
-        raw_rows.append(raw)
+    for row in table.rows:
         reason = None
         for name, parameter in template.parameters.items():
             try:
-                table[name].append(_read_value(raw.get(name, ""), parameter, f"line {line}, {name}"))
+                columns[name].append(_read_value(row.cells[name], parameter, f"line {row.line}, {name}"))
             except GraderError as problem:
-                table[name].append(float("nan"))
+                columns[name].append(math.nan)
                 reason = reason or str(problem)
-        if None in row:
-            reason = reason or f"line {line}: more cells than header columns"
         errors.append(reason)
-    return table, raw_rows, errors
+    return columns, [row.cells for row in table.rows], errors
 
 
 def _table(header: Sequence[str], rows: Sequence[Sequence[str]]) -> str:

@@ -11,6 +11,26 @@ grader.errors.TemplateError: bank/x.yaml: parameters.e.domain: expected an inter
 
 from __future__ import annotations
 
+import reprlib
+from typing import Any
+
+_SHOWN = reprlib.Repr()  # keyword arguments need Python 3.12
+_SHOWN.maxlevel, _SHOWN.maxstring, _SHOWN.maxother, _SHOWN.maxlong = 3, 60, 60, 40
+_SHOWN.maxdict = _SHOWN.maxlist = _SHOWN.maxtuple = _SHOWN.maxset = _SHOWN.maxfrozenset = 6
+
+
+def shown(value: Any, limit: int = 80) -> str:
+    """``repr`` of input for a message, cut to ``limit`` characters; bounded work whatever its size
+    (never ``repr`` an untrusted structure whole).
+
+    >>> shown(list(range(100)))
+    '[0, 1, 2, 3, 4, 5, ...]'
+    >>> len(shown("x" * 500)), len(shown({"title": "x" * 10**6}))
+    (60, 71)
+    """
+    text = _SHOWN.repr(value)
+    return text if len(text) <= limit else text[:limit - 3] + "..."
+
 
 class GraderError(Exception):
     """Base of every error caused by input a user can correct (exit code 2)."""

@@ -11,13 +11,9 @@ A failed run leaves either the old file or none, never half a file.
 
 from __future__ import annotations
 
-import csv
-import io
 import os
 import tempfile
 from pathlib import Path
-
-from grader.errors import GraderError
 
 
 def _umask() -> int:
@@ -47,16 +43,3 @@ def write_atomic(path: Path, text: str | bytes) -> None:
     except BaseException:
         Path(temporary).unlink(missing_ok=True)
         raise
-
-
-def open_csv(path: Path) -> csv.DictReader[str]:
-    """A CSV file as rows: UTF-8 with or without a byte-order mark; comma, semicolon or tab,
-    whichever the header line uses most. Errors name the file."""
-    try:
-        text = path.read_text(encoding="utf-8-sig")
-    except OSError as error:
-        raise GraderError(f"{path}: cannot read ({error.strerror})") from None
-    except UnicodeDecodeError:
-        raise GraderError(f"{path}: expected UTF-8 text") from None
-    header = text.split("\n", 1)[0]
-    return csv.DictReader(io.StringIO(text), delimiter=max(",;\t", key=header.count))

@@ -101,11 +101,13 @@ def test_file_level_problems_name_the_file(tmp_path: Path) -> None:
     """Bad YAML, a non-mapping, an id that is not the file name, duplicate ids."""
     cases = {"broken.yaml": "id: [unclosed", "list.yaml": "- a\n- b\n",
              "renamed.yaml": (bank_dir() / "drop-rebound.yaml").read_text(encoding="utf-8")}
-    expected = {"broken.yaml": "(file): expected valid YAML", "list.yaml": "(file): expected a mapping",
+    expected = {"broken.yaml": "expected valid YAML, got expected ',' or ']', but got '<stream end>' "
+                               "(line 1, column 14)",
+                "list.yaml": "(file): expected a mapping",
                 "renamed.yaml": "id: expected the file name's stem 'renamed'"}
     for name, text in cases.items():
         (tmp_path / name).write_text(text, encoding="utf-8")
-        with pytest.raises(TemplateError) as error:
+        with pytest.raises(GraderError) as error:
             load_template(tmp_path / name)
         assert str(error.value).startswith(str(tmp_path / name))
         assert expected[name] in str(error.value)

@@ -43,7 +43,7 @@ def test_values_with_their_own_units_are_converted(capsys: pytest.CaptureFixture
     (["solve", "pile-drivr", "--set", "m_ram=1"], "unknown template 'pile-drivr'; did you mean pile-driver?"),
     (["solve", "pile-driver", "--set", "m_ram=800"], "missing parameter(s) m_pile, h_drop, h_rebound"),
     (["solve", "pile-driver", *PILE, "--set", "mass=3"], "unknown parameter(s) mass"),
-    (["solve", "pile-driver", "--set", "m_ram=heavy", *PILE[2:]], "--set m_ram: expected a number in kg, got 'heavy'"),
+    (["solve", "pile-driver", "--set", "m_ram=heavy", *PILE[2:]], "--set m_ram: expected a finite number in kg, got 'heavy'"),
     (["solve", "pile-driver", "--set", "m_ram=800s", *PILE[2:]], "'s' cannot be converted to kg"),
     (["solve", "pile-driver", "--set", "m_ram", *PILE[2:]], "expected NAME=VALUE"),
     (["solve", "pile-driver", *PILE, "--set", "h_drop=3"], "h_drop is given twice"),
@@ -80,7 +80,7 @@ def test_batch_answers_every_row_in_order_and_exits_3_when_some_are_refused(
     assert [r["row"] for r in records] == [1, 2, 3, 4, 5]
     assert records[0]["answers"]["e"]["value"] == pytest.approx(0.7237, abs=1e-4)
     assert "cannot bounce higher" in records[1]["error"]
-    assert "expected a number in mm" in records[2]["error"]
+    assert "expected a finite number in mm" in records[2]["error"]
     assert "outside its domain (0, inf)" in records[3]["error"]
     assert records[4]["answers"]["e"]["value"] == 1.0
     assert records[4]["answers"]["loss_pct"]["value"] == 0.0

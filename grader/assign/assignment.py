@@ -11,16 +11,15 @@
 from __future__ import annotations
 
 import re
+import unicodedata
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-import yaml
-
 from grader.bank.template import Interval, Template, Tolerance
-from grader.errors import GraderError, TemplateError
-from grader.files import open_csv
+from grader.errors import GraderError, TemplateError, shown
+from grader.inputs import read_csv, read_yaml
 
 _KEY = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_-]{0,15}$")
 _ROSTER_COLUMNS = ("id", "name", "email", "section")
@@ -65,12 +64,7 @@ class Student:
 def load_assignment(path: Path) -> Assignment:
     """Read and validate an assignment file (problems are checked against the bank separately)."""
     where = str(path)
-    try:
-        raw = yaml.safe_load(path.read_text(encoding="utf-8-sig"))
-    except OSError as error:
-        raise GraderError(f"{where}: cannot read ({error.strerror})") from None
-    except yaml.YAMLError as error:
-        raise TemplateError(where, "(file)", "valid YAML", str(error).replace("\n", " ")) from None
+    raw = read_yaml(path)
     if not isinstance(raw, Mapping):
         raise TemplateError(where, "(file)", "a mapping with title, course, seed, problems", type(raw).__name__)
     allowed = {"title", "course", "seed", "due", "instructions", "problems"}
@@ -79,7 +73,7 @@ def load_assignment(path: Path) -> Assignment:
                             f"only {', '.join(sorted(allowed))}", "unknown key(s)")
     problems_raw = raw.get("problems")
     if not isinstance(problems_raw, list) or not problems_raw:
-        raise TemplateError(where, "problems", "a non-empty list of problems", repr(problems_raw))
+        raise TemplateError(where, "problems", "a non-empty list of problems", shown(problems_raw))
     problems = tuple(_problem(item, index, where) for index, item in enumerate(problems_raw))
     keys = [p.key for p in problems]
     duplicated = sorted({k for k in keys if keys.count(k) > 1})
@@ -87,7 +81,7 @@ def load_assignment(path: Path) -> Assignment:
         raise TemplateError(where, "problems", "a different key for each problem", f"{', '.join(duplicated)} twice")
     seed = raw.get("seed")
     if isinstance(seed, bool) or not isinstance(seed, (int, str)) or not str(seed).strip():
-        raise TemplateError(where, "seed", "a number or text (the assignment seed)", repr(seed))
+        raise TemplateError(where, "seed", "a number or text (the assignment seed)", shown(seed))
     return Assignment(where, _text(raw, "title", where), _text(raw, "course", where), str(seed).strip(),
                       _text(raw, "due", where, required=False), _text(raw, "instructions", where, required=False),
                       problems)
@@ -96,7 +90,7 @@ def load_assignment(path: Path) -> Assignment:
 def _text(raw: Mapping[str, Any], key: str, where: str, required: bool = True) -> str:
     value = raw.get(key, "" if not required else None)
     if not isinstance(value, (str, int, float)) or isinstance(value, bool) or (required and not str(value).strip()):
-        raise TemplateError(where, key, "text", repr(value))
+        raise TemplateError(where, key, "text", shown(value))
     return str(value).strip()
 
 
@@ -104,28 +98,29 @@ def _problem(raw: Any, index: int, where: str) -> ProblemSpec:
     key = f"problems[{index}]"
     allowed = {"key", "template", "points", "fixed", "narrow", "tolerance"}
     if not isinstance(raw, Mapping) or "template" not in raw or set(raw) - allowed:
-        raise TemplateError(where, key, f"a mapping with template and only {', '.join(sorted(allowed))}", repr(raw))
+        raise TemplateError(where, key, f"a mapping with template and only {', '.join(sorted(allowed))}", shown(raw))
     problem_key = str(raw.get("key", index + 1))
     if not _KEY.match(problem_key):
-        raise TemplateError(where, f"{key}.key", "a short label of letters and digits, like 1 or 2b", repr(problem_key))
+        raise TemplateError(where, f"{key}.key", "a short label of letters and digits, like 1 or 2b",
+                            shown(problem_key))
     points = raw.get("points", 1)
     if isinstance(points, (int, float)) and not isinstance(points, bool):
         points = {"*": points}
     if not isinstance(points, Mapping) or not all(_number(v) and v >= 0 for v in points.values()):
-        raise TemplateError(where, f"{key}.points", "a number, or answer name -> number (>= 0)", repr(points))
+        raise TemplateError(where, f"{key}.points", "a number, or answer name -> number (>= 0)", shown(points))
     fixed = raw.get("fixed") or {}
     if not isinstance(fixed, Mapping) or not all(_number(v) for v in fixed.values()):
-        raise TemplateError(where, f"{key}.fixed", "parameter name -> number", repr(fixed))
+        raise TemplateError(where, f"{key}.fixed", "parameter name -> number", shown(fixed))
     narrowed = raw.get("narrow") or {}
     if not isinstance(narrowed, Mapping) or not all(
             isinstance(v, list) and len(v) == 2 and all(_number(x) for x in v) and v[0] <= v[1]
             for v in narrowed.values()):
-        raise TemplateError(where, f"{key}.narrow", "parameter name -> [low, high] with low <= high", repr(narrowed))
+        raise TemplateError(where, f"{key}.narrow", "parameter name -> [low, high] with low <= high", shown(narrowed))
     tolerances = raw.get("tolerance") or {}
     if not isinstance(tolerances, Mapping) or not all(
             isinstance(v, Mapping) and set(v) <= {"rtol", "atol"} and all(_number(x) and x >= 0 for x in v.values())
             for v in tolerances.values()):
-        raise TemplateError(where, f"{key}.tolerance", "answer name -> {rtol: X, atol: Y}", repr(tolerances))
+        raise TemplateError(where, f"{key}.tolerance", "answer name -> {rtol: X, atol: Y}", shown(tolerances))
     return ProblemSpec(problem_key, str(raw["template"]), {str(k): float(v) for k, v in points.items()},
                        {str(k): float(v) for k, v in fixed.items()},
                        {str(k): (float(v[0]), float(v[1])) for k, v in narrowed.items()},
@@ -148,7 +143,7 @@ def check_against_bank(assignment: Assignment, bank: Mapping[str, Template]) -> 
             close = difflib.get_close_matches(problem.template, list(bank), n=3, cutoff=0.5)
             raise TemplateError(assignment.where, f"{key}.template", f"a template id of the bank"
                                 f"{' (did you mean ' + ' or '.join(close) + '?)' if close else ''}",
-                                repr(problem.template))
+                                shown(problem.template))
         template = bank[problem.template]
         for label, names in (("fixed", problem.fixed), ("narrow", problem.narrowed)):
             unknown = set(names) - set(template.parameters)
@@ -173,24 +168,34 @@ def _inside(domain: Interval, value: float, where: str, key: str) -> None:
 
 def load_roster(path: Path) -> tuple[Student, ...]:
     """Read a roster: columns id, name, email, section (UTF-8 with or without BOM; , ; or tab)."""
-    reader = open_csv(path)
-    header = [(h or "").strip().lower() for h in (reader.fieldnames or [])]
-    missing = [c for c in _ROSTER_COLUMNS if c not in header]
+    table = read_csv(path)
+    columns = {name.lower(): name for name in table.header}
+    missing = [c for c in _ROSTER_COLUMNS if c not in columns]
     if missing:
         raise GraderError(f"{path}: missing column(s) {', '.join(missing)}; expected a header with "
-                          f"{', '.join(_ROSTER_COLUMNS)} (got {', '.join(header) or 'nothing'})")
-    reader.fieldnames = header
+                          f"{', '.join(_ROSTER_COLUMNS)} (got {', '.join(table.header)})")
     students, seen = [], set()
-    for line, row in enumerate(reader, 2):
-        values = {c: (row.get(c) or "").strip() for c in _ROSTER_COLUMNS}
-        if not any(values.values()):
-            continue
-        if not values["id"]:
-            raise GraderError(f"{path}: line {line}: empty student id (every student needs one)")
+    for row in table.rows:
+        values = {c: row.cells[columns[c]] for c in _ROSTER_COLUMNS}
+        _check_id(values["id"], f"{path}: line {row.line}")
         if values["id"] in seen:
-            raise GraderError(f"{path}: line {line}: student id '{values['id']}' appears twice")
+            raise GraderError(f"{path}: line {row.line}: student id '{values['id']}' appears twice")
         seen.add(values["id"])
         students.append(Student(values["id"], values["name"], values["email"], values["section"]))
     if not students:
         raise GraderError(f"{path}: the roster has no students")
     return tuple(students)
+
+
+def _check_id(student_id: str, where: str) -> None:
+    """An id names files and matches submissions: printable, not a path's ``.``/``..``."""
+    if not student_id:
+        raise GraderError(f"{where}: empty student id (every student needs one)")
+    hidden = next((c for c in student_id if unicodedata.category(c)[0] in "CZ" and c != " "), None)
+    if hidden is not None:
+        raise GraderError(f"{where}: student id {shown(student_id)} holds the invisible or control character "
+                          f"U+{ord(hidden):04X} ({unicodedata.name(hidden, 'unnamed')}); expected visible "
+                          "characters (letters, digits, punctuation, spaces)")
+    if set(student_id) == {"."}:
+        raise GraderError(f"{where}: student id {shown(student_id)} would name a hidden or parent folder; "
+                          "expected letters or digits")

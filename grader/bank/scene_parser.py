@@ -13,7 +13,7 @@ import re
 from collections.abc import Mapping
 from typing import Any
 
-from grader.errors import ExpressionError, TemplateError
+from grader.errors import ExpressionError, TemplateError, shown
 from grader.model.expr import Node, names, parse
 from grader.model.scene import Body, Gravity, Scene, Stage, Velocity
 from grader.physics.effects import CATALOGUE, Effect, Field
@@ -26,39 +26,39 @@ def parse_scene(raw: Mapping[str, Any], where: str, gravity: Gravity | None) -> 
     bodies = _parse_bodies(raw.get("bodies"), where)
     stages_raw = raw.get("stages")
     if not isinstance(stages_raw, list) or not stages_raw:
-        raise TemplateError(where, "stages", "a non-empty list of stages", repr(stages_raw))
+        raise TemplateError(where, "stages", "a non-empty list of stages", shown(stages_raw))
     stages = tuple(_parse_stage(item, index, where, bodies) for index, item in enumerate(stages_raw))
     return Scene(where, bodies, stages, gravity)
 
 
 def _parse_bodies(raw: Any, where: str) -> dict[str, Body]:
     if not isinstance(raw, Mapping) or not raw:
-        raise TemplateError(where, "bodies", "a mapping of body names to {mass: ...} or {fixed: true}", repr(raw))
+        raise TemplateError(where, "bodies", "a mapping of body names to {mass: ...} or {fixed: true}", shown(raw))
     bodies = {}
     for name, spec in raw.items():
         key = f"bodies.{name}"
         if not IDENTIFIER.match(str(name)):
-            raise TemplateError(where, key, "a name of letters, digits and _", repr(name))
+            raise TemplateError(where, key, "a name of letters, digits and _", shown(name))
         if not isinstance(spec, Mapping) or set(spec) - {"mass", "fixed", "radius"}:
-            raise TemplateError(where, key, "{mass: EXPR} or {fixed: true}", repr(spec))
+            raise TemplateError(where, key, "{mass: EXPR} or {fixed: true}", shown(spec))
         if spec.get("fixed") is True:
             if "mass" in spec:
-                raise TemplateError(where, key, "either a mass or fixed: true, not both", repr(spec))
+                raise TemplateError(where, key, "either a mass or fixed: true, not both", shown(spec))
             bodies[name] = Body(name, None)
         elif "mass" in spec:
             bodies[name] = Body(name, _expr(spec["mass"], where, f"{key}.mass"))
         else:
-            raise TemplateError(where, key, "a mass or fixed: true", repr(spec))
+            raise TemplateError(where, key, "a mass or fixed: true", shown(spec))
     return bodies
 
 
 def _parse_stage(raw: Any, index: int, where: str, bodies: Mapping[str, Body]) -> Stage:
     key = f"stages[{index}]"
     if not isinstance(raw, Mapping) or "effect" not in raw:
-        raise TemplateError(where, key, "a mapping with an 'effect' key", repr(raw))
+        raise TemplateError(where, key, "a mapping with an 'effect' key", shown(raw))
     effect = CATALOGUE.get(raw["effect"])
     if effect is None:
-        raise TemplateError(where, f"{key}.effect", f"one of {', '.join(sorted(CATALOGUE))}", repr(raw["effect"]))
+        raise TemplateError(where, f"{key}.effect", f"one of {', '.join(sorted(CATALOGUE))}", shown(raw["effect"]))
     allowed = {f.name for f in effect.fields} | {"effect"}
     unknown = set(raw) - allowed
     if unknown:
@@ -76,32 +76,32 @@ def _parse_stage(raw: Any, index: int, where: str, bodies: Mapping[str, Body]) -
     stage = Stage(index, effect.name, fields, source, frozenset(_quantities(effect, fields)))
     if "bodies" in fields and bodies[fields["bodies"][0]].mass is None:
         raise TemplateError(where, f"{key}.bodies", "the first body to be movable (list the fixed one second)",
-                            repr(list(fields["bodies"])))
+                            shown(list(fields["bodies"])))
     return stage
 
 
 def _parse_field(spec: Field, value: Any, where: str, key: str, bodies: Mapping[str, Body]) -> Any:
     if spec.kind == "body":
         if value not in bodies:
-            raise TemplateError(where, key, f"one of the bodies ({', '.join(bodies)})", repr(value))
+            raise TemplateError(where, key, f"one of the bodies ({', '.join(bodies)})", shown(value))
         return value
     if spec.kind == "bodies":
         if not (isinstance(value, list) and len(value) == 2 and all(v in bodies for v in value)
                 and value[0] != value[1]):
-            raise TemplateError(where, key, f"two different bodies from ({', '.join(bodies)})", repr(value))
+            raise TemplateError(where, key, f"two different bodies from ({', '.join(bodies)})", shown(value))
         return tuple(value)
     if spec.kind == "name":
         if not (isinstance(value, str) and IDENTIFIER.match(value)):
-            raise TemplateError(where, key, "a quantity name of letters, digits and _", repr(value))
+            raise TemplateError(where, key, "a quantity name of letters, digits and _", shown(value))
         return value
     if spec.kind.startswith("choice:"):
         options = spec.kind.split(":", 1)[1].split("|")
         if value not in options:
-            raise TemplateError(where, key, f"one of {', '.join(options)}", repr(value))
+            raise TemplateError(where, key, f"one of {', '.join(options)}", shown(value))
         return value
     if spec.kind == "flag":
         if not isinstance(value, bool):
-            raise TemplateError(where, key, "true or false", repr(value))
+            raise TemplateError(where, key, "true or false", shown(value))
         return value
     if spec.kind == "velocities":
         return _parse_velocities(value, where, key, bodies)
@@ -110,16 +110,16 @@ def _parse_field(spec: Field, value: Any, where: str, key: str, bodies: Mapping[
 
 def _parse_velocities(value: Any, where: str, key: str, bodies: Mapping[str, Body]) -> dict[str, Velocity]:
     if not isinstance(value, Mapping):
-        raise TemplateError(where, key, "a mapping of body name to velocity", repr(value))
+        raise TemplateError(where, key, "a mapping of body name to velocity", shown(value))
     result = {}
     for body, given in value.items():
         if body not in bodies:
-            raise TemplateError(where, f"{key}.{body}", f"one of the bodies ({', '.join(bodies)})", repr(body))
+            raise TemplateError(where, f"{key}.{body}", f"one of the bodies ({', '.join(bodies)})", shown(body))
         if bodies[body].mass is None:
-            raise TemplateError(where, f"{key}.{body}", "no velocity for a fixed body (it stays at rest)", repr(given))
+            raise TemplateError(where, f"{key}.{body}", "no velocity for a fixed body (it stays at rest)", shown(given))
         if isinstance(given, Mapping):
             if set(given) - {"n", "t"} or "n" not in given:
-                raise TemplateError(where, f"{key}.{body}", "{n: EXPR, t: EXPR}", repr(given))
+                raise TemplateError(where, f"{key}.{body}", "{n: EXPR, t: EXPR}", shown(given))
             t = _expr(given["t"], where, f"{key}.{body}.t") if "t" in given else None
             result[body] = Velocity(_expr(given["n"], where, f"{key}.{body}.n"), t)
         else:
@@ -129,11 +129,11 @@ def _parse_velocities(value: Any, where: str, key: str, bodies: Mapping[str, Bod
 
 def _expr(value: Any, where: str, key: str) -> Node:
     if isinstance(value, bool) or not isinstance(value, (str, int, float)):
-        raise TemplateError(where, key, "an expression (text or number)", repr(value))
+        raise TemplateError(where, key, "an expression (text or number)", shown(value))
     try:
         return parse(str(value))
     except ExpressionError as error:
-        raise TemplateError(where, key, "a valid expression", f"{value!r} ({error})") from None
+        raise TemplateError(where, key, "a valid expression", f"{shown(value)} ({error})") from None
 
 
 def _quantities(effect: Effect, fields: Mapping[str, Any]) -> set[str]:

@@ -16,10 +16,9 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-import yaml
-
 from grader.bank.scene_parser import IDENTIFIER, parse_scene
-from grader.errors import ExpressionError, GraderError, TemplateError
+from grader.errors import ExpressionError, GraderError, TemplateError, shown
+from grader.inputs import YAML_BYTES, parse_yaml, read_bytes
 from grader.model.expr import Node, Op, names, parse
 from grader.model.scene import Gravity, Scene
 from grader.model.units import Unit, parse_unit
@@ -49,10 +48,10 @@ class Interval:
         """Read ``[a, b]``, ``(a, b)``, ``[a, inf)`` and mixed forms."""
         match = _INTERVAL.match(str(text))
         if not match:
-            raise TemplateError(where, key, "an interval like '[0, 1]' or '(0, inf)'", repr(text))
+            raise TemplateError(where, key, "an interval like '[0, 1]' or '(0, inf)'", shown(text))
         low, high = float(match.group(2)), float(match.group(3))
         if not low < high:
-            raise TemplateError(where, key, "an interval with low < high", repr(text))
+            raise TemplateError(where, key, "an interval with low < high", shown(text))
         return cls(low, high, match.group(1) == "(", match.group(4) == ")")
 
     def contains(self, value: Any) -> Any:
@@ -153,7 +152,7 @@ def load_bank(directory: Path | None = None) -> dict[str, Template]:
     for path in sorted(folder.glob("*.yaml")):
         template = load_template(path)
         if template.id in templates:
-            raise TemplateError(str(path), "id", "an id no other template uses", repr(template.id))
+            raise TemplateError(str(path), "id", "an id no other template uses", shown(template.id))
         templates[template.id] = template
     return templates
 
@@ -161,13 +160,8 @@ def load_bank(directory: Path | None = None) -> dict[str, Template]:
 def load_template(path: Path) -> Template:
     """Read, parse and validate one template file."""
     where = str(path)
-    try:
-        data = path.read_bytes()
-        raw = yaml.safe_load(data)
-    except OSError as error:
-        raise GraderError(f"{where}: cannot read ({error.strerror})") from None
-    except yaml.YAMLError as error:
-        raise TemplateError(where, "(file)", "valid YAML", str(error).replace("\n", " ")) from None
+    data = read_bytes(path, YAML_BYTES)
+    raw = parse_yaml(data, path)
     if not isinstance(raw, Mapping):
         raise TemplateError(where, "(file)", "a mapping of template keys", type(raw).__name__)
     return parse_template(raw, where, hashlib.sha256(data).hexdigest(), path.stem)
@@ -181,18 +175,18 @@ def parse_template(raw: Mapping[str, Any], where: str, source_hash: str, stem: s
                             f"only the keys {', '.join(sorted(_TOP_KEYS))}", "unknown key(s)")
     template_id = _text(raw, "id", where)
     if not re.match(r"^[a-z0-9][a-z0-9-]*$", template_id):
-        raise TemplateError(where, "id", "lower-case letters, digits and -", repr(template_id))
+        raise TemplateError(where, "id", "lower-case letters, digits and -", shown(template_id))
     if stem is not None and stem != template_id:
-        raise TemplateError(where, "id", f"the file name's stem '{stem}'", repr(template_id))
+        raise TemplateError(where, "id", f"the file name's stem '{stem}'", shown(template_id))
     version = raw.get("version")
     if not isinstance(version, int) or isinstance(version, bool) or version < 1:
-        raise TemplateError(where, "version", "a whole number >= 1", repr(version))
+        raise TemplateError(where, "version", "a whole number >= 1", shown(version))
     gravity = _gravity(raw.get("gravity"), where)
     parameters = {name: _parameter(name, spec, where) for name, spec in _mapping(raw, "parameters", where).items()}
     symbols = {name: _symbol(name, spec, where) for name, spec in (raw.get("symbols") or {}).items()}
     for name in list(parameters) + list(symbols):
         if not IDENTIFIER.match(name) or name in RESERVED:
-            raise TemplateError(where, name, "a name of letters, digits and _, not g or pi", repr(name))
+            raise TemplateError(where, name, "a name of letters, digits and _, not g or pi", shown(name))
     both = set(parameters) & set(symbols)
     if both:
         raise TemplateError(where, "symbols", "names not also parameters", ", ".join(sorted(both)))
@@ -253,14 +247,14 @@ def _check_statement(template: Template, given: set[str]) -> None:
 def _text(raw: Mapping[str, Any], key: str, where: str) -> str:
     value = raw.get(key)
     if not isinstance(value, str) or not value.strip():
-        raise TemplateError(where, key, "non-empty text", repr(value))
+        raise TemplateError(where, key, "non-empty text", shown(value))
     return value.strip()
 
 
 def _mapping(raw: Mapping[str, Any], key: str, where: str) -> Mapping[str, Any]:
     value = raw.get(key)
     if not isinstance(value, Mapping) or not value:
-        raise TemplateError(where, key, "a non-empty mapping", repr(value))
+        raise TemplateError(where, key, "a non-empty mapping", shown(value))
     return value
 
 
@@ -278,7 +272,7 @@ def _gravity(text: Any, where: str) -> Gravity | None:
     unit = _unit(match.group(2), where, "gravity") if match else None
     if not match or unit is None or unit.dimension != (1, 0, -2, 0) or float(match.group(1)) <= 0:
         raise TemplateError(where, "gravity", "a positive acceleration like '9.81 m/s^2' or '32.2 ft/s^2'",
-                            repr(text))
+                            shown(text))
     from fractions import Fraction
     return Gravity(Fraction(match.group(1)) * unit.factor, str(text).strip())
 
@@ -286,7 +280,7 @@ def _gravity(text: Any, where: str) -> Gravity | None:
 def _parameter(name: str, spec: Any, where: str) -> Parameter:
     key = f"parameters.{name}"
     if not isinstance(spec, Mapping):
-        raise TemplateError(where, key, "a mapping with unit, domain, sample and decimals or sig_figs", repr(spec))
+        raise TemplateError(where, key, "a mapping with unit, domain, sample and decimals or sig_figs", shown(spec))
     allowed = {"unit", "domain", "sample", "decimals", "sig_figs", "description"}
     if set(spec) - allowed:
         raise TemplateError(where, key, f"only {', '.join(sorted(allowed))}",
@@ -296,10 +290,10 @@ def _parameter(name: str, spec: Any, where: str) -> Parameter:
     decimals, sig_figs = spec.get("decimals"), spec.get("sig_figs")
     if (decimals is None) == (sig_figs is None):
         raise TemplateError(where, key, "exactly one of decimals or sig_figs (the printed precision)",
-                            f"decimals={decimals!r}, sig_figs={sig_figs!r}")
+                            f"decimals={shown(decimals)}, sig_figs={shown(sig_figs)}")
     for label, value, least in (("decimals", decimals, 0), ("sig_figs", sig_figs, 1)):
         if value is not None and (not isinstance(value, int) or isinstance(value, bool) or not least <= value <= 15):
-            raise TemplateError(where, f"{key}.{label}", f"a whole number from {least} to 15", repr(value))
+            raise TemplateError(where, f"{key}.{label}", f"a whole number from {least} to 15", shown(value))
     return Parameter(name, _unit(spec.get("unit"), where, f"{key}.unit"), domain, sample, decimals, sig_figs,
                      str(spec.get("description", name)))
 
@@ -308,15 +302,15 @@ def _sampling(spec: Any, where: str, key: str, domain: Interval) -> Sampling:
     kinds = ("uniform", "log_uniform", "choice")
     if not isinstance(spec, Mapping) or len(spec) != 1 or next(iter(spec)) not in kinds:
         raise TemplateError(where, key, "one of {uniform: [a, b]}, {log_uniform: [a, b]}, {choice: [x, ...]}",
-                            repr(spec))
+                            shown(spec))
     kind, values = next(iter(spec.items()))
     if not isinstance(values, list) or not values or not all(
             isinstance(v, (int, float)) and not isinstance(v, bool) for v in values):
-        raise TemplateError(where, f"{key}.{kind}", "a list of numbers", repr(values))
+        raise TemplateError(where, f"{key}.{kind}", "a list of numbers", shown(values))
     if kind != "choice" and (len(values) != 2 or not values[0] < values[1]):
-        raise TemplateError(where, f"{key}.{kind}", "[low, high] with low < high", repr(values))
+        raise TemplateError(where, f"{key}.{kind}", "[low, high] with low < high", shown(values))
     if kind == "log_uniform" and values[0] <= 0:
-        raise TemplateError(where, f"{key}.{kind}", "a positive range for log_uniform", repr(values))
+        raise TemplateError(where, f"{key}.{kind}", "a positive range for log_uniform", shown(values))
     outside = [v for v in values if not domain.contains(float(v))]
     if outside:
         raise TemplateError(where, f"{key}.{kind}", f"values inside the domain {domain}",
@@ -326,18 +320,18 @@ def _sampling(spec: Any, where: str, key: str, domain: Interval) -> Sampling:
 
 def _symbol(name: str, spec: Any, where: str) -> SymbolSpec:
     if not isinstance(spec, Mapping) or set(spec) - {"unit", "description"}:
-        raise TemplateError(where, f"symbols.{name}", "{unit: ..., description: ...}", repr(spec))
+        raise TemplateError(where, f"symbols.{name}", "{unit: ..., description: ...}", shown(spec))
     return SymbolSpec(name, _unit(spec.get("unit"), where, f"symbols.{name}.unit"),
                       str(spec.get("description", name)))
 
 
 def _tolerance(spec: Any, where: str, key: str, default: Tolerance) -> Tolerance:
     if not isinstance(spec, Mapping) or set(spec) - {"rtol", "atol"}:
-        raise TemplateError(where, key, "{rtol: X, atol: Y}", repr(spec))
+        raise TemplateError(where, key, "{rtol: X, atol: Y}", shown(spec))
     values = {k: spec.get(k, getattr(default, k)) for k in ("rtol", "atol")}
     for k, value in values.items():
         if isinstance(value, bool) or not isinstance(value, (int, float)) or not 0 <= value < 1e300:
-            raise TemplateError(where, f"{key}.{k}", "a number >= 0", repr(value))
+            raise TemplateError(where, f"{key}.{k}", "a number >= 0", shown(value))
     return Tolerance(float(values["rtol"]), float(values["atol"]))
 
 
@@ -345,10 +339,10 @@ def _answer(name: str, spec: Any, where: str, default: Tolerance) -> AnswerSpec:
     key = f"answers.{name}"
     allowed = {"value", "unit", "description", "tolerance", "symbolic"}
     if not isinstance(spec, Mapping) or "value" not in spec or set(spec) - allowed:
-        raise TemplateError(where, key, f"a mapping with value and only {', '.join(sorted(allowed))}", repr(spec))
+        raise TemplateError(where, key, f"a mapping with value and only {', '.join(sorted(allowed))}", shown(spec))
     symbolic = spec.get("symbolic") or []
     if not isinstance(symbolic, list) or not all(isinstance(s, str) for s in symbolic):
-        raise TemplateError(where, f"{key}.symbolic", "a list of names", repr(symbolic))
+        raise TemplateError(where, f"{key}.symbolic", "a list of names", shown(symbolic))
     return AnswerSpec(name, _parse(spec["value"], where, f"{key}.value"),
                       _unit(spec.get("unit"), where, f"{key}.unit"), str(spec.get("description", name)),
                       _tolerance(spec.get("tolerance", {}), where, f"{key}.tolerance", default), tuple(symbolic))
@@ -357,10 +351,10 @@ def _answer(name: str, spec: Any, where: str, default: Tolerance) -> AnswerSpec:
 def _constraint(index: int, spec: Any, where: str) -> Constraint:
     key = f"constraints[{index}]"
     if not isinstance(spec, Mapping) or set(spec) != {"require", "message"}:
-        raise TemplateError(where, key, "{require: EXPR, message: TEXT}", repr(spec))
+        raise TemplateError(where, key, "{require: EXPR, message: TEXT}", shown(spec))
     holds = _parse(spec["require"], where, f"{key}.require", compare=True)
     if not (isinstance(holds, Op) and holds.op in ("lt", "le", "gt", "ge", "and", "or")):
-        raise TemplateError(where, f"{key}.require", "a comparison like 'h_rebound <= h_drop'", repr(spec["require"]))
+        raise TemplateError(where, f"{key}.require", "a comparison like 'h_rebound <= h_drop'", shown(spec["require"]))
     return Constraint(holds, str(spec["require"]), str(spec["message"]))
 
 
@@ -368,10 +362,10 @@ def _parse(text: Any, where: str, key: str, compare: bool = False) -> Node:
     try:
         return parse(str(text), allow_compare=compare)
     except ExpressionError as error:
-        raise TemplateError(where, key, "a valid expression", f"{text!r} ({error})") from None
+        raise TemplateError(where, key, "a valid expression", f"{shown(text)} ({error})") from None
 
 
 def _example(raw: Any, parameters: Mapping[str, Parameter], where: str) -> dict[str, float]:
     if not isinstance(raw, Mapping) or set(raw) - set(parameters):
-        raise TemplateError(where, "example", "a mapping of parameter names to values", repr(raw))
+        raise TemplateError(where, "example", "a mapping of parameter names to values", shown(raw))
     return {k: float(v) for k, v in raw.items()}

@@ -17,6 +17,7 @@ grader.errors.GraderError: unknown unit 'furlong' in 'furlong' (known: %, cm, de
 
 from __future__ import annotations
 
+import math
 import re
 from dataclasses import dataclass
 from fractions import Fraction
@@ -55,6 +56,9 @@ _BASE: dict[str, tuple[Fraction, int, tuple[int, int, int, int]]] = {
 }
 _ALIASES = {"°": "deg", "mph": "mi/h", "km/hr": "km/h", "sec": "s", "ft-lb": "ft*lbf", "ft*lb": "ft*lbf"}
 _TOKEN = re.compile(r"\s*([*/])?\s*([A-Za-z%°]+|1)\s*(?:(?:\^|\*\*)\s*(-?\d+))?\s*")
+_NUMBER = re.compile(r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?")
+MAX_POWER = 9  # no unit of mechanics needs more; bounds the exact factor's size
+MAX_TEXT = 100  # characters of a number with its unit
 
 
 @dataclass(frozen=True)
@@ -69,7 +73,6 @@ class Unit:
     @property
     def to_si(self) -> float:
         """The conversion factor to SI as a float (deg -> rad included)."""
-        import math
         return float(self.factor) * math.pi ** self.pi_power
 
     def same_dimension(self, other: Unit) -> bool:
@@ -79,6 +82,8 @@ class Unit:
 
 def parse_unit(text: str) -> Unit:
     """Parse ``m``, ``m/s``, ``m/s^2``, ``kg*m/s``, ``deg``, ``%``; empty means dimensionless."""
+    if len(text) > MAX_TEXT:
+        raise GraderError(f"a unit of {len(text):,} characters; expected at most {MAX_TEXT}")
     cleaned = _ALIASES.get(text.strip(), text.strip())
     if cleaned in ("", "-"):
         cleaned = "1"
@@ -96,6 +101,9 @@ def parse_unit(text: str) -> Unit:
                               "powers of them)")
         base_factor, base_pi, base_dimension = _BASE[name]
         power = int(power_text or 1) * (-1 if operator == "/" else 1)
+        if abs(power) > MAX_POWER:
+            raise GraderError(f"the power {power} in '{text}' is beyond what a unit of mechanics needs; "
+                              f"expected powers from -{MAX_POWER} to {MAX_POWER}")
         factor *= base_factor ** power
         pi_power += base_pi * power
         dimension = [d + b * power for d, b in zip(dimension, base_dimension, strict=True)]
@@ -104,3 +112,18 @@ def parse_unit(text: str) -> Unit:
 
 
 DIMENSIONLESS = parse_unit("")
+
+
+def split_quantity(text: str) -> tuple[float, str] | None:
+    """A number and the unit text after it (``"2.1 m"`` -> ``(2.1, "m")``), or None when the text
+    does not start with a finite float64 number or is longer than ``MAX_TEXT``. Linear in the text.
+
+    >>> split_quantity(" 2.1e3 mm "), split_quantity("1e309"), split_quantity("abc")
+    ((2100.0, 'mm'), None, None)
+    """
+    text = text.strip()
+    match = _NUMBER.match(text) if len(text) <= MAX_TEXT else None
+    if match is None:
+        return None
+    value = float(match.group())
+    return (value, text[match.end():].strip()) if math.isfinite(value) else None

@@ -1,0 +1,270 @@
+"""Reading the files users hand us (templates, assignments, rosters, batch CSVs), with bounds.
+
+Every reader names the file and the line of a problem, and refuses what could hang or exhaust
+memory before it does: files over a size limit, YAML aliases that expand beyond a small budget,
+nesting too deep, duplicate keys (YAML's "last one wins" silently drops the first), numbers
+beyond float64, NUL bytes and cells too long to be an answer.
+
+>>> import tempfile, pathlib
+>>> folder = pathlib.Path(tempfile.mkdtemp())
+>>> _ = (folder / "a.yaml").write_text("h: 1e308\\nlist: [1, 2]\\n")
+>>> read_yaml(folder / "a.yaml")
+{'h': 1e+308, 'list': [1, 2]}
+>>> _ = (folder / "b.yaml").write_text("h: 1\\nh: 2\\n")
+>>> read_yaml(folder / "b.yaml")
+Traceback (most recent call last):
+...
+grader.errors.GraderError: ...b.yaml: line 2: the key 'h' appears twice (expected each key once)
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import math
+import re
+from collections.abc import Hashable, Iterator
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import yaml
+
+from grader.errors import GraderError, shown
+
+YAML_BYTES = 1 << 20  # 1 MiB: a template or an assignment is a few kB
+CSV_BYTES = 64 << 20  # 64 MiB: 100,000 rows of 50 cells
+CELL_CHARS = 1000  # no answer, id or parameter value is longer
+YAML_NODES = 100_000  # nodes after alias expansion
+YAML_DEPTH = 64
+
+
+def read_bytes(path: Path, limit: int) -> bytes:
+    """A file's bytes, refused beyond ``limit`` (read no further: ``/dev/zero`` is a file too)."""
+    try:
+        with open(path, "rb") as stream:
+            data = stream.read(limit + 1)
+    except OSError as error:
+        raise GraderError(f"{path}: cannot read ({error.strerror or error})") from None
+    if len(data) > limit:
+        raise GraderError(f"{path}: larger than {limit >> 20 or 1} MiB; expected a text file of ordinary size")
+    return data
+
+
+def decode_text(data: bytes, path: Path) -> str:
+    """UTF-8 text (a byte-order mark is dropped); NUL bytes are refused as binary data."""
+    try:
+        text = data.decode("utf-8-sig")
+    except UnicodeDecodeError as error:
+        line = data[:error.start].count(b"\n") + 1
+        raise GraderError(f"{path}: line {line}: expected UTF-8 text, got the byte 0x{data[error.start]:02x} "
+                          "(save the file as UTF-8)") from None
+    if "\0" in text:
+        line = text[:text.index("\0")].count("\n") + 1
+        raise GraderError(f"{path}: line {line}: expected text, got a NUL byte (is this a binary file?)")
+    return text
+
+
+# --- YAML ---------------------------------------------------------------------------------------
+
+_FLOAT_12 = re.compile(r"^[-+]?(?:[0-9][0-9_]*(?:\.[0-9_]*)?|\.[0-9_]+)(?:[eE][-+]?[0-9]+)?$")
+
+
+class _Loader(yaml.SafeLoader):
+    """PyYAML's safe loader, bounded: depth, expanded size, duplicate keys, finite numbers; and
+    YAML 1.2 floats, so ``1e308`` is a number as every other reader takes it, not text."""
+
+    def __init__(self, stream: str) -> None:
+        super().__init__(stream)
+        self._depth = 0
+
+    def compose_node(self, parent: Any, index: Any) -> Any:
+        self._depth += 1
+        if self._depth > YAML_DEPTH:
+            mark = self.peek_event().start_mark  # type: ignore[no-untyped-call]
+            raise GraderError(f"line {mark.line + 1}: nested deeper than {YAML_DEPTH} levels; expected a "
+                              "template-sized structure")
+        try:
+            return super().compose_node(parent, index)
+        finally:
+            self._depth -= 1
+
+    def get_single_node(self) -> Any:
+        node = super().get_single_node()
+        if node is not None:
+            _check_expanded_size(node)
+        return node
+
+    def construct_mapping(self, node: Any, deep: bool = False) -> dict[Hashable, Any]:
+        seen: set[Any] = set()
+        for key_node, _ in node.value:
+            key = self.construct_object(key_node, deep=True)
+            if isinstance(key, Hashable) and key in seen:
+                raise GraderError(f"line {key_node.start_mark.line + 1}: the key {shown(key)} appears twice "
+                                  "(expected each key once)")
+            seen.add(key if isinstance(key, Hashable) else id(key))
+        return super().construct_mapping(node, deep=deep)
+
+    def construct_yaml_int(self, node: Any) -> int:
+        value: int = super().construct_yaml_int(node)
+        _check_finite(value, node)
+        return value
+
+    def construct_yaml_float(self, node: Any) -> float:
+        value: float = super().construct_yaml_float(node)
+        _check_finite(value, node)
+        return value
+
+
+_Loader.add_constructor("tag:yaml.org,2002:int", _Loader.construct_yaml_int)
+_Loader.add_constructor("tag:yaml.org,2002:float", _Loader.construct_yaml_float)
+_Loader.add_implicit_resolver("tag:yaml.org,2002:float", _FLOAT_12, list("-+0123456789."))
+
+
+def _check_finite(value: float, node: Any) -> None:
+    try:
+        finite = math.isfinite(float(value))
+    except OverflowError:
+        finite = False
+    if not finite:
+        raise GraderError(f"line {node.start_mark.line + 1}: expected a finite number within float64 "
+                          f"(about ±1.8e308), got {shown(node.value)}")
+
+
+def _check_expanded_size(root: Any) -> None:
+    """Count the nodes the document expands to, aliases included, without expanding it."""
+    sizes: dict[int, int] = {}
+    stack: list[tuple[Any, bool]] = [(root, False)]
+    while stack:
+        node, children_done = stack.pop()
+        if id(node) in sizes:
+            continue
+        children = _children(node)
+        if not children_done:
+            stack.append((node, True))
+            stack.extend((child, False) for child in children if id(child) not in sizes)
+            continue
+        size = 1 + sum(sizes.get(id(child), 0) for child in children)
+        if size > YAML_NODES:
+            raise GraderError(f"line {node.start_mark.line + 1}: expands to more than {YAML_NODES:,} values "
+                              "through aliases (*name); expected a template-sized structure")
+        sizes[id(node)] = size
+
+
+def _children(node: Any) -> list[Any]:
+    if isinstance(node, yaml.MappingNode):
+        return [part for pair in node.value for part in pair]
+    if isinstance(node, yaml.SequenceNode):
+        return list(node.value)
+    return []
+
+
+def read_yaml(path: Path) -> Any:
+    """A YAML file's data, with the bounds above; errors name the file and the line."""
+    return parse_yaml(read_bytes(path, YAML_BYTES), path)
+
+
+def parse_yaml(data: bytes, path: Path) -> Any:
+    """YAML data read from ``path`` (for messages), with the bounds above."""
+    text = decode_text(data, path)
+    try:
+        return yaml.load(text, Loader=_Loader)  # noqa: S506  (_Loader is a bounded SafeLoader)
+    except GraderError as error:
+        raise GraderError(f"{path}: {error}") from None
+    except yaml.YAMLError as error:
+        raise GraderError(f"{path}: expected valid YAML, got {_yaml_problem(error)}") from None
+
+
+def _yaml_problem(error: yaml.YAMLError) -> str:
+    mark = getattr(error, "problem_mark", None)
+    problem = getattr(error, "problem", None) or str(error).splitlines()[0]
+    return f"{problem} (line {mark.line + 1}, column {mark.column + 1})" if mark else str(problem)
+
+
+# --- CSV ----------------------------------------------------------------------------------------
+
+@dataclass(frozen=True)
+class CsvRow:
+    """One data row: the line it starts on, and its cells by header name (stripped)."""
+
+    line: int
+    cells: dict[str, str]
+
+
+@dataclass(frozen=True)
+class CsvTable:
+    """A CSV file: its header (stripped, as written) and its non-blank data rows."""
+
+    path: Path
+    header: tuple[str, ...]
+    rows: tuple[CsvRow, ...]
+    header_line: int
+
+
+def read_csv(path: Path) -> CsvTable:
+    """A CSV file: UTF-8 with or without a byte-order mark; comma, semicolon or tab, whichever the
+    header uses most. Blank lines are skipped (before the header too); a row's line is where it
+    starts, so a quoted cell over several lines does not shift the numbers. Refused, naming the
+    line: duplicate or missing header names (an empty column at the end is dropped), more cells
+    than header columns, cells longer than ``CELL_CHARS``, NUL bytes, files over ``CSV_BYTES``.
+
+    >>> import tempfile, pathlib
+    >>> path = pathlib.Path(tempfile.mkdtemp()) / "b.csv"
+    >>> _ = path.write_text('\\nh_drop;h_rebound;\\n2100;1100;\\n\\n"2,0";1\\n')
+    >>> table = read_csv(path)
+    >>> table.header, [(row.line, row.cells) for row in table.rows]
+    (('h_drop', 'h_rebound'), [(3, {'h_drop': '2100', 'h_rebound': '1100'}), (5, {'h_drop': '2,0', 'h_rebound': '1'})])
+    """
+    text = decode_text(read_bytes(path, CSV_BYTES), path)
+    lines = text.split("\n")
+    first = next((i for i, line in enumerate(lines) if line.strip()), None)
+    if first is None:
+        raise GraderError(f"{path}: empty file; expected a header line")
+    delimiter = max(",;\t", key=lines[first].count)
+    records = _records(io.StringIO("\n".join(lines[first:])), path, delimiter, first)
+    header_line, header_cells = next(records)
+    header = _header(header_cells, path, header_line)
+    rows = []
+    for line, cells in records:
+        if len(cells) > len(header) and any(c.strip() for c in cells[len(header):]):
+            raise GraderError(f"{path}: line {line}: {len(cells)} cells, but the header has {len(header)} "
+                              "columns; expected one cell per column")
+        rows.append(CsvRow(line, {name: (cells[i].strip() if i < len(cells) else "")
+                                  for i, name in enumerate(header)}))
+    return CsvTable(path, header, tuple(rows), header_line)
+
+
+def _records(stream: io.StringIO, path: Path, delimiter: str, offset: int) -> Iterator[tuple[int, list[str]]]:
+    reader = csv.reader(stream, delimiter=delimiter)
+    end = 0
+    while True:
+        start = end + 1
+        try:
+            cells = next(reader)
+        except StopIteration:
+            return
+        except csv.Error as error:
+            raise GraderError(f"{path}: line {offset + reader.line_num}: {error}") from None
+        end = reader.line_num
+        if not any(cell.strip() for cell in cells):
+            continue
+        long = next((c for c in cells if len(c) > CELL_CHARS), None)
+        if long is not None:
+            raise GraderError(f"{path}: line {offset + start}: a cell of {len(long):,} characters; expected at "
+                              f"most {CELL_CHARS}")
+        yield offset + start, cells
+
+
+def _header(cells: list[str], path: Path, line: int) -> tuple[str, ...]:
+    names = [cell.strip() for cell in cells]
+    while names and not names[-1]:
+        names.pop()  # a trailing delimiter, as spreadsheets write
+    if "" in names:
+        raise GraderError(f"{path}: line {line}: column {names.index('') + 1} has no name; expected a name "
+                          "for every column of the header")
+    lowered = [n.lower() for n in names]
+    twice = sorted({n for n in names if lowered.count(n.lower()) > 1})
+    if twice:
+        raise GraderError(f"{path}: line {line}: the column {', '.join(map(repr, twice))} appears twice; "
+                          "expected each column once")
+    return tuple(names)

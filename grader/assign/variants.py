@@ -18,7 +18,7 @@ import hashlib
 from collections import Counter
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, replace
-from decimal import ROUND_HALF_UP, Decimal
+from decimal import MAX_EMAX, MIN_EMIN, ROUND_HALF_UP, Context, Decimal
 from typing import Any
 
 import numpy as np
@@ -34,6 +34,8 @@ from grader.solve.evaluate import Columns, answer_at, solve_columns
 MAX_DRAWS = 25
 NEAR_ZERO = 0.02  # an answer below 2% of its typical size is too close to zero to grade relatively
 PILOT = 256  # draws that set an answer's typical size, from a generator of their own
+PRINTED_CHARS = 24  # a printed value longer than this is no number a student can read or type
+_EXACT = Context(prec=1000, Emax=MAX_EMAX, Emin=MIN_EMIN)  # any float64, printed exactly
 
 
 @dataclass(frozen=True)
@@ -92,15 +94,22 @@ def variant_generator(seed: str, problem_key: str, student_id: str) -> tuple[np.
 
 
 def printed_text(value: float, decimals: int | None, sig_figs: int | None) -> str:
-    """A value as printed on the page: fixed decimals, or significant figures (halves round up)."""
+    """A value as printed on the page: fixed decimals, or significant figures (halves round up).
+    Never ``-0``: a value that rounds to zero prints without a sign.
+
+    >>> printed_text(-0.004, 2, None), printed_text(1e30, None, 2), printed_text(-0.0, None, 3)
+    ('0.00', '1000000000000000000000000000000', '0')
+    """
     number = Decimal(repr(float(value)))
     if decimals is not None:
-        return str(number.quantize(Decimal(1).scaleb(-decimals), ROUND_HALF_UP))
-    assert sig_figs is not None  # a Parameter always has one of the two (validated on load)
-    if number == 0:
+        rounded = number.quantize(Decimal(1).scaleb(-decimals), ROUND_HALF_UP, context=_EXACT)
+        return str(abs(rounded) if rounded.is_zero() else rounded)
+    if sig_figs is None:
+        raise ValueError("a printed precision needs decimals or sig_figs")
+    if number.is_zero():
         return "0"
     exponent = number.adjusted() - (sig_figs - 1)
-    rounded = number.quantize(Decimal(1).scaleb(exponent), ROUND_HALF_UP)
+    rounded = number.quantize(Decimal(1).scaleb(exponent), ROUND_HALF_UP, context=_EXACT)
     return f"{rounded:f}" if exponent < 0 else str(int(rounded))
 
 
@@ -119,7 +128,14 @@ def _draw(parameter: Parameter, problem: ProblemSpec, rng: np.random.Generator) 
     else:
         low, high = parameter.sample.values
         value = float(rng.uniform(low, high))
-    return printed_text(value, parameter.decimals, parameter.sig_figs)
+    text = printed_text(value, parameter.decimals, parameter.sig_figs)
+    if len(text) > PRINTED_CHARS:
+        precision = f"{parameter.decimals} decimals" if parameter.decimals is not None else \
+            f"{parameter.sig_figs} significant figures"
+        raise GraderError(f"{name} = {value:g} prints as {len(text)} characters with "
+                          f"{precision}; expected values that print in at most {PRINTED_CHARS} (choose a value "
+                          "of ordinary size, or another unit in the template)")
+    return text
 
 
 def _restitution_answers(template: Template) -> set[str]:
@@ -135,6 +151,7 @@ class _Problem:
 
     def __init__(self, assignment: Assignment, problem: ProblemSpec, template: Template) -> None:
         self.assignment, self.problem, self.template = assignment, problem, template
+        self.where = f"{assignment.where}: problem {problem.key} ({template.id})"
         self.compiled: Compiled = compiled_for(template)
         self.restitution = _restitution_answers(template)
         self.typical = self._typical_sizes()
@@ -144,11 +161,23 @@ class _Problem:
         rows = [self._draw_row(rng) for _ in range(PILOT)]
         result = solve_columns(self.template, self.compiled, self._table(rows))
         ok = np.array([reason is None for reason in result.refusals])
-        return {name: float(np.median(np.abs(values[ok]))) if ok.any() else 0.0
-                for name, values in result.values.items()}
+        typical = {}
+        for name, values in result.values.items():
+            defined = ok & np.array([reason is None for reason in result.undefined[name]])
+            typical[name] = float(np.median(np.abs(values[defined]))) if defined.any() else 0.0
+            if ok.any() and typical[name] == 0 and tolerance(self.problem, self.template, name).atol == 0:
+                what = "undefined" if not defined.any() else "0"
+                raise GraderError(f"{self.where}: answer {name} is {what} for every variant the fixed and narrowed "
+                                  "parameters allow, so it cannot be graded with a relative tolerance; expected "
+                                  "parameters that give it a nonzero value (change fixed/narrow, or give the answer "
+                                  "an atol)")
+        return typical
 
     def _draw_row(self, rng: np.random.Generator) -> dict[str, str]:
-        return {name: _draw(p, self.problem, rng) for name, p in self.template.parameters.items()}
+        try:
+            return {name: _draw(p, self.problem, rng) for name, p in self.template.parameters.items()}
+        except GraderError as error:
+            raise GraderError(f"{self.where}: {error}") from None
 
     def _table(self, rows: Sequence[Mapping[str, str]]) -> dict[str, Any]:
         return {name: np.array([float(row[name]) for row in rows]) for name in self.template.parameters}
@@ -181,9 +210,9 @@ class _Problem:
             for student_id in pending:
                 rows[student_id] = self._draw_row(generators[student_id])
         first = pending[0]
-        raise GraderError(f"{self.assignment.where}: problem {self.problem.key} ({self.template.id}): no valid variant "
-                          f"for student {first} in {MAX_DRAWS} draws; the last was refused because {last[first]} "
-                          "(check fixed/narrowed parameters against the template's constraints)")
+        raise GraderError(f"{self.where}: no valid variant for student {first} in {MAX_DRAWS} draws; the last was "
+                          f"refused because {last[first]} (check fixed/narrowed parameters against the template's "
+                          "constraints)")
 
 
 def generate(assignment: Assignment, roster: Sequence[Student], bank: Mapping[str, Template]) -> Generation:
@@ -210,13 +239,19 @@ def _blank_parts(problem: ProblemSpec, template: Template) -> list[AnswerPart]:
     """What every student's answer parts share: label, unit, points, tolerance (overrides applied)."""
     parts = []
     for index, (name, spec) in enumerate(template.answers.items()):
-        override = problem.tolerances.get(name)
-        tolerance = spec.tolerance if override is None else Tolerance(
-            override.rtol if override.rtol >= 0 else spec.tolerance.rtol,
-            override.atol if override.atol >= 0 else spec.tolerance.atol)
         parts.append(AnswerPart(name, f"{problem.key}{chr(ord('a') + index)}", None, spec.unit.text,
-                                problem.points.get(name, problem.points.get("*", 1.0)), tolerance, spec.description))
+                                problem.points.get(name, problem.points.get("*", 1.0)),
+                                tolerance(problem, template, name), spec.description))
     return parts
+
+
+def tolerance(problem: ProblemSpec, template: Template, name: str) -> Tolerance:
+    """An answer's tolerance: the template's, with the assignment's overrides (a negative field: not overridden)."""
+    spec, override = template.answers[name].tolerance, problem.tolerances.get(name)
+    if override is None:
+        return spec
+    return Tolerance(override.rtol if override.rtol >= 0 else spec.rtol,
+                     override.atol if override.atol >= 0 else spec.atol)
 
 
 def _answer_parts(blanks: Sequence[AnswerPart], template: Template, compiled: Compiled, result: Columns,

@@ -10,6 +10,7 @@
 from __future__ import annotations
 
 import hashlib
+import math
 import re
 from collections.abc import Mapping
 from dataclasses import dataclass
@@ -25,7 +26,8 @@ from grader.model.units import Unit, parse_unit
 from grader.resources import bank_dir
 
 RESERVED = {"g", "pi"}
-_INTERVAL = re.compile(r"^\s*([\[(])\s*(-?inf|[-+0-9.eE]+)\s*,\s*(inf|[-+0-9.eE]+)\s*([\])])\s*$")
+_BOUND = r"(-?inf|[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)"
+_INTERVAL = re.compile(rf"^\s*([\[(])\s*{_BOUND}\s*,\s*{_BOUND}\s*([\])])\s*$")
 _TOP_KEYS = {"id", "title", "version", "gravity", "bodies", "stages", "symbols", "parameters",
              "constraints", "answers", "tolerance", "statement", "example"}
 
@@ -50,6 +52,8 @@ class Interval:
         if not match:
             raise TemplateError(where, key, "an interval like '[0, 1]' or '(0, inf)'", shown(text))
         low, high = float(match.group(2)), float(match.group(3))
+        if not all(math.isfinite(float(bound)) or "inf" in bound for bound in match.group(2, 3)):
+            raise TemplateError(where, key, "bounds within float64 (about ±1.8e308) or inf", shown(text))
         if not low < high:
             raise TemplateError(where, key, "an interval with low < high", shown(text))
         return cls(low, high, match.group(1) == "(", match.group(4) == ")")
@@ -148,8 +152,11 @@ def load_bank(directory: Path | None = None) -> dict[str, Template]:
     folder = directory or bank_dir()
     if not folder.is_dir():
         raise GraderError(f"{folder}: problem bank folder not found")
+    paths = sorted(folder.glob("*.yaml"))
+    if not paths:
+        raise GraderError(f"{folder}: no templates in this folder; expected problem templates as *.yaml files")
     templates: dict[str, Template] = {}
-    for path in sorted(folder.glob("*.yaml")):
+    for path in paths:
         template = load_template(path)
         if template.id in templates:
             raise TemplateError(str(path), "id", "an id no other template uses", shown(template.id))
@@ -368,4 +375,10 @@ def _parse(text: Any, where: str, key: str, compare: bool = False) -> Node:
 def _example(raw: Any, parameters: Mapping[str, Parameter], where: str) -> dict[str, float]:
     if not isinstance(raw, Mapping) or set(raw) - set(parameters):
         raise TemplateError(where, "example", "a mapping of parameter names to values", shown(raw))
+    for name, value in raw.items():
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            raise TemplateError(where, f"example.{name}", "a number", shown(value))
+        if not parameters[name].domain.contains(float(value)):
+            raise TemplateError(where, f"example.{name}", f"a value in the domain {parameters[name].domain}",
+                                shown(value))
     return {k: float(v) for k, v in raw.items()}

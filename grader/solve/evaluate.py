@@ -27,6 +27,9 @@ from grader.model.expr import Node, Num, fold, substitute, to_text
 from grader.model.kernel import evaluate
 from grader.solve.compiled import Compiled
 
+OVERFLOW = ("the given values are too extreme for float64: a step of the solution overflows or loses all its "
+            "digits; expected values of less extreme size")
+
 
 @dataclass(frozen=True)
 class AnswerValue:
@@ -121,6 +124,7 @@ def _check_physics(compiled: Compiled, env: Mapping[str, Any], refusals: list[st
         holds = np.asarray(evaluate(check.holds, env), dtype=bool)
         if check.subject is not None and "{value}" in check.message:
             subject = np.broadcast_to(evaluate(check.subject, env), holds.shape)
+            _refuse(refusals, ~np.isfinite(subject), OVERFLOW)
             _refuse(refusals, ~holds, lambda row, s=subject, m=check.message: m.replace("{value}", _show(s[row])))
         else:
             _refuse(refusals, ~holds, check.message)
@@ -141,8 +145,7 @@ def _numeric_answers(compiled: Compiled, env: Mapping[str, Any], refusals: list[
         value = np.broadcast_to(np.asarray(evaluate(answer.numeric, env), dtype=float), (count,))
         values[name] = value
         bad = ~np.isfinite(value) & np.array([m is None for m in missing])
-        _refuse(refusals, bad, f"answer {name} is not a finite number for these values "
-                               "(they are beyond what float64 can represent)")
+        _refuse(refusals, bad, f"answer {name}: {OVERFLOW}")
     return values, undefined
 
 
@@ -164,7 +167,7 @@ def answer_at(template: Template, compiled: Compiled, result: Columns, name: str
         return None, reason
     symbolic = compiled.answers[name].symbolic
     if symbolic is None:
-        return float(result.values[name][row]), None
+        return float(result.values[name][row]) + 0.0, None  # -0 is 0
     params = {parameter: float(column[row]) for parameter, column in result.params.items()}
     return symbolic_text(symbolic, params, template.answers[name].symbolic), None
 

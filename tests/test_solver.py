@@ -92,10 +92,11 @@ def test_forward_and_inverse_from_one_scene() -> None:
     from the first bounce's height, e and then the second bounce follow."""
     raw = yaml.safe_load(TWO_BOUNCES)
     raw["parameters"]["h1"] = raw["parameters"].pop("e") | {"domain": "(0, inf)"}
+    del raw["parameters"]["J"]  # no answer here uses it (an unused parameter is refused)
     raw["answers"] = {"e": {"value": "e", "unit": ""}, "h2": {"value": "h2", "unit": "m"}}
     raw["statement"] = "Dropped from {{ h_drop }} m, the first bounce reaches {{ h1 }} m."
     inverse = parse_template(raw, "test:inverse", "inverse")
-    solution = solve_one(inverse, compile_template(inverse), {"h_drop": 2.0, "h1": 0.8**2 * 2.0, "J": 0.0})
+    solution = solve_one(inverse, compile_template(inverse), {"h_drop": 2.0, "h1": 0.8**2 * 2.0})
     assert solution.answers is not None, solution.error
     assert math.isclose(solution.answers["e"].value, 0.8, rel_tol=1e-14)
     assert math.isclose(solution.answers["h2"].value, 0.8**4 * 2.0, rel_tol=1e-14)

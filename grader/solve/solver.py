@@ -23,6 +23,7 @@ import sympy as sp
 
 from grader.bank.template import Template
 from grader.errors import TemplateError
+from grader.model.expr import names
 from grader.model.units import Unit
 from grader.physics.effects import CATALOGUE, Relation
 from grader.physics.symbolic import Context, cosd, from_node, sind, to_node
@@ -134,11 +135,29 @@ class _Compiler:
             # doit(): display forms keep sqrt(2*g*h) whole; the numeric composition wants it evaluated.
             composed[solved.unknown] = solved.numeric.doit().xreplace(composed)
         answers = {name: self._answer(name, expr, chain, composed) for name, expr in wanted.items()}
+        checks = self._checks(composed)
+        self._check_every_parameter_used(chain, wanted.values(), checks)
         return Compiled(
             template_id=self.template.id, source_hash=self.template.source_hash,
             parameters=tuple(self.template.parameters),
             constants={"g": float(self.template.scene.gravity.si)} if self.template.scene.gravity else {},
-            steps=tuple(self._step(s) for s in chain), checks=self._checks(composed), answers=answers)
+            steps=tuple(self._step(s) for s in chain), checks=checks, answers=answers)
+
+    def _check_every_parameter_used(self, chain: list[_Solved], wanted: Iterable[Any],
+                                    checks: Iterable[Check]) -> None:
+        """A parameter no step, answer or check uses is printed but ignored: the scene is over-determined
+        (a constant fixes what it would decide) or it asks nothing that depends on it."""
+        used = {str(s) for s in set().union(*(sp.sympify(w).free_symbols for w in wanted))}
+        for solved in chain:
+            used |= {str(s) for s in solved.display.free_symbols | solved.numeric.free_symbols}
+        for check in checks:
+            used |= names(check.holds)
+        for name in self.template.parameters:
+            if name not in used:
+                raise TemplateError(self.template.where, f"parameters.{name}", "a parameter the answers depend on",
+                                    "one no step of the solution uses: the scene is over-determined (a constant or "
+                                    "another parameter already fixes what it would decide) or no answer needs it; "
+                                    "remove it, make it a symbol, or turn the constant into a parameter")
 
     def _coupled(self, known: set[Any]) -> str:
         """Why the chain stopped: the unknowns the unused equations still tie together."""
@@ -205,17 +224,21 @@ class _Compiler:
         known = self.inputs | set(composed)
         checks = []
         for relation in self.relations:
-            if not relation.symbols() <= known:
-                continue
             for condition in relation.requires:
+                # A condition applies as soon as its own quantities are known, whatever else its relation has.
+                if not sp.sympify(condition.holds).free_symbols <= known:
+                    continue
                 holds = self._user_units(sp.sympify(condition.holds).xreplace(dict(composed)))
                 if holds is sp.true:
                     continue
                 if holds is sp.false:
+                    value = sp.sympify(condition.subject).xreplace(dict(composed)) if condition.subject else None
+                    shown_value = str(value) if value is not None and value.is_number else "a constant"
                     raise TemplateError(self.template.where, "stages", "a scene that can hold",
-                                        f"a condition that never holds: {condition.message}")
+                                        "a condition that never holds: "
+                                        + condition.message.replace("{value}", shown_value))
                 subject = None
-                if condition.subject is not None:
+                if condition.subject is not None and sp.sympify(condition.subject).free_symbols <= known:
                     subject = self._tree(self._user_units(sp.sympify(condition.subject).xreplace(dict(composed))),
                                          "(check)")
                 check = Check(self._tree_condition(holds), condition.message, subject)

@@ -92,7 +92,7 @@ def test_answer_the_scene_cannot_determine_is_refused_at_compile_time() -> None:
 
 def test_numeric_answer_that_depends_on_a_symbol_is_refused() -> None:
     """An answer still in terms of the ball's mass m has no number: say so."""
-    raw = mutated(set_in("answers/e", {"value": "m*e", "unit": ""}))
+    raw = mutated(set_in("answers/e", {"value": "m*e", "unit": "kg"}))
     with pytest.raises(TemplateError, match=r"answers.e: expected a number once the parameters are given, .* on m"):
         compile_template(parse_template(raw, "x.yaml", "hash"))
 

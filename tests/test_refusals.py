@@ -49,7 +49,7 @@ def test_invalid_parameters_are_refused_with_the_reason(template_id: str, params
 @pytest.fixture(scope="module")
 def two_bodies() -> tuple[Template, Compiled]:
     raw = yaml.safe_load(TWO_BODIES)
-    raw["answers"]["square"] = {"value": "u1*u1*a2", "unit": ""}  # overflows where a1, a2 do not
+    raw["answers"]["square"] = {"value": "u1*u1*a2", "unit": "m^3/s^3"}  # overflows where a1, a2 do not
     template = parse_template(raw, "test:two-bodies", "two-bodies")
     return template, compile_template(template)
 

@@ -24,7 +24,7 @@ symbols: {m: {unit: kg}}
 parameters:
   h_drop: {unit: m, domain: "(0, inf)", sample: {uniform: [1, 2]}, decimals: 2}
   e: {unit: "", domain: "[0, 1]", sample: {uniform: [0.5, 0.9]}, decimals: 2}
-  J: {unit: "", domain: "[0, 1]", sample: {uniform: [0, 1]}, decimals: 2, description: "named like an impulse"}
+  J: {unit: m, domain: "[0, 1]", sample: {uniform: [0, 1]}, decimals: 2, description: "named like an impulse"}
 stages:
   - {effect: free_fall, body: ball, height: h_drop, speed: v1}
   - {effect: impact, bodies: [ball, floor], restitution: e, before: {ball: v1}, after: {ball: w1}}
@@ -91,7 +91,7 @@ def test_forward_and_inverse_from_one_scene() -> None:
     """Swapping which quantities are given turns the same scene around (no formula is rewritten):
     from the first bounce's height, e and then the second bounce follow."""
     raw = yaml.safe_load(TWO_BOUNCES)
-    raw["parameters"]["h1"] = raw["parameters"].pop("e") | {"domain": "(0, inf)"}
+    raw["parameters"]["h1"] = raw["parameters"].pop("e") | {"domain": "(0, inf)", "unit": "m"}
     del raw["parameters"]["J"]  # no answer here uses it (an unused parameter is refused)
     raw["answers"] = {"e": {"value": "e", "unit": ""}, "h2": {"value": "h2", "unit": "m"}}
     raw["statement"] = "Dropped from {{ h_drop }} m, the first bounce reaches {{ h1 }} m."
@@ -106,7 +106,7 @@ def test_coupled_unknowns_are_refused_with_what_ties_them() -> None:
     """Given only the second bounce, e appears in both impacts with h1 between them: a chain of
     one-unknown steps cannot untangle that, and the message says which unknowns are tied."""
     raw = yaml.safe_load(TWO_BOUNCES)
-    raw["parameters"]["h2"] = raw["parameters"].pop("e") | {"domain": "(0, inf)"}
+    raw["parameters"]["h2"] = raw["parameters"].pop("e") | {"domain": "(0, inf)", "unit": "m"}
     raw["answers"] = {"e": {"value": "e", "unit": ""}}
     raw["statement"] = "Dropped from {{ h_drop }} m, the second bounce reaches {{ h2 }} m."
     with pytest.raises(TemplateError, match=r"nothing fixes e; the equations left tie .*e, h1.* together"):

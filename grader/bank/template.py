@@ -20,9 +20,10 @@ from typing import Any
 from grader.bank.scene_parser import IDENTIFIER, parse_scene
 from grader.errors import ExpressionError, GraderError, TemplateError, shown
 from grader.inputs import YAML_BYTES, parse_yaml, read_bytes
-from grader.model.expr import Node, Op, names, parse
+from grader.model.expr import Node, Op, Sym, names, parse, to_text
 from grader.model.scene import Gravity, Scene
-from grader.model.units import Unit, parse_unit
+from grader.model.units import MASS, Dimension, Unit, dimension_from, dimension_name, dimension_of, parse_unit
+from grader.physics.effects import CATALOGUE
 from grader.resources import bank_dir
 
 RESERVED = {"g", "pi"}
@@ -235,6 +236,51 @@ def _check_names(template: Template) -> None:
             raise TemplateError(where, f"constraints[{index}].require", "an expression in the parameters",
                                 f"unknown {', '.join(sorted(missing))}")
     _check_statement(template, given)
+    _check_dimensions(template)
+
+
+def _check_dimensions(template: Template) -> None:
+    """Each stage field measures what its effect says (a height is a length, a mass a mass), and
+    each answer what its unit says; a name a stage introduces takes its field's dimension."""
+    known: dict[str, Dimension] = {n: _dimension(p.unit) for n, p in template.parameters.items()}
+    known |= {n: _dimension(s.unit) for n, s in template.symbols.items()}
+    if template.scene.gravity is not None:
+        known["g"] = dimension_from(1, time=-2)
+    for body in template.scene.bodies.values():
+        if body.mass is not None:
+            _expect(body.mass, MASS, known, template.where, f"bodies.{body.name}.mass")
+    for stage in template.scene.stages:
+        for spec in CATALOGUE[stage.effect].fields:
+            value = stage.fields.get(spec.name)
+            if spec.dimension is None or value is None:
+                continue
+            key = f"stages[{stage.index}].{spec.name}"
+            if spec.kind == "velocities":
+                for body, velocity in value.items():
+                    for part in (velocity.n, velocity.t):
+                        if part is not None:
+                            _expect(part, spec.dimension, known, template.where, f"{key}.{body}")
+            else:
+                _expect(Sym(value) if spec.kind == "name" else value, spec.dimension, known, template.where, key)
+    for name, answer in template.answers.items():
+        _expect(answer.value, _dimension(answer.unit), known, template.where, f"answers.{name}.value")
+
+
+def _dimension(unit: Unit) -> Dimension:
+    return dimension_from(*unit.dimension)
+
+
+def _expect(node: Node, expected: Dimension, known: dict[str, Dimension], where: str, key: str) -> None:
+    try:
+        found = dimension_of(node, known)
+    except GraderError as error:
+        raise TemplateError(where, key, "an expression whose terms have one dimension",
+                            f"'{to_text(node)}', which {error}") from None
+    if found is None and isinstance(node, Sym):
+        known[node.name] = expected
+    elif found is not None and found != expected:
+        raise TemplateError(where, key, f"{dimension_name(expected)} (check the parameters' units)",
+                            f"'{to_text(node)}', which is {dimension_name(found)}")
 
 
 def _check_statement(template: Template, given: set[str]) -> None:

@@ -19,10 +19,15 @@ from __future__ import annotations
 
 import math
 import re
+from collections.abc import Mapping
 from dataclasses import dataclass
 from fractions import Fraction
 
 from grader.errors import GraderError
+from grader.model.expr import Node, Num, Op, Sym
+
+Dimension = tuple[Fraction, Fraction, Fraction, Fraction]
+"""Exponents of (length, mass, time, angle)."""
 
 # dimension exponents: (length, mass, time, angle)
 _BASE: dict[str, tuple[Fraction, int, tuple[int, int, int, int]]] = {
@@ -127,3 +132,70 @@ def split_quantity(text: str) -> tuple[float, str] | None:
         return None
     value = float(match.group())
     return (value, text[match.end():].strip()) if math.isfinite(value) else None
+
+
+def dimension_from(length: int = 0, mass: int = 0, time: int = 0, angle: int = 0) -> Dimension:
+    """A dimension from its exponents."""
+    return Fraction(length), Fraction(mass), Fraction(time), Fraction(angle)
+
+
+LENGTH, MASS, SPEED = dimension_from(1), dimension_from(mass=1), dimension_from(1, time=-1)
+ANGLE, PURE = dimension_from(angle=1), dimension_from()
+_NAMES = {LENGTH: "a length", MASS: "a mass", SPEED: "a speed", ANGLE: "an angle", PURE: "a pure number"}
+
+
+def dimension_name(dim: Dimension) -> str:
+    """``a length``, ``a speed``, …, or the exponents for anything else."""
+    if dim in _NAMES:
+        return _NAMES[dim]
+    parts = [f"{base}^{power}" if power != 1 else base
+             for base, power in zip(("m", "kg", "s", "rad"), dim, strict=True) if power]
+    return "*".join(parts)
+
+
+def dimension_of(node: Node, known: Mapping[str, Dimension]) -> Dimension | None:
+    """The dimension of an expression, or None where it depends on a name of unknown dimension;
+    a sum of unlike dimensions raises :class:`GraderError`.
+
+    >>> from grader.model.expr import parse
+    >>> dimension_name(dimension_of(parse("sqrt(2*g*h)"), {"g": dimension_from(1, time=-2), "h": LENGTH}))
+    'a speed'
+    >>> dimension_of(parse("h + m"), {"h": LENGTH, "m": MASS})
+    Traceback (most recent call last):
+    ...
+    grader.errors.GraderError: adds a length to a mass
+    """
+    if isinstance(node, Num):
+        return PURE
+    if isinstance(node, Sym):
+        return PURE if node.name == "pi" else known.get(node.name)
+    assert isinstance(node, Op)
+    args = [dimension_of(arg, known) for arg in node.args]
+    if node.op in ("add", "sub", "hypot", "Max", "Min", "abs", "neg"):
+        found = [a for a in args if a is not None]
+        if any(a != found[0] for a in found):
+            other = next(a for a in found if a != found[0])
+            raise GraderError(f"adds {dimension_name(found[0])} to {dimension_name(other)}")
+        return found[0] if len(found) == len(args) else None
+    found_all = [a for a in args if a is not None]
+    if len(found_all) != len(args):
+        return None
+    first = found_all[0]
+    if node.op in ("mul", "div"):
+        sign = 1 if node.op == "mul" else -1
+        return _scaled(first, 1, found_all[1], sign)
+    if node.op == "pow":
+        exponent = node.args[1]
+        if isinstance(exponent, Num):
+            return _scaled(first, Fraction(exponent.value))
+        return PURE if first == PURE else None
+    if node.op == "sqrt":
+        return _scaled(first, Fraction(1, 2))
+    if node.op == "atan2":
+        return ANGLE
+    return PURE  # sin, cos, exp, log, …: a pure number
+
+
+def _scaled(first: Dimension, power: Fraction | int, second: Dimension = PURE, sign: int = 1) -> Dimension:
+    a, b, c, d = (p * power + sign * q for p, q in zip(first, second, strict=True))
+    return a, b, c, d

@@ -12,6 +12,8 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
+from grader.model.units import Dimension
+
 if TYPE_CHECKING:
     import sympy as sp
 
@@ -33,6 +35,7 @@ class Field:
     kind: str
     required: bool = True
     doc: str = ""
+    dimension: Dimension | None = None  # what an expression or velocity here must measure
 
 
 @dataclass(frozen=True)

@@ -11,6 +11,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from grader.model.units import LENGTH, SPEED
 from grader.physics.effects.base import Condition, Effect, Field, Relation
 from grader.physics.integrate import Mode, integrate
 
@@ -21,8 +22,8 @@ if TYPE_CHECKING:
 
 _FIELDS = (
     Field("body", "body", doc="the body that moves"),
-    Field("height", "expr", doc="height fallen or risen (m)"),
-    Field("speed", "expr", doc="speed at the bottom of the path, >= 0"),
+    Field("height", "expr", doc="height fallen or risen (m)", dimension=LENGTH),
+    Field("speed", "expr", doc="speed at the bottom of the path, >= 0", dimension=SPEED),
 )
 
 

@@ -20,6 +20,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from grader.model.expr import Sym
+from grader.model.units import PURE, SPEED, dimension_from
 from grader.physics.effects.base import Condition, Effect, Field, Relation, Stable
 from grader.physics.integrate import Mode, integrate
 from grader.physics.run import ContactRecord
@@ -233,19 +234,25 @@ def _output_energies(stage: Stage, run: Run, inverse: tuple[float, float], befor
             run.output(Sym(stage.fields[key]), value)
 
 
+ENERGY = dimension_from(2, 1, -2)
+
 IMPACT = Effect(
     "impact",
     "direct or oblique central impact with restitution e; smooth surfaces; a body may be fixed",
     (
         Field("bodies", "bodies", doc="[first, second]: n points from the first into the second"),
-        Field("restitution", "expr", doc="coefficient of restitution e, 0..1"),
-        Field("before", "velocities", doc="per body: n-velocity, or {n: .., t: ..}; omitted = at rest"),
-        Field("after", "velocities", required=False, doc="per body: names for the velocities after"),
-        Field("impulse", "name", required=False, doc="name for the normal impulse J"),
-        Field("energy_before", "name", required=False, doc="name for the kinetic energy before"),
-        Field("energy_after", "name", required=False, doc="name for the kinetic energy after"),
-        Field("energy_lost", "name", required=False, doc="name for the energy lost"),
-        Field("loss_fraction", "name", required=False, doc="name for the fraction of energy lost"),
+        Field("restitution", "expr", doc="coefficient of restitution e, 0..1", dimension=PURE),
+        Field("before", "velocities", doc="per body: n-velocity, or {n: .., t: ..}; omitted = at rest",
+              dimension=SPEED),
+        Field("after", "velocities", required=False, doc="per body: names for the velocities after",
+              dimension=SPEED),
+        Field("impulse", "name", required=False, doc="name for the normal impulse J",
+              dimension=dimension_from(1, 1, -1)),
+        Field("energy_before", "name", required=False, doc="name for the kinetic energy before", dimension=ENERGY),
+        Field("energy_after", "name", required=False, doc="name for the kinetic energy after", dimension=ENERGY),
+        Field("energy_lost", "name", required=False, doc="name for the energy lost", dimension=ENERGY),
+        Field("loss_fraction", "name", required=False, doc="name for the fraction of energy lost",
+              dimension=PURE),
         Field("weight_during_contact", "flag", required=False,
               doc="simulate the weight during contact (the closed form neglects it); default false"),
     ),

@@ -9,6 +9,7 @@ from __future__ import annotations
 import math
 from typing import TYPE_CHECKING
 
+from grader.model.units import ANGLE, SPEED
 from grader.physics.effects.base import Condition, Effect, Field, Relation
 
 if TYPE_CHECKING:
@@ -63,11 +64,11 @@ VELOCITY = Effect(
     "velocity",
     "a velocity given by speed and angle, related to its n and t components",
     (
-        Field("speed", "expr", doc="magnitude"),
-        Field("angle", "expr", doc="direction, measured from the `from` axis toward the other"),
+        Field("speed", "expr", doc="magnitude", dimension=SPEED),
+        Field("angle", "expr", doc="direction, measured from the `from` axis toward the other", dimension=ANGLE),
         Field("from", "choice:t|n", required=False, doc="axis the angle is measured from (default t)"),
-        Field("n", "expr", doc="component along the line of impact"),
-        Field("t", "expr", doc="component along the tangent"),
+        Field("n", "expr", doc="component along the line of impact", dimension=SPEED),
+        Field("t", "expr", doc="component along the tangent", dimension=SPEED),
     ),
     _components,
     _simulate_components,

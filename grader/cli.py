@@ -307,6 +307,10 @@ def _simulate(arguments: argparse.Namespace) -> int:
                         100 if arguments.steps_per_contact is None else arguments.steps_per_contact,
                         1e-10 if arguments.rtol is None else arguments.rtol, dense=arguments.plot is not None)
     options = Options(settings, arguments.contact_duration, arguments.weight_during_contact)
+    if arguments.plot is not None:
+        from grader.simulate.plots import check_plot_target, plot_simulation
+
+        check_plot_target(arguments.plot)  # before any work: nothing is written for a name we cannot write
     closed = solve_one(template, compiled_for(template), params)
     if closed.error is not None:
         _print_solution(template, closed.params, None, closed.error, arguments.json, None)
@@ -314,14 +318,17 @@ def _simulate(arguments: argparse.Namespace) -> int:
     result = simulate(template, params, options)
     rows = {}
     for name, simulated in result.answers.items():
-        exact = closed.answers[name].value if closed.answers else None
+        answer = closed.answers[name] if closed.answers else None
+        exact = answer.value if answer is not None and isinstance(answer.value, float) else None
         differs = None
-        if isinstance(exact, float) and simulated is not None:
+        if exact is not None and simulated is not None:
             differs = abs(simulated - exact) / abs(exact) if exact else abs(simulated - exact)
-        rows[name] = {"simulated": simulated, "closed_form": exact, "rel_diff": differs}
+            differs = min(differs, sys.float_info.max)  # 1e300 against 1e-10 overflows: "huge" is the truth
+        why = {"simulated": result.undefined.get(name) if simulated is None else None,
+               "closed_form": (answer.undefined or "undefined") if answer is not None and exact is None else None}
+        rows[name] = {"simulated": simulated, "closed_form": exact, "rel_diff": differs,
+                      "undefined": {k: v for k, v in why.items() if v is not None} or None}
     if arguments.plot is not None:
-        from grader.simulate.plots import plot_simulation
-
         plot_simulation(result, arguments.plot)
     record = {"template": template.id, "params": result.params, "method": settings.method,
               "effects": list(result.effects), "steps": result.steps, "seconds": result.seconds, "answers": rows,
@@ -331,11 +338,26 @@ def _simulate(arguments: argparse.Namespace) -> int:
               "settings": {"steps_per_contact": settings.steps, "rtol": settings.rtol,
                            "contact_duration": options.contact_duration,
                            "weight_during_contact": options.weight_during_contact}}
+    record = _plain_numbers(record)
     if arguments.json:
-        print(json.dumps(record))
+        print(json.dumps(record, allow_nan=False))
         return EXIT_OK
     _print_simulation(template, record)
     return EXIT_OK
+
+
+def _plain_numbers(value: Any) -> Any:
+    """A simulation record with every -0 made 0; a number that is not finite is a bug (the
+    simulator refuses what would produce one and reports undefined quantities as None)."""
+    if isinstance(value, dict):
+        return {key: _plain_numbers(item) for key, item in value.items()}
+    if isinstance(value, list | tuple):
+        return [_plain_numbers(item) for item in value]
+    if isinstance(value, float):
+        if value != value or value in (float("inf"), float("-inf")):
+            raise ValueError(f"a simulation produced a number that is not finite: {value}")
+        return value + 0.0
+    return value
 
 
 def _print_simulation(template: Template, record: dict[str, Any]) -> None:
@@ -357,6 +379,9 @@ def _print_simulation(template: Template, record: dict[str, Any]) -> None:
         (name, "undefined" if row["simulated"] is None else f"{row['simulated']:.10g}",
          "undefined" if row["closed_form"] is None else f"{row['closed_form']:.10g}",
          "-" if row["rel_diff"] is None else f"{row['rel_diff']:.2g}") for name, row in record["answers"].items()]))
+    reasons = {why for row in record["answers"].values() for why in (row["undefined"] or {}).values()}
+    for why in sorted(reasons):
+        print(f"undefined: {why}")
 
 
 def _generate(arguments: argparse.Namespace) -> int:

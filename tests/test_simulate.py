@@ -5,6 +5,8 @@ from __future__ import annotations
 import dataclasses
 import json
 import math
+import re
+import time
 from pathlib import Path
 
 import numpy as np
@@ -235,3 +237,129 @@ def test_a_contact_that_never_ends_says_why(bank: dict[str, Template]) -> None:
     options = Options(contact_duration=0.1, weight_during_contact=True)
     with pytest.raises(SimulationError, match=r"drop-rebound: the contact mode did not end .* the bodies stay in"):
         simulate(forward, {"h_drop": 2000.0, "e": 0.05}, options)
+
+
+def _simulate_cli(capsys: pytest.CaptureFixture[str], *argv: str) -> tuple[int, str, str]:
+    code = main(["simulate", *argv])
+    captured = capsys.readouterr()
+    return code, captured.out, captured.err
+
+
+BALL_PLATE = ("ball-plate", "--set", "v=50", "--set", "theta=30", "--set", "e=0.5")
+
+
+def test_plot_to_an_unknown_format_is_refused_and_nothing_written(capsys: pytest.CaptureFixture[str],
+                                                                  tmp_path: Path) -> None:
+    """Regression: --plot x.txt raised matplotlib's ValueError; now exit 2 naming the formats, no file."""
+    code, out, err = _simulate_cli(capsys, *BALL_PLATE, "--plot", str(tmp_path / "x.txt"))
+    assert (code, out) == (2, "")
+    assert "--plot" in err and ".png" in err and ".pdf" in err and "got '.txt'" in err
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize(("v", "argv", "message"), [
+    ("1e307", (), "its size (m, m/s) reaches 1.52e+303, outside [1e-305, 1e+300]"),
+    ("1e298", (), "its force per unit mass (m/s^2) reaches 1.58e+301, outside [1e-305, 1e+300]"),
+    ("1e-320", (), "outside [1e-305, 1e+300]"),
+    ("50", ("--method", "rk4", "--steps-per-contact", "100000"), "steps per contact must be at most 10000"),
+])
+def test_work_that_would_overflow_or_not_end_is_refused_at_once(capsys: pytest.CaptureFixture[str], v: str,
+                                                                argv: tuple[str, ...], message: str) -> None:
+    """Regression: v=1e307 and 100000 rk4 steps per contact ran without end; now refused within a
+    second, with the limit. (1 ft/s = 0.3048 m/s; 1e298 ft/s at 1 ms: omega v = pi/1e-3 * 0.3048e298.)"""
+    started = time.perf_counter()
+    code, _, err = _simulate_cli(capsys, "ball-plate", "--set", f"v={v}", "--set", "theta=30", "--set", "e=0.5",
+                                 *argv)
+    assert time.perf_counter() - started < 1.0
+    assert code == 2 and message in err and err.count("\n") == 1, err
+
+
+def test_a_search_that_would_exceed_the_step_limit_is_refused_before_it_starts(bank: dict[str, Template]) -> None:
+    """drop-rebound searches e over about 25 passes of 3 stages: 10000 rk4 steps would be 1.5e6 steps."""
+    started = time.perf_counter()
+    with pytest.raises(SimulationError, match=r"up to 1,500,000 steps .* limit of 500,000; use at most 3333"):
+        simulate(bank["drop-rebound"], {"h_drop": 2100, "h_rebound": 1000}, Options(Settings("rk4", steps=10_000)))
+    assert time.perf_counter() - started < 1.0
+
+
+def test_a_simulation_over_its_time_limit_stops_with_the_limit(bank: dict[str, Template]) -> None:
+    """The wall-clock budget covers every pass of a search."""
+    options = Options(Settings("rk4", steps=3000), time_limit=0.05)
+    started = time.perf_counter()
+    with pytest.raises(SimulationError, match=r"drop-rebound: the simulation took more than 0.05 s, the limit"):
+        simulate(bank["drop-rebound"], {"h_drop": 2100, "h_rebound": 1000}, options)
+    assert time.perf_counter() - started < 1.0
+
+
+def test_simulate_json_is_strict_and_reports_undefined_with_a_reason(capsys: pytest.CaptureFixture[str]) -> None:
+    """Regression: --json wrote NaN/Infinity. Head-on with e = 0 the ball stops: its rebound angle is
+    undefined (null, with the closed form's reason), its speed exactly 0 (cos 90 deg is 0)."""
+    code, out, _ = _simulate_cli(capsys, "ball-plate", "--set", "v=50", "--set", "theta=90", "--set", "e=0",
+                                 "--json")
+    record = json.loads(out, parse_constant=lambda constant: pytest.fail(f"not strict JSON: {constant}"))
+    assert code == 0
+    angle = record["answers"]["theta_out"]
+    assert angle["simulated"] is None and angle["closed_form"] is None
+    assert angle["undefined"] == {"simulated": "v_out is zero, so it has no direction",
+                                  "closed_form": "v_out is zero, so it has no direction"}
+    assert record["answers"]["v_out"]["simulated"] == 0.0
+    assert record["contacts"][0]["measured_e"] == 0.0
+
+
+def test_rebound_angle_of_a_stopped_ball_is_undefined_in_the_table(capsys: pytest.CaptureFixture[str]) -> None:
+    """Regression: theta=90, e=0 printed theta_out = 78.68 where the closed form says undefined."""
+    code, out, _ = _simulate_cli(capsys, "ball-plate", "--set", "v=50", "--set", "theta=90", "--set", "e=0")
+    assert code == 0
+    assert re.search(r"^theta_out +undefined +undefined +-$", out, re.MULTILINE)
+    assert "undefined: v_out is zero, so it has no direction" in out
+
+
+@pytest.mark.parametrize(("template_id", "params", "e"), [
+    # The ram stops dead: m_ram v = m_pile v_pile, so e = v_pile / v = m_ram / m_pile.
+    ("pile-driver", {"m_ram": 800, "m_pile": 2400, "h_drop": 2, "h_rebound": 0}, 1 / 3),
+    # The ball does not bounce at all: e = sqrt(h_rebound / h_drop) = 0.
+    ("drop-rebound", {"h_drop": 2100, "h_rebound": 0}, 0.0),
+])
+def test_inverse_scene_with_zero_rebound_finds_e(template_id: str, params: dict[str, float], e: float,
+                                                 bank: dict[str, Template]) -> None:
+    """Regression: h_rebound = 0 was refused (the rebound height is flat at 0 for every e at which
+    the body moves on down); now the search finds the e at which it just stops."""
+    result = simulate(bank[template_id], params, ADAPTIVE)
+    assert result.answers["e"] == pytest.approx(e, rel=1e-9, abs=1e-12)
+
+
+def test_refusal_names_the_template_once(capsys: pytest.CaptureFixture[str]) -> None:
+    """Regression: 'drop-rebound: drop-rebound: no coefficient ...' repeated the template id."""
+    code, _, err = _simulate_cli(capsys, "drop-rebound", "--set", "h_drop=2100", "--set", "h_rebound=2100",
+                                 "--weight-during-contact", "--contact-duration", "0.1")
+    assert code == 2 and "no coefficient of restitution in [0, 1]" in err
+    assert err.count("drop-rebound:") == 1, err
+
+
+@pytest.mark.parametrize("v", [1e-300, 1e-150, 1e150, 1e290])
+def test_tiny_and_huge_speeds_give_the_closed_form_angle(v: float, bank: dict[str, Template]) -> None:
+    """Regression: v=1e-300 gave theta_out 7.6 instead of 16.1 (an absolute tolerance floor of 1e-300
+    swallowed the motion). tan(theta_out) = e tan(theta): atan(0.5 tan 30 deg) = 16.102113751 deg."""
+    result = simulate(bank["ball-plate"], {"v": v, "theta": 30, "e": 0.5}, ADAPTIVE)
+    assert result.answers["theta_out"] == pytest.approx(math.degrees(math.atan(0.5 * math.tan(math.pi / 6))),
+                                                        rel=1e-8)
+    assert result.answers["v_out"] == pytest.approx(v * math.hypot(math.cos(math.pi / 6), 0.5 * 0.5), rel=1e-8)
+
+
+@pytest.mark.parametrize("e", [0.6, 1.0])
+def test_loss_pct_of_a_head_on_impact_is_never_negative(e: float, bank: dict[str, Template]) -> None:
+    """Regression: oblique-spheres at theta=0 gave a tiny negative loss_pct (T - T' cancelling).
+    Equal masses head-on: loss = 1/2 mu (1 - e^2) v^2 over 1/2 m v^2 = (1 - e^2)/2."""
+    params = {"v1": 6, "theta": 0, "e": e, "m1": 1, "m2": 1}
+    loss = simulate(bank["oblique-spheres"], params, ADAPTIVE).answers["loss_pct"]
+    assert loss is not None and loss >= 0
+    assert loss == pytest.approx(100 * (1 - e * e) / 2, rel=1e-8, abs=1e-12)
+
+
+def test_simulate_never_prints_minus_zero(capsys: pytest.CaptureFixture[str]) -> None:
+    """Regression: -0 in the table or the JSON; a ball stopped head-on has v_out = 0, not -0."""
+    argv = ("oblique-spheres", "--set", "v1=6", "--set", "theta=0", "--set", "e=0", "--set", "m1=1", "--set", "m2=1")
+    code, out, _ = _simulate_cli(capsys, *argv)
+    json_code, json_out, _ = _simulate_cli(capsys, *argv, "--json")
+    assert code == json_code == 0
+    assert not re.search(r"(?<![\w.])-0(?![.\d]*[1-9])", out + json_out), out + json_out

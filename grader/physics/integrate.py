@@ -22,6 +22,7 @@ limit ``2/omega`` of a mode is refused, never silently blown up.
 from __future__ import annotations
 
 import math
+import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import Any
@@ -33,7 +34,14 @@ from scipy.optimize import brentq
 from grader.errors import GraderError
 
 METHODS = ("euler", "rk4", "adaptive")
-MAX_STEPS = 5_000_000
+# rk4 reaches rounding (1e-16) at about 10,000 steps per contact, and Euler's first-order error
+# is 2e-6 there: more steps buy nothing a user can see, and only cost time (tens of us a step).
+MAX_STEPS_PER_CONTACT = 10_000
+MAX_STEPS = 500_000  # steps in one simulation, all phases and all passes of a search together
+TIME_LIMIT = 60.0  # s of wall time for one simulation
+# Magnitudes (SI) a mode may involve: a margin of 1e8 below float64's overflow, so sums and products
+# of a few of them stay finite, and of 1e3 above its subnormal range, where precision is lost.
+LARGEST, SMALLEST = 1e300, 1e-305
 
 
 class SimulationError(GraderError):
@@ -73,8 +81,40 @@ class Settings:
             raise SimulationError(f"unknown method '{self.method}' (use one of {', '.join(METHODS)})")
         if not isinstance(self.steps, int) or self.steps < 1:
             raise SimulationError(f"steps per contact must be a whole number >= 1, got {self.steps!r}")
-        if not 1e-14 <= self.rtol < 1:
+        if self.steps > MAX_STEPS_PER_CONTACT:
+            raise SimulationError(f"steps per contact must be at most {MAX_STEPS_PER_CONTACT} (rk4 is at rounding "
+                                  f"error there; for more accuracy use rk4 or adaptive), got {self.steps}")
+        if not (isinstance(self.rtol, float | int) and 1e-14 <= self.rtol < 1):
             raise SimulationError(f"rtol must be between 1e-14 and 1, got {self.rtol!r}")
+
+
+class Budget:
+    """The work one simulation may do, shared by all its phases: a number of steps and a wall-clock
+    deadline. Spending past either raises :class:`SimulationError` naming the limit.
+
+    >>> budget = Budget(steps=10, seconds=60.0)
+    >>> budget.spend(4); budget.left
+    6
+    >>> budget.spend(7)  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    grader.physics.integrate.SimulationError: the simulation needs more than 10 steps, the limit; ...
+    """
+
+    def __init__(self, steps: int = MAX_STEPS, seconds: float = TIME_LIMIT) -> None:
+        self.steps, self.seconds = steps, seconds
+        self.left = steps
+        self.deadline = time.perf_counter() + seconds
+
+    def spend(self, steps: int) -> None:
+        """Count ``steps`` (0 only checks the clock)."""
+        self.left -= steps
+        if self.left < 0:
+            raise SimulationError(f"the simulation needs more than {self.steps} steps, the limit; use fewer steps "
+                                  "per contact or a larger rtol")
+        if time.perf_counter() > self.deadline:
+            raise SimulationError(f"the simulation took more than {self.seconds:g} s, the limit; use fewer steps "
+                                  "per contact or a larger rtol")
 
 
 @dataclass
@@ -92,17 +132,43 @@ class Path:
         self.force.append(mode.force(y) if mode.force is not None else 0.0)
 
 
-def integrate(modes: Sequence[Mode], y0: Any, settings: Settings, t0: float = 0.0) -> Path:
+def integrate(modes: Sequence[Mode], y0: Any, settings: Settings, t0: float = 0.0,
+              budget: Budget | None = None) -> Path:
     """Run the modes one after another, each until its event; return the whole path."""
     path = Path()
+    budget = budget or Budget()
     t, y = t0, np.asarray(y0, dtype=float)
     for mode in modes:
+        _check_magnitudes(mode, t, y)
         path.add(t, y, mode)
         if settings.method == "adaptive":
-            t, y = _adaptive(mode, t, y, settings.rtol, path, settings.dense)
+            t, y = _adaptive(mode, t, y, settings.rtol, path, settings.dense, budget)
         else:
-            t, y = _fixed(mode, t, y, settings, path)
+            t, y = _fixed(mode, t, y, settings, path, budget)
     return path
+
+
+def _check_magnitudes(mode: Mode, t: float, y: Any) -> None:
+    """Refuse a mode whose scales float64 cannot carry: its state, its time scale, the change of
+    its state over that time scale and its frequency must lie within [SMALLEST, LARGEST] (zeros
+    aside), so nothing overflows and nothing is lost in subnormal rounding."""
+    with np.errstate(all="ignore"):
+        # Sizes, not the state itself: a position that is 0 up to a rounding (an overlap at onset)
+        # is not a scale.
+        scales = {"time scale (s)": np.array([mode.scale, mode.omega * mode.scale]),
+                  "size (m, m/s)": _sizes(mode, t, y),
+                  "change over the time scale (m, m/s)": np.abs(np.asarray(mode.rhs(t, y), dtype=float)) * mode.scale}
+        if mode.omega > 0:
+            sizes, half = _sizes(mode, t, y), len(y) // 2
+            scales["force per unit mass (m/s^2)"] = np.concatenate([np.float64(mode.omega) ** 2 * sizes[:half],
+                                                                    mode.omega * sizes[half:]])
+    for what, values in scales.items():
+        values = np.asarray(values, dtype=float)
+        bad = values[~np.isfinite(values) | (values > LARGEST) | ((values != 0) & (values < SMALLEST))]
+        if bad.size:
+            raise SimulationError(f"the {mode.name} mode cannot be simulated in float64: its {what} reaches "
+                                  f"{float(bad[0]):.3g}, outside [{SMALLEST:g}, {LARGEST:g}]; use less extreme "
+                                  "values (or another contact duration)")
 
 
 def _step(method: str, rhs: Callable[[float, Any], Any], t: float, y: Any, dt: float) -> Any:
@@ -123,14 +189,15 @@ def _crossed(mode: Mode, before: float, after: float) -> bool:
     return before < 0 <= after
 
 
-def _fixed(mode: Mode, t: float, y: Any, settings: Settings, path: Path) -> tuple[float, Any]:
+def _fixed(mode: Mode, t: float, y: Any, settings: Settings, path: Path, budget: Budget) -> tuple[float, Any]:
     dt = mode.scale / settings.steps
     if mode.omega > 0 and dt * mode.omega >= 2:
         raise SimulationError(
             f"{settings.method}: a step of {dt:.3g} s is at or above the stability limit 2/omega = "
             f"{2 / mode.omega:.3g} s of the {mode.name} mode; use at least "
             f"{math.floor(mode.scale * mode.omega / 2) + 1} steps per contact")
-    for count in range(MAX_STEPS):
+    for count in range(MAX_STEPS + 1):
+        budget.spend(1)
         following = _step(settings.method, mode.rhs, t, y, dt)
         path.steps += 1
         if count == 0 and mode.omega > 0 and mode.event(following) * mode.direction >= 0:
@@ -168,39 +235,46 @@ def _locate(mode: Mode, method: str, t: float, y: Any, dt: float) -> float:
                         xtol=1e-15, rtol=8.9e-16))
 
 
-def _adaptive(mode: Mode, t: float, y: Any, rtol: float, path: Path, dense: bool) -> tuple[float, Any]:
+def _adaptive(mode: Mode, t: float, y: Any, rtol: float, path: Path, dense: bool,
+              budget: Budget) -> tuple[float, Any]:
+    # Time in units of the mode's own scale and each state component in units of its own size:
+    # the event is located to a tolerance relative to the contact's duration (a 1 ns contact
+    # survives), and the error of a 1e-300 m/s motion is measured against itself, with no
+    # absolute floor that would swallow it.
+    start, unit = t, mode.scale
+    sizes = _sizes(mode, t, y)
+    sizes = np.where(sizes > 0, sizes, 1.0)
+
     def event(_: float, state: Any) -> float:
-        return mode.event(state)
+        return mode.event(state * sizes)
 
     event.terminal = True  # type: ignore[attr-defined]
     event.direction = mode.direction  # type: ignore[attr-defined]
-    atol = np.maximum(rtol * _sizes(mode, t, y), 1e-300)
-    # Time in units of the mode's own scale: the event is located to a tolerance relative to the
-    # contact's duration, not to an absolute 1e-15 s (which a 1 ns contact would not survive).
-    start, unit = t, mode.scale
 
     def scaled(s: float, state: Any) -> Any:
-        return unit * mode.rhs(start + s * unit, state)
+        budget.spend(0)
+        return unit * mode.rhs(start + s * unit, state * sizes) / sizes
 
-    horizon = 0.0
+    horizon, y = 0.0, y / sizes
     for _ in range(60):
         origin, horizon = horizon, horizon + 10
-        solution = solve_ivp(scaled, (origin, horizon), y, method="DOP853", rtol=rtol, atol=atol, events=event,
+        solution = solve_ivp(scaled, (origin, horizon), y, method="DOP853", rtol=rtol, atol=rtol, events=event,
                              dense_output=dense)
         path.steps += len(solution.t) - 1
+        budget.spend(len(solution.t) - 1)
         if solution.status < 0:
             raise SimulationError(f"the {mode.name} mode could not be integrated: {solution.message}")
         interior = (((s, solution.sol(s)) for s in np.linspace(origin, solution.t[-1], 50)[1:-1]) if dense
                     else zip(solution.t[1:-1], solution.y.T[1:-1], strict=True))
         for s, state in interior:
-            path.add(start + float(s) * unit, state, mode)
+            path.add(start + float(s) * unit, state * sizes, mode)
         end, y = float(solution.t[-1]), solution.y[:, -1]
         if solution.status == 1:
             end, y = float(solution.t_events[0][0]), solution.y_events[0][0]
         t = start + end * unit
-        path.add(t, y, mode)
+        path.add(t, y * sizes, mode)
         if solution.status == 1:
-            return t, y
+            return t, y * sizes
         horizon = end
     raise SimulationError(f"the {mode.name} mode did not end within {600 * mode.scale:.3g} s{_never_ends(mode)}")
 

@@ -6,12 +6,14 @@ phase's path and each contact's record. Effects' force laws read and write it; t
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass, field
+from typing import Any
 
 from grader.model.expr import Node, Sym, names
 from grader.model.kernel import evaluate
 from grader.model.scene import Scene
-from grader.physics.integrate import Path, Settings, SimulationError
+from grader.physics.integrate import TIME_LIMIT, Budget, Mode, Path, Settings, SimulationError, integrate
 
 DEFAULT_CONTACT_DURATION = 1e-3  # s: stiffness follows from it and the reduced mass
 
@@ -24,11 +26,14 @@ class Options:
     settings: Settings = field(default_factory=Settings)
     contact_duration: float = DEFAULT_CONTACT_DURATION
     weight_during_contact: bool = False
+    time_limit: float = TIME_LIMIT  # s of wall time for one simulation, searches included
 
     def __post_init__(self) -> None:
         if not (math.isfinite(self.contact_duration) and self.contact_duration > 0):
             raise SimulationError(f"the contact duration must be a positive number of seconds, "
                                   f"got {self.contact_duration!r}")
+        if not (math.isfinite(self.time_limit) and self.time_limit > 0):
+            raise SimulationError(f"the time limit must be a positive number of seconds, got {self.time_limit!r}")
 
 
 @dataclass(frozen=True)
@@ -64,6 +69,8 @@ class Run:
     observed: dict[str, tuple[float, float]] = field(default_factory=dict)
     problems: list[str] = field(default_factory=list)
     contacts: list[ContactRecord] = field(default_factory=list)
+    undefined: dict[str, str] = field(default_factory=dict)  # quantity -> why it has no value
+    budget: Budget = field(default_factory=Budget)
     steps: int = 0
 
     def value(self, node: Node) -> float:
@@ -86,6 +93,10 @@ class Run:
         else:
             raise SimulationError(f"{self.scene.where}: cannot simulate: '{node}' is an expression of "
                                   "quantities nothing has produced yet")
+
+    def integrate(self, modes: Sequence[Mode], y0: Any, settings: Settings | None = None) -> Path:
+        """Integrate modes with this run's settings, spending from its budget."""
+        return integrate(modes, y0, settings or self.options.settings, budget=self.budget)
 
     def gravity(self) -> float:
         """g in SI."""

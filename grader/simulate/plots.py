@@ -3,17 +3,18 @@ phase (a 1 ms contact and a 0.6 s fall do not share a time axis legibly)."""
 
 from __future__ import annotations
 
+import io
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from grader.errors import GraderError
+from grader.files import write_atomic
 
 if TYPE_CHECKING:
     from grader.simulate.walker import Simulation
 
 
-def plot_simulation(simulation: Simulation, target: Path) -> None:
-    """Write a PNG of every phase's positions, velocities and contact force."""
+def _pyplot() -> Any:
     try:
         import matplotlib
 
@@ -21,6 +22,39 @@ def plot_simulation(simulation: Simulation, target: Path) -> None:
         import matplotlib.pyplot as plt
     except ImportError:
         raise GraderError("--plot needs matplotlib: pip install matplotlib") from None
+    return plt
+
+
+def plot_formats() -> tuple[str, ...]:
+    """The file name endings a plot can be written as (matplotlib's, without the dot).
+
+    >>> {"png", "pdf", "svg"} <= set(plot_formats())
+    True
+    """
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    _pyplot()
+    return tuple(sorted(FigureCanvasAgg.get_supported_filetypes()))
+
+
+def check_plot_target(target: Path) -> str:
+    """The format of a plot file, from its name; refused before any work if it has none we write."""
+    formats = plot_formats() if target.suffix else ()
+    fmt = target.suffix[1:].lower()
+    if fmt not in formats:
+        raise GraderError(f"--plot {target}: expected a file name ending in one of "
+                          f"{', '.join('.' + f for f in (formats or plot_formats()))}, got "
+                          f"{repr(target.suffix) if target.suffix else 'no ending'}")
+    if target.is_dir():
+        raise GraderError(f"--plot {target}: expected a file name, got a folder")
+    return fmt
+
+
+def plot_simulation(simulation: Simulation, target: Path) -> None:
+    """Write a picture (PNG, PDF, SVG, ...; the name's ending says which) of every phase's positions,
+    velocities and contact force. Written atomically: a failed run leaves no half-written file."""
+    fmt = check_plot_target(target)
+    plt = _pyplot()
     import numpy as np
 
     phases = simulation.phases
@@ -44,6 +78,10 @@ def plot_simulation(simulation: Simulation, target: Path) -> None:
         axes[0][column].set_title(phase.label, fontsize=10)
     nominal = f"; {', '.join(simulation.nominal)} = 1 (no value in the template)" if simulation.nominal else ""
     figure.suptitle(f"{simulation.template}: simulated with {', '.join(simulation.effects)}{nominal}")
-    target.parent.mkdir(parents=True, exist_ok=True)
-    figure.savefig(target, dpi=110)
+    picture = io.BytesIO()
+    figure.savefig(picture, format=fmt, dpi=110)
     plt.close(figure)
+    try:
+        write_atomic(target, picture.getvalue())
+    except OSError as error:
+        raise GraderError(f"--plot {target}: cannot write ({error.strerror})") from None

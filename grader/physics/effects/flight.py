@@ -13,7 +13,7 @@ import numpy as np
 
 from grader.model.units import LENGTH, SPEED
 from grader.physics.effects.base import Condition, Effect, Field, Relation
-from grader.physics.integrate import Mode, integrate
+from grader.physics.integrate import Mode
 
 if TYPE_CHECKING:
     from grader.model.scene import Stage
@@ -75,7 +75,7 @@ def _simulate_fall(stage: Stage, run: Run) -> None:
         return
     # The time scale only sets fixed step sizes; the motion itself is integrated.
     landing = Mode("free fall", gravity(g), lambda y: y[0], -1, scale=math.sqrt(2 * height / g))
-    path = integrate([landing], np.array([height, 0.0]), run.options.settings)
+    path = run.integrate([landing], np.array([height, 0.0]))
     run.record(f"{body} falls", ("height", "velocity"), path)
     run.output(stage.fields["speed"], -float(path.y[-1][1]))
 
@@ -87,10 +87,14 @@ def _simulate_rise(stage: Stage, run: Run) -> None:
         if speed < 0:
             run.problems.append(f"{body} does not move up after the previous stage, so it cannot rise to "
                                 f"{stage.text('height')}")
-        run.output(stage.fields["height"], 0.0)  # continuous in speed, so a search for e can cross it
+        # A body moving down at |v| is where a rise of -v^2/(2 g) would have started: continuing the
+        # height below 0 keeps a search for e strictly monotone through a measured rise of 0, so it
+        # finds the e at which the body just stops (the closed form's), not any e at which it
+        # moves on down. The run has a problem then, so this never becomes an answer.
+        run.output(stage.fields["height"], -speed * speed / (2 * g))
         return
     apex = Mode("rise", gravity(g), lambda y: y[1], -1, scale=speed / g)
-    path = integrate([apex], np.array([0.0, speed]), run.options.settings)
+    path = run.integrate([apex], np.array([0.0, speed]))
     run.record(f"{body} rises", ("height", "velocity"), path)
     run.output(stage.fields["height"], float(path.y[-1][0]))
 

@@ -22,7 +22,7 @@ import numpy as np
 from grader.model.expr import Sym
 from grader.model.units import PURE, SPEED, dimension_from
 from grader.physics.effects.base import Condition, Effect, Field, Relation, Stable
-from grader.physics.integrate import Mode, integrate
+from grader.physics.integrate import Mode
 from grader.physics.run import ContactRecord
 
 if TYPE_CHECKING:
@@ -183,10 +183,16 @@ def _contact(stage: Stage, run: Run, bodies: tuple[str, str], inverse: tuple[flo
     exit_event = (lambda y: y[4] - y[6]) if law.sticks else (lambda y: y[0] - y[2])
     contact = Mode("contact", pressed, exit_event, -1, scale=duration, omega=law.omega,
                    force=lambda y: law.specific_force(y[0] - y[2], y[4] - y[6]) / (w1 + w2), sizes=lambda y: sizes)
-    path = integrate([entry, contact], y0, run.options.settings)
+    path = run.integrate([entry, contact], y0)
     label = f"impact of {bodies[0]} and {bodies[1]}"
     run.record(label, ("x1n", "x1t", "x2n", "x2t", "v1n", "v1t", "v2n", "v2t"), path)
     after = [float(v) for v in path.y[-1][4:]]
+    if law.sticks:
+        # The contact ended where the relative normal velocity is zero (its event): the bodies move
+        # on together, at the velocity the simulated momentum gives; what remains of the relative
+        # velocity is the event's location error, and would give a zero velocity a direction.
+        common = share2 * after[0] + share1 * after[2]
+        after[0] = after[2] = common
     run.contacts.append(ContactRecord(stage.index, label, e, (after[2] - after[0]) / approach, law.zeta, duration))
     return after
 
@@ -224,10 +230,16 @@ def _output_energies(stage: Stage, run: Run, inverse: tuple[float, float], befor
     def kinetic(v: list[float]) -> float:
         return sum((math.hypot(v[2 * i], v[2 * i + 1]) / unit) ** 2 / (2 * w) for i, w in enumerate(inverse) if w)
 
+    # The loss in the stable form 1/2 mu (v_rel - v_sep)(v_rel + v_sep) of the simulated normal
+    # velocities (smooth surfaces: the t-velocities do not change), never T - T', which cancels.
+    # The contact is passive (a spring and a dashpot with c >= 0), so a negative value can only be
+    # the integration error of a separation one rounding above the approach: it is 0.
+    approach, separation = (before[0] - before[2]) / unit, (after[2] - after[0]) / unit
     scaled_before, scaled_after = kinetic(before), kinetic(after)
+    scaled_lost = max(0.0, (approach - separation) * (approach + separation) / (2 * (inverse[0] + inverse[1])))
     measured = {"energy_before": scaled_before * unit * unit, "energy_after": scaled_after * unit * unit,
-                "energy_lost": (scaled_before - scaled_after) * unit * unit,
-                "loss_fraction": (scaled_before - scaled_after) / scaled_before if scaled_before else math.nan,
+                "energy_lost": scaled_lost * unit * unit,
+                "loss_fraction": scaled_lost / scaled_before,
                 "impulse": (before[0] - after[0]) / inverse[0]}
     for key, value in measured.items():
         if key in stage.fields:

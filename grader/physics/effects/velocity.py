@@ -9,6 +9,8 @@ from __future__ import annotations
 import math
 from typing import TYPE_CHECKING
 
+from grader.model.expr import to_text
+from grader.model.kernel import cosd, sind
 from grader.model.units import ANGLE, SPEED
 from grader.physics.effects.base import Condition, Effect, Field, Relation
 
@@ -50,14 +52,20 @@ def _simulate_components(stage: Stage, run: Run) -> None:
     fields = stage.fields
     along_key, across_key = ("t", "n") if fields.get("from", "t") == "t" else ("n", "t")
     if run.known(fields["speed"]) and run.known(fields["angle"]):
-        speed, angle = run.value(fields["speed"]), run.value(fields["angle"])
-        run.output(fields[along_key], speed * math.cos(angle))
-        run.output(fields[across_key], speed * math.sin(angle))
+        # In degrees, reduced exactly (as the closed form does): cos 90 deg is 0, not 6e-17, so a
+        # head-on impact has no tangential motion to give a stopped ball a direction.
+        speed, degrees = run.value(fields["speed"]), math.degrees(run.value(fields["angle"]))
+        run.output(fields[along_key], speed * float(cosd(degrees)))
+        run.output(fields[across_key], speed * float(sind(degrees)))
         return
     along, across = run.value(fields[along_key]), run.value(fields[across_key])
     speed = math.hypot(along, across)
     run.output(fields["speed"], speed)
-    run.output(fields["angle"], math.atan2(across, along) if speed > 0 else math.nan)
+    if speed > 0:
+        run.output(fields["angle"], math.atan2(across, along))
+    else:
+        run.undefined[to_text(fields["angle"])] = f"{stage.text('speed')} is zero, so it has no direction"
+        run.output(fields["angle"], math.nan)
 
 
 VELOCITY = Effect(

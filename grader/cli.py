@@ -81,6 +81,9 @@ def build_parser() -> argparse.ArgumentParser:
 def _output_options(command: argparse.ArgumentParser) -> None:
     command.add_argument("--jobs", type=int, default=1, metavar="N", help="render PDFs in N parallel jobs")
     command.add_argument("--force", action="store_true", help="replace a non-empty output folder")
+    command.add_argument("--font-dir", type=Path, action="append", default=[], metavar="DIR", dest="font_dirs",
+                         help="also use the fonts in DIR (repeatable), e.g. for names in scripts the embedded "
+                              "fonts and any installed Noto CJK / emoji fonts lack")
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -389,7 +392,8 @@ def _generate(arguments: argparse.Namespace) -> int:
 
     _check_jobs(arguments.jobs)
     job = Job(arguments.assignment, arguments.roster, arguments.out, pdf=not arguments.no_pdf,
-              jobs=arguments.jobs, keep_source=arguments.keep_source, force=arguments.force)
+              jobs=arguments.jobs, keep_source=arguments.keep_source, force=arguments.force,
+              font_dirs=tuple(arguments.font_dirs))
     _print_summary(run(job, _bank(arguments)))
     return EXIT_OK
 
@@ -398,7 +402,8 @@ def _demo(arguments: argparse.Namespace) -> int:
     from grader.render.generate import demo
 
     _check_jobs(arguments.jobs)
-    summary = demo(arguments.out, _bank(arguments), jobs=arguments.jobs, force=arguments.force)
+    summary = demo(arguments.out, _bank(arguments), jobs=arguments.jobs, force=arguments.force,
+                   font_dirs=tuple(arguments.font_dirs))
     _print_summary(summary)
     print(f"The assignment and roster it used are in {summary.out}: edit them and run\n"
           f"  grader generate {summary.out / 'assignment.yaml'} --roster {summary.out / 'roster.csv'} --out OTHER")

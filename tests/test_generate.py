@@ -212,3 +212,66 @@ def test_jobs_below_one_exits_2(tmp_path: Path, capsys: pytest.CaptureFixture[st
     assert (code, out) == (2, "")
     assert "--jobs must be 1 or more, got 0" in err
     assert list(tmp_path.iterdir()) == []
+
+
+# --- hostile templates (hardening) ----------------------------------------------------------------
+
+ONE_PROBLEM = {"title": "HW", "course": "C", "seed": "s1",
+               "problems": [{"key": "1", "template": "drop-rebound", "points": 1}]}
+SUBCLASSES = ("{% for c in ''.__class__.__mro__[1].__subclasses__() %}{% if c.__name__ == 'Popen' %}"
+              "{{ c.__init__.__globals__['system']('touch F') }}{% endif %}{% endfor %}")
+
+
+def hostile_bank(folder: Path, statement: str) -> Path:
+    """A --bank folder holding drop-rebound with ``statement`` put first in its statement, an
+    assignment of that one problem, a roster of four and a secret file, all in ``folder``."""
+    bank_folder = folder / "bank"
+    bank_folder.mkdir()
+    raw = yaml.safe_load((Path(__file__).parents[1] / "problem_bank" / "drop-rebound.yaml").read_text("utf-8"))
+    raw["statement"] = statement + "\n" + raw["statement"]
+    (bank_folder / "drop-rebound.yaml").write_text(yaml.safe_dump(raw), encoding="utf-8")
+    (folder / "a.yaml").write_text(yaml.safe_dump(ONE_PROBLEM), encoding="utf-8")
+    (folder / "roster.csv").write_text("\n".join(ROSTER.read_text("utf-8").splitlines()[:5]) + "\n", "utf-8")
+    (folder / "secret.txt").write_text("TOPSECRET", encoding="utf-8")
+    return bank_folder
+
+
+@pytest.mark.parametrize(("statement", "got"), [
+    (SUBCLASSES, "got a for loop"),
+    ("{{ ''.__class__ }}", "got attribute access"),
+    ("{{ 'x' * 10**9 }}", "more than 10000 characters"),
+    ("{{ 2 ** 1000000000 }}", "more than 10000 characters"),
+    ("{{ (('x' * 9999) ~ ('x' * 9999)) ~ ('x' * 9999) }}", "more than 20000 characters of output"),
+    ("{{ 'x'|center(10**9) }}", "filter 'center'"),
+    ("{{ '%0999999999d' % 1 }}", "string formatting"),
+    ('#read("secret.txt")', 'a Typst call that reads files: read("secret.txt")'),
+    ('$ read("secret.txt") $', 'reads files: read("secret.txt")'),
+    ('#image("secret.txt")', "reads files: image("),
+    ('#import "@preview/cetz:0.2.2": *', 'reads files: import "@preview/cetz:0.2.2"'),
+    ('#include "secret.txt"', "reads files: include"),
+    ('#let r = std.read; #r("secret.txt")', "reads files: std.read"),
+    ('#eval("re" + "ad(\\"secret.txt\\")")', "reads files: eval("),
+    ('#re{{ h_drop|string|lower|trim|default }}ad("secret.txt")', "reads files: read("),
+])
+def test_a_hostile_template_statement_is_refused_with_exit_2_before_anything_runs(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch, statement: str,
+        got: str) -> None:
+    """Code in a statement never runs, a costly one is refused in well under a second, Typst that
+    reads files is refused when the template loads: exit 2, the file and `statement` named, no output."""
+    import time
+
+    bank_folder = hostile_bank(tmp_path, statement)
+    monkeypatch.chdir(tmp_path)
+    started = time.perf_counter()
+    code, _, err = run(capsys, "--bank", bank_folder, "generate", "a.yaml", "--roster", "roster.csv", "--out", "out")
+    assert time.perf_counter() - started < 1.0
+    assert code == 2
+    assert f"{bank_folder / 'drop-rebound.yaml'}: statement: expected" in err and got in err, err
+    assert not (tmp_path / "F").exists() and not (tmp_path / "out").exists()
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a.yaml", "bank", "roster.csv", "secret.txt"]
+
+
+def test_a_font_dir_that_is_not_a_folder_exits_2(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    code, _, err = run(capsys, "demo", "--out", tmp_path / "out", "--font-dir", tmp_path / "nowhere")
+    assert code == 2 and "--font-dir" in err and "does not exist" in err
+    assert not (tmp_path / "out").exists()

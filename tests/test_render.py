@@ -17,8 +17,9 @@ from grader.assign.variants import AnswerPart, Generation, ProblemVariant, Stude
 from grader.bank.template import Template, parse_template
 from grader.errors import GraderError
 from grader.model.expr import parse
-from grader.render.documents import file_names, render_all, render_page_png, safe_file_name
+from grader.render.documents import file_names, render_all, render_page_png, safe_file_name, statement
 from grader.render.figures import figure
+from grader.render.typeset import compile_typst, font_paths, system_fonts, uncovered
 from grader.render.worked import Typ, dimension, math, unit_of, worked
 from grader.resources import sample_dir
 from grader.solve.cache import compiled_for
@@ -334,3 +335,96 @@ def test_scenes_of_other_shapes_get_a_figure_and_a_worked_solution(source: str, 
     png = render_page_png(one, generated, {template.id: template}, 0)
     ARTIFACTS.mkdir(exist_ok=True)
     (ARTIFACTS / f"extra-{template.id}.png").write_bytes(png)
+
+
+# --- hardening: statements, the Typst root, fonts -------------------------------------------------
+
+def test_a_statement_that_skipped_the_load_check_still_runs_no_code(bank: dict[str, Template],
+                                                                   generation: Generation) -> None:
+    """The sandbox itself refuses dunder access and sizes; statement() names the file and `statement`."""
+    import jinja2.sandbox
+
+    from grader.bank import statement as statements
+
+    with pytest.raises(jinja2.sandbox.SecurityError):
+        statements._environment().from_string("{{ ''.__class__.__mro__ }}").render()
+    with pytest.raises(statements.StatementRefused, match="more than 10000"):
+        statements._environment().from_string("{{ 'x' * 10**9 }}").render()
+    variant = generation.students[0].problems[0]
+    evil = dataclasses.replace(bank[variant.template], statement="{{ ''.__class__ }}")
+    with pytest.raises(GraderError, match=r"\.yaml: statement: expected values filled in, not code, got attr"):
+        statement(evil, variant)
+
+
+def test_a_secret_file_in_the_working_folder_never_reaches_a_pdf(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch, assignment: Assignment, bank: dict[str, Template],
+        few: Generation) -> None:
+    """Typst's root is an empty private folder: reading a file fails even when the text gets that far;
+    a template asking for one is refused at load, and in rendering; no PDF holds the secret."""
+    (tmp_path / "secret.txt").write_text("TOPSECRET", encoding="utf-8")
+    monkeypatch.chdir(tmp_path)
+    for source in ('#read("secret.txt")', f'#read("{tmp_path / "secret.txt"}")', '#image("secret.txt")',
+                   '#include "secret.txt"', '#import "@local/x:0.1.0"'):
+        with pytest.raises(GraderError, match="Typst could not typeset"):
+            compile_typst(source)
+    raw = yaml.safe_load((Path(__file__).parents[1] / "problem_bank" / "drop-rebound.yaml").read_text("utf-8"))
+    with pytest.raises(GraderError, match=r'x\.yaml: statement: expected text and math only, got a Typst call '
+                                          r'that reads files: read\("secret\.txt"\)'):
+        parse_template({**raw, "statement": '#read("secret.txt")'}, "x.yaml", "0", "drop-rebound")
+    template = few.students[0].problems[0].template
+    leaky = {**bank, template: dataclasses.replace(bank[template], statement='#read("secret.txt")')}
+    with pytest.raises(GraderError, match="reads files"):
+        render_all(assignment, few, leaky, tmp_path / "out")
+    render_all(assignment, Generation(few.students[:1], few.collisions), bank, tmp_path / "ok")
+    assert all("TOPSECRET" not in pdf_text(p) for p in (tmp_path / "ok").rglob("*.pdf"))
+
+
+def dejavu_sans(folder: Path) -> Path:
+    """A font folder holding only matplotlib's DejaVu Sans (which has Tifinagh; the embedded fonts do not)."""
+    import matplotlib
+
+    folder.mkdir()
+    shipped = Path(matplotlib.get_data_path()) / "fonts" / "ttf" / "DejaVuSans.ttf"
+    (folder / "DejaVuSans.ttf").write_bytes(shipped.read_bytes())
+    return folder
+
+
+def test_characters_no_font_has_are_found_and_font_dir_adds_fonts(tmp_path: Path) -> None:
+    """Typst is asked which characters print as empty boxes; a font folder adds what it covers."""
+    extra = str(dejavu_sans(tmp_path / "fonts"))
+    assert uncovered(["Ωжé 李 𓀀 ⴰ"], ()) == {"李", "𓀀", "ⴰ"}
+    assert uncovered(["Ωжé 李 𓀀 ⴰ"], (extra,)) == {"李", "𓀀"}
+
+
+def test_a_name_no_font_has_is_warned_about_naming_the_student(tmp_path: Path, capsys: pytest.CaptureFixture[str],
+                                                              assignment: Assignment, bank: dict[str, Template],
+                                                              few: Generation) -> None:
+    """Without the font, a warning on stderr names the student; the PDFs are still written."""
+    from grader.render.generate import Job, _write
+
+    entry = few.students[0]
+    odd = Generation((dataclasses.replace(entry, student=dataclasses.replace(entry.student, name="Amun 𓀀")),),
+                     few.collisions)
+    job = Job(sample_dir() / "assignment.yaml", sample_dir() / "roster.csv", tmp_path)
+    assert _write(job, assignment, odd, bank, tmp_path) == 5
+    err = capsys.readouterr().err
+    assert f"warning: student {entry.student.id} (Amun 𓀀): no font has 𓀀 (U+13000)" in err
+
+
+@pytest.mark.skipif(not any("CJK" in f.name for f in system_fonts()),
+                    reason="no Noto CJK font installed (apt-get install fonts-noto-cjk); the embedded fonts lack CJK")
+def test_cjk_and_hangul_names_print_with_the_system_noto_font(tmp_path: Path, capsys: pytest.CaptureFixture[str],
+                                                             assignment: Assignment, bank: dict[str, Template],
+                                                             few: Generation) -> None:
+    """With fonts-noto-cjk, 李华 and 김민준 are text in the PDF, not boxes, and nobody is warned about."""
+    from grader.render.generate import Job, _write
+
+    entry = few.students[0]
+    name = "李华 김민준"
+    cjk = Generation((dataclasses.replace(entry, student=dataclasses.replace(entry.student, name=name)),),
+                     few.collisions)
+    _write(Job(sample_dir() / "assignment.yaml", sample_dir() / "roster.csv", tmp_path), assignment, cjk, bank,
+           tmp_path)
+    assert "warning" not in capsys.readouterr().err
+    assert name in pdf_text(tmp_path / "students" / f"{entry.student.id}.pdf")
+    assert not uncovered([name], font_paths(()))

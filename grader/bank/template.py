@@ -287,14 +287,29 @@ def _check_statement(template: Template, given: set[str]) -> None:
     import jinja2
     import jinja2.meta
 
+    from grader.bank.statement import StatementRefused, check_jinja, fill_statement, typst_file_access
+
     try:
-        syntax = jinja2.Environment(autoescape=True).parse(template.statement)
+        syntax = check_jinja(template.statement)
     except jinja2.TemplateSyntaxError as error:
         raise TemplateError(template.where, "statement", "a valid Jinja2 snippet", error.message) from None
+    except StatementRefused as error:
+        raise TemplateError(template.where, "statement", "values filled in, not code", str(error)) from None
     unknown = jinja2.meta.find_undeclared_variables(syntax) - given - {"g"}
     if unknown:
         raise TemplateError(template.where, "statement", "only parameters, symbols and g",
                             f"unknown {', '.join(sorted(unknown))}")
+    # A trial fill (parameters and g as "1", symbols as their names, as a sheet shows them) refuses
+    # what would be too costly for every student alike, and Typst code assembled from pieces.
+    values = {**dict.fromkeys([*template.parameters, "g"], "1"), **{n: n for n in template.symbols}}
+    try:
+        filled = fill_statement(template.statement, values)
+    except StatementRefused as error:
+        raise TemplateError(template.where, "statement", "values filled in, not code", str(error)) from None
+    reading = typst_file_access(template.statement) or typst_file_access(filled)
+    if reading is not None:
+        raise TemplateError(template.where, "statement", "text and math only",
+                            f"a Typst call that reads files: {reading}")
 
 
 def _text(raw: Mapping[str, Any], key: str, where: str) -> str:

@@ -8,7 +8,9 @@ byte-identical PDFs.
 Text from the roster and the assignment (names, ids, titles, descriptions) is never interpreted:
 every ``{{ }}`` of a document template is shown as a Typst string literal unless this module
 marked the value as Typst source (:class:`~grader.render.worked.Typ`). A template's ``statement`` is
-instructor-written Typst markup and is inserted as markup, with the printed values filled in.
+instructor-written Typst markup (text and math only, checked) and is inserted as markup, with the
+printed values filled in by a bounded Jinja2 sandbox (:mod:`grader.bank.statement`). Typst compiles
+in an empty private root (:mod:`grader.render.typeset`), so no document can read a file.
 
 >>> safe_file_name("2026100"), safe_file_name("a/b c")
 ('2026100', 'a_b_c-0af99a6091')
@@ -19,28 +21,28 @@ from __future__ import annotations
 import concurrent.futures
 import hashlib
 import re
-import threading
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
-from typing import Any, Literal
+from typing import Any
 
 import jinja2
 
 from grader.assign.assignment import Assignment
 from grader.assign.variants import AnswerPart, Generation, ProblemVariant
+from grader.bank.statement import StatementRefused, fill_statement, typst_file_access
 from grader.bank.template import Template
 from grader.errors import GraderError
 from grader.model.expr import parse
 from grader.render.figures import figure
+from grader.render.typeset import compile_typst, font_paths, one_pdf
 from grader.render.worked import Typ, Worked, WorkedStep, answer_math, math, name, number, string, text, worked
 from grader.resources import templates_dir
 from grader.solve.cache import compiled_for
 from grader.solve.compiled import Compiled
 
 PAPER = "us-letter"
-TIMESTAMP = 0  # the PDFs' creation date: fixed, so that output is reproducible
 _SAFE = re.compile(r"[A-Za-z0-9._-]+")
 
 
@@ -304,22 +306,22 @@ def _key_answer(template: Template, part: AnswerPart) -> KeyAnswer:
 
 # --- statements ---------------------------------------------------------------------------------
 
-@lru_cache(maxsize=64)
-def _statement_template(source: str) -> jinja2.Template:
-    environment = jinja2.Environment(undefined=jinja2.StrictUndefined, autoescape=False)  # noqa: S701 (Typst, not HTML)
-    return environment.from_string(source)
-
-
 def statement(template: Template, variant: ProblemVariant) -> Typ:
-    """The template's statement (trusted Typst markup) with the variant's printed values."""
+    """The template's statement (instructor-written Typst markup, text and math only) with the
+    variant's printed values, filled in by the bounded sandbox of :mod:`grader.bank.statement`."""
     values: dict[str, Any] = {n: n for n in template.symbols}
     if template.scene.gravity is not None:
         values["g"] = template.scene.gravity.text.split()[0]
     values.update(variant.printed)
     try:
-        return Typ(_statement_template(template.statement).render(values).strip())
-    except jinja2.TemplateError as error:
-        raise GraderError(f"{template.where}: statement: cannot fill in the values ({error})") from None
+        filled = fill_statement(template.statement, values)
+    except StatementRefused as error:
+        raise GraderError(f"{template.where}: statement: expected values filled in, not code, got {error}") from None
+    reading = typst_file_access(filled)
+    if reading is not None:
+        raise GraderError(f"{template.where}: statement: expected text and math only, got a Typst call that reads "
+                          f"files: {reading}")
+    return Typ(filled)
 
 
 # --- documents ----------------------------------------------------------------------------------
@@ -369,29 +371,8 @@ def key_source(documents: _Documents, indices: Sequence[int], overview: bool = T
         document_title=f"{assignment.title}: answer key")
 
 
-_LOCAL = threading.local()
-
-
-def compile_typst(source: str, fmt: Literal["pdf", "png"] = "pdf", ppi: float | None = None,
-                  tagged: bool = True) -> bytes | list[bytes]:
-    """Compile a source with embedded fonts only and the fixed timestamp (one compiler per thread);
-    ``tagged``: with the PDF structure tags screen readers use."""
-    import typst
-
-    compiler = getattr(_LOCAL, "compiler", None)
-    if compiler is None:
-        compiler = _LOCAL.compiler = typst.Compiler(ignore_system_fonts=True)
-    try:
-        result = compiler.compile(source.encode("utf-8"), format=fmt, ppi=ppi, timestamp=TIMESTAMP, pdf_tags=tagged)
-    except typst.TypstError as error:
-        where = "\n".join(str(error.diagnostic).splitlines()[:6])
-        raise GraderError(f"Typst could not typeset a document: {error.message}\n{where}") from None
-    if result is None:
-        raise GraderError("Typst produced no output")
-    return result
-
-
-def check_statements(assignment: Assignment, generation: Generation, bank: Mapping[str, Template]) -> None:
+def check_statements(assignment: Assignment, generation: Generation, bank: Mapping[str, Template],
+                     fonts: tuple[str, ...] = ()) -> None:
     """Typeset each problem's statement alone once, so that a statement Typst cannot read is
     reported with its template's file, not as a failure of a whole document."""
     if not generation.students:
@@ -399,17 +380,18 @@ def check_statements(assignment: Assignment, generation: Generation, bank: Mappi
     for variant in generation.students[0].problems:
         template = bank[variant.template]
         try:
-            compile_typst(f"#set page(width: 12cm, height: auto)\n{statement(template, variant)}\n")
+            compile_typst(f"#set page(width: 12cm, height: auto)\n{statement(template, variant)}\n", fonts=fonts)
         except GraderError as error:
             raise GraderError(f"{template.where}: statement: {error}") from None
 
 
 def render_all(assignment: Assignment, generation: Generation, bank: Mapping[str, Template], out: Path, *,
-               jobs: int = 1, keep_source: bool = False,
-               progress: Callable[[int], None] | None = None) -> list[Path]:
+               jobs: int = 1, keep_source: bool = False, progress: Callable[[int], None] | None = None,
+               font_dirs: Sequence[Path] = ()) -> list[Path]:
     """Write ``out/students/<file name>.pdf`` per student (names from :func:`file_names`),
     ``out/class.pdf`` (every sheet, each student from a new page) and ``out/answer-key.pdf``;
-    with ``keep_source`` also their Typst sources under ``out/source/``.
+    with ``keep_source`` also their Typst sources under ``out/source/``. Fonts: the embedded ones,
+    Noto CJK and emoji where installed, and those in ``font_dirs`` (:func:`font_paths`).
 
     ``progress(1)`` is called as each of the ``len(students) + 2`` documents is written. Student
     sheets compile in ``jobs`` threads (Typst releases the GIL). The class PDF is the student PDFs
@@ -420,7 +402,8 @@ def render_all(assignment: Assignment, generation: Generation, bank: Mapping[str
     """
     if not generation.students:
         raise GraderError("there are no students to make PDFs for")
-    check_statements(assignment, generation, bank)
+    fonts = font_paths(tuple(font_dirs))
+    check_statements(assignment, generation, bank, fonts)
     documents = _Documents(assignment, generation, bank)
     everyone = list(range(len(generation.students)))
     names = file_names([s.student.id for s in generation.students])
@@ -428,17 +411,17 @@ def render_all(assignment: Assignment, generation: Generation, bank: Mapping[str
     key_path, key = out / "answer-key.pdf", key_source(documents, everyone)
     (out / "students").mkdir(parents=True, exist_ok=True)
     with concurrent.futures.ThreadPoolExecutor(max_workers=max(1, jobs)) as pool:
-        futures = {pool.submit(compile_typst, source): path for path, source in sheets}
+        futures = {pool.submit(compile_typst, source, fonts=fonts): path for path, source in sheets}
         for future in concurrent.futures.as_completed(futures):
-            futures[future].write_bytes(_pdf(future.result()))
+            futures[future].write_bytes(one_pdf(future.result()))
             if progress is not None:
                 progress(1)
         # The key typesets (without the GIL) while the class PDF is joined in this thread.
-        typesetting = pool.submit(compile_typst, key, tagged=False)
+        typesetting = pool.submit(compile_typst, key, tagged=False, fonts=fonts)
         _join_pdfs([path for path, _ in sheets], out / "class.pdf")
         if progress is not None:
             progress(1)
-        key_path.write_bytes(_pdf(typesetting.result()))
+        key_path.write_bytes(one_pdf(typesetting.result()))
     if progress is not None:
         progress(1)
     written = [path for path, _ in sheets] + [out / "class.pdf", key_path]
@@ -449,11 +432,6 @@ def render_all(assignment: Assignment, generation: Generation, bank: Mapping[str
             kept.write_text(source, encoding="utf-8")
             written.append(kept)
     return written
-
-
-def _pdf(result: bytes | list[bytes]) -> bytes:
-    assert isinstance(result, bytes)  # a PDF compile returns one document
-    return result
 
 
 def _join_pdfs(parts: Sequence[Path], target: Path) -> None:
@@ -468,13 +446,14 @@ def _join_pdfs(parts: Sequence[Path], target: Path) -> None:
 
 
 def render_page_png(assignment: Assignment, generation: Generation, bank: Mapping[str, Template],
-                    student_index: int, *, key: bool = False, page: int = 0, ppi: int = 110) -> bytes:
+                    student_index: int, *, key: bool = False, page: int = 0, ppi: int = 110,
+                    font_dirs: Sequence[Path] = ()) -> bytes:
     """One page of a student's sheet as PNG, or with ``key`` of that student's worked solutions in
     the answer key (without the class overview)."""
     documents = _Documents(assignment, generation, bank)
     source = key_source(documents, [student_index], overview=False) if key else \
         student_source(documents, [student_index])
-    pages = compile_typst(source, "png", ppi)
+    pages = compile_typst(source, "png", ppi, fonts=font_paths(tuple(font_dirs)))
     pages = [pages] if isinstance(pages, bytes) else pages
     if not 0 <= page < len(pages):
         raise GraderError(f"page {page} does not exist: the document has {len(pages)} page(s)")

@@ -36,6 +36,7 @@ class Job:
     jobs: int = 1
     keep_source: bool = False
     force: bool = False
+    font_dirs: tuple[Path, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -57,6 +58,10 @@ def run(job: Job, bank: Mapping[str, Template], extra: Mapping[str, Path] | None
     roster = load_roster(job.roster)
     check_against_bank(assignment, bank)
     _check_output(job.out, job.force)
+    if job.pdf:
+        from grader.render.typeset import font_paths
+
+        font_paths(job.font_dirs)  # refuses a --font-dir that is not a folder before any work
     generation = generate(assignment, roster, bank)
     with _staging(job.out) as staging:
         for name, source in (extra or {}).items():
@@ -66,10 +71,11 @@ def run(job: Job, bank: Mapping[str, Template], extra: Mapping[str, Path] | None
                    time.perf_counter() - started)
 
 
-def demo(out: Path, bank: Mapping[str, Template], jobs: int = 1, force: bool = False) -> Summary:
+def demo(out: Path, bank: Mapping[str, Template], jobs: int = 1, force: bool = False,
+         font_dirs: tuple[Path, ...] = ()) -> Summary:
     """The whole job on the shipped sample; the assignment and roster it used are written beside it."""
     samples = sample_dir()
-    job = Job(samples / "assignment.yaml", samples / "roster.csv", out, jobs=jobs, force=force)
+    job = Job(samples / "assignment.yaml", samples / "roster.csv", out, jobs=jobs, force=force, font_dirs=font_dirs)
     return run(job, bank, {"assignment.yaml": samples / "assignment.yaml", "roster.csv": samples / "roster.csv"})
 
 
@@ -107,10 +113,16 @@ def _write(job: Job, assignment: Assignment, generation: Generation, bank: Mappi
     written = 2
     if job.pdf:
         from grader.render.documents import render_all
+        from grader.render.typeset import font_paths, missing_glyph_warnings
 
+
+        people = [(s.student.id, s.student.name) for s in generation.students]
+        for warning in missing_glyph_warnings(people, font_paths(job.font_dirs)):
+            print(warning, file=sys.stderr)
         with _progress(len(generation.students) + 2, "PDFs") as advance:
             written += len(render_all(assignment, generation, bank, staging, jobs=job.jobs,
-                                      keep_source=job.keep_source, progress=advance))
+                                      keep_source=job.keep_source, progress=advance,
+                                      font_dirs=job.font_dirs))
     return written
 
 

@@ -10,6 +10,7 @@ import argparse
 import difflib
 import json
 import math
+import os
 import sys
 from collections.abc import Sequence
 from pathlib import Path
@@ -18,6 +19,7 @@ from typing import Any
 from grader import __version__
 from grader.bank.template import Parameter, Template, load_bank
 from grader.errors import GraderError, UsageError, shown
+from grader.files import describe_os_error
 from grader.inputs import read_csv
 from grader.model.units import parse_unit, split_quantity
 
@@ -80,22 +82,54 @@ def build_parser() -> argparse.ArgumentParser:
 
 def _output_options(command: argparse.ArgumentParser) -> None:
     command.add_argument("--jobs", type=int, default=1, metavar="N", help="render PDFs in N parallel jobs")
-    command.add_argument("--force", action="store_true", help="replace a non-empty output folder")
+    command.add_argument("--force", action="store_true",
+                         help="replace an output folder an earlier run wrote (as its .grader-manifest.json says)")
     command.add_argument("--font-dir", type=Path, action="append", default=[], metavar="DIR", dest="font_dirs",
                          help="also use the fonts in DIR (repeatable), e.g. for names in scripts the embedded "
                               "fonts and any installed Noto CJK / emoji fonts lack")
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """Run the command line; returns the exit code."""
+    """Run the command line; returns the exit code.
+
+    A file-system error (a full disk, a read-only folder, a name too long, a full or closed standard
+    output) is one line naming the path and the reason, exit code 2; other exceptions are bugs and keep
+    their traceback. A reader that stops early (``grader list | head -1``) ends the run quietly.
+    """
     arguments = build_parser().parse_args(argv)
     try:
-        return _COMMANDS[arguments.command](arguments)
+        code = _COMMANDS[arguments.command](arguments)
+        sys.stdout.flush()
+        return code
     except GraderError as error:
-        print(f"grader: error: {error}", file=sys.stderr)
-        return EXIT_USAGE
+        return _error(str(error))
     except BrokenPipeError:
+        _discard_stdout()
         return EXIT_OK
+    except OSError as error:
+        # Every file error of this package names its path (write_atomic and output_folder add it where
+        # the operating system does not), so one that names none comes from writing standard output.
+        if error.filename is None:
+            _discard_stdout()
+            return _error(f"cannot write to standard output ({error.strerror}); free some space, or send the "
+                          "output to a file or program that takes it")
+        return _error(describe_os_error(error))
+
+
+def _error(message: str) -> int:
+    print(f"grader: error: {message}", file=sys.stderr)
+    return EXIT_USAGE
+
+
+def _discard_stdout() -> None:
+    """Send what is still buffered for a stdout that fails to the null device, so that Python's own
+    flush at exit does not fail again with a traceback."""
+    try:
+        null = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(null, sys.stdout.fileno())
+        os.close(null)
+    except (OSError, ValueError):  # a stdout with no file descriptor (tests capture it) needs nothing
+        pass
 
 
 def _bank(arguments: argparse.Namespace) -> dict[str, Template]:

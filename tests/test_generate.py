@@ -2,7 +2,11 @@
 
 from __future__ import annotations
 
+import errno
 import json
+import os
+import subprocess
+import sys
 from pathlib import Path
 
 import pytest
@@ -12,6 +16,7 @@ from grader.assign.assignment import load_assignment, load_roster
 from grader.assign.variants import generate
 from grader.bank.template import Template
 from grader.cli import main
+from grader.files import MANIFEST
 from grader.resources import sample_dir
 from grader.solve.compiled import Compiled
 from grader.solve.evaluate import solve_one
@@ -132,15 +137,13 @@ def test_infeasible_constraint_names_the_template_and_the_constraint(tmp_path: P
 
 
 def test_an_existing_output_folder_is_kept_unless_forced(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    """A non-empty --out is refused (exit 2) and untouched; --force replaces it whole."""
+    """A non-empty --out is refused (exit 2) and untouched; --force replaces an earlier run's output whole."""
     out = tmp_path / "out"
-    out.mkdir()
-    (out / "notes.txt").write_text("mine", encoding="utf-8")
+    assert run(capsys, "generate", ASSIGNMENT, "--roster", ROSTER, "--out", out, "--no-pdf")[0] == 0
     code, _, err = run(capsys, "generate", ASSIGNMENT, "--roster", ROSTER, "--out", out, "--no-pdf")
     assert code == 2 and "exists and is not empty" in err
-    assert (out / "notes.txt").read_text(encoding="utf-8") == "mine"
     assert run(capsys, "generate", ASSIGNMENT, "--roster", ROSTER, "--out", out, "--no-pdf", "--force")[0] == 0
-    assert sorted(p.name for p in out.iterdir()) == ["key.csv", "key.json"]
+    assert sorted(p.name for p in out.iterdir()) == [".grader-manifest.json", "key.csv", "key.json"]
     assert [p.name for p in tmp_path.iterdir()] == ["out"]
 
 
@@ -186,7 +189,7 @@ def test_demo_writes_its_inputs_and_generate_from_them_reproduces_it(tmp_path: P
     assert {"key.json", "key.csv", "class.pdf", "answer-key.pdf"} <= {str(p) for p in produced}
     assert len([p for p in produced if str(p).startswith("students")]) == 30
     for path in produced:
-        if path.name not in ("assignment.yaml", "roster.csv"):
+        if path.name not in ("assignment.yaml", "roster.csv", MANIFEST):  # the demo lists its inputs too
             assert (demo / path).read_bytes() == (other / path).read_bytes(), path
 
 
@@ -275,3 +278,240 @@ def test_a_font_dir_that_is_not_a_folder_exits_2(tmp_path: Path, capsys: pytest.
     code, _, err = run(capsys, "demo", "--out", tmp_path / "out", "--font-dir", tmp_path / "nowhere")
     assert code == 2 and "--font-dir" in err and "does not exist" in err
     assert not (tmp_path / "out").exists()
+
+
+# --- the output folder: --force, races, file-system errors (hardening) --------------------------------------
+
+
+def _inputs_in(folder: Path) -> tuple[Path, Path]:
+    folder.mkdir(parents=True, exist_ok=True)
+    return _write(folder / "assignment.yaml", ASSIGNMENT.read_text(encoding="utf-8")), _write(
+        folder / "roster.csv", ROSTER_TEXT)
+
+
+def _tree(folder: Path) -> dict[str, bytes]:
+    return {str(p.relative_to(folder)): p.read_bytes() for p in sorted(folder.rglob("*")) if p.is_file()}
+
+
+def _one_line_error(code: int, out: str, err: str) -> str:
+    assert (code, out) == (2, ""), err
+    assert err.count("\n") == 1 and err.startswith("grader: error: ") and "Traceback" not in err, err
+    return err
+
+
+def test_force_does_not_delete_the_inputs_of_the_demo_folder(tmp_path: Path, capsys: pytest.CaptureFixture[str],
+                                                             bank: dict[str, Template]) -> None:
+    """`demo --out d`, then `generate d/assignment.yaml --roster d/roster.csv --out d --force`: refused, d kept.
+    (d is made as the demo makes it, without PDFs to keep the test fast; its manifest lists the inputs.)"""
+    from grader.render.generate import Job
+    from grader.render.generate import run as generate_into
+
+    demo = tmp_path / "d"
+    generate_into(Job(ASSIGNMENT, ROSTER, demo, pdf=False), bank, {"assignment.yaml": ASSIGNMENT,
+                                                                   "roster.csv": ROSTER})
+    assert "roster.csv" in json.loads((demo / MANIFEST).read_text(encoding="utf-8"))["files"]
+    before = _tree(demo)
+    err = _one_line_error(*run(capsys, "generate", demo / "assignment.yaml", "--roster", demo / "roster.csv",
+                               "--out", demo, "--no-pdf", "--force"))
+    assert f"{demo}: is or holds the input {demo / 'assignment.yaml'}" in err
+    assert _tree(demo) == before
+    assert [p.name for p in tmp_path.iterdir()] == ["d"]
+
+
+@pytest.mark.parametrize("where", ["out", "ancestor"])
+def test_force_does_not_delete_the_inputs_or_unrelated_files(tmp_path: Path, capsys: pytest.CaptureFixture[str],
+                                                             where: str) -> None:
+    """--out that holds the assignment and roster (directly or further down), and notes.txt: nothing goes."""
+    hw = tmp_path / "hw"
+    assignment, roster = _inputs_in(hw / "inputs" if where == "ancestor" else hw)
+    _write(hw / "notes.txt", "mine")
+    before = _tree(hw)
+    err = _one_line_error(*run(capsys, "generate", assignment, "--roster", roster, "--out", hw, "--no-pdf",
+                               "--force"))
+    assert "is or holds the input" in err and "choose an --out that holds none of the inputs" in err
+    assert _tree(hw) == before
+    assert [p.name for p in tmp_path.iterdir()] == ["hw"]
+
+
+def test_force_does_not_delete_a_folder_grader_did_not_write(tmp_path: Path,
+                                                             capsys: pytest.CaptureFixture[str]) -> None:
+    """A folder without a manifest is never replaced, not even with --force."""
+    out = tmp_path / "out"
+    out.mkdir()
+    _write(out / "notes.txt", "mine")
+    err = _one_line_error(*run(capsys, "generate", ASSIGNMENT, "--roster", ROSTER, "--out", out, "--no-pdf",
+                               "--force"))
+    assert f"{out}: exists and is not empty, and no grader run wrote it (there is no {MANIFEST})" in err
+    assert _tree(out) == {"notes.txt": b"mine"}
+
+
+@pytest.mark.parametrize(("change", "listed"), [
+    ("add", "notes.txt (not written by grader)"),
+    ("edit", "key.csv (changed since grader wrote it)"),
+    ("folder", "mine/ (a folder not made by grader)"),
+], ids=["extra-file", "edited-file", "extra-folder"])
+def test_force_refuses_a_folder_that_does_not_match_its_manifest(tmp_path: Path,
+                                                                 capsys: pytest.CaptureFixture[str],
+                                                                 change: str, listed: str) -> None:
+    """An extra file or folder, or an edited file, in an earlier output: --force is refused and names it."""
+    out = tmp_path / "out"
+    assert run(capsys, "generate", ASSIGNMENT, "--roster", ROSTER, "--out", out, "--no-pdf")[0] == 0
+    if change == "add":
+        _write(out / "notes.txt", "mine")
+    elif change == "edit":
+        _write(out / "key.csv", "my corrections")
+    else:
+        (out / "mine").mkdir()
+    before = _tree(out)
+    err = _one_line_error(*run(capsys, "generate", ASSIGNMENT, "--roster", ROSTER, "--out", out, "--no-pdf",
+                               "--force"))
+    assert listed in err and "move those out of it, or choose another --out" in err
+    assert _tree(out) == before and (change != "folder" or (out / "mine").is_dir())
+    assert [p.name for p in tmp_path.iterdir()] == ["out"]
+
+
+@pytest.mark.parametrize("where", [".", "..", "home"])
+def test_out_that_is_the_current_or_home_folder_is_refused(tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
+                                                          capsys: pytest.CaptureFixture[str], where: str) -> None:
+    """`--out .` (even an empty cwd), an ancestor of it, or the home folder: refused, nothing written."""
+    cwd = tmp_path / "work"
+    cwd.mkdir()
+    monkeypatch.chdir(cwd)
+    monkeypatch.setenv("HOME", str(tmp_path / "home"))
+    (tmp_path / "home").mkdir()
+    out = tmp_path / "home" if where == "home" else Path(where)
+    err = _one_line_error(*run(capsys, "generate", ASSIGNMENT, "--roster", ROSTER, "--out", out, "--no-pdf",
+                               "--force"))
+    assert "folder or holds it, and --out is replaced whole" in err
+    assert sorted(p.name for p in tmp_path.rglob("*")) == ["home", "work"]
+
+
+def test_a_second_run_into_the_same_out_fails_while_the_first_is_writing(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """The work folder .out.partial is made exclusively: a run that finds it refuses and leaves it alone."""
+    work = tmp_path / ".out.partial"
+    work.mkdir()
+    err = _one_line_error(*run(capsys, "generate", ASSIGNMENT, "--roster", ROSTER, "--out", tmp_path / "out",
+                               "--no-pdf"))
+    assert "another grader run is writing it" in err and f"delete {work}" in err
+    assert [p.name for p in tmp_path.iterdir()] == [".out.partial"]
+
+
+def test_an_output_that_appears_during_the_run_is_not_replaced(tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
+                                                               capsys: pytest.CaptureFixture[str]) -> None:
+    """Race: --out is new when the run checks it and exists (written by someone else) before the move."""
+    import grader.render.generate
+
+    out = tmp_path / "out"
+    real = grader.render.generate.generate
+
+    def racing(*args: object) -> object:
+        out.mkdir()
+        _write(out / "key.json", "the other run")
+        return real(*args)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(grader.render.generate, "generate", racing)
+    err = _one_line_error(*run(capsys, "generate", ASSIGNMENT, "--roster", ROSTER, "--out", out, "--no-pdf"))
+    assert f"{out}: appeared while this run was writing it" in err
+    assert _tree(out) == {"key.json": b"the other run"}
+    assert [p.name for p in tmp_path.iterdir()] == ["out"]
+
+
+@pytest.mark.parametrize("failing", [1, 2], ids=["moving-the-old-aside", "moving-the-new-in"])
+def test_a_failed_replace_leaves_the_previous_output_and_no_work_folder(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str], failing: int) -> None:
+    """os.rename fails (EBUSY, as for a mount point) at either step of --force: old output intact, no leftovers."""
+    import grader.files
+
+    out = tmp_path / "out"
+    assert run(capsys, "generate", ASSIGNMENT, "--roster", ROSTER, "--out", out, "--no-pdf")[0] == 0
+    before = _tree(out)
+    calls: list[int] = []
+    real = os.rename
+
+    def busy(source: str, destination: str) -> None:
+        calls.append(1)
+        if len(calls) == failing:
+            raise OSError(errno.EBUSY, os.strerror(errno.EBUSY), source)
+        real(source, destination)
+
+    monkeypatch.setattr(grader.files.os, "rename", busy)
+    err = _one_line_error(*run(capsys, "generate", ASSIGNMENT, "--roster", ROSTER, "--out", out, "--no-pdf",
+                               "--force"))
+    assert "Device or resource busy" in err and "the previous output is unchanged" in err
+    assert _tree(out) == before
+    assert [p.name for p in tmp_path.iterdir()] == ["out"]
+
+
+def _read_only(error: int) -> object:
+    def refuse(self: Path, *args: object, **kwargs: object) -> None:
+        raise OSError(error, os.strerror(error), str(self))
+    return refuse
+
+
+@pytest.mark.parametrize("case", ["through-a-file", "name-too-long", "read-only-parent", "missing-parents"])
+def test_file_system_errors_are_one_line_naming_the_path(tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
+                                                        capsys: pytest.CaptureFixture[str], case: str) -> None:
+    """--out afile/sub, a 250-character name, a read-only (EROFS) parent: exit 2, one line, nothing left."""
+    _write(tmp_path / "afile", "text")
+    out = {"through-a-file": tmp_path / "afile" / "sub", "name-too-long": tmp_path / ("x" * 250),
+           "read-only-parent": tmp_path / "ro" / "out", "missing-parents": tmp_path / "a" / "b" / "out"}[case]
+    expected = {"through-a-file": f"{out}: expected a path through folders, but {tmp_path / 'afile'} is a file",
+                "name-too-long": "expected a folder name of at most 246 bytes", "read-only-parent":
+                f"{out}: cannot write in {out.parent} (Read-only file system); choose an --out in a folder",
+                "missing-parents": f"{out}: cannot create its folder ({out.parent}: Read-only file system"}[case]
+    if case == "read-only-parent":
+        (tmp_path / "ro").mkdir()
+        monkeypatch.setattr(Path, "mkdir", _read_only(errno.EROFS))
+    if case == "missing-parents":
+        monkeypatch.setattr(os, "mkdir", lambda path, *a, **k: (_ for _ in ()).throw(
+            OSError(errno.EROFS, os.strerror(errno.EROFS), str(path))))
+    err = _one_line_error(*run(capsys, "generate", ASSIGNMENT, "--roster", ROSTER, "--out", out, "--no-pdf"))
+    monkeypatch.undo()
+    assert expected in err
+    assert sorted(p.name for p in tmp_path.rglob("*")) == ["afile"] + (["ro"] if case == "read-only-parent" else [])
+
+
+@pytest.mark.skipif(os.geteuid() == 0, reason="root writes into read-only folders: see the EROFS case above")
+def test_a_read_only_parent_folder_is_one_line(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """A real read-only folder (chmod 555) as --out's parent: exit 2, one line naming it."""
+    locked = tmp_path / "locked"
+    locked.mkdir(mode=0o555)
+    try:
+        err = _one_line_error(*run(capsys, "generate", ASSIGNMENT, "--roster", ROSTER, "--out", locked / "out",
+                                   "--no-pdf"))
+    finally:
+        locked.chmod(0o755)
+    assert f"cannot write in {locked} (Permission denied)" in err
+    assert list(locked.iterdir()) == []
+
+
+@pytest.mark.skipif(not Path("/dev/full").exists(), reason="needs /dev/full")
+def test_a_full_disk_while_writing_the_key_is_one_line_and_leaves_nothing(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]) -> None:
+    """Every atomic write goes to /dev/full (ENOSPC from the kernel): the path, the reason, nothing left."""
+    import grader.files
+
+    def full(handle: int, mode: str = "rb") -> object:
+        os.close(handle)
+        return open("/dev/full", mode)
+
+    monkeypatch.setattr(grader.files.os, "fdopen", full)
+    err = _one_line_error(*run(capsys, "generate", ASSIGNMENT, "--roster", ROSTER, "--out", tmp_path / "out",
+                               "--no-pdf"))
+    monkeypatch.undo()
+    assert f"{tmp_path / 'out' / 'key.json'}: No space left on device; nothing was written to" in err
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.skipif(not Path("/dev/full").exists(), reason="needs /dev/full")
+@pytest.mark.parametrize("command", [["list"], ["solve", "drop-rebound", "--set", "h_drop=2", "--set",
+                                                 "h_rebound=1", "--json"]], ids=["list", "solve-json"])
+def test_a_full_stdout_is_one_line_on_stderr_not_a_traceback(command: list[str]) -> None:
+    """`grader list > /dev/full`: exit 2 and one line on stderr, no traceback, no 'Exception ignored'."""
+    with open("/dev/full", "w") as full:
+        result = subprocess.run([sys.executable, "-m", "grader", *command], stdout=full, stderr=subprocess.PIPE,
+                                text=True, timeout=60)
+    assert result.returncode == 2
+    assert result.stderr == ("grader: error: cannot write to standard output (No space left on device); free some "
+                             "space, or send the output to a file or program that takes it\n")

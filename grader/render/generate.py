@@ -1,15 +1,14 @@
 """``grader generate`` and ``grader demo``: an assignment and a roster become a key and PDFs.
 
-Everything is written into a temporary folder beside the output and moved into place at the end,
-so a failed run leaves nothing behind and a previous output stays untouched.
+Everything is written into a work folder beside the output and moved into place at the end, with a
+manifest of what was written (:func:`grader.files.output_folder`): a failed run leaves nothing behind,
+a previous output stays untouched, and ``--force`` replaces only what an earlier run wrote.
 """
 
 from __future__ import annotations
 
-import os
 import shutil
 import sys
-import tempfile
 import time
 from collections.abc import Callable, Iterator, Mapping
 from contextlib import contextmanager
@@ -20,8 +19,7 @@ from grader.assign.assignment import Assignment, check_against_bank, load_assign
 from grader.assign.keyfile import key_csv, key_document, key_json
 from grader.assign.variants import Generation, generate
 from grader.bank.template import Template
-from grader.errors import GraderError
-from grader.files import usual_mode, write_atomic
+from grader.files import output_folder, write_atomic
 from grader.resources import sample_dir
 
 
@@ -57,13 +55,13 @@ def run(job: Job, bank: Mapping[str, Template], extra: Mapping[str, Path] | None
     assignment = load_assignment(job.assignment)
     roster = load_roster(job.roster)
     check_against_bank(assignment, bank)
-    _check_output(job.out, job.force)
     if job.pdf:
         from grader.render.typeset import font_paths
 
         font_paths(job.font_dirs)  # refuses a --font-dir that is not a folder before any work
-    generation = generate(assignment, roster, bank)
-    with _staging(job.out) as staging:
+    with output_folder(job.out, command="grader generate", inputs=(job.assignment, job.roster),
+                       force=job.force) as staging:
+        generation = generate(assignment, roster, bank)
         for name, source in (extra or {}).items():
             shutil.copyfile(source, staging / name)
         written = _write(job, assignment, generation, bank, staging)
@@ -77,33 +75,6 @@ def demo(out: Path, bank: Mapping[str, Template], jobs: int = 1, force: bool = F
     samples = sample_dir()
     job = Job(samples / "assignment.yaml", samples / "roster.csv", out, jobs=jobs, force=force, font_dirs=font_dirs)
     return run(job, bank, {"assignment.yaml": samples / "assignment.yaml", "roster.csv": samples / "roster.csv"})
-
-
-def _check_output(out: Path, force: bool) -> None:
-    if out.exists() and not out.is_dir():
-        raise GraderError(f"{out}: exists and is not a folder; choose another --out")
-    if out.is_dir() and any(out.iterdir()) and not force:
-        raise GraderError(f"{out}: the output folder exists and is not empty; choose another --out, or --force to "
-                          "replace it")
-
-
-@contextmanager
-def _staging(out: Path) -> Iterator[Path]:
-    out.parent.mkdir(parents=True, exist_ok=True)
-    staging = Path(tempfile.mkdtemp(prefix=f".{out.name}.", suffix=".partial", dir=out.parent))
-    usual_mode(staging, folder=True)
-    try:
-        yield staging
-    except BaseException:
-        shutil.rmtree(staging, ignore_errors=True)
-        raise
-    if out.exists():
-        retired = Path(tempfile.mkdtemp(prefix=f".{out.name}.", suffix=".old", dir=out.parent))
-        os.replace(out, retired / "previous")
-        os.replace(staging, out)
-        shutil.rmtree(retired, ignore_errors=True)
-    else:
-        os.replace(staging, out)
 
 
 def _write(job: Job, assignment: Assignment, generation: Generation, bank: Mapping[str, Template],

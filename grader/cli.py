@@ -226,7 +226,7 @@ def _print_solution(template: Template, params: Any, answers: Any, error: str | 
             record["answers"] = {name: value.to_json() for name, value in answers.items()}
         else:
             record["error"] = error
-        print(json.dumps(record))
+        print(json.dumps(record, allow_nan=False))
         return
     heading = f"{template.id}" + (f", row {row}" if row is not None else "") + ": " + ", ".join(
         f"{name} = {_number(value)}{_unit(template.parameters[name])}" for name, value in params.items()

@@ -222,7 +222,10 @@ def read_csv(path: Path) -> CsvTable:
         raise GraderError(f"{path}: empty file; expected a header line")
     delimiter = max(",;\t", key=lines[first].count)
     records = _records(io.StringIO("\n".join(lines[first:])), path, delimiter, first)
-    header_line, header_cells = next(records)
+    first_record = next(records, None)
+    if first_record is None:  # only quotes or delimiters: no cell has text
+        raise GraderError(f"{path}: no header line with text; expected a header line")
+    header_line, header_cells = first_record
     header = _header(header_cells, path, header_line)
     rows = []
     for line, cells in records:

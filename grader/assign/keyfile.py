@@ -39,12 +39,23 @@ _FORMULA_START = ("=", "+", "-", "@", "\t", "\r", "\n")
 
 
 def safe_cell(text: str) -> str:
-    """A CSV text cell a spreadsheet will not run as a formula (DESIGN: formula injection).
+    """A CSV text cell a spreadsheet will not run as a formula (DESIGN: formula injection): a cell
+    starting with ``= + - @``, tab, CR or LF gets a leading ``'``, and so does one that already
+    starts with ``'``, so the original is always recovered by :func:`original_cell`.
 
-    >>> safe_cell("=HYPERLINK(1)"), safe_cell("Ana")
-    ("'=HYPERLINK(1)", 'Ana')
+    >>> safe_cell("=HYPERLINK(1)"), safe_cell("Ana"), safe_cell("'quoted")
+    ("'=HYPERLINK(1)", 'Ana', "''quoted")
     """
-    return "'" + text if text.startswith(_FORMULA_START) else text
+    return "'" + text if text.startswith((*_FORMULA_START, "'")) else text
+
+
+def original_cell(cell: str) -> str:
+    """The text :func:`safe_cell` guarded: one leading ``'`` dropped.
+
+    >>> original_cell("'=1+1"), original_cell("''quoted"), original_cell("Ana")
+    ('=1+1', "'quoted", 'Ana')
+    """
+    return cell[1:] if cell.startswith("'") else cell
 
 
 def key_document(assignment: Assignment, generation: Generation, bank: Mapping[str, Template]) -> dict[str, Any]:
@@ -85,8 +96,9 @@ def key_json(document: Mapping[str, Any]) -> str:
     >>> json.loads(key_json({"schema": "grader-key", "students": [{"id": "1"}, {"id": "2"}]}))["students"][1]
     {'id': '2'}
     """
-    head = json.dumps({k: v for k, v in document.items() if k != "students"}, ensure_ascii=False, indent=1)
-    students = ",\n  ".join(json.dumps(s, ensure_ascii=False) for s in document["students"])
+    head = json.dumps({k: v for k, v in document.items() if k != "students"}, ensure_ascii=False, indent=1,
+                      allow_nan=False)
+    students = ",\n  ".join(json.dumps(s, ensure_ascii=False, allow_nan=False) for s in document["students"])
     return f'{head[:-2]},\n "students": [\n  {students}\n ]\n}}\n'
 
 

@@ -336,9 +336,9 @@ def _unit(text: Any, where: str, key: str) -> Unit:
 def _gravity(text: Any, where: str) -> Gravity | None:
     if text is None:
         return None
-    match = re.match(r"^\s*([0-9.]+(?:[eE][-+]?\d+)?)\s+(\S+)\s*$", str(text))
+    match = re.match(r"^\s*((?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s+(\S+)\s*$", str(text))
     unit = _unit(match.group(2), where, "gravity") if match else None
-    if not match or unit is None or unit.dimension != (1, 0, -2, 0) or float(match.group(1)) <= 0:
+    if not match or unit is None or unit.dimension != (1, 0, -2, 0) or not 0 < float(match.group(1)) < 1e300:
         raise TemplateError(where, "gravity", "a positive acceleration like '9.81 m/s^2' or '32.2 ft/s^2'",
                             shown(text))
     from fractions import Fraction

@@ -141,6 +141,8 @@ def test_400_digit_integers_in_an_assignment_are_refused(tmp_path: Path, capsys:
     ("unit: mm", "unit: kg", "stages[0].height: expected a length (check the parameters' units), got 'h_drop', "
                              "which is a mass"),
     ("unit: mm", "unit: mm^9999999", "expected powers from -9 to 9"),
+    ("statement: |\n", "statement: |\n  {{ " + "(" * 50_000 + "1" + ")" * 50_000 + " }}\n",
+     "statement: expected values filled in, not code, got expressions nested too deeply"),
 ])
 def test_bad_template_values_are_refused_not_a_traceback(tmp_path: Path, capsys: pytest.CaptureFixture[str],
                                                           old: str, new: str, message: str) -> None:

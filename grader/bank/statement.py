@@ -107,8 +107,12 @@ def _environment() -> jinja2.Environment:
 def check_jinja(source: str) -> jinja2.nodes.Template:
     """The statement's syntax tree, if it only fills in values; else :class:`StatementRefused`
     naming the first construct that is not allowed (``jinja2.TemplateSyntaxError`` passes through)."""
-    syntax = _environment().parse(source)
-    for node in _walk(syntax):
+    try:
+        syntax = _environment().parse(source)
+        found = list(_walk(syntax))
+    except RecursionError:
+        raise StatementRefused("expressions nested too deeply to read (a statement only fills in values)") from None
+    for node in found:
         if type(node) not in _ALLOWED:
             found = _REFUSED.get(type(node), f"a {type(node).__name__} expression")
             raise StatementRefused(f"{found} (a statement only fills in values: text, {{{{ name }}}}, {{% if %}})")

@@ -109,10 +109,10 @@ def check_jinja(source: str) -> jinja2.nodes.Template:
     naming the first construct that is not allowed (``jinja2.TemplateSyntaxError`` passes through)."""
     try:
         syntax = _environment().parse(source)
-        found = list(_walk(syntax))
+        every_node = list(_walk(syntax))
     except RecursionError:
         raise StatementRefused("expressions nested too deeply to read (a statement only fills in values)") from None
-    for node in found:
+    for node in every_node:
         if type(node) not in _ALLOWED:
             found = _REFUSED.get(type(node), f"a {type(node).__name__} expression")
             raise StatementRefused(f"{found} (a statement only fills in values: text, {{{{ name }}}}, {{% if %}})")

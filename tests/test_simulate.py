@@ -314,6 +314,21 @@ def test_rebound_angle_of_a_stopped_ball_is_undefined_in_the_table(capsys: pytes
     assert "undefined: v_out is zero, so it has no direction" in out
 
 
+@pytest.mark.parametrize("method", [Settings(), Settings("rk4", steps=200), Settings("euler", steps=50)])
+def test_a_body_stopped_up_to_integration_error_has_no_direction(bank: dict[str, Template],
+                                                                 method: Settings) -> None:
+    """Regression: equal spheres head-on with e = 1 gave sphere 1 a direction (-90 deg) from a
+    leftover speed of 1e-10 v, which is integration error; the closed form says undefined."""
+    params = {"v1": 6, "theta": 0, "e": 1, "m1": 1, "m2": 1}
+    template = bank["oblique-spheres"]
+    closed = solve_one(template, compile_template(template), params)
+    assert closed.answers is not None and closed.answers["theta1_out"].value is None  # the reference
+    result = simulate(template, params, Options(settings=method))
+    assert result.answers["theta1_out"] is None
+    assert "within what the simulation resolves" in result.undefined["theta1_out"]
+    assert result.answers["v2_out"] == pytest.approx(6.0, rel=1e-2)
+
+
 @pytest.mark.parametrize(("template_id", "params", "e"), [
     # The ram stops dead: m_ram v = m_pile v_pile, so e = v_pile / v = m_ram / m_pile.
     ("pile-driver", {"m_ram": 800, "m_pile": 2400, "h_drop": 2, "h_rebound": 0}, 1 / 3),

@@ -15,6 +15,7 @@ from grader.model.kernel import evaluate
 from grader.model.scene import Scene
 from grader.physics.integrate import TIME_LIMIT, Budget, Mode, Path, Settings, SimulationError, integrate
 
+RESOLUTION = 1e-8  # relative: below this share of a run's speeds, a simulated speed counts as zero
 DEFAULT_CONTACT_DURATION = 1e-3  # s: stiffness follows from it and the reduced mass
 
 
@@ -72,6 +73,20 @@ class Run:
     undefined: dict[str, str] = field(default_factory=dict)  # quantity -> why it has no value
     budget: Budget = field(default_factory=Budget)
     steps: int = 0
+    speed_scale: float = 0.0  # the largest speed an impact of this run involved (SI)
+
+    def resolves(self, speed: float) -> bool:
+        """Whether a simulated speed is told apart from zero: above ``RESOLUTION`` of the run's
+        speeds, or ten times the relative error its contacts made in reproducing their e
+        (a velocity that is 1e-10 of the approach speed is integration error, not motion).
+
+        >>> from grader.model.scene import Scene
+        >>> run = Run(Scene("x", {}, (), None), Options(), {}, speed_scale=5.0)
+        >>> run.resolves(1e-3), run.resolves(1e-9)
+        (True, False)
+        """
+        error = max((abs(c.measured_e - c.e) for c in self.contacts), default=0.0)
+        return speed > self.speed_scale * max(RESOLUTION, 10 * error)
 
     def value(self, node: Node) -> float:
         """A stage field's value; every name in it must be known by now."""

@@ -139,6 +139,7 @@ def _simulate_impact(stage: Stage, run: Run) -> None:
     e = run.value(stage.fields["restitution"])
     before = [_component(run, stage, body, "before", axis) for body in (first, second) for axis in ("n", "t")]
     approach = before[0] - before[2]
+    run.speed_scale = max(run.speed_scale, *map(abs, before))
     if approach <= 0 or not 0 <= e <= 1:
         run.problems.append(f"{first} and {second} do not collide (relative normal velocity {approach:g}) "
                             if approach <= 0 else f"the coefficient of restitution {e:g} is outside [0, 1]")

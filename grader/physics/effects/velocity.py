@@ -61,10 +61,11 @@ def _simulate_components(stage: Stage, run: Run) -> None:
     along, across = run.value(fields[along_key]), run.value(fields[across_key])
     speed = math.hypot(along, across)
     run.output(fields["speed"], speed)
-    if speed > 0:
+    if speed > 0 and run.resolves(speed):
         run.output(fields["angle"], math.atan2(across, along))
     else:
-        run.undefined[to_text(fields["angle"])] = f"{stage.text('speed')} is zero, so it has no direction"
+        reason = "is zero" if speed == 0 else "is zero within what the simulation resolves"
+        run.undefined[to_text(fields["angle"])] = f"{stage.text('speed')} {reason}, so it has no direction"
         run.output(fields["angle"], math.nan)
 
 

@@ -11,7 +11,10 @@ import difflib
 import json
 import math
 import os
+import re
+import signal
 import sys
+import threading
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
@@ -23,7 +26,8 @@ from grader.files import describe_os_error
 from grader.inputs import read_csv
 from grader.model.units import parse_unit, split_quantity
 
-EXIT_OK, EXIT_USAGE, EXIT_REFUSED = 0, 2, 3
+EXIT_OK, EXIT_USAGE, EXIT_REFUSED, EXIT_INTERRUPTED = 0, 2, 3, 130
+_CONTROL = re.compile(r"[\x00-\x1f\x7f-\x9f\u202a-\u202e\u2066-\u2069]")
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -97,12 +101,19 @@ def main(argv: Sequence[str] | None = None) -> int:
     their traceback. A reader that stops early (``grader list | head -1``) ends the run quietly.
     """
     arguments = build_parser().parse_args(argv)
+    if sys.stdout is None:  # started with standard output closed (`grader ... >&-`)
+        return _error("standard output is closed; send the output to a file or a program")
+    previous = signal.signal(signal.SIGTERM, _terminated) if _main_thread() else None
     try:
         code = _COMMANDS[arguments.command](arguments)
         sys.stdout.flush()
         return code
     except GraderError as error:
         return _error(str(error))
+    except KeyboardInterrupt:
+        # Cleanup ran on the way out (work folders removed, the previous output kept).
+        _error("interrupted; nothing was left half-written")
+        return EXIT_INTERRUPTED
     except BrokenPipeError:
         _discard_stdout()
         return EXIT_OK
@@ -114,11 +125,32 @@ def main(argv: Sequence[str] | None = None) -> int:
             return _error(f"cannot write to standard output ({error.strerror}); free some space, or send the "
                           "output to a file or program that takes it")
         return _error(describe_os_error(error))
+    finally:
+        if previous is not None:
+            signal.signal(signal.SIGTERM, previous)
+
+
+def _main_thread() -> bool:
+    return threading.current_thread() is threading.main_thread()
+
+
+def _terminated(signum: int, frame: object) -> None:
+    """SIGTERM (``kill``, ``timeout``) unwinds like Ctrl-C, so work folders are removed."""
+    raise KeyboardInterrupt
 
 
 def _error(message: str) -> int:
-    print(f"grader: error: {message}", file=sys.stderr)
+    print(f"grader: error: {_printable(message)}", file=sys.stderr)
     return EXIT_USAGE
+
+
+def _printable(message: str) -> str:
+    r"""One line, with no control character a terminal would act on (input is echoed in messages).
+
+    >>> _printable("cannot read unit '\x1b[31mred'\nsecond line")
+    "cannot read unit '\\x1b[31mred'; second line"
+    """
+    return _CONTROL.sub(lambda m: "; " if m.group() == "\n" else repr(m.group())[1:-1], message.strip())
 
 
 def _discard_stdout() -> None:

@@ -26,7 +26,7 @@ import re
 from collections.abc import Hashable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, ClassVar
 
 import yaml
 
@@ -67,12 +67,23 @@ def decode_text(data: bytes, path: Path) -> str:
 
 # --- YAML ---------------------------------------------------------------------------------------
 
-_FLOAT_12 = re.compile(r"^[-+]?(?:[0-9][0-9_]*(?:\.[0-9_]*)?|\.[0-9_]+)(?:[eE][-+]?[0-9]+)?$")
+# YAML 1.2's core schema, which every other reader of these files uses: `on`, `no`, `off`, `yes` and
+# dates stay text (YAML 1.1 made a parameter named `on` the boolean true), `010` is ten, and `1e308`
+# is a number.
+_CORE = {
+    "tag:yaml.org,2002:null": (r"^(?:~|null|Null|NULL|)$", [*"~nN", None]),  # None: the empty scalar
+    "tag:yaml.org,2002:bool": (r"^(?:true|True|TRUE|false|False|FALSE)$", [*"tTfF"]),
+    "tag:yaml.org,2002:int": (r"^(?:[-+]?[0-9]+|0o[0-7]+|0x[0-9a-fA-F]+)$", [*"-+0123456789"]),
+    "tag:yaml.org,2002:float": (r"^(?:[-+]?(?:\.[0-9]+|[0-9]+(?:\.[0-9]*)?)(?:[eE][-+]?[0-9]+)?"
+                                r"|[-+]?\.(?:inf|Inf|INF)|\.(?:nan|NaN|NAN))$", [*"-+0123456789."]),
+}
 
 
 class _Loader(yaml.SafeLoader):
-    """PyYAML's safe loader, bounded: depth, expanded size, duplicate keys, finite numbers; and
-    YAML 1.2 floats, so ``1e308`` is a number as every other reader takes it, not text."""
+    """PyYAML's safe loader with YAML 1.2's core schema, bounded: depth, expanded size, text keys
+    each given once, finite numbers."""
+
+    yaml_implicit_resolvers: ClassVar[dict[Any, Any]] = {}  # filled with _CORE below, not YAML 1.1's
 
     def __init__(self, stream: str) -> None:
         super().__init__(stream)
@@ -96,17 +107,21 @@ class _Loader(yaml.SafeLoader):
         return node
 
     def construct_mapping(self, node: Any, deep: bool = False) -> dict[Hashable, Any]:
-        seen: set[Any] = set()
+        seen: set[str] = set()
         for key_node, _ in node.value:
             key = self.construct_object(key_node, deep=True)
-            if isinstance(key, Hashable) and key in seen:
-                raise GraderError(f"line {key_node.start_mark.line + 1}: the key {shown(key)} appears twice "
-                                  "(expected each key once)")
-            seen.add(key if isinstance(key, Hashable) else id(key))
+            line = key_node.start_mark.line + 1
+            if not isinstance(key, str):
+                raise GraderError(f"line {line}: expected a key that is a name, got {shown(key)} (write a name, "
+                                  "or quote it)")
+            if key in seen:
+                raise GraderError(f"line {line}: the key {shown(key)} appears twice (expected each key once)")
+            seen.add(key)
         return super().construct_mapping(node, deep=deep)
 
     def construct_yaml_int(self, node: Any) -> int:
-        value: int = super().construct_yaml_int(node)
+        text = str(self.construct_scalar(node))
+        value = int(text, 16 if text.startswith("0x") else 8 if text.startswith("0o") else 10)
         _check_finite(value, node)
         return value
 
@@ -118,7 +133,8 @@ class _Loader(yaml.SafeLoader):
 
 _Loader.add_constructor("tag:yaml.org,2002:int", _Loader.construct_yaml_int)
 _Loader.add_constructor("tag:yaml.org,2002:float", _Loader.construct_yaml_float)
-_Loader.add_implicit_resolver("tag:yaml.org,2002:float", _FLOAT_12, list("-+0123456789."))
+for _tag, (_pattern, _first) in _CORE.items():
+    _Loader.add_implicit_resolver(_tag, re.compile(_pattern), _first)
 
 
 def _check_finite(value: float, node: Any) -> None:

@@ -26,7 +26,7 @@ import re
 from collections.abc import Hashable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, ClassVar
+from typing import Any
 
 import yaml
 
@@ -83,7 +83,7 @@ class _Loader(yaml.SafeLoader):
     """PyYAML's safe loader with YAML 1.2's core schema, bounded: depth, expanded size, text keys
     each given once, finite numbers."""
 
-    yaml_implicit_resolvers: ClassVar[dict[Any, Any]] = {}  # filled with _CORE below, not YAML 1.1's
+    yaml_implicit_resolvers = {}  # noqa: RUF012  (PyYAML's own class attribute: filled with _CORE below)
 
     def __init__(self, stream: str) -> None:
         super().__init__(stream)

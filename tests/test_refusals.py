@@ -67,7 +67,8 @@ def test_overflowing_answer_is_refused_not_printed_as_inf(two_bodies: tuple[Temp
     template, compiled = two_bodies
     solution = solve_one(template, compiled, {"m1": 1, "m2": 1, "u1": 1e200, "u2": -1e200, "e": 0.5})
     assert solution.answers is None
-    assert solution.error is not None and solution.error.startswith("answer square: the given values are too extreme")
+    assert solution.error is not None
+    assert solution.error.startswith("answer square: a step of the solution is not a finite number")
 
 
 def test_refused_rows_do_not_stop_the_others(two_bodies: tuple[Template, Compiled]) -> None:

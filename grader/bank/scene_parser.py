@@ -56,7 +56,7 @@ def _parse_stage(raw: Any, index: int, where: str, bodies: Mapping[str, Body]) -
     key = f"stages[{index}]"
     if not isinstance(raw, Mapping) or "effect" not in raw:
         raise TemplateError(where, key, "a mapping with an 'effect' key", shown(raw))
-    effect = CATALOGUE.get(raw["effect"])
+    effect = CATALOGUE.get(raw["effect"]) if isinstance(raw["effect"], str) else None
     if effect is None:
         raise TemplateError(where, f"{key}.effect", f"one of {', '.join(sorted(CATALOGUE))}", shown(raw["effect"]))
     allowed = {f.name for f in effect.fields} | {"effect"}
@@ -82,11 +82,11 @@ def _parse_stage(raw: Any, index: int, where: str, bodies: Mapping[str, Body]) -
 
 def _parse_field(spec: Field, value: Any, where: str, key: str, bodies: Mapping[str, Body]) -> Any:
     if spec.kind == "body":
-        if value not in bodies:
+        if not isinstance(value, str) or value not in bodies:
             raise TemplateError(where, key, f"one of the bodies ({', '.join(bodies)})", shown(value))
         return value
     if spec.kind == "bodies":
-        if not (isinstance(value, list) and len(value) == 2 and all(v in bodies for v in value)
+        if not (isinstance(value, list) and len(value) == 2 and all(isinstance(v, str) and v in bodies for v in value)
                 and value[0] != value[1]):
             raise TemplateError(where, key, f"two different bodies from ({', '.join(bodies)})", shown(value))
         return tuple(value)

@@ -2,21 +2,22 @@
 
 Templates may come from colleagues, so a statement is untrusted twice over:
 
-* as **Jinja2** it may only fill in values: text, ``{{ name }}`` (with arithmetic, comparisons and a
-  few harmless filters) and ``{% if %}``. Loops, ``set``, macros, calls, attribute and item access
-  are refused when the template loads, and every statement renders in Jinja2's
-  ``ImmutableSandboxedEnvironment`` with arithmetic checked before it runs and the output capped,
-  so even a statement that skipped the load-time check can neither run code nor take long;
-* as **Typst** it may only be text and math: code that reads files (``read``, ``image``, ``json``,
-  ``include``, ``import``, packages, ...) or reaches them indirectly (``eval``, ``std``) is refused.
+* as **Jinja2** it may only fill in values: text and ``{{ name }}`` (with a few harmless filters).
+  Loops, conditions, arithmetic, ``set``, macros, calls, attribute and item access are refused when
+  the template loads, and every statement renders in Jinja2's ``ImmutableSandboxedEnvironment``
+  with arithmetic checked before it runs and the output capped, so even a statement that skipped
+  the load-time check can neither run code nor take long;
+* as **Typst** it may only be text and math, with a handful of markup calls (``#emph[..]``,
+  ``#h(1em)``, ``#sym.arrow``): code that reads files (``read``, ``image``, ``import``, packages,
+  ``eval``, ``std``) or could loop or vary (``#for``, ``#range``, ``#datetime``) is refused.
   (The compiler's root is an empty private folder too, so nothing outside could be read anyway.)
 
 >>> fill_statement("Dropped from {{ h }} mm", {"h": "2100"})
 'Dropped from 2100 mm'
->>> fill_statement("{{ 'x' * 10**9 }}", {})
+>>> fill_statement("{{ h * 3 }}", {"h": "2.50"})
 Traceback (most recent call last):
 ...
-grader.bank.statement.StatementRefused: a value of more than 10000 characters or digits
+grader.bank.statement.StatementRefused: arithmetic (values are filled in as printed text; ...
 >>> typst_file_access('See #read("secret.txt") here')
 'read("secret.txt")'
 >>> typst_file_access("Find $v_A'$ #h(1em) and read the figure") is None
@@ -39,19 +40,24 @@ MAX_OUTPUT = 20_000  # characters a filled-in statement may have
 MAX_VALUE = 10_000  # characters of a string, digits of a number, inside a statement
 FILTERS = ("abs", "round", "int", "float", "string", "lower", "upper", "title", "capitalize", "trim", "default")
 
-# Jinja2 nodes a statement may use: text, values, arithmetic, comparisons, conditions, filters.
+# Jinja2 nodes a statement may use: text, values and filters. Parameters are filled in as the text
+# printed on the page ("2.50"), so arithmetic or comparisons on them would work on text
+# ({{ h * 3 }} repeats it): values a statement needs are computed in the template, not here.
 _ALLOWED: dict[type[nodes.Node], str] = {
     nodes.Template: "", nodes.Output: "", nodes.TemplateData: "", nodes.Name: "", nodes.Const: "",
-    nodes.If: "", nodes.CondExpr: "", nodes.Compare: "", nodes.Operand: "", nodes.And: "", nodes.Or: "",
-    nodes.Not: "", nodes.Neg: "", nodes.Pos: "", nodes.Add: "", nodes.Sub: "", nodes.Mul: "", nodes.Div: "",
-    nodes.FloorDiv: "", nodes.Mod: "", nodes.Pow: "", nodes.Concat: "", nodes.Filter: "",
+    nodes.Filter: "", nodes.Concat: "",
 }
+_ARITHMETIC = "arithmetic (values are filled in as printed text; compute what the page shows in the template)"
+_CONDITION = "a condition (a statement shows the same text to every student)"
 _REFUSED: dict[type[nodes.Node], str] = {
     nodes.For: "a for loop", nodes.Macro: "a macro", nodes.CallBlock: "a call block", nodes.Call: "a call",
     nodes.Getattr: "attribute access (.name)", nodes.Getitem: "item access ([...])", nodes.Assign: "a set",
     nodes.AssignBlock: "a set block", nodes.Include: "an include", nodes.Import: "an import",
     nodes.FromImport: "an import", nodes.Extends: "an extends", nodes.FilterBlock: "a filter block",
     nodes.With: "a with block", nodes.Block: "a block",
+    **dict.fromkeys((nodes.Add, nodes.Sub, nodes.Mul, nodes.Div, nodes.FloorDiv, nodes.Mod, nodes.Pow, nodes.Neg,
+                     nodes.Pos), _ARITHMETIC),
+    **dict.fromkeys((nodes.If, nodes.CondExpr, nodes.Compare, nodes.And, nodes.Or, nodes.Not), _CONDITION),
 }
 
 
@@ -115,7 +121,7 @@ def check_jinja(source: str) -> jinja2.nodes.Template:
     for node in every_node:
         if type(node) not in _ALLOWED:
             found = _REFUSED.get(type(node), f"a {type(node).__name__} expression")
-            raise StatementRefused(f"{found} (a statement only fills in values: text, {{{{ name }}}}, {{% if %}})")
+            raise StatementRefused(f"{found} (a statement only fills in values: text and {{{{ name }}}})")
         if isinstance(node, nodes.Filter) and node.name not in FILTERS:
             raise StatementRefused(f"the filter '{node.name}' (allowed: {', '.join(FILTERS)})")
     return syntax
@@ -164,10 +170,62 @@ _KEYWORDS = {"let", "set", "show", "if", "else", "for", "while", "import", "incl
 _CLOSE = {"(": ")", "[": "]", "{": "}"}
 
 
+# The only Typst code a statement may hold: emphasis and the like on a content block, a space of a
+# fixed length, a line break, a named symbol. Anything else (#for, #range, #let, #datetime, a code
+# block) could loop for ever, exhaust memory, or print something other than the same for everyone.
+_ALLOWED_CODE = re.compile(r"#(?:(?:emph|strong|sub|super|underline|overline|smallcaps|highlight)(?=\[)"
+                           r"|[hv]\(\s*-?\d+(?:\.\d+)?\s*(?:pt|mm|cm|in|em)\s*\)"
+                           r"|linebreak\(\)|sym(?:\.[A-Za-z]+)+)")
+
+
+def typst_refusal(source: str) -> str | None:
+    """Why a statement's Typst is refused (it reads files, or holds code that is not markup), or None.
+
+    >>> typst_refusal('#read("x")')
+    'a Typst call that reads files: read("x")'
+    >>> typst_refusal("#range(10**9).len()")  # doctest: +ELLIPSIS
+    'Typst code that is not markup: #range(10**9).len() (allowed: #emph[..], ...)'
+    """
+    reading = typst_file_access(source)
+    if reading is not None:
+        return f"a Typst call that reads files: {reading}"
+    code = typst_code(source)
+    if code is not None:
+        return (f"Typst code that is not markup: {code} (allowed: #emph[..], #strong[..], #h(1em), #v(1em), "
+                "#linebreak(), #sym.name)")
+    return None
+
+
+def typst_code(source: str) -> str | None:
+    """The first piece of Typst code in ``source`` that is not plain markup, or None.
+
+    >>> typst_code("Find #emph[both] speeds #h(1em) and $v_A'$ #sym.arrow.r done")
+    >>> typst_code("#for i in range(10) [x]"), typst_code("#emph[a].text")
+    ('#for i in range(10) [x]', '#emph[a].text')
+    """
+    text = _without_jinja(source)
+    for hash_ in _unescaped_hashes(text):
+        allowed = _ALLOWED_CODE.match(text, hash_)
+        end = allowed.end() if allowed else hash_ + 1
+        if allowed and text.startswith("[", end):
+            end = _balanced(text, end)
+        if allowed is None or (end < len(text) and text[end] in ".([{"):
+            return text[hash_:min(_expression_end(text, hash_ + 1), hash_ + 40)]
+    return None
+
+
+def _without_jinja(source: str) -> str:
+    return re.sub(r"\{\{.*?\}\}|\{%.*?%\}|\{#.*?#\}", "", source, flags=re.DOTALL) if "{" in source else source
+
+
+def _unescaped_hashes(text: str) -> Iterator[int]:
+    return (m.start() for m in re.finditer(r"(?<!\\)#", text))
+
+
 def typst_file_access(source: str) -> str | None:
     """The first piece of Typst code in ``source`` that reads files (``read("x")``, ``import ...``),
     or None. Jinja2 tags are removed first, so a name split across tags is still seen whole."""
-    text = re.sub(r"\{\{.*?\}\}|\{%.*?%\}|\{#.*?#\}", "", source, flags=re.DOTALL) if "{" in source else source
+    text = _without_jinja(source)
     if not _ANY_FILE_ACCESS.search(text):
         return None
     # Math calls functions by name too: $ read("x") $ is a call.

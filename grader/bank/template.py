@@ -191,7 +191,10 @@ def parse_template(raw: Mapping[str, Any], where: str, source_hash: str, stem: s
         raise TemplateError(where, "version", "a whole number >= 1", shown(version))
     gravity = _gravity(raw.get("gravity"), where)
     parameters = {name: _parameter(name, spec, where) for name, spec in _mapping(raw, "parameters", where).items()}
-    symbols = {name: _symbol(name, spec, where) for name, spec in (raw.get("symbols") or {}).items()}
+    symbols_raw = raw.get("symbols") or {}
+    if not isinstance(symbols_raw, Mapping):
+        raise TemplateError(where, "symbols", "a mapping of names to {unit: ..., description: ...}", shown(symbols_raw))
+    symbols = {name: _symbol(name, spec, where) for name, spec in symbols_raw.items()}
     for name in list(parameters) + list(symbols):
         if not IDENTIFIER.match(name) or name in RESERVED:
             raise TemplateError(where, name, "a name of letters, digits and _, not g or pi", shown(name))
@@ -204,7 +207,7 @@ def parse_template(raw: Mapping[str, Any], where: str, source_hash: str, stem: s
     template = Template(
         id=template_id, title=_text(raw, "title", where), version=version, where=where,
         source_hash=source_hash, scene=scene, parameters=parameters, symbols=symbols,
-        constraints=tuple(_constraint(i, c, where) for i, c in enumerate(raw.get("constraints") or [])),
+        constraints=tuple(_constraint(i, c, where) for i, c in enumerate(_list(raw, "constraints", where))),
         answers=answers, statement=_text(raw, "statement", where),
         example=_example(raw.get("example") or {}, parameters, where),
     )
@@ -287,7 +290,7 @@ def _check_statement(template: Template, given: set[str]) -> None:
     import jinja2
     import jinja2.meta
 
-    from grader.bank.statement import StatementRefused, check_jinja, fill_statement, typst_file_access
+    from grader.bank.statement import StatementRefused, check_jinja, fill_statement, typst_refusal
 
     try:
         syntax = check_jinja(template.statement)
@@ -306,10 +309,9 @@ def _check_statement(template: Template, given: set[str]) -> None:
         filled = fill_statement(template.statement, values)
     except StatementRefused as error:
         raise TemplateError(template.where, "statement", "values filled in, not code", str(error)) from None
-    reading = typst_file_access(template.statement) or typst_file_access(filled)
-    if reading is not None:
-        raise TemplateError(template.where, "statement", "text and math only",
-                            f"a Typst call that reads files: {reading}")
+    refusal = typst_refusal(template.statement) or typst_refusal(filled)
+    if refusal is not None:
+        raise TemplateError(template.where, "statement", "text and math only", refusal)
 
 
 def _text(raw: Mapping[str, Any], key: str, where: str) -> str:
@@ -317,6 +319,13 @@ def _text(raw: Mapping[str, Any], key: str, where: str) -> str:
     if not isinstance(value, str) or not value.strip():
         raise TemplateError(where, key, "non-empty text", shown(value))
     return value.strip()
+
+
+def _list(raw: Mapping[str, Any], key: str, where: str) -> list[Any]:
+    value = raw.get(key) or []
+    if not isinstance(value, list):
+        raise TemplateError(where, key, "a list", shown(value))
+    return value
 
 
 def _mapping(raw: Mapping[str, Any], key: str, where: str) -> Mapping[str, Any]:

@@ -14,6 +14,7 @@ keeps full relative accuracy.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Mapping
 from fractions import Fraction
 from typing import Any
@@ -62,10 +63,22 @@ OPERATIONS: dict[str, Callable[..., Any]] = {
 }
 
 
+def _float(value: Fraction | float) -> float:
+    """An exact constant as float64: beyond its range, an infinity the caller refuses like any overflow.
+
+    >>> _float(Fraction(10**400, 3)), _float(Fraction(1, 4))
+    (inf, 0.25)
+    """
+    try:
+        return float(value)
+    except OverflowError:
+        return math.inf if value > 0 else -math.inf
+
+
 def evaluate(node: Node, env: Mapping[str, Any]) -> Any:
     """Evaluate a tree with numpy; names are looked up in ``env`` (``pi`` is built in)."""
     if isinstance(node, Num):
-        return float(node.value) if isinstance(node.value, Fraction) else node.value
+        return _float(node.value)
     if isinstance(node, Sym):
         if node.name == "pi":
             return np.pi

@@ -23,6 +23,8 @@ from grader.errors import TemplateError
 from grader.model.expr import FUNCTIONS, Node, Num, Op, Sym, parse  # noqa: F401  (parse: doctest)
 from grader.model.scene import Scene, Stage
 
+INNER = "(compiled expression)"  # the ``where`` of an error raised without the template's file
+
 
 class hypot(sp.Function):  # type: ignore[misc]  # noqa: N801  (named like the numpy function it becomes)
     """``sqrt(x**2 + y**2)`` without overflow; the sign of either argument does not matter."""
@@ -151,7 +153,7 @@ def to_node(expr: Any) -> Node:
         return Op("and" if isinstance(expr, sp.And) else "or", tuple(to_node(a) for a in expr.args))
     name = {sp.Abs: "abs", sp.atan2: "atan2"}.get(type(expr), type(expr).__name__)
     if name not in FUNCTIONS:
-        raise TemplateError("(compiled expression)", str(expr), "only functions the kernels know", name)
+        raise TemplateError(INNER, str(expr), "only real, finite expressions of functions the kernels know", name)
     args = tuple(to_node(a) for a in expr.args)
     if name in ("Max", "Min") and len(args) > 2:  # sympy's Max takes any number of arguments
         return Op(name, (args[0], to_node(type(expr)(*expr.args[1:]))))

@@ -31,7 +31,7 @@ import jinja2
 
 from grader.assign.assignment import Assignment
 from grader.assign.variants import AnswerPart, Generation, ProblemVariant
-from grader.bank.statement import StatementRefused, fill_statement, typst_file_access
+from grader.bank.statement import StatementRefused, fill_statement, typst_refusal
 from grader.bank.template import Template
 from grader.errors import GraderError
 from grader.model.expr import parse
@@ -317,10 +317,9 @@ def statement(template: Template, variant: ProblemVariant) -> Typ:
         filled = fill_statement(template.statement, values)
     except StatementRefused as error:
         raise GraderError(f"{template.where}: statement: expected values filled in, not code, got {error}") from None
-    reading = typst_file_access(filled)
-    if reading is not None:
-        raise GraderError(f"{template.where}: statement: expected text and math only, got a Typst call that reads "
-                          f"files: {reading}")
+    refusal = typst_refusal(filled)
+    if refusal is not None:
+        raise GraderError(f"{template.where}: statement: expected text and math only, got {refusal}")
     return Typ(filled)
 
 

@@ -27,8 +27,8 @@ from grader.model.expr import Node, Num, fold, substitute, to_text
 from grader.model.kernel import evaluate
 from grader.solve.compiled import Compiled
 
-OVERFLOW = ("the given values are too extreme for float64: a step of the solution overflows or loses all its "
-            "digits; expected values of less extreme size")
+OVERFLOW = ("a step of the solution is not a finite number for these values (it overflows float64, divides by "
+            "zero or leaves the real numbers); expected values for which every step is defined")
 
 
 @dataclass(frozen=True)

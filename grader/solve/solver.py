@@ -22,10 +22,11 @@ from typing import Any
 import sympy as sp
 
 from grader.bank.template import Template
-from grader.errors import TemplateError
+from grader.errors import TemplateError, shown
 from grader.model.expr import names
 from grader.model.units import Unit
 from grader.physics.effects import CATALOGUE, Relation
+from grader.physics.symbolic import INNER as _INNER
 from grader.physics.symbolic import Context, cosd, from_node, sind, to_node
 from grader.solve.compiled import Check, Compiled, CompiledAnswer, Step, Undefined
 from grader.solve.stable import stabilize
@@ -284,5 +285,19 @@ def _tidy(expr: Any) -> Any:
 
 
 def compile_template(template: Template) -> Compiled:
-    """Derive and compile a template's answers (sympy; slow the first time, then cached)."""
-    return _Compiler(template).compile()
+    """Derive and compile a template's answers (sympy; slow the first time, then cached).
+
+    Templates come from colleagues: an expression sympy cannot handle (``h**h**h**h`` to solve for,
+    ``1/0``, a constant beyond float64) is a :class:`TemplateError` naming the file, not a traceback.
+    """
+    try:
+        return _Compiler(template).compile()
+    except TemplateError as error:
+        if error.where == _INNER:  # raised below the solver, which does not know the file
+            raise TemplateError(template.where, "stages or answers", error.expected,
+                                f"{error.key} ({error.got})") from None
+        raise
+    except (ArithmeticError, TypeError, ValueError, AttributeError, NotImplementedError, RecursionError) as error:
+        raise TemplateError(template.where, "stages or answers", "expressions the solver can work with (real, "
+                            "finite, solvable one unknown at a time)",
+                            f"{type(error).__name__}: {shown(str(error), 120)}") from None

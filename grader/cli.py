@@ -286,12 +286,22 @@ def _check_names(given: Sequence[str], template: Template, where: str) -> None:
     missing = [n for n in template.parameters if n not in given]
     problems = []
     if unknown:
-        problems.append(f"unknown parameter(s) {', '.join(unknown)}")
+        problems.append(f"unknown parameter(s) {_some(unknown)}")
     if missing:
-        problems.append(f"missing parameter(s) {', '.join(missing)}")
+        problems.append(f"missing parameter(s) {_some(missing)}")
     if problems:
         raise UsageError(f"{where}: {'; '.join(problems)} (template '{template.id}' takes "
                          f"{', '.join(template.parameters)})")
+
+
+def _some(names: Sequence[str], most: int = 10) -> str:
+    """Names for a message, at most ``most`` of them.
+
+    >>> _some([f"c{i}" for i in range(25)], 3)
+    'c0, c1, c2 and 22 more'
+    """
+    shown_names = ", ".join(shown(n, 40)[1:-1] for n in names[:most])
+    return shown_names + (f" and {len(names) - most:,} more" if len(names) > most else "")
 
 
 def _read_assignments(assignments: Sequence[str], template: Template) -> dict[str, float]:

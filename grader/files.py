@@ -177,7 +177,7 @@ def _read_manifest(folder: Path, shown: Path | None = None) -> dict[str, Any]:
     except FileNotFoundError:
         raise GraderError(f"{shown}: exists and is not empty, and no grader run wrote it (there is no {MANIFEST}); "
                           "choose a new or empty --out: --force replaces only a folder a grader run wrote") from None
-    except (OSError, ValueError) as error:
+    except (OSError, ValueError, RecursionError) as error:
         raise GraderError(f"{shown / MANIFEST}: expected a manifest grader wrote, got an unreadable file ({error}); "
                           "choose another --out") from None
     if not (isinstance(document, dict) and document.get("schema") == "grader-manifest"

@@ -23,6 +23,7 @@ import csv
 import io
 import math
 import re
+from collections import Counter
 from collections.abc import Hashable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
@@ -281,8 +282,8 @@ def _header(cells: list[str], path: Path, line: int) -> tuple[str, ...]:
     if "" in names:
         raise GraderError(f"{path}: line {line}: column {names.index('') + 1} has no name; expected a name "
                           "for every column of the header")
-    lowered = [n.lower() for n in names]
-    twice = sorted({n for n in names if lowered.count(n.lower()) > 1})
+    counts = Counter(n.lower() for n in names)
+    twice = sorted({n for n in names if counts[n.lower()] > 1})[:10]
     if twice:
         raise GraderError(f"{path}: line {line}: the column {', '.join(map(repr, twice))} appears twice; "
                           "expected each column once")

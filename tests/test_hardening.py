@@ -131,7 +131,7 @@ def test_400_digit_integers_in_an_assignment_are_refused(tmp_path: Path, capsys:
 
 @pytest.mark.parametrize(("old", "new", "message"), [
     ("example: {h_drop: 2100", "example: {h_drop: " + "9" * 400, "expected a finite number within float64"),
-    ("gravity: 9.81 m/s^2", "gravity: 9.81e400 m/s^2", "gravity: expected a positive acceleration"),
+    ("gravity: 9.81 m/s^2", "gravity: 9.81e400 m/s^2", "gravity: expected a positive acceleration below 1e300"),
     ("gravity: 9.81 m/s^2", "gravity: 9.8.1 m/s^2", "gravity: expected a positive acceleration"),
     ('domain: "(0, inf)"', 'domain: "[., 1]"', "domain: expected an interval"),
     ('domain: "(0, inf)"', 'domain: "[e, 5000]"', "domain: expected an interval"),
@@ -374,3 +374,133 @@ def test_arbitrary_bytes_as_an_assignment(tmp_path: Path, capsys: pytest.Capture
     code, stdout, err = run(capsys, "generate", a, "--roster", ROSTER, "--out", out, "--no-pdf")
     assert_clean_exit(code, stdout, err, out)
 
+
+
+# --- found by the hostile sweep of the merged command line -------------------------------------------
+
+@pytest.mark.parametrize(("old", "new", "message"), [
+    # YAML 1.1 read these keys as true, None, a number: a parameter named `on` is ordinary text now
+    ("  h_drop:", "  1:", "line 12: expected a key that is a name, got 1"),
+    ("symbols:\n  m: {unit: kg, description: mass of the ball (it cancels)}", "symbols: m",
+     "symbols: expected a mapping of names"),
+    ("constraints:\n  - require: h_rebound <= h_drop\n    message: the ball cannot bounce higher than it was "
+     "dropped from\n", "constraints: 5\n", "constraints: expected a list, got 5"),
+    ("  - effect: free_fall", "  - effect: [free_fall]", "stages[0].effect: expected one of free_fall"),
+    ("    body: ball\n    height: h_drop", "    body: {b: 1}\n    height: h_drop", "stages[0].body: expected one"),
+    ("value: f_loss", "value: h_drop**h_drop", "answers.loss_pct.value: expected an expression whose terms have one "
+                                               "dimension, got 'h_drop**h_drop', which raises to a power that is a "
+                                               "length"),
+    ("value: f_loss", "value: sqrt(-e)", "drop-rebound.yaml: stages or answers: expected only real, finite"),
+    ("restitution: e\n", "restitution: e**e**e**e\n", "drop-rebound.yaml: stages or answers: expected "
+                                                          "expressions the solver can work with"),
+])
+def test_hostile_template_structures_are_refused_naming_the_file(tmp_path: Path, capsys: pytest.CaptureFixture[str],
+                                                                 old: str, new: str, message: str) -> None:
+    folder = bank_with(tmp_path, "drop-rebound", old, new)
+    err = refused(capsys, "--bank", folder, "solve", "drop-rebound", "--set", "h_drop=2000", "--set", "h_rebound=900",
+                  within=5)
+    assert message in err, err
+
+
+def test_a_parameter_named_on_is_a_name_not_true(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    text = (bank_dir() / "drop-rebound.yaml").read_text(encoding="utf-8")
+    folder = tmp_path / "bank"
+    folder.mkdir()
+    write(folder / "drop-rebound.yaml", text.replace("h_drop", "on"))
+    code, out, err = run(capsys, "--bank", folder, "solve", "drop-rebound", "--set", "on=2100", "--set",
+                         "h_rebound=1100", "--json")
+    assert code == 0, err
+    assert json.loads(out)["answers"]["e"]["value"] == pytest.approx((1100 / 2100) ** 0.5, rel=1e-12)
+
+
+@pytest.mark.parametrize(("template", "old", "new"), [
+    ("ball-plate", "restitution: e", "restitution: 1/0"),
+    ("ball-plate", "before: {ball: {n: v_n, t: v_t}}", "before: {}"),
+])
+def test_expressions_the_solver_cannot_handle_are_template_errors(tmp_path: Path,
+                                                                  capsys: pytest.CaptureFixture[str],
+                                                                  template: str, old: str, new: str) -> None:
+    folder = bank_with(tmp_path, template, old, new)
+    err = refused(capsys, "--bank", folder, "solve", template, "--set", "v=1", "--set", "theta=30", "--set", "e=0.5",
+                  within=5)
+    assert f"{template}.yaml: " in err and "expected" in err
+
+
+def test_a_constant_answer_beyond_float64_is_a_refused_row(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    folder = bank_with(tmp_path, "drop-rebound", "value: f_loss", "value: 1e308")
+    code, out, _ = run(capsys, "--bank", folder, "solve", "drop-rebound", "--set", "h_drop=2", "--set", "h_rebound=1")
+    assert code == 3 and "answer loss_pct: a step of the solution is not a finite number" in out
+
+
+def test_a_named_pipe_in_the_bank_is_refused_not_waited_on(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    import os
+
+    os.mkfifo(tmp_path / "fifo.yaml")
+    assert "fifo.yaml: expected a template file, got a special file" in refused(capsys, "--bank", tmp_path, "list")
+
+
+def test_a_header_of_20000_columns_is_refused_quickly_with_a_short_message(tmp_path: Path,
+                                                                          capsys: pytest.CaptureFixture[str]) -> None:
+    batch = write(tmp_path / "b.csv", "h_drop,h_rebound," + ",".join(f"c{i}" for i in range(20_000)) + "\n1,1\n")
+    err = refused(capsys, "solve", "drop-rebound", "--batch", batch)
+    assert "unknown parameter(s) c0, c1, c2, c3, c4, c5, c6, c7, c8, c9 and 19,990 more" in err and len(err) < 400
+
+
+def test_a_deeply_nested_manifest_is_refused(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    out = tmp_path / "out"
+    out.mkdir()
+    write(out / ".grader-manifest.json", '{"a":' + "[" * 100_000 + "1" + "]" * 100_000 + "}")
+    a = write(tmp_path / "a.yaml", ONE_PROBLEM)
+    err = refused(capsys, "generate", a, "--roster", ROSTER, "--out", out, "--no-pdf", "--force")
+    assert ".grader-manifest.json: expected a manifest grader wrote" in err
+
+
+def test_plot_into_a_missing_folder_is_refused_and_creates_nothing(tmp_path: Path,
+                                                                   capsys: pytest.CaptureFixture[str]) -> None:
+    err = refused(capsys, "simulate", "drop-rebound", "--set", "h_drop=2100", "--set", "h_rebound=1100", "--plot",
+                  tmp_path / "no" / "such" / "p.png", within=5)
+    assert "does not exist; create it first" in err and not (tmp_path / "no").exists()
+
+
+@pytest.mark.parametrize("how", ["ctrl-c", "sigterm"])
+def test_an_interrupted_run_is_one_line_and_leaves_nothing(tmp_path: Path, capsys: pytest.CaptureFixture[str],
+                                                           monkeypatch: pytest.MonkeyPatch, how: str) -> None:
+    """Ctrl-C printed a KeyboardInterrupt traceback; a SIGTERM left the .partial work folder behind."""
+    import os
+    import signal
+
+    import grader.render.generate as job
+
+    def stop(*_: object) -> None:
+        if how == "ctrl-c":
+            raise KeyboardInterrupt
+        os.kill(os.getpid(), signal.SIGTERM)
+
+    monkeypatch.setattr(job, "generate", stop)
+    a = write(tmp_path / "a.yaml", ONE_PROBLEM)
+    code, out, err = run(capsys, "generate", a, "--roster", ROSTER, "--out", tmp_path / "out", "--no-pdf")
+    assert (code, out) == (130, "") and err == "grader: error: interrupted; nothing was left half-written\n"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a.yaml"]
+
+
+def test_a_closed_standard_output_is_one_line(capsys: pytest.CaptureFixture[str],
+                                              monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr("sys.stdout", None)
+    assert main(["list"]) == 2
+    assert "standard output is closed" in capsys.readouterr().err
+
+
+def test_control_characters_from_input_are_escaped_in_messages(capsys: pytest.CaptureFixture[str]) -> None:
+    err = refused(capsys, "solve", "ball-plate", "--set", "v=5 \x1b[31mred", "--set", "theta=30", "--set", "e=0.5")
+    assert "\x1b" not in err and "\\x1b[31mred" in err
+
+
+@pytest.mark.parametrize(("name", "message"), [
+    ("Ana\u202eevil", "U+202E"),
+    ("\u200b\u200b", "has no visible character"),
+    ('"Ana\nBo"', "U+000A"),
+])
+def test_roster_names_that_would_print_wrongly_are_refused(tmp_path: Path, capsys: pytest.CaptureFixture[str],
+                                                           name: str, message: str) -> None:
+    err = generate_refused(capsys, tmp_path, ONE_PROBLEM, f"id,name,email,section\ns1,{name},a@x,1\n")
+    assert message in err

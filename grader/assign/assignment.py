@@ -178,6 +178,7 @@ def load_roster(path: Path) -> tuple[Student, ...]:
     for row in table.rows:
         values = {c: row.cells[columns[c]] for c in _ROSTER_COLUMNS}
         _check_id(values["id"], f"{path}: line {row.line}")
+        _check_name(values["name"], f"{path}: line {row.line}")
         if values["id"] in seen:
             raise GraderError(f"{path}: line {row.line}: student id '{values['id']}' appears twice")
         seen.add(values["id"])
@@ -185,6 +186,20 @@ def load_roster(path: Path) -> tuple[Student, ...]:
     if not students:
         raise GraderError(f"{path}: the roster has no students")
     return tuple(students)
+
+
+_BIDI = set("\u202a\u202b\u202c\u202d\u202e\u2066\u2067\u2068\u2069")
+
+
+def _check_name(name: str, where: str) -> None:
+    """A name is printed on the sheet: no control characters or bidi overrides (which reorder what
+    follows), and something visible when it is not empty."""
+    bad = next((c for c in name if unicodedata.category(c) == "Cc" or c in _BIDI), None)
+    if bad is not None:
+        raise GraderError(f"{where}: the name {shown(name)} holds the control character U+{ord(bad):04X} "
+                          f"({unicodedata.name(bad, 'unnamed')}); expected a name as printed")
+    if name and all(unicodedata.category(c)[0] in "CZ" for c in name):
+        raise GraderError(f"{where}: the name {shown(name)} has no visible character; expected a name, or none")
 
 
 def _check_id(student_id: str, where: str) -> None:

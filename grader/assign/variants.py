@@ -192,7 +192,8 @@ class _Problem:
                 if abs(value) < NEAR_ZERO * self.typical.get(name, 0.0):
                     flaws[row] = f"answer {name} = {value:.3g} is too close to zero to grade with a relative tolerance"
                 elif name in self.restitution and not 0.01 <= value <= 0.99:
-                    flaws[row] = f"the derived coefficient of restitution {name} = {value:.4g} is at 0 or 1"
+                    flaws[row] = (f"the derived coefficient of restitution {name} = {value:.4g} is within 0.01 "
+                                  "of 0 or 1 (a variant at a limit of e is a special case, not the problem asked)")
         return flaws
 
     def draw(self, students: Sequence[Student]) -> tuple[list[dict[str, str]], list[str]]:

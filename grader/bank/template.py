@@ -158,6 +158,9 @@ def load_bank(directory: Path | None = None) -> dict[str, Template]:
         raise GraderError(f"{folder}: no templates in this folder; expected problem templates as *.yaml files")
     templates: dict[str, Template] = {}
     for path in paths:
+        if not path.is_file():  # a named pipe would block the run, a folder cannot be read
+            kind = "a folder" if path.is_dir() else "a special file (a pipe or a device)"
+            raise GraderError(f"{path}: expected a template file, got {kind}")
         template = load_template(path)
         if template.id in templates:
             raise TemplateError(str(path), "id", "an id no other template uses", shown(template.id))
@@ -348,7 +351,8 @@ def _gravity(text: Any, where: str) -> Gravity | None:
     match = re.match(r"^\s*((?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s+(\S+)\s*$", str(text))
     unit = _unit(match.group(2), where, "gravity") if match else None
     if not match or unit is None or unit.dimension != (1, 0, -2, 0) or not 0 < float(match.group(1)) < 1e300:
-        raise TemplateError(where, "gravity", "a positive acceleration like '9.81 m/s^2' or '32.2 ft/s^2'",
+        raise TemplateError(where, "gravity", "a positive acceleration below 1e300, like '9.81 m/s^2' or "
+                            "'32.2 ft/s^2'",
                             shown(text))
     from fractions import Fraction
     return Gravity(Fraction(match.group(1)) * unit.factor, str(text).strip())

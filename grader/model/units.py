@@ -164,6 +164,10 @@ def dimension_of(node: Node, known: Mapping[str, Dimension]) -> Dimension | None
     Traceback (most recent call last):
     ...
     grader.errors.GraderError: adds a length to a mass
+    >>> dimension_of(parse("h**h"), {"h": LENGTH})
+    Traceback (most recent call last):
+    ...
+    grader.errors.GraderError: raises to a power that is a length
     """
     if isinstance(node, Num):
         return PURE
@@ -188,11 +192,17 @@ def dimension_of(node: Node, known: Mapping[str, Dimension]) -> Dimension | None
         exponent = node.args[1]
         if isinstance(exponent, Num):
             return _scaled(first, Fraction(exponent.value))
-        return PURE if first == PURE else None
+        if found_all[1] != PURE:
+            raise GraderError(f"raises to a power that is {dimension_name(found_all[1])}")
+        if first != PURE:
+            raise GraderError(f"raises {dimension_name(first)} to a power that is not a fixed number")
+        return PURE
     if node.op == "sqrt":
         return _scaled(first, Fraction(1, 2))
     if node.op == "atan2":
         return ANGLE
+    if first not in (PURE, ANGLE) or (first == ANGLE and node.op in ("exp", "log")):
+        raise GraderError(f"takes {node.op} of {dimension_name(first)}")
     return PURE  # sin, cos, exp, log, …: a pure number
 
 

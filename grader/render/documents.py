@@ -21,6 +21,7 @@ from __future__ import annotations
 import concurrent.futures
 import hashlib
 import re
+from collections import Counter
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from functools import lru_cache
@@ -43,7 +44,7 @@ from grader.solve.cache import compiled_for
 from grader.solve.compiled import Compiled
 
 PAPER = "us-letter"
-_SAFE = re.compile(r"[A-Za-z0-9._-]+")
+_SAFE = re.compile(r"[A-Za-z0-9_-][A-Za-z0-9._-]*")  # not starting with "." (a hidden file)
 
 
 # --- file names ---------------------------------------------------------------------------------
@@ -51,10 +52,13 @@ _SAFE = re.compile(r"[A-Za-z0-9._-]+")
 def safe_file_name(student_id: str) -> str:
     """The file name (without ``.pdf``) for a student id.
 
-    An id made only of ASCII letters, digits, ``.``, ``_`` and ``-`` (at most 120 characters) is
-    kept as it is. Any other id becomes its safe characters, runs of others replaced by ``_``
-    (at most 60), then ``-`` and the first 10 hex digits of the SHA-256 of the id (UTF-8), so two
-    different ids never share a name.
+    An id made only of ASCII letters, digits, ``.``, ``_`` and ``-`` (at most 120 characters, not
+    starting with ``.``, which would hide the file) is kept as it is. Any other id becomes its safe
+    characters, runs of others replaced by ``_`` (at most 60), then ``-`` and the first 10 hex digits
+    of the SHA-256 of the id (UTF-8), so two different ids never share a name.
+
+    >>> safe_file_name("s-001"), safe_file_name(".grader-manifest.json").startswith("grader-manifest.json-")
+    ('s-001', True)
     """
     if _SAFE.fullmatch(student_id) and len(student_id) <= 120:
         return student_id
@@ -70,8 +74,8 @@ def file_names(student_ids: Sequence[str]) -> list[str]:
     ['AB1-2d2c442062', 'ab1-ca5ba87c93', 'x']
     """
     names = [safe_file_name(i) for i in student_ids]
-    folded = [n.casefold() for n in names]
-    return [f"{n}-{hashlib.sha256(i.encode('utf-8')).hexdigest()[:10]}" if folded.count(n.casefold()) > 1 else n
+    folded = Counter(n.casefold() for n in names)
+    return [f"{n}-{hashlib.sha256(i.encode('utf-8')).hexdigest()[:10]}" if folded[n.casefold()] > 1 else n
             for n, i in zip(names, student_ids, strict=True)]
 
 

@@ -47,6 +47,11 @@ def check_plot_target(target: Path) -> str:
                           f"{repr(target.suffix) if target.suffix else 'no ending'}")
     if target.is_dir():
         raise GraderError(f"--plot {target}: expected a file name, got a folder")
+    folder = target.parent
+    if not folder.is_dir():
+        raise GraderError(f"--plot {target}: expected a file in an existing folder, but {folder} "
+                          f"{'is a file' if folder.exists() else 'does not exist'}; create it first or choose "
+                          "another name")
     return fmt
 
 

@@ -350,7 +350,7 @@ def _read_batch(path: Path, template: Template) -> tuple[dict[str, Any], list[di
     columns: dict[str, list[float]] = {name: [] for name in template.parameters}
     errors: list[str | None] = []
     for row in table.rows:
-        reason = None
+        reason = row.problem
         for name, parameter in template.parameters.items():
             try:
                 columns[name].append(_read_value(row.cells[name], parameter, f"line {row.line}, {name}"))

@@ -202,10 +202,12 @@ def _yaml_problem(error: yaml.YAMLError) -> str:
 
 @dataclass(frozen=True)
 class CsvRow:
-    """One data row: the line it starts on, and its cells by header name (stripped)."""
+    """One data row: the line it starts on, its cells by header name (stripped), and what is wrong
+    with the row as a whole (more cells than columns), for the caller to refuse the row or the file."""
 
     line: int
     cells: dict[str, str]
+    problem: str | None = None
 
 
 @dataclass(frozen=True)
@@ -222,8 +224,9 @@ def read_csv(path: Path) -> CsvTable:
     """A CSV file: UTF-8 with or without a byte-order mark; comma, semicolon or tab, whichever the
     header uses most. Blank lines are skipped (before the header too); a row's line is where it
     starts, so a quoted cell over several lines does not shift the numbers. Refused, naming the
-    line: duplicate or missing header names (an empty column at the end is dropped), more cells
-    than header columns, cells longer than ``CELL_CHARS``, NUL bytes, files over ``CSV_BYTES``.
+    line: duplicate or missing header names (an empty column at the end is dropped), unclosed
+    quotes, cells longer than ``CELL_CHARS``, NUL bytes, files over ``CSV_BYTES``. A row with more
+    cells than columns carries its ``problem``.
 
     >>> import tempfile, pathlib
     >>> path = pathlib.Path(tempfile.mkdtemp()) / "b.csv"
@@ -246,16 +249,17 @@ def read_csv(path: Path) -> CsvTable:
     header = _header(header_cells, path, header_line)
     rows = []
     for line, cells in records:
+        problem = None
         if len(cells) > len(header) and any(c.strip() for c in cells[len(header):]):
-            raise GraderError(f"{path}: line {line}: {len(cells)} cells, but the header has {len(header)} "
-                              "columns; expected one cell per column")
+            problem = (f"line {line}: {len(cells)} cells, but the header has {len(header)} column"
+                       f"{'s' if len(header) > 1 else ''}; expected one cell per column")
         rows.append(CsvRow(line, {name: (cells[i].strip() if i < len(cells) else "")
-                                  for i, name in enumerate(header)}))
+                                  for i, name in enumerate(header)}, problem))
     return CsvTable(path, header, tuple(rows), header_line)
 
 
 def _records(stream: io.StringIO, path: Path, delimiter: str, offset: int) -> Iterator[tuple[int, list[str]]]:
-    reader = csv.reader(stream, delimiter=delimiter)
+    reader = csv.reader(stream, delimiter=delimiter, strict=True)  # an unclosed quote is an error, not a cell
     end = 0
     while True:
         start = end + 1
@@ -264,7 +268,9 @@ def _records(stream: io.StringIO, path: Path, delimiter: str, offset: int) -> It
         except StopIteration:
             return
         except csv.Error as error:
-            raise GraderError(f"{path}: line {offset + reader.line_num}: {error}") from None
+            reason = (f"a cell longer than {CELL_CHARS} characters" if "field limit" in str(error)
+                      else f"{error} (check the quotes)")
+            raise GraderError(f"{path}: line {offset + reader.line_num}: {reason}; expected CSV") from None
         end = reader.line_num
         if not any(cell.strip() for cell in cells):
             continue

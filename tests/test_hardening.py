@@ -182,7 +182,7 @@ def test_a_header_only_batch_is_refused_for_every_template(tmp_path: Path, capsy
 @pytest.mark.parametrize(("text", "message"), [
     ("h_drop,h_rebound,h_drop\n1,1,1\n", "the column 'h_drop' appears twice"),
     ("h_drop,,h_rebound\n1,,1\n", "column 2 has no name"),
-    ("h_drop,h_rebound\n2000,1000,5\n", "line 2: 3 cells, but the header has 2 columns"),
+    ('h_drop,h_rebound\n"2000,1000\n', "line 2: unexpected end of data (check the quotes); expected CSV"),
     ("h_drop,h_rebound\n" + "1" * 100_000 + ",1\n", "a cell of 100,000 characters; expected at most 1000"),
     ("h_drop,h_rebound\n\0,1\n", "line 2: expected text, got a NUL byte"),
 ])
@@ -191,6 +191,16 @@ def test_malformed_batch_files_are_refused_naming_the_line(tmp_path: Path, capsy
     """Duplicate headers made the last one win; a 100 KB cell took 36 s in a quadratic regex."""
     batch = write(tmp_path / "b.csv", text)
     assert message in refused(capsys, "solve", "drop-rebound", "--batch", batch)
+
+
+def test_a_batch_row_with_more_cells_than_columns_is_a_refused_row(tmp_path: Path,
+                                                                  capsys: pytest.CaptureFixture[str]) -> None:
+    """One bad row costs that row, not the run (a short row already did the same)."""
+    batch = write(tmp_path / "b.csv", "h_drop,h_rebound\n2000,1000,5\n2100,1100\n")
+    code, out, _ = run(capsys, "solve", "drop-rebound", "--batch", batch, "--json")
+    first, second = (json.loads(line) for line in out.splitlines())
+    assert code == 3 and first["error"] == "line 2: 3 cells, but the header has 2 columns; expected one cell per column"
+    assert second["answers"]["e"]["value"] == pytest.approx((1100 / 2100) ** 0.5, rel=1e-12)
 
 
 def test_batch_line_numbers_count_blank_lines_and_quoted_line_breaks(tmp_path: Path,

@@ -176,6 +176,8 @@ def load_roster(path: Path) -> tuple[Student, ...]:
                           f"{', '.join(_ROSTER_COLUMNS)} (got {', '.join(table.header)})")
     students, seen = [], set()
     for row in table.rows:
+        if row.problem is not None:
+            raise GraderError(f"{path}: {row.problem}")
         values = {c: row.cells[columns[c]] for c in _ROSTER_COLUMNS}
         _check_id(values["id"], f"{path}: line {row.line}")
         _check_name(values["name"], f"{path}: line {row.line}")

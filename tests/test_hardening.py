@@ -236,8 +236,12 @@ def test_dev_zero_as_a_csv_is_refused_by_size_not_memory(tmp_path: Path, capsys:
     ("a\u202eb,Ana,a@x,1", "U+202E (RIGHT-TO-LEFT OVERRIDE)"),
     ("..,Ana,a@x,1", "would name a hidden or parent folder"),
     (".,Ana,a@x,1", "would name a hidden or parent folder"),
+    # names are printed: no control characters, no bidi overrides (they reorder what follows), not invisible
+    ("s1,Ana\u202eevil,a@x,1", "holds the control character U+202E (RIGHT-TO-LEFT OVERRIDE)"),
+    ("s1,\u200b\u200b,a@x,1", "has no visible character"),
+    ('s1,"Ana\nBo",a@x,1', "U+000A"),
 ])
-def test_roster_rows_that_cannot_be_ids_are_refused(tmp_path: Path, capsys: pytest.CaptureFixture[str],
+def test_roster_rows_that_cannot_be_ids_or_names_are_refused(tmp_path: Path, capsys: pytest.CaptureFixture[str],
                                                     row: str, message: str) -> None:
     err = generate_refused(capsys, tmp_path, ONE_PROBLEM, f"id,name,email,section\n{row}\n")
     assert message in err
@@ -302,6 +306,15 @@ def test_fixed_parameters_that_zero_an_answer_for_everyone_stop_the_run(
     text = f"title: HW\ncourse: C\nseed: s\nproblems:\n  - template: {template}\n    fixed: {fixed}\n"
     err = generate_refused(capsys, tmp_path, text)
     assert f"problem 1 ({template}): {answer}" in err and "cannot be graded with a relative tolerance" in err
+
+
+@pytest.mark.parametrize("points", ["1e308", "-2", "{e: 2000000}"])
+def test_points_beyond_a_million_or_negative_are_refused(tmp_path: Path, capsys: pytest.CaptureFixture[str],
+                                                          points: str) -> None:
+    """1e308 per part was accepted: a total of two overflows to inf."""
+    err = generate_refused(capsys, tmp_path, ONE_PROBLEM + f"    points: {points}\n")
+    assert "problems[0].points: expected a number, or answer name -> number (0 to 1,000,000)" in err
+    assert "'*'" not in err  # the file's own words, not the internal form
 
 
 # --- key.csv ids ------------------------------------------------------------------------------------
@@ -503,14 +516,3 @@ def test_a_closed_standard_output_is_one_line(capsys: pytest.CaptureFixture[str]
 def test_control_characters_from_input_are_escaped_in_messages(capsys: pytest.CaptureFixture[str]) -> None:
     err = refused(capsys, "solve", "ball-plate", "--set", "v=5 \x1b[31mred", "--set", "theta=30", "--set", "e=0.5")
     assert "\x1b" not in err and "\\x1b[31mred" in err
-
-
-@pytest.mark.parametrize(("name", "message"), [
-    ("Ana\u202eevil", "U+202E"),
-    ("\u200b\u200b", "has no visible character"),
-    ('"Ana\nBo"', "U+000A"),
-])
-def test_roster_names_that_would_print_wrongly_are_refused(tmp_path: Path, capsys: pytest.CaptureFixture[str],
-                                                           name: str, message: str) -> None:
-    err = generate_refused(capsys, tmp_path, ONE_PROBLEM, f"id,name,email,section\ns1,{name},a@x,1\n")
-    assert message in err

@@ -23,6 +23,7 @@ from grader.inputs import read_csv, read_yaml
 
 _KEY = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_-]{0,15}$")
 _ROSTER_COLUMNS = ("id", "name", "email", "section")
+MAX_POINTS = 1_000_000  # per answer part: any class's totals stay exact in float64
 
 
 @dataclass(frozen=True)
@@ -106,8 +107,9 @@ def _problem(raw: Any, index: int, where: str) -> ProblemSpec:
     points = raw.get("points", 1)
     if isinstance(points, (int, float)) and not isinstance(points, bool):
         points = {"*": points}
-    if not isinstance(points, Mapping) or not all(_number(v) and v >= 0 for v in points.values()):
-        raise TemplateError(where, f"{key}.points", "a number, or answer name -> number (>= 0)", shown(points))
+    if not isinstance(points, Mapping) or not all(_number(v) and 0 <= v <= MAX_POINTS for v in points.values()):
+        raise TemplateError(where, f"{key}.points", f"a number, or answer name -> number (0 to {MAX_POINTS:,})",
+                            shown(raw.get("points", 1)))
     fixed = raw.get("fixed") or {}
     if not isinstance(fixed, Mapping) or not all(_number(v) for v in fixed.values()):
         raise TemplateError(where, f"{key}.fixed", "parameter name -> number", shown(fixed))

@@ -63,7 +63,7 @@ def test_every_answer_in_the_key_equals_solving_the_printed_parameters(
     """The key's answers are the solver's answers for the numbers on the student's page."""
     run(capsys, "generate", ASSIGNMENT, "--roster", ROSTER, "--out", tmp_path / "out", "--no-pdf")
     key = json.loads((tmp_path / "out" / "key.json").read_text(encoding="utf-8"))
-    assert key["schema"] == "grader-key" and key["version"] == 1
+    assert key["schema"] == "grader-key" and key["version"] == 2
     for student in key["students"]:
         for problem in student["problems"]:
             assert {n: float(t) for n, t in problem["printed"].items()} == problem["params"]

@@ -40,6 +40,13 @@ class ProblemSpec:
 
 
 @dataclass(frozen=True)
+class Grading:
+    """How answers are read: ``numeric_expressions``, whether ``sqrt(2*9.81*2)`` counts as a number."""
+
+    numeric_expressions: bool = True
+
+
+@dataclass(frozen=True)
 class Assignment:
     """An assignment: what every student gets, and the seed their variants come from."""
 
@@ -50,6 +57,7 @@ class Assignment:
     due: str
     instructions: str
     problems: tuple[ProblemSpec, ...]
+    grading: Grading = Grading()
 
 
 @dataclass(frozen=True)
@@ -68,7 +76,7 @@ def load_assignment(path: Path) -> Assignment:
     raw = read_yaml(path)
     if not isinstance(raw, Mapping):
         raise TemplateError(where, "(file)", "a mapping with title, course, seed, problems", type(raw).__name__)
-    allowed = {"title", "course", "seed", "due", "instructions", "problems"}
+    allowed = {"title", "course", "seed", "due", "instructions", "problems", "grading"}
     if set(raw) - allowed:
         raise TemplateError(where, ", ".join(sorted(map(str, set(raw) - allowed))),
                             f"only {', '.join(sorted(allowed))}", "unknown key(s)")
@@ -85,7 +93,18 @@ def load_assignment(path: Path) -> Assignment:
         raise TemplateError(where, "seed", "a number or text (the assignment seed)", shown(seed))
     return Assignment(where, _text(raw, "title", where), _text(raw, "course", where), str(seed).strip(),
                       _text(raw, "due", where, required=False), _text(raw, "instructions", where, required=False),
-                      problems)
+                      problems, _grading(raw.get("grading"), where))
+
+
+def _grading(raw: Any, where: str) -> Grading:
+    if raw is None:
+        return Grading()
+    if not isinstance(raw, Mapping) or set(raw) - {"numeric_expressions"}:
+        raise TemplateError(where, "grading", "{numeric_expressions: true or false}", shown(raw))
+    value = raw.get("numeric_expressions", True)
+    if not isinstance(value, bool):
+        raise TemplateError(where, "grading.numeric_expressions", "true or false", shown(value))
+    return Grading(numeric_expressions=value)
 
 
 def _text(raw: Mapping[str, Any], key: str, where: str, required: bool = True) -> str:
@@ -119,15 +138,29 @@ def _problem(raw: Any, index: int, where: str) -> ProblemSpec:
             for v in narrowed.values()):
         raise TemplateError(where, f"{key}.narrow", "parameter name -> [low, high] with low <= high", shown(narrowed))
     tolerances = raw.get("tolerance") or {}
-    if not isinstance(tolerances, Mapping) or not all(
-            isinstance(v, Mapping) and set(v) <= {"rtol", "atol"} and all(_number(x) and x >= 0 for x in v.values())
-            for v in tolerances.values()):
-        raise TemplateError(where, f"{key}.tolerance", "answer name -> {rtol: X, atol: Y}", shown(tolerances))
+    if not isinstance(tolerances, Mapping):
+        raise TemplateError(where, f"{key}.tolerance", "answer name -> tolerance", shown(tolerances))
+    tolerance_specs = {str(k): _tolerance(v, where, f"{key}.tolerance.{k}") for k, v in tolerances.items()}
     return ProblemSpec(problem_key, str(raw["template"]), {str(k): float(v) for k, v in points.items()},
                        {str(k): float(v) for k, v in fixed.items()},
                        {str(k): (float(v[0]), float(v[1])) for k, v in narrowed.items()},
-                       {str(k): Tolerance(float(v.get("rtol", -1)), float(v.get("atol", -1)))
-                        for k, v in tolerances.items()})
+                       tolerance_specs)
+
+
+def _tolerance(raw: Any, where: str, key: str) -> Tolerance:
+    """``{rtol: X, atol: Y}`` (either may be left to the template: -1 marks it), ``{sigfigs: N}`` or
+    ``{decimals: N}`` (PrairieLearn's rules)."""
+    expected = "{rtol: X, atol: Y}, {sigfigs: N} or {decimals: N}"
+    if isinstance(raw, Mapping) and len(raw) == 1 and set(raw) <= {"sigfigs", "decimals"}:
+        mode, digits = next(iter(raw.items()))
+        least = 1 if mode == "sigfigs" else 0
+        if isinstance(digits, bool) or not isinstance(digits, int) or not least <= digits <= 15:
+            raise TemplateError(where, f"{key}.{mode}", f"a whole number from {least} to 15", shown(digits))
+        return Tolerance(-1.0, -1.0, mode, digits)
+    if not (isinstance(raw, Mapping) and raw and set(raw) <= {"rtol", "atol"}
+            and all(_number(x) and 0 <= x < 1e300 for x in raw.values())):
+        raise TemplateError(where, key, expected, shown(raw))
+    return Tolerance(float(raw.get("rtol", -1)), float(raw.get("atol", -1)))
 
 
 def _number(value: Any) -> bool:

@@ -3,19 +3,25 @@
 Re-grading reads the key; it never regenerates variants. Nothing in the key depends on the time
 of the run, so generating twice gives byte-identical files.
 
-Schema ``grader-key`` version 1::
+Schema ``grader-key`` version 2 (version 1, still read by grading, lacks ``grading``, ``symbols``,
+and the tolerance's ``mode``: its tolerances are ``{"rtol", "atol"}``)::
 
-    {"schema": "grader-key", "version": 1, "generator": "grader X.Y.Z",
-     "assignment": {"title", "course", "seed", "due", "instructions", "source_sha256"},
+    {"schema": "grader-key", "version": 2, "generator": "grader X.Y.Z",
+     "assignment": {"title", "course", "seed", "due", "instructions", "source_sha256",
+                    "grading": {"numeric_expressions": true}},
      "templates": {ID: {"version", "sha256"}},
-     "problems": [{"key", "template", "title", "answers": [{"name", "label", "unit", "points"}]}],
+     "problems": [{"key", "template", "title",
+                   "answers": [{"name", "label", "unit", "points",
+                                "symbols": {NAME: [low, high]} (symbolic answers only: where each
+                                           name is drawn to compare expressions)}]}],
      "collisions": {PROBLEM_KEY: number of students sharing their numbers with another},
      "students": [{"id", "name", "email", "section",
                    "problems": [{"key", "template", "variant_seed",
                                  "params": {NAME: value as printed, a number},
                                  "printed": {NAME: the text on the page, e.g. "2.10"},
                                  "answers": {NAME: {"value", "unit", "label", "points",
-                                                    "tolerance": {"rtol", "atol"},
+                                                    "tolerance": {"mode": "rtol", "rtol", "atol"}
+                                                        or {"mode": "sigfigs" | "decimals", "digits"},
                                                     "undefined": reason (only when there is no value)}}}]}]}
 """
 
@@ -30,11 +36,12 @@ from pathlib import Path
 from typing import Any
 
 from grader import __version__
-from grader.assign.assignment import Assignment
+from grader.assign.assignment import Assignment, ProblemSpec
 from grader.assign.variants import AnswerPart, Generation
 from grader.bank.template import Template
 
-SCHEMA, VERSION = "grader-key", 1
+SCHEMA, VERSION = "grader-key", 2
+SYMBOL_RANGE = (1.0, 10.0)  # where a symbol with no sampled range (a speed v) is drawn to compare expressions
 _FORMULA_START = ("=", "+", "-", "@", "\t", "\r", "\n")
 
 
@@ -66,11 +73,12 @@ def key_document(assignment: Assignment, generation: Generation, bank: Mapping[s
         "schema": SCHEMA, "version": VERSION, "generator": f"grader {__version__}",
         "assignment": {"title": assignment.title, "course": assignment.course, "seed": assignment.seed,
                        "due": assignment.due, "instructions": assignment.instructions,
-                       "source_sha256": hashlib.sha256(Path(assignment.where).read_bytes()).hexdigest()},
+                       "source_sha256": hashlib.sha256(Path(assignment.where).read_bytes()).hexdigest(),
+                       "grading": {"numeric_expressions": assignment.grading.numeric_expressions}},
         "templates": {t.id: {"version": t.version, "sha256": t.source_hash} for t in used.values()},
         "problems": [{"key": v.key, "template": v.template, "title": used[v.template].title,
-                      "answers": [{"name": a.name, "label": a.label, "unit": a.unit, "points": a.points}
-                                  for a in v.answers]} for v in first],
+                      "answers": [_part(a, used[v.template], spec) for a in v.answers]}
+                     for v, spec in zip(first, assignment.problems, strict=False)],
         "collisions": dict(generation.collisions),
         "students": [{"id": s.student.id, "name": s.student.name, "email": s.student.email,
                       "section": s.student.section,
@@ -81,9 +89,28 @@ def key_document(assignment: Assignment, generation: Generation, bank: Mapping[s
     }
 
 
+def _part(part: AnswerPart, template: Template, problem: ProblemSpec) -> dict[str, Any]:
+    data: dict[str, Any] = {"name": part.name, "label": part.label, "unit": part.unit, "points": part.points}
+    symbolic = template.answers[part.name].symbolic
+    if symbolic:
+        data["symbols"] = {name: list(_symbol_range(name, template, problem)) for name in symbolic}
+    return data
+
+
+def _symbol_range(name: str, template: Template, problem: ProblemSpec) -> tuple[float, float]:
+    """Where a name of a symbolic answer varies: its narrowed or sampled range; a symbol, 1 to 10."""
+    if name in problem.narrowed:
+        return problem.narrowed[name]
+    parameter = template.parameters.get(name)
+    if parameter is None:
+        return SYMBOL_RANGE
+    values = parameter.sample.values
+    return (min(values), max(values))
+
+
 def _answer(part: AnswerPart) -> dict[str, Any]:
     data: dict[str, Any] = {"value": part.value, "unit": part.unit, "label": part.label, "points": part.points,
-                            "tolerance": {"rtol": part.tolerance.rtol, "atol": part.tolerance.atol}}
+                            "tolerance": part.tolerance.to_json()}
     if part.undefined is not None:
         data["undefined"] = part.undefined
     return data

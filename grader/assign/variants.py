@@ -251,6 +251,8 @@ def tolerance(problem: ProblemSpec, template: Template, name: str) -> Tolerance:
     spec, override = template.answers[name].tolerance, problem.tolerances.get(name)
     if override is None:
         return spec
+    if override.mode != "rtol":
+        return Tolerance(0.0, 0.0, override.mode, override.digits)
     return Tolerance(override.rtol if override.rtol >= 0 else spec.rtol,
                      override.atol if override.atol >= 0 else spec.atol)
 

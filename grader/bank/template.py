@@ -103,10 +103,19 @@ class SymbolSpec:
 
 @dataclass(frozen=True)
 class Tolerance:
-    """Grading tolerance: ``|s - t| <= atol + rtol*|t|`` (atol in the answer's unit)."""
+    """Grading tolerance. ``rtol`` mode: ``|s - t| <= atol + rtol*|t|`` (atol in the answer's unit);
+    ``sigfigs``/``decimals`` modes: PrairieLearn's rules with ``digits`` figures or places."""
 
     rtol: float
     atol: float
+    mode: str = "rtol"
+    digits: int = 0
+
+    def to_json(self) -> dict[str, Any]:
+        """The key's form: ``{"mode": "rtol", "rtol", "atol"}`` or ``{"mode": "sigfigs", "digits"}``."""
+        if self.mode == "rtol":
+            return {"mode": "rtol", "rtol": self.rtol, "atol": self.atol}
+        return {"mode": self.mode, "digits": self.digits}
 
 
 @dataclass(frozen=True)

@@ -186,6 +186,10 @@ def tolerance_text(part: AnswerPart) -> str:
     >>> tolerance_text(AnswerPart("e", "1a", 0.5, "", 1.0, Tolerance(0.01, 0.0), "e"))
     '±1%'
     """
+    if part.tolerance.mode == "sigfigs":
+        return f"{part.tolerance.digits} significant figures"
+    if part.tolerance.mode == "decimals":
+        return f"{part.tolerance.digits} decimal places"
     relative = f"{part.tolerance.rtol * 100:.3g}%" if part.tolerance.rtol else ""
     absolute = f"{part.tolerance.atol:g} {part.unit}".strip() if part.tolerance.atol else ""
     if relative and absolute:

@@ -19,6 +19,7 @@ grader.errors.GraderError: ...b.yaml: line 2: the key 'h' appears twice (expecte
 
 from __future__ import annotations
 
+import codecs
 import csv
 import io
 import math
@@ -64,6 +65,63 @@ def decode_text(data: bytes, path: Path) -> str:
         line = text[:text.index("\0")].count("\n") + 1
         raise GraderError(f"{path}: line {line}: expected text, got a NUL byte (is this a binary file?)")
     return text
+
+
+def decode_export(data: bytes, path: Path) -> tuple[str, str]:
+    """Text as spreadsheets and LMSs export it, and the encoding it was read in: UTF-8 (with or
+    without a byte-order mark), UTF-16 with a byte-order mark (Excel's "Unicode text"), or else a
+    clean Windows-1252/Latin-1 file (no control characters, no UTF-8 sequences: not a mix). Anything
+    else is refused with the byte offset of the first byte that is not UTF-8.
+
+    >>> decode_export("Zoë".encode("utf-16"), Path("a.txt"))
+    ('Zoë', 'UTF-16')
+    >>> decode_export("Zoë".encode("cp1252"), Path("a.csv"))
+    ('Zoë', 'Windows-1252')
+    >>> decode_export(b"id\\n\\x89PNG\\x00", Path("a.csv"))
+    Traceback (most recent call last):
+    ...
+    grader.errors.GraderError: a.csv: byte offset 3 (line 2): expected UTF-8 or UTF-16 text, got the byte 0x89 ...
+    """
+    if data.startswith((codecs.BOM_UTF16_LE, codecs.BOM_UTF16_BE)):
+        try:
+            text, encoding = data.decode("utf-16"), "UTF-16"
+        except UnicodeDecodeError as error:
+            raise GraderError(f"{path}: byte offset {error.start}: expected UTF-16 text after the UTF-16 byte-order "
+                              f"mark, got {error.reason}") from None
+    else:
+        bom = len(codecs.BOM_UTF8) if data.startswith(codecs.BOM_UTF8) else 0
+        try:
+            text, encoding = data[bom:].decode("utf-8"), "UTF-8"
+        except UnicodeDecodeError as error:
+            legacy = _clean_cp1252(data)
+            if legacy is None:
+                offset = bom + error.start
+                line = data[:offset].count(b"\n") + 1
+                raise GraderError(f"{path}: byte offset {offset} (line {line}): expected "
+                                  f"UTF-8 or UTF-16 text, got the byte 0x{data[offset]:02x} (save the file as "
+                                  '"CSV UTF-8")') from None
+            text, encoding = legacy, "Windows-1252"
+    if "\0" in text:
+        line = text[:text.index("\0")].count("\n") + 1
+        raise GraderError(f"{path}: line {line}: expected text, got a NUL byte (is this a binary file?)")
+    return text, encoding
+
+
+_UTF8_SEQUENCE = re.compile(rb"[\xc2-\xdf][\x80-\xbf]|[\xe0-\xef][\x80-\xbf]{2}|[\xf0-\xf4][\x80-\xbf]{3}")
+_CONTROL = re.compile("[\x00-\x08\x0b\x0c\x0e-\x1f\x7f]")
+
+
+def _clean_cp1252(data: bytes) -> str | None:
+    """``data`` as Windows-1252 when it reads as such throughout: no bytes it leaves undefined, no
+    control characters (binary data), and no UTF-8 sequences (a UTF-8 file with one stray byte would
+    otherwise turn every ``é`` into ``Ã©``)."""
+    if _UTF8_SEQUENCE.search(data):
+        return None
+    try:
+        text = data.decode("cp1252")
+    except UnicodeDecodeError:
+        return None
+    return None if _CONTROL.search(text) else text
 
 
 # --- YAML ---------------------------------------------------------------------------------------
@@ -212,21 +270,29 @@ class CsvRow:
 
 @dataclass(frozen=True)
 class CsvTable:
-    """A CSV file: its header (stripped, as written) and its non-blank data rows."""
+    """A CSV file: its header (stripped, as written) and its non-blank data rows; the delimiter and
+    the encoding it was read with."""
 
     path: Path
     header: tuple[str, ...]
     rows: tuple[CsvRow, ...]
     header_line: int
+    delimiter: str = ","
+    encoding: str = "UTF-8"
 
 
-def read_csv(path: Path) -> CsvTable:
+def read_csv(path: Path, *, exports: bool = False) -> CsvTable:
     """A CSV file: UTF-8 with or without a byte-order mark; comma, semicolon or tab, whichever the
-    header uses most. Blank lines are skipped (before the header too); a row's line is where it
+    header uses most outside quotes. Blank lines are skipped (before the header too); a row's line is where it
     starts, so a quoted cell over several lines does not shift the numbers. Refused, naming the
     line: duplicate or missing header names (an empty column at the end is dropped), unclosed
     quotes, cells longer than ``CELL_CHARS``, NUL bytes, files over ``CSV_BYTES``. A row with more
     cells than columns carries its ``problem``.
+
+    ``exports=True`` reads files as LMSs and spreadsheets export them, where one bad row must not
+    cost the others: the encodings of :func:`decode_export`, and a data row with a cell longer than
+    ``CELL_CHARS`` carries its ``problem`` instead of refusing the file (cells beyond the ``csv``
+    module's own limit of 131,072 characters still refuse it).
 
     >>> import tempfile, pathlib
     >>> path = pathlib.Path(tempfile.mkdtemp()) / "b.csv"
@@ -235,27 +301,45 @@ def read_csv(path: Path) -> CsvTable:
     >>> table.header, [(row.line, row.cells) for row in table.rows]
     (('h_drop', 'h_rebound'), [(3, {'h_drop': '2100', 'h_rebound': '1100'}), (5, {'h_drop': '2,0', 'h_rebound': '1'})])
     """
-    text = decode_text(read_bytes(path, CSV_BYTES), path)
+    data = read_bytes(path, CSV_BYTES)
+    text, encoding = decode_export(data, path) if exports else (decode_text(data, path), "UTF-8")
     lines = text.split("\n")
     first = next((i for i, line in enumerate(lines) if line.strip()), None)
     if first is None:
         raise GraderError(f"{path}: empty file; expected a header line")
-    delimiter = max(",;\t", key=lines[first].count)
+    delimiter = max(",;\t", key=lambda candidate: _count_outside_quotes(lines[first], candidate))
     records = _records(io.StringIO("\n".join(lines[first:])), path, delimiter, first)
     first_record = next(records, None)
     if first_record is None:  # only quotes or delimiters: no cell has text
         raise GraderError(f"{path}: no header line with text; expected a header line")
     header_line, header_cells = first_record
+    _check_cell_lengths(header_cells, path, header_line)
     header = _header(header_cells, path, header_line)
     rows = []
     for line, cells in records:
         problem = None
+        if not exports:
+            _check_cell_lengths(cells, path, line)
+        elif any(len(c) > CELL_CHARS for c in cells):
+            problem = (f"line {line}: a cell of {max(map(len, cells)):,} characters; expected at most "
+                       f"{CELL_CHARS}")
         if len(cells) > len(header) and any(c.strip() for c in cells[len(header):]):
             problem = (f"line {line}: {len(cells)} cells, but the header has {len(header)} column"
                        f"{'s' if len(header) > 1 else ''}; expected one cell per column")
         rows.append(CsvRow(line, {name: (cells[i].strip() if i < len(cells) else "")
                                   for i, name in enumerate(header)}, problem))
-    return CsvTable(path, header, tuple(rows), header_line)
+    return CsvTable(path, header, tuple(rows), header_line, delimiter, encoding)
+
+
+def _count_outside_quotes(line: str, delimiter: str) -> int:
+    """How often ``delimiter`` separates cells of ``line`` (a quoted ``"1a, speed"`` is one cell)."""
+    return sum(part.count(delimiter) for part in line.split('"')[::2])
+
+
+def _check_cell_lengths(cells: list[str], path: Path, line: int) -> None:
+    long = next((c for c in cells if len(c) > CELL_CHARS), None)
+    if long is not None:
+        raise GraderError(f"{path}: line {line}: a cell of {len(long):,} characters; expected at most {CELL_CHARS}")
 
 
 def _records(stream: io.StringIO, path: Path, delimiter: str, offset: int) -> Iterator[tuple[int, list[str]]]:
@@ -274,10 +358,6 @@ def _records(stream: io.StringIO, path: Path, delimiter: str, offset: int) -> It
         end = reader.line_num
         if not any(cell.strip() for cell in cells):
             continue
-        long = next((c for c in cells if len(c) > CELL_CHARS), None)
-        if long is not None:
-            raise GraderError(f"{path}: line {offset + start}: a cell of {len(long):,} characters; expected at "
-                              f"most {CELL_CHARS}")
         yield offset + start, cells
 
 

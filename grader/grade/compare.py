@@ -1,0 +1,432 @@
+"""Does a submitted number match the key? Tolerance modes, angles, errors, and the sentence that says why.
+
+Three modes, the last two exactly PrairieLearn's ``is_correct_scalar_sf`` / ``is_correct_scalar_dd``:
+
+- ``rtol``: correct iff ``|s - t| <= atol + rtol*|t|`` (the default, ``rtol`` 1 %);
+- ``sigfigs`` n: iff ``|s - t| < 0.51*10**(floor(log10|t|) - n + 1)`` (``t = 0``: ``0.51*10**(1 - n)``);
+- ``decimals`` n: iff ``|s - t| < 0.51*10**-n``.
+
+Every number is taken as the decimal it prints as (``repr``): ``6.3226`` is exactly 1 % above ``6.26``
+and so is accepted at ``rtol`` 1 %, as a person checking by hand would decide. PrairieLearn evaluates
+the same rules in float64; the two can differ only for a value within a rounding of the boundary.
+Angles (``angle_unit`` ``"deg"`` or ``"rad"``) compare as directions: the difference is reduced to a
+half turn either way, and the tolerance is computed from the key as stored.
+
+>>> bool(is_correct(6.3226, 6.26, Tolerance()))
+True
+>>> is_correct([6.26, 6.27, 6.2651], 6.26, Tolerance("sigfigs", digits=3)).tolist()
+[True, False, False]
+>>> bool(is_correct(340.9, -19.1, Tolerance(), angle_unit="deg"))
+True
+>>> feedback(6.5, 6.26, "m/s", Tolerance(), False)
+'6.5 m/s is 3.8 % above 6.26 m/s; only ±1 % is accepted'
+"""
+
+from __future__ import annotations
+
+import hashlib
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from decimal import Decimal
+from fractions import Fraction
+from functools import lru_cache
+from typing import Any, Literal
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from grader.errors import GraderError, shown
+from grader.model.expr import Node, names, to_text
+from grader.model.kernel import evaluate
+
+Mode = Literal["rtol", "sigfigs", "decimals"]
+MODES: tuple[Mode, ...] = ("rtol", "sigfigs", "decimals")
+MAX_DIGITS = 17
+"""float64 carries 17 significant digits; more cannot be told apart."""
+
+LARGEST = float(np.finfo(np.float64).max)
+"""What :func:`errors` reports for an error too large for float64 (and for input that is not finite)."""
+
+_PERIOD = {"deg": 360.0, "rad": 2 * math.pi}
+_PRAIRIELEARN_HALF = Fraction(51, 100)  # half a unit in the last place, and a little more
+
+
+class ToleranceError(GraderError, ValueError):
+    """A tolerance that is not one of the accepted forms; the message names the field."""
+
+
+@dataclass(frozen=True)
+class Tolerance:
+    """How close a submitted number must be to the key.
+
+    Values that do not apply to the mode (``digits`` in ``rtol`` mode, ``rtol``/``atol`` in the digit
+    modes) must stay at their defaults, so two tolerances are equal exactly when they grade alike.
+
+    >>> Tolerance().describe(), Tolerance(atol=0.05).describe("m/s")
+    ('±1 %', '±1 % + 0.05 m/s')
+    >>> Tolerance("sigfigs", digits=3).describe(), Tolerance("decimals", digits=1).describe()
+    ('3 significant figures', '1 decimal place')
+    >>> Tolerance("sigfigs", digits=0)
+    Traceback (most recent call last):
+    ...
+    grader.grade.compare.ToleranceError: tolerance.digits: expected a whole number from 1 to 17, got 0
+    """
+
+    mode: Mode = "rtol"
+    rtol: float = 0.01
+    atol: float = 0.0
+    digits: int = 3
+
+    def __post_init__(self) -> None:
+        if self.mode not in MODES:
+            _refuse("mode", "'rtol', 'sigfigs' or 'decimals'", self.mode)
+        for name in ("rtol", "atol"):
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, (int, float)) or not 0 <= value < 1e300:
+                _refuse(name, "a number from 0 to 1e300", value)
+            object.__setattr__(self, name, float(value))
+        lowest = 1 if self.mode == "sigfigs" else 0
+        if isinstance(self.digits, bool) or not isinstance(self.digits, int) or not lowest <= self.digits <= MAX_DIGITS:
+            _refuse("digits", f"a whole number from {lowest} to {MAX_DIGITS}", self.digits)
+        if self.mode == "rtol" and self.digits != 3:
+            _refuse("digits", "no digits in rtol mode (digits count only for sigfigs and decimals)", self.digits)
+        if self.mode != "rtol" and (self.rtol, self.atol) != (0.01, 0.0):
+            _refuse("rtol", f"no rtol or atol in {self.mode} mode (they count only in rtol mode)",
+                    {"rtol": self.rtol, "atol": self.atol})
+
+    def describe(self, unit: str = "") -> str:
+        """What is accepted, in words; ``atol`` is in the answer's ``unit``."""
+        if self.mode == "sigfigs":
+            return _count(self.digits, "significant figure")
+        if self.mode == "decimals":
+            return _count(self.digits, "decimal place")
+        relative = f"{_plain(self.rtol * 100)} %"
+        if not self.atol:
+            return f"±{relative}"
+        absolute = _with_unit(_plain(self.atol), unit)
+        return f"±{relative} + {absolute}" if self.rtol else f"±{absolute}"
+
+    @classmethod
+    def from_json(cls, data: Mapping[str, Any]) -> Tolerance:
+        """Read ``{"rtol": .., "atol": ..}`` (key version 1; both optional) or ``{"mode": .., "digits": ..}``.
+
+        >>> Tolerance.from_json({"mode": "sigfigs", "digits": 2}) == Tolerance("sigfigs", digits=2)
+        True
+        >>> Tolerance.from_json({"rtol": 0.02, "digits": 3})
+        Traceback (most recent call last):
+        ...
+        grader.grade.compare.ToleranceError: tolerance: expected only the keys atol, mode, rtol in rtol mode, got digits
+        """
+        if not isinstance(data, Mapping):
+            raise ToleranceError(f"tolerance: expected a mapping like {{'rtol': 0.01}}, got {shown(data)}")
+        mode = data.get("mode", "rtol")
+        if mode not in MODES:
+            _refuse("mode", "'rtol', 'sigfigs' or 'decimals'", mode)
+        allowed = {"mode", "rtol", "atol"} if mode == "rtol" else {"mode", "digits"}
+        extra = [str(key) for key in data if key not in allowed]
+        if extra:
+            raise ToleranceError(f"tolerance: expected only the keys {', '.join(sorted(allowed))} in {mode} mode, "
+                                 f"got {shown(', '.join(sorted(extra)))[1:-1]}")
+        return cls(**{str(key): value for key, value in data.items()})
+
+    def to_json(self) -> dict[str, Any]:
+        """The JSON form; ``rtol`` mode keeps key version 1's ``{"rtol", "atol"}`` exactly.
+
+        >>> Tolerance().to_json(), Tolerance("decimals", digits=2).to_json()
+        ({'rtol': 0.01, 'atol': 0.0}, {'mode': 'decimals', 'digits': 2})
+        """
+        if self.mode == "rtol":
+            return {"rtol": self.rtol, "atol": self.atol}
+        return {"mode": self.mode, "digits": self.digits}
+
+
+def _refuse(name: str, expected: str, got: Any) -> None:
+    raise ToleranceError(f"tolerance.{name}: expected {expected}, got {shown(got)}")
+
+
+def _count(n: int, noun: str) -> str:
+    return f"{n} {noun}" + ("" if n == 1 else "s")
+
+
+# ---- verdicts -------------------------------------------------------------------------------------
+
+def is_correct(submitted: ArrayLike, expected: ArrayLike, tolerance: Tolerance, *,
+               angle_unit: str | None = None) -> np.ndarray:
+    """Element-wise verdicts (broadcast like numpy); input that is not finite is never correct.
+
+    Symmetric in ``submitted`` and ``expected`` where the accepted band does not depend on the key:
+    ``decimals`` mode, and ``rtol`` mode with ``rtol = 0``. Elsewhere the key sets the band's width.
+
+    >>> is_correct([6.32, 6.33, float("nan")], 6.26, Tolerance()).tolist()
+    [True, False, False]
+    >>> is_correct(0.004, 0.0, Tolerance("decimals", digits=2)).item()
+    True
+    """
+    period = _period(angle_unit)
+    s, t, finite = _finite_pairs(submitted, expected)
+    with np.errstate(all="ignore"):
+        distance = np.abs(_difference(s, t, period))
+        bound, unsure = _bound(t, tolerance)
+        verdict = distance <= bound if tolerance.mode == "rtol" else distance < bound
+        # Rounding in float64 cannot move a verdict unless the distance is this close to the bound;
+        # there the exact rule decides.
+        scale = np.maximum(np.maximum(bound, np.abs(s)), np.maximum(np.abs(t), period or 0.0))
+        unsure |= ~(np.isfinite(distance) & np.isfinite(bound)) | (np.abs(distance - bound) <= 1e-9 * scale + 1e-300)
+    verdict &= finite.ravel()
+    for index in np.flatnonzero(unsure & finite.ravel()):
+        verdict[index] = _exact_verdict(float(s[index]), float(t[index]), tolerance, angle_unit)
+    return np.asarray(verdict.reshape(finite.shape), dtype=bool)
+
+
+def _finite_pairs(submitted: ArrayLike, expected: ArrayLike) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Both broadcast and flattened, with 0 where either is not finite; and where both are (in shape)."""
+    s, t = np.broadcast_arrays(np.asarray(submitted, dtype=float), np.asarray(expected, dtype=float))
+    finite = np.isfinite(s) & np.isfinite(t)
+    return np.where(finite, s, 0.0).ravel(), np.where(finite, t, 0.0).ravel(), finite
+
+
+def errors(submitted: ArrayLike, expected: ArrayLike, *,
+           angle_unit: str | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Absolute error ``|s - t|`` and relative error ``|s - t|/|t|``, element-wise, always finite.
+
+    Choices, so that nothing NaN or infinite is returned: where the key is 0 the relative error is
+    the absolute error (the error relative to one unit of the answer, as ``atol`` reads); an error
+    beyond float64, and any input that is not finite, is reported as :data:`LARGEST`. For angles the
+    error is the turn to the nearer direction.
+
+    >>> absolute, relative = errors([6.5, 1.0, float("inf")], [6.26, 0.0, 1.0])
+    >>> [round(x, 4) for x in absolute.tolist()], [round(x, 4) for x in relative.tolist()]
+    ([0.24, 1.0, 1.7976931348623157e+308], [0.0383, 1.0, 1.7976931348623157e+308])
+    >>> [e.tolist() for e in errors(359.0, 1.0, angle_unit="deg")]
+    [2.0, 2.0]
+    """
+    period = _period(angle_unit)
+    s, t, finite = _finite_pairs(submitted, expected)
+    with np.errstate(all="ignore"):
+        absolute = np.abs(_difference(s, t, period))
+        relative = np.where(t == 0, absolute, absolute / np.where(t == 0, 1.0, np.abs(t)))
+    usable = finite.ravel()
+    absolute = np.where(usable & np.isfinite(absolute), absolute, LARGEST).reshape(finite.shape)
+    relative = np.where(usable & np.isfinite(relative), relative, LARGEST).reshape(finite.shape)
+    return absolute, relative
+
+
+def _period(angle_unit: str | None) -> float | None:
+    if angle_unit is not None and angle_unit not in _PERIOD:
+        raise ValueError(f"angle_unit: expected 'deg', 'rad' or None, got {shown(angle_unit)}")
+    return None if angle_unit is None else _PERIOD[angle_unit]
+
+
+def _difference(s: np.ndarray, t: np.ndarray, period: float | None) -> np.ndarray:
+    """``s - t``; for angles reduced to ``(-period/2, period/2]`` (each reduced first: ``fmod`` is exact)."""
+    if period is None:
+        return np.asarray(s - t)
+    turn = np.fmod(s, period) - np.fmod(t, period)
+    return np.asarray(turn - period * np.ceil((turn - period / 2) / period))
+
+
+def _bound(t: np.ndarray, tolerance: Tolerance) -> tuple[np.ndarray, np.ndarray]:
+    """The accepted distance from ``t`` in float64, and where float64 cannot be trusted to find it."""
+    if tolerance.mode == "rtol":
+        return tolerance.atol + tolerance.rtol * np.abs(t), np.zeros(t.shape, dtype=bool)
+    if tolerance.mode == "decimals":
+        return np.full(t.shape, 0.51 * 10.0 ** -tolerance.digits), np.zeros(t.shape, dtype=bool)
+    magnitude = np.log10(np.where(t == 0, 1.0, np.abs(t)))
+    # Near a power of ten log10 may round across it; far below 1e-290 the bound is subnormal.
+    exponent = np.where(t == 0, 0.0, np.floor(magnitude)) - tolerance.digits + 1
+    unsure = (np.abs(magnitude - np.round(magnitude)) < 1e-9) & (t != 0) | (exponent < -290)
+    return 0.51 * np.power(10.0, np.maximum(exponent, -290)), unsure
+
+
+def _exact_verdict(submitted: float, expected: float, tolerance: Tolerance, angle_unit: str | None) -> bool:
+    """The rule in exact arithmetic on the numbers as they print.
+
+    >>> _exact_verdict(6.3226, 6.26, Tolerance(), None), _exact_verdict(1e-320, 1e-320, Tolerance("sigfigs"), None)
+    (True, True)
+    """
+    s, t = _decimal(submitted), _decimal(expected)
+    distance = abs(s - t)
+    if angle_unit is not None:
+        period = _decimal(_PERIOD[angle_unit])  # 2π as it prints, like the numbers it reduces
+        distance = abs((s - t) - period * math.ceil((s - t - period / 2) / period))
+    if tolerance.mode == "rtol":
+        return distance <= _decimal(tolerance.atol) + _decimal(tolerance.rtol) * abs(t)
+    if tolerance.mode == "decimals":
+        return distance < _PRAIRIELEARN_HALF * Fraction(10) ** -tolerance.digits
+    return distance < _PRAIRIELEARN_HALF * Fraction(10) ** (leading_exponent(expected) - tolerance.digits + 1)
+
+
+def _decimal(value: float) -> Fraction:
+    return Fraction(repr(float(value)))
+
+
+def leading_exponent(value: float) -> int:
+    """``floor(log10|value|)`` exactly, of the number as it prints (0 for 0).
+
+    >>> [leading_exponent(x) for x in (1000.0, 999.9999999999999, 1e-5, 5e-324, 1e308, -0.02)]
+    [3, 2, -5, -324, 308, -2]
+    """
+    if value == 0:
+        return 0
+    return int(Decimal(repr(float(value))).adjusted())
+
+
+# ---- feedback ------------------------------------------------------------------------------------
+
+def feedback(submitted: float, expected: float, unit: str, tolerance: Tolerance, correct: bool, *,
+             angle_unit: str | None = None) -> str:
+    """One sentence that explains the verdict ``correct`` to the student.
+
+    >>> feedback(6.32, 6.26, "m/s", Tolerance(), True)
+    '6.32 m/s is 0.96 % above 6.26 m/s; within ±1 % is accepted'
+    >>> feedback(6.27, 6.26, "", Tolerance("sigfigs", digits=3), False)
+    '6.27 does not match 6.26 to 3 significant figures (it is 0.01 above)'
+    >>> feedback(340.9, -19.1, "deg", Tolerance(), True, angle_unit="deg")
+    '340.9° is the same direction as -19.1°; within ±1 % is accepted'
+    """
+    period = _period(angle_unit)
+    unit = unit or {"deg": "°", "rad": "rad"}.get(angle_unit or "", "")
+    if not math.isfinite(expected):
+        return "this answer has no finite value in the key; please ask your instructor to check it"
+    key = _with_unit(_shown(expected), unit)
+    if not math.isfinite(submitted):
+        return f"{_shown(submitted)} is not a finite number, so it cannot match {key}"
+    distance = float(_difference(np.array([submitted], dtype=float), np.array([expected], dtype=float), period)[0])
+    subject = _with_unit(_shown(submitted, full=True), unit)
+    if period is not None and abs((submitted - expected) - distance) > 1e-9 * period:
+        # The student's direction, written within a half turn of the key.
+        if distance == 0 and tolerance.mode == "rtol":
+            return f"{subject} is the same direction as {key}{_clause(tolerance, unit, correct)}"
+        subject = f"{subject} is the same direction as {_with_unit(_shown(expected + distance), unit)}, which"
+    return f"{subject} {_comparison(distance, expected, unit, tolerance, correct)}"
+
+
+def _comparison(distance: float, expected: float, unit: str, tolerance: Tolerance, correct: bool) -> str:
+    """``is 1.2 % above 6.26 m/s; ...`` or ``matches 6.26 to 3 significant figures``."""
+    side = "above" if distance > 0 else "below"
+    if tolerance.mode != "rtol":
+        n = tolerance.digits
+        key = _shown(expected, digits=n) if tolerance.mode == "sigfigs" else f"{expected + 0.0:.{n}f}"
+        words = f"{_with_unit(key, unit)} to {tolerance.describe()}"
+        if correct:
+            return f"matches {words}"
+        return f"does not match {words} (it is {_with_unit(_shown(abs(distance)), unit)} {side})"
+    key = _with_unit(_shown(expected), unit)
+    if distance == 0:
+        return f"equals {key}{_clause(tolerance, unit, correct)}"
+    absolute = _with_unit(_shown(abs(distance)), unit)
+    percent = f"{_percent(abs(distance) / abs(expected))} %" if expected else ""
+    if not tolerance.rtol or not percent:
+        size = absolute
+    elif tolerance.atol:
+        size = f"{absolute} ({percent})"
+    else:
+        size = percent
+    return f"is {size} {side} {key}{_clause(tolerance, unit, correct)}"
+
+
+def _clause(tolerance: Tolerance, unit: str, correct: bool) -> str:
+    return f"; {'within' if correct else 'only'} {tolerance.describe(unit)} is accepted"
+
+
+def _with_unit(text: str, unit: str) -> str:
+    if unit in ("deg", "degree", "degrees", "°"):
+        return f"{text}°"
+    return f"{text} {unit}" if unit else text
+
+
+def _shown(value: float, *, full: bool = False, digits: int = 6) -> str:
+    """A number as a student reads it: ``6.26``, ``1.5e-7``; ``full`` keeps every digit (their own answer)."""
+    value = float(value) + 0.0  # never -0
+    if not math.isfinite(value):
+        return repr(value)
+    text = repr(value) if full else f"{value:.{digits}g}"
+    if not full and digits < 6 and "e" not in text:
+        text = f"{value:#.{digits}g}".rstrip(".")  # keep the significant trailing zeros: 6.20
+    mantissa, _, power = text.partition("e")
+    if mantissa.endswith(".0"):
+        mantissa = mantissa[:-2]
+    return f"{mantissa}e{int(power)}" if power else mantissa
+
+
+def _percent(ratio: float) -> str:
+    percent = ratio * 100
+    if 10 <= percent < 1e6:
+        return f"{percent:.0f}"
+    return _shown(float(f"{percent:.2g}"))
+
+
+def _plain(value: float) -> str:
+    """A tolerance figure without float noise: ``0.07*100`` prints as ``7``."""
+    return _shown(float(f"{value:.12g}"), digits=12)
+
+
+# ---- symbolic answers ----------------------------------------------------------------------------
+
+@dataclass(frozen=True)
+class _Form:
+    """An expression keyed by its normalised text (the tree rides along, outside the key)."""
+
+    text: str
+    tree: Node = field(compare=False, hash=False)
+
+
+def equivalent(student: Node, expected: Node, domains: Mapping[str, tuple[float, float]], *, seed: str,
+               rtol: float = 1e-6, points: int = 8) -> bool | str:
+    """Whether two expressions agree at ``points`` seeded random points (WeBWorK's method).
+
+    Each name is drawn uniformly from its domain. Points where the key is undefined are skipped
+    (more are drawn than needed); a student expression undefined where the key is defined is not
+    equivalent. Returns a reason instead of a verdict when no comparison is possible: the caller
+    marks the cell invalid. Results are cached per (texts, domains, seed, rtol, points).
+
+    >>> from grader.model.expr import parse
+    >>> domains = {"v": (1.0, 10.0), "p": (0.1, 5.0)}
+    >>> equivalent(parse("(v - 0.1*p*v)/(1 + p)"), parse("v*(1 - 0.1*p)/(p + 1)"), domains, seed="s1")
+    True
+    >>> equivalent(parse("v/(p - p)"), parse("v*(1 - 0.1*p)/(p + 1)"), domains, seed="s1")
+    'the expression cannot be evaluated at any test point (division by zero?)'
+    """
+    if not 0 < rtol < 1 or isinstance(points, bool) or not isinstance(points, int) or not 1 <= points <= 1000:
+        raise ValueError(f"equivalent: expected 0 < rtol < 1 and 1 <= points <= 1000, got {rtol!r}, {points!r}")
+    for name, (low, high) in domains.items():
+        if not (math.isfinite(low) and math.isfinite(high) and low <= high):
+            raise ValueError(f"equivalent: domain of {name}: expected finite low <= high, got {shown((low, high))}")
+    key = tuple(sorted((name, (float(low), float(high))) for name, (low, high) in domains.items()))
+    return _equivalent(_Form(to_text(student), student), _Form(to_text(expected), expected), key, seed, rtol, points)
+
+
+@lru_cache(maxsize=4096)
+def _equivalent(student: _Form, expected: _Form, domains: tuple[tuple[str, tuple[float, float]], ...],
+                seed: str, rtol: float, points: int) -> bool | str:
+    known = dict(domains)
+    missing = sorted((names(student.tree) | names(expected.tree)) - set(known))
+    if missing:
+        return f"the expression uses {', '.join(missing)}, which this answer does not know"
+    digest = hashlib.sha256("\n".join((seed, student.text, expected.text)).encode()).digest()
+    generator = np.random.default_rng(np.random.SeedSequence(int.from_bytes(digest, "big")))
+    drawn = 4 * points
+    env = {name: generator.uniform(low, high, drawn) for name, (low, high) in domains}
+    key_values, student_values = _values(expected.tree, env, drawn), _values(student.tree, env, drawn)
+    usable = np.flatnonzero(np.isfinite(key_values))[:points]
+    if usable.size == 0:
+        return "the key's expression cannot be evaluated at any test point; please ask your instructor to check it"
+    b, a = key_values[usable], student_values[usable]
+    if not np.isfinite(a).any():
+        return "the expression cannot be evaluated at any test point (division by zero?)"
+    if not np.isfinite(a).all():
+        return False
+    # The floor lets a value that cancels to near zero at one point agree to the size of the others.
+    floor = 1e-3 * rtol * float(np.max(np.abs(b)))
+    return bool(np.all(np.abs(a - b) <= rtol * np.maximum(np.abs(a), np.abs(b)) + floor))
+
+
+def _values(tree: Node, env: Mapping[str, np.ndarray], size: int) -> np.ndarray:
+    """The tree at every point; NaN wherever it is undefined, and everywhere if it cannot be evaluated."""
+    try:
+        with np.errstate(all="ignore"):
+            values = np.asarray(evaluate(tree, env), dtype=float)
+        return np.broadcast_to(values, (size,)).copy()
+    except (ArithmeticError, ValueError, TypeError, KeyError):
+        return np.full(size, np.nan)

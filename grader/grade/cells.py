@@ -1,0 +1,256 @@
+"""What a student typed in one cell, as a value: a number in the expected unit, or an expression.
+
+Student text is never run. Numbers are read by regular expressions; arithmetic and symbolic answers
+by our own tokenizer (which writes out the multiplications students leave implicit) and then
+:func:`grader.model.expr.parse` (Python's ``ast`` with an allow-list); units by
+:mod:`grader.grade.quantities` (our grammar, then pint one word at a time).
+
+>>> read_number("6.26 m/s", "m/s")
+CellNumber(value=6.26, unit_given='m/s')
+>>> read_number("v_pile = 6,26", "m/s", delimiter=";", names=["v_pile"])
+CellNumber(value=6.26, unit_given=None)
+>>> read_number("1,234", "m")
+CellInvalid(reason="'1,234' could be 1234 or 1.234; write it without the comma")
+>>> read_number("12 kg", "m/s")
+CellWrongUnit(reason='expected a speed (m/s), got a mass (kg)')
+>>> read_expression("v(1 - 0.1p)", ["p", "v"]).text
+'v*(1 - 0.1*p)'
+>>> read_expression("2m", ["p", "v"])
+CellInvalid(reason='unknown name m; use p and v')
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+from grader.grade.notation import ReadError, check_powers, cut, listed, tree_of, value_of
+from grader.grade.quantities import UnitMismatchError, UnknownUnitError, unit_factor, unit_factors
+from grader.model.expr import Node, names, to_text
+
+MAX_CELL = 1000
+
+
+@dataclass(frozen=True)
+class CellBlank:
+    """Nothing typed (empty or only spaces)."""
+
+
+@dataclass(frozen=True)
+class CellInvalid:
+    """Text that cannot be read; ``reason`` is for the student."""
+
+    reason: str
+
+
+@dataclass(frozen=True)
+class CellWrongUnit:
+    """A number with a unit of another dimension than the answer's."""
+
+    reason: str
+
+
+@dataclass(frozen=True)
+class CellNumber:
+    """A finite number in the answer's unit; ``unit_given`` is the unit text the student typed (None: none)."""
+
+    value: float
+    unit_given: str | None
+
+
+@dataclass(frozen=True)
+class CellExpression:
+    """A symbolic answer and its normalised text."""
+
+    tree: Node
+    text: str
+
+
+_SPACES = str.maketrans({"\u00a0": " ", "\u2009": " ", "\u202f": " ", "\u2007": " ", "\t": " ", "\n": " ",
+                         "\r": " ", "\u2212": "-", "\u200b": None, "\ufeff": None})
+_SUPERSCRIPTS = str.maketrans("⁰¹²³⁴⁵⁶⁷⁸⁹⁻⁺", "0123456789-+")
+_SUPERSCRIPT_RUN = re.compile("[⁰¹²³⁴⁵⁶⁷⁸⁹⁻⁺]+")
+_UNDEFINED = frozenset({"", "undefined", "none", "n/a", "-", "no direction"})
+
+_NUM = r"(?>\d+(?:\.\d*)?|\.\d+)"  # atomic: no backtracking on long runs of digits
+_PLAIN = re.compile(rf"(?P<sign>[-+]?)\s*(?P<digits>{_NUM}(?>[eE][-+]?\d+)?)")
+_SCIENTIFIC = re.compile(rf"(?P<sign>[-+]?)\s*(?P<mantissa>{_NUM})\s*[×xX*·]\s*10\s*(?:\^|\*\*)\s*"
+                         r"(?P<open>\(?)\s*(?P<exponent>[-+]?\d+)\s*(?P<close>\)?)")
+_FRACTION = re.compile(rf"(?P<sign>[-+]?)\s*(?P<top>{_NUM})\s*/\s*(?P<bottom>{_NUM})")
+_TWO_NUMBERS = re.compile(rf"{_NUM}(?:\s*(?:[,;–]|\bor\b|\band\b|\bto\b)\s*|\s+){_NUM}", re.IGNORECASE)
+_GROUPED = re.compile(r"(?<![\d.,])\d{1,3}(?: \d{3})+(?!\d)")
+_COMMA_NUMBER = re.compile(r"(?<![\w.,])(?P<groups>\d+(?:,\d+)+)(?P<fraction>\.\d*)?(?![\d,])")
+_CALL = re.compile(r"[A-Za-z_]\w*\s*\(")
+_ASSIGNMENT = re.compile(r"(?P<word>[A-Za-z_][\w']*)\s*=")
+
+
+def read_number(text: str, unit: str, *, delimiter: str = ",", numeric_expressions: bool = True,
+                names: Sequence[str] = ()) -> CellBlank | CellInvalid | CellWrongUnit | CellNumber:
+    """Read a numeric answer and convert it into ``unit``, the answer's unit as printed on the sheet.
+
+    ``delimiter`` is the CSV file's: a decimal comma is read in a ``;`` or tab file, and in a comma file
+    wherever it cannot be a thousands separator. ``names`` are the answer's name and label, so that
+    ``v_pile = 6.26`` reads as 6.26. Arithmetic is evaluated unless ``numeric_expressions`` is False.
+
+    >>> read_number("≈ 6.26×10^3", "m").value, round(read_number("sqrt(2*9.81*2)", "m/s").value, 4)
+    (6260.0, 6.2642)
+    >>> read_number("30°", "rad").value == math.pi / 6, read_number("50 %", "").value
+    (True, 0.5)
+    >>> read_number("6.2 or 6.3", "m")
+    CellInvalid(reason='two numbers (6.2 or 6.3); give one answer')
+    """
+    cleaned = _clean(text)
+    if not isinstance(cleaned, str):
+        return cleaned
+    cleaned = _without_prefix(cleaned, names)
+    try:
+        _refuse_formula(cleaned, names)
+        number_text, unit_text = _split_unit(cleaned)
+        value = _readvalue_of(number_text, delimiter, numeric_expressions)
+        if unit_text:
+            value *= unit_factor(unit_text, unit)
+            if not math.isfinite(value):
+                raise ReadError(f"{cut(number_text, 40)} {unit_text} is too large a number in {unit or 'units'}")
+    except (ReadError, UnknownUnitError) as problem:
+        return CellInvalid(str(problem))
+    except UnitMismatchError as problem:
+        return CellWrongUnit(str(problem))
+    return CellNumber(value + 0.0, unit_text or None)
+
+
+def read_expression(text: str, symbols: Sequence[str], *,
+                    delimiter: str = ",") -> CellBlank | CellInvalid | CellExpression:
+    """Read a symbolic answer in ``symbols``: implicit products (``2v``, ``v(1 + p)``), ``^`` or ``**``,
+    the functions of :data:`grader.model.expr.FUNCTIONS`. Decimal commas are refused whatever the
+    file's ``delimiter`` (a comma separates a function's arguments).
+
+    >>> read_expression("(1+p)(1-p) v^2", ["p", "v"]).text
+    '(1 + p)*(1 - p)*v**2'
+    >>> read_expression("0.5", ["p", "v"])
+    CellInvalid(reason='a number; expected an expression in p and v')
+    """
+    cleaned = _clean(text)
+    if not isinstance(cleaned, str):
+        return cleaned
+    try:
+        _refuse_formula(cleaned, ())
+        tree = tree_of(cleaned, tuple(symbols))
+        if not names(tree):
+            raise ReadError(f"a number; expected an expression in {listed(symbols)}")
+        check_powers(tree)
+    except ReadError as problem:
+        return CellInvalid(str(problem))
+    return CellExpression(tree, to_text(tree))
+
+
+def undefined_word(text: str) -> bool:
+    """Whether a cell says "no value": blank, ``undefined``, ``none``, ``n/a``, ``-``, ``no direction``.
+
+    >>> undefined_word(" N/A "), undefined_word("No  direction"), undefined_word("0")
+    (True, True, False)
+    """
+    if len(text) > 100:
+        return False
+    return " ".join(text.translate(_SPACES).split()).lower() in _UNDEFINED
+
+
+def _clean(text: str) -> str | CellBlank | CellInvalid:
+    """Length checked first, spaces and minus signs unified, control characters refused, superscript
+    powers written out (``10⁻³`` is ``10^-3``)."""
+    if len(text) > MAX_CELL:
+        return CellInvalid(f"{len(text):,} characters; an answer has at most {MAX_CELL:,}")
+    text = text.translate(_SPACES)
+    if not text.isprintable():
+        text = "".join(" " if char.isspace() else char for char in text)
+        bad = next((char for char in text if not char.isprintable() and char != " "), None)
+        if bad is not None:
+            return CellInvalid(f"contains an invisible control character (U+{ord(bad):04X}); type the answer again")
+    text = text.strip()
+    if not text:
+        return CellBlank()
+    return _SUPERSCRIPT_RUN.sub(lambda run: "^" + run.group().translate(_SUPERSCRIPTS), text)
+
+
+def _without_prefix(text: str, names: Sequence[str]) -> str:
+    """Drop a leading ``NAME =`` (the answer's name or label) and ``≈`` or ``~``."""
+    lowered = text.lower()
+    for name in names:
+        if name and lowered.startswith(name.lower()):
+            rest = text[len(name):].lstrip()
+            if rest[:1] in ("=", "≈"):
+                text = rest[1:]
+                break
+    return text.lstrip(" ≈~")
+
+
+def _refuse_formula(text: str, names: Sequence[str]) -> None:
+    if not text:
+        raise ReadError("no value after the '='")
+    if text[0] in "=@":
+        raise ReadError(f"starts with '{text[0]}' like a spreadsheet formula; type the value itself")
+    assignment = _ASSIGNMENT.match(text)
+    if assignment:
+        hint = f" (or write {names[0]} = ...)" if names else ""
+        raise ReadError(f"starts with '{assignment['word']} ='; give only the value{hint}")
+
+
+def _split_unit(text: str) -> tuple[str, str]:
+    """The number and the unit after it: the first word from which the rest is a unit, after a number."""
+    for start in range(max(1, len(text) - 40), len(text)):
+        char, before = text[start], text[start - 1]
+        if not (char.isalpha() or char in "°%") or before.isalpha() or before == "_":
+            continue
+        head = text[:start].rstrip()
+        if head and (head[-1].isdigit() or head[-1] in ".)") and unit_factors(text[start:]) is not None:
+            return head, text[start:].strip()
+    return text, ""
+
+
+def _readvalue_of(text: str, delimiter: str, numeric_expressions: bool) -> float:
+    text = _GROUPED.sub(lambda group: group.group().replace(" ", ""), text)
+    text = _decimal_commas(text, delimiter)
+    if plain := _PLAIN.fullmatch(text):
+        return _finite(float(plain["sign"] + plain["digits"]), text)
+    if (scientific := _SCIENTIFIC.fullmatch(text)) and bool(scientific["open"]) == bool(scientific["close"]):
+        return _finite(float(f"{scientific['sign']}{scientific['mantissa']}e{scientific['exponent']}"), text)
+    if fraction := _FRACTION.fullmatch(text):
+        if float(fraction["bottom"]) == 0:
+            raise ReadError(f"{text} divides by zero")
+        return _finite(float(fraction["sign"] + "1") * float(fraction["top"]) / float(fraction["bottom"]), text)
+    two = None if _CALL.search(text) else _TWO_NUMBERS.search(text)
+    if two:
+        raise ReadError(f"two numbers ({cut(two.group(), 40)}); give one answer")
+    if not numeric_expressions:
+        raise ReadError(f"cannot read '{cut(text, 40)}' as a number; give the number itself, without arithmetic")
+    return value_of(tree_of(text, ()))
+
+
+def _decimal_commas(text: str, delimiter: str) -> str:
+    """``6,26`` is 6.26; ``1,234,567`` and ``1,234.5`` are thousands; ``1,234`` in a comma file is ambiguous.
+    Commas between a function's arguments (``hypot(3, 4)``) are left alone."""
+    if "," not in text or _CALL.search(text):
+        return text
+    pieces, end = [], 0
+    for match in _COMMA_NUMBER.finditer(text):
+        groups, fraction = match["groups"].split(","), match["fraction"] or ""
+        thousands = len(groups[0]) <= 3 and all(len(group) == 3 for group in groups[1:])
+        if fraction or len(groups) > 2:
+            if not thousands:
+                raise ReadError(f"cannot read '{match.group()}': commas and points do not group digits by three")
+            number = "".join(groups) + fraction
+        elif thousands and delimiter == "," and not groups[0].startswith("0"):
+            raise ReadError(f"'{match.group()}' could be {''.join(groups)} or {'.'.join(groups)}; "
+                              "write it without the comma")
+        else:
+            number = ".".join(groups)
+        pieces += [text[end:match.start()], number]
+        end = match.end()
+    return "".join([*pieces, text[end:]])
+
+
+def _finite(value: float, text: str) -> float:
+    if not math.isfinite(value):
+        raise ReadError(f"{cut(text, 40)} is too large for a number (beyond about 1.8e308)")
+    return value

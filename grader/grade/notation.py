@@ -1,0 +1,189 @@
+"""Arithmetic as students write it: implicit products written out, then parsed by the allow-list parser
+of :mod:`grader.model.expr`, bounded in size, and (without names) evaluated step by step.
+
+>>> to_text(tree_of("2v(1 + p)", ("p", "v")))
+'2*v*(1 + p)'
+>>> value_of(tree_of("sqrt(2*9.81*2)", ()))
+6.26418390534633
+>>> value_of(tree_of("9^9^9", ()))
+Traceback (most recent call last):
+...
+grader.grade.notation.ReadError: the power 3.8742e+08 is larger than 64
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from collections.abc import Sequence
+
+import numpy as np
+
+from grader.errors import ExpressionError
+from grader.model.expr import CONSTANTS, FUNCTIONS, MAX_EXPONENT, Node, Num, Op, Sym, names, parse, to_text
+from grader.model.kernel import OPERATIONS
+
+MAX_NODES = 200
+MAX_NAME = 50
+
+
+class ReadError(ValueError):
+    """Text that cannot be read; the message is the student's reason."""
+
+
+_TOKEN = re.compile(r"\s*(?:(?P<num>(?>\d+(?:\.\d*)?|\.\d+)(?>[eE][-+]?\d+)?)|(?P<name>[A-Za-z_][A-Za-z_0-9]*)"
+                    r"|(?P<op>\*\*|[-+*/^×·(),]))")
+_TOKEN_NO_E = re.compile(_TOKEN.pattern.replace(r"(?>[eE][-+]?\d+)?", ""))
+
+
+def tree_of(text: str, symbols: tuple[str, ...]) -> Node:
+    """Parse with the allow-list parser after writing out implicit products; bounded in size."""
+    written = _with_products(text, symbols)
+    try:
+        tree = parse(written)
+    except ExpressionError as error:
+        raise ReadError(str(error).replace(written, cut(text, 60))) from None
+    if _count(tree) > MAX_NODES:
+        raise ReadError(f"more than {MAX_NODES} numbers, names and operations; simplify the answer")
+    return tree
+
+
+def _with_products(text: str, symbols: tuple[str, ...]) -> str:
+    """Text :func:`parse` accepts: ``2v(1+p)`` becomes ``2*v*(1+p)``; names outside ``symbols``,
+    the functions and ``pi`` are refused, and so are characters outside the allow-list."""
+    tokenizer = _TOKEN_NO_E if {"e", "E"} & set(symbols) else _TOKEN
+    out: list[str] = []
+    previous = ""  # kind of the last token: num, name, func, ( , ) or op
+    calls: list[bool] = []  # for each open parenthesis: does it hold a function's arguments?
+    position = 0
+    while position < len(text):
+        match = tokenizer.match(text, position)
+        if match is None:
+            rest = text[position:].lstrip()
+            if not rest:
+                break
+            if rest[0] == "∞":
+                raise ReadError("infinity is not a finite number")
+            raise ReadError(f"unexpected character '{rest[0]}'" if rest[0].isprintable() else
+                              f"unexpected character U+{ord(rest[0]):04X}")
+        position = match.end()
+        if match["num"] is not None:
+            if previous == "num":
+                raise ReadError(f"two numbers side by side ({cut(text, 40)}); give one answer")
+            kind, parts = "num", [match["num"]]
+        elif match["name"] is not None:
+            kind, parts = _name(match["name"], symbols, text[position:].lstrip()[:1] == "(")
+        else:
+            kind, parts = match["op"], [{"^": "**", "×": "*", "·": "*"}.get(match["op"], match["op"])]
+            if kind == "(":
+                calls.append(previous == "func")
+            elif kind == ")" and calls:
+                calls.pop()
+            elif kind == ",":
+                _check_comma(calls, previous, text[position:])
+        if previous in ("num", "name", ")") and kind in ("num", "name", "func", "("):
+            out.append("*")
+        out += parts
+        previous = kind
+    return "".join(out)
+
+
+def _name(word: str, symbols: tuple[str, ...], called: bool) -> tuple[str, list[str]]:
+    if word in symbols or word in CONSTANTS:
+        return "name", [word]
+    if word in FUNCTIONS:
+        if not called:
+            raise ReadError(f"write {word}(...) with parentheses")
+        return "func", [word]
+    split = _split_name(word, (*symbols, *CONSTANTS)) if len(word) <= MAX_NAME else None
+    if split is None:
+        if not symbols and word.lower() in ("inf", "infinity", "nan"):
+            raise ReadError(f"{word} is not a finite number")
+        if not symbols:
+            raise ReadError(f"cannot read '{word[:30]}' as a number")
+        raise ReadError(f"unknown name {word[:30]}; use {listed(symbols)}")
+    return "name", [part for name in split for part in ("*", name)][1:]
+
+
+def _split_name(word: str, known: Sequence[str]) -> list[str] | None:
+    """``pv`` as ``p*v`` when both are symbols: the first way to write ``word`` as known names."""
+    ways: list[list[str] | None] = [[]] + [None] * len(word)
+    for start in range(len(word)):
+        way = ways[start]
+        if way is None:
+            continue
+        for name in known:
+            end = start + len(name)
+            if name and word.startswith(name, start) and ways[end] is None:
+                ways[end] = [*way, name]
+    return ways[-1]
+
+
+def _check_comma(calls: list[bool], previous: str, rest: str) -> None:
+    if calls and calls[-1]:
+        return
+    if previous == "num" and rest[:1].isdigit():
+        raise ReadError("a decimal comma; write a decimal point in an expression (0.5, not 0,5)")
+    raise ReadError("a comma outside a function's parentheses; give one answer")
+
+
+def cut(text: str, limit: int) -> str:
+    """``text`` for a message, cut to ``limit`` characters."""
+    return text if len(text) <= limit else text[:limit - 3] + "..."
+
+
+def listed(symbols: Sequence[str]) -> str:
+    if not symbols:
+        return "no names"
+    return symbols[0] if len(symbols) == 1 else ", ".join(symbols[:-1]) + " and " + symbols[-1]
+
+
+def _count(tree: Node) -> int:
+    count, stack = 0, [tree]
+    while stack:
+        node = stack.pop()
+        count += 1
+        if isinstance(node, Op):
+            stack.extend(node.args)
+    return count
+
+
+def check_powers(tree: Node) -> None:
+    """Exponents without names are numbers we can bound now (``p^(2^10)``); the others are bounded
+    where the expression is evaluated."""
+    if isinstance(tree, Op):
+        for arg in tree.args:
+            check_powers(arg)
+        if tree.op == "pow" and not names(tree.args[1]) and abs(value_of(tree.args[1])) > MAX_EXPONENT:
+            raise ReadError(f"the power {to_text(tree.args[1])} is larger than {MAX_EXPONENT}")
+
+
+def value_of(tree: Node) -> float:
+    """The value of an expression without names, every step finite and every power at most
+    :data:`MAX_EXPONENT`, or :class:`ReadError` saying which step failed."""
+    with np.errstate(all="ignore"):
+        return _step(tree)
+
+
+def _step(node: Node) -> float:
+    if isinstance(node, Num):
+        try:
+            return float(node.value)
+        except OverflowError:
+            raise ReadError(f"{cut(to_text(node), 40)} is too large for a number") from None
+    if isinstance(node, Sym):
+        if node.name == "pi":
+            return math.pi
+        raise ReadError(f"cannot read '{node.name}' as a number")
+    args = [_step(arg) for arg in node.args]
+    if node.op == "pow" and abs(args[1]) > MAX_EXPONENT:
+        raise ReadError(f"the power {args[1]:g} is larger than {MAX_EXPONENT}")
+    result = float(OPERATIONS[node.op](*args))
+    if math.isfinite(result):
+        return result
+    step = cut(to_text(node), 60)
+    if node.op == "div" or (node.op == "pow" and args[0] == 0):
+        raise ReadError(f"{step} divides by zero")
+    if math.isnan(result) or node.op == "log":
+        raise ReadError(f"{step} is not defined")
+    raise ReadError(f"{step} is too large for a number (beyond about 1.8e308)")

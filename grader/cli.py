@@ -77,6 +77,18 @@ def build_parser() -> argparse.ArgumentParser:
     generate.add_argument("--no-pdf", action="store_true", help="write key.json and key.csv only")
     generate.add_argument("--keep-source", action="store_true", help="also keep the Typst sources")
 
+    grading = commands.add_parser("grade", help="grade CSV submissions against a key.json")
+    grading.add_argument("submissions", type=Path, nargs="+", metavar="SUBMISSIONS.csv")
+    grading.add_argument("--key", type=Path, required=True, metavar="DIR/key.json",
+                         help="the key grader generate wrote")
+    grading.add_argument("--out", type=Path, required=True, metavar="DIR", help="output folder (new or empty)")
+    grading.add_argument("--format", choices=("auto", "long", "wide"), default="auto",
+                         help="long: a row per answer (student, label, answer); wide: a row per submission, a "
+                              "column per label; auto (default): told apart from the header")
+    grading.add_argument("--force", action="store_true",
+                         help="replace an output folder an earlier run wrote (as its .grader-manifest.json says)")
+    grading.add_argument("--json", action="store_true", help="print a summary object on stdout")
+
     demo = commands.add_parser("demo", help="the whole job on shipped sample data (5 problems, 30 students)")
     demo.add_argument("--out", type=Path, default=Path("grader-demo"), metavar="DIR",
                       help="output folder (default: ./grader-demo)")
@@ -500,5 +512,22 @@ def _print_summary(summary: Any) -> None:
               ", ".join(f"problem {key}: {n}" for key, n in collided.items()))
 
 
+def _grade(arguments: argparse.Namespace) -> int:
+    from grader.grade.run import run as run_grading
+
+    summary = run_grading(arguments.key, arguments.submissions, arguments.out, arguments.format, arguments.force)
+    verdicts = ", ".join(f"{n} {kind}" for kind, n in summary.verdicts.items() if n)
+    rows = f"{summary.rows_not_graded} row{'' if summary.rows_not_graded == 1 else 's'}"
+    print(f"{summary.students} students ({summary.submitted} submitted), {summary.parts} parts graded ({verdicts}); "
+          f"{rows} not graded (see problems.csv) -> {summary.out}", file=sys.stderr)
+    if summary.ignored_columns:
+        print(f"columns ignored: {_some(list(summary.ignored_columns))}", file=sys.stderr)
+    for note in summary.notes:
+        print(f"note: {_printable(note)}", file=sys.stderr)
+    if arguments.json:
+        print(json.dumps(summary.to_json(), allow_nan=False))
+    return EXIT_REFUSED if summary.rows_not_graded else EXIT_OK
+
+
 _COMMANDS = {"list": _list, "show": _show, "solve": _solve, "simulate": _simulate, "generate": _generate,
-             "demo": _demo}
+             "demo": _demo, "grade": _grade}

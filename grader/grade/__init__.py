@@ -1,2 +1,2 @@
 """Grading: submissions read from CSV, cells parsed safely, compared to key.json with tolerance and
-units, scored, explained, and written as files an LMS imports. (Empty until the grading issue.)"""
+units, each verdict explained, and written as grades, details, problems and a Canvas import."""

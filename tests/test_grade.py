@@ -1,0 +1,175 @@
+"""`grader grade` end to end: the key submitted as answers scores full marks, every input row is
+accounted for, reruns are byte-identical, and unusable input leaves nothing behind."""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from grader.cli import main
+from grader.resources import sample_dir
+
+
+def run(capsys: pytest.CaptureFixture[str], *argv: object) -> tuple[int, str, str]:
+    code = main([str(a) for a in argv])
+    captured = capsys.readouterr()
+    return code, captured.out, captured.err
+
+
+@pytest.fixture(scope="module")
+def key_path(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The sample assignment's key (30 students, 5 problems, no PDFs)."""
+    out = tmp_path_factory.mktemp("key") / "hw"
+    assert main(["generate", str(sample_dir() / "assignment.yaml"), "--roster", str(sample_dir() / "roster.csv"),
+                 "--out", str(out), "--no-pdf"]) == 0
+    return out / "key.json"
+
+
+def key_document(path: Path) -> dict[str, Any]:
+    return json.loads(path.read_text(encoding="utf-8"))  # type: ignore[no-any-return]
+
+
+def key_answers(path: Path, rounding: str | None = None) -> list[tuple[str, str, str]]:
+    """(student id, label, answer text) for every part: the key's own value, or blank where undefined."""
+    rows = []
+    for student in key_document(path)["students"]:
+        for problem in student["problems"]:
+            for answer in problem["answers"].values():
+                value = answer["value"]
+                text = "" if value is None else value if isinstance(value, str) else (
+                    format(value, rounding) if rounding else repr(value))
+                rows.append((student["id"], answer["label"], text))
+    return rows
+
+
+def long_csv(rows: list[tuple[str, str, str]]) -> str:
+    stream = io.StringIO()
+    writer = csv.writer(stream, lineterminator="\n")
+    writer.writerow(["student_id", "label", "answer"])
+    writer.writerows(rows)
+    return stream.getvalue()
+
+
+def read(path: Path) -> list[dict[str, str]]:
+    with open(path, encoding="utf-8", newline="") as stream:
+        return list(csv.DictReader(stream))
+
+
+@pytest.mark.parametrize("rounding", [None, ".3g"])
+def test_the_key_submitted_as_answers_scores_full_marks(tmp_path: Path, capsys: pytest.CaptureFixture[str],
+                                                        key_path: Path, rounding: str | None) -> None:
+    """Every template's answers, exact and rounded to 3 significant figures (within the 1 % default)."""
+    submissions = tmp_path / "answers.csv"
+    submissions.write_text(long_csv(key_answers(key_path, rounding)), encoding="utf-8")
+    code, out, err = run(capsys, "grade", "--key", key_path, submissions, "--out", tmp_path / "grades", "--json")
+    assert code == 0, err
+    summary = json.loads(out)
+    assert summary["rows_not_graded"] == 0 and summary["verdicts"]["correct"] == summary["parts"]
+    grades = read(tmp_path / "grades" / "grades.csv")
+    assert len(grades) == 30 and all(row["total"] == row["possible"] for row in grades)
+    details = read(tmp_path / "grades" / "details.csv")
+    assert {row["verdict"] for row in details} == {"correct"}
+    assert all(row["feedback"] for row in details)
+
+
+def test_wide_submissions_with_form_style_headers_grade_alike(tmp_path: Path, capsys: pytest.CaptureFixture[str],
+                                                               key_path: Path) -> None:
+    rows = key_answers(key_path)
+    labels = list(dict.fromkeys(label for _, label, _ in rows))
+    by_student: dict[str, dict[str, str]] = {}
+    for student, label, text in rows:
+        by_student.setdefault(student, {})[label] = text
+    stream = io.StringIO()
+    writer = csv.writer(stream, lineterminator="\n")
+    writer.writerow(["Timestamp", "Student ID", "Name", *(f"{label} (your answer)" for label in labels)])
+    for student, answers in by_student.items():
+        writer.writerow(["2026-12-04 10:00:00", student, "someone", *(answers[label] for label in labels)])
+    (tmp_path / "wide.csv").write_text(stream.getvalue(), encoding="utf-8")
+    code, out, err = run(capsys, "grade", "--key", key_path, tmp_path / "wide.csv", "--out", tmp_path / "g", "--json")
+    assert code == 0, err
+    assert json.loads(out)["verdicts"]["correct"] == len(rows)
+    assert "Name" in err  # the ignored column is reported once
+
+
+def test_every_row_is_accounted_for_and_nobody_is_lost(tmp_path: Path, capsys: pytest.CaptureFixture[str],
+                                                       key_path: Path) -> None:
+    """A student who submitted nothing is in grades.csv with 0; an unknown student's row is in
+    problems.csv; a wrong answer is incorrect with feedback; exit 3 because a row was not graded."""
+    rows = key_answers(key_path)
+    first = rows[0][0]
+    kept = [r for r in rows if r[0] != first]  # the first student submits nothing
+    student, label, text = kept[0]
+    kept[0] = (student, label, str(float(text) * 1.5))
+    kept.append(("nobody", "1a", "0.5"))
+    (tmp_path / "a.csv").write_text(long_csv(kept), encoding="utf-8")
+    code, _, err = run(capsys, "grade", "--key", key_path, tmp_path / "a.csv", "--out", tmp_path / "g")
+    assert code == 3, err
+    grades = {row["student_id"]: row for row in read(tmp_path / "g" / "grades.csv")}
+    assert len(grades) == 30 and grades[first]["total"] == "0"
+    details = {(row["student_id"], row["label"]): row for row in read(tmp_path / "g" / "details.csv")}
+    assert details[(first, "1a")]["verdict"] == "missing"
+    wrong = details[(student, label)]
+    assert wrong["verdict"] == "incorrect" and "50 % above" in wrong["feedback"], wrong
+    problems = read(tmp_path / "g" / "problems.csv")
+    assert [(p["student_id"], p["line"]) for p in problems] == [("nobody", str(len(kept) + 1))]
+
+
+def test_reruns_are_byte_identical(tmp_path: Path, capsys: pytest.CaptureFixture[str], key_path: Path) -> None:
+    (tmp_path / "a.csv").write_text(long_csv(key_answers(key_path, ".2g")), encoding="utf-8")
+    for out in ("g1", "g2"):
+        run(capsys, "grade", "--key", key_path, tmp_path / "a.csv", "--out", tmp_path / out)
+    for name in ("grades.csv", "details.csv", "problems.csv", "canvas.csv"):
+        assert (tmp_path / "g1" / name).read_bytes() == (tmp_path / "g2" / name).read_bytes(), name
+
+
+@pytest.mark.parametrize(("key_text", "message"), [
+    ("{}", "expected a grader answer key"),
+    ('{"schema": "grader-key", "version": 9}', "expected key schema version 1 or 2, got 9"),
+    ("not json", "got invalid JSON"),
+    ('{"schema": "grader-key", "version": 2, "students": [{"id": NaN}]}', "got invalid JSON"),
+])
+def test_an_unusable_key_exits_2_and_writes_nothing(tmp_path: Path, capsys: pytest.CaptureFixture[str],
+                                                    key_text: str, message: str) -> None:
+    (tmp_path / "key.json").write_text(key_text, encoding="utf-8")
+    (tmp_path / "a.csv").write_text("student_id,label,answer\ns1,1a,1\n", encoding="utf-8")
+    code, out, err = run(capsys, "grade", "--key", tmp_path / "key.json", tmp_path / "a.csv", "--out", tmp_path / "g")
+    assert (code, out) == (2, "") and message in err
+    assert not (tmp_path / "g").exists()
+
+
+def test_a_version_1_key_still_grades(tmp_path: Path, capsys: pytest.CaptureFixture[str], key_path: Path) -> None:
+    """Keys written before version 2: no grading section, no symbol ranges, tolerances without a mode."""
+    document = key_document(key_path)
+    document["version"] = 1
+    document["assignment"].pop("grading")
+    for problem in document["problems"]:
+        for answer in problem["answers"]:
+            answer.pop("symbols", None)
+    for student in document["students"]:
+        for problem in student["problems"]:
+            for answer in problem["answers"].values():
+                answer["tolerance"].pop("mode")
+    (tmp_path / "key.json").write_text(json.dumps(document), encoding="utf-8")
+    (tmp_path / "a.csv").write_text(long_csv(key_answers(key_path)), encoding="utf-8")
+    code, out, err = run(capsys, "grade", "--key", tmp_path / "key.json", tmp_path / "a.csv", "--out",
+                         tmp_path / "g", "--json")
+    assert code == 0, err
+    summary = json.loads(out)
+    assert summary["verdicts"]["correct"] == summary["parts"]
+
+
+def test_text_cells_in_the_reports_cannot_run_as_formulas(tmp_path: Path, capsys: pytest.CaptureFixture[str],
+                                                          key_path: Path) -> None:
+    rows = key_answers(key_path)
+    student, label, _ = rows[0]
+    rows[0] = (student, label, '=HYPERLINK("http://x")')
+    (tmp_path / "a.csv").write_text(long_csv(rows), encoding="utf-8")
+    run(capsys, "grade", "--key", key_path, tmp_path / "a.csv", "--out", tmp_path / "g")
+    details = {(row["student_id"], row["label"]): row for row in read(tmp_path / "g" / "details.csv")}
+    row = details[(student, label)]
+    assert row["submitted"].startswith("'=") and row["verdict"] == "invalid"

@@ -173,3 +173,14 @@ def test_text_cells_in_the_reports_cannot_run_as_formulas(tmp_path: Path, capsys
     details = {(row["student_id"], row["label"]): row for row in read(tmp_path / "g" / "details.csv")}
     row = details[(student, label)]
     assert row["submitted"].startswith("'=") and row["verdict"] == "invalid"
+
+
+def test_a_key_whose_student_lacks_a_part_is_refused(tmp_path: Path, capsys: pytest.CaptureFixture[str],
+                                                     key_path: Path) -> None:
+    """A hand-edited key (a part deleted for one student) is refused, not a KeyError halfway."""
+    document = key_document(key_path)
+    document["students"][0]["problems"][0]["answers"].popitem()
+    (tmp_path / "key.json").write_text(json.dumps(document), encoding="utf-8")
+    (tmp_path / "a.csv").write_text("student_id,label,answer\n", encoding="utf-8")
+    code, _, err = run(capsys, "grade", "--key", tmp_path / "key.json", tmp_path / "a.csv", "--out", tmp_path / "g")
+    assert code == 2 and "a missing or malformed entry" in err and not (tmp_path / "g").exists()

@@ -175,12 +175,6 @@ def totals(graded: Graded) -> Mapping[str, Mapping[str, float]]:
     return result
 
 
-def possible(key: Key, student_id: str) -> float:
-    """The points a student could earn."""
-    student = next(s for s in key.students if s.id == student_id)
-    return sum(part.points for part in student.parts.values())
-
-
 def counts(verdicts: Sequence[Verdict]) -> dict[str, int]:
     """How many verdicts of each kind."""
     return {kind: sum(v.verdict == kind for v in verdicts) for kind in VERDICTS}

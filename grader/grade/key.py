@@ -61,6 +61,11 @@ class KeyStudent:
     section: str
     parts: Mapping[str, KeyPart]
 
+    @property
+    def possible(self) -> float:
+        """The points this student could earn."""
+        return sum(part.points for part in self.parts.values())
+
 
 @dataclass(frozen=True)
 class KeyProblem:
@@ -123,6 +128,10 @@ def _key(raw: Mapping[str, Any], where: str, version: int) -> Key:
     ids = [s.id for s in students]
     if len(set(ids)) != len(ids):
         raise ValueError("a student id appears twice")
+    labels = {label for problem in problems for label in problem.labels}
+    for student in students:
+        if set(student.parts) != labels:
+            raise ValueError(f"student {student.id} has parts {sorted(student.parts)}, the problems {sorted(labels)}")
     grading = raw["assignment"].get("grading", {})
     return Key(where, version, str(raw["assignment"]["title"]), bool(grading.get("numeric_expressions", True)),
                problems, students)

@@ -15,7 +15,7 @@ from pathlib import Path
 
 from grader.assign.keyfile import safe_cell
 from grader.files import write_atomic
-from grader.grade.grading import Graded, possible, totals
+from grader.grade.grading import Graded, totals
 
 GRADES, DETAILS, PROBLEMS, CANVAS = "grades.csv", "details.csv", "problems.csv", "canvas.csv"
 
@@ -37,8 +37,7 @@ def grades_csv(graded: Graded) -> str:
                                  "total", "possible"]]
     for student in key.students:
         per_problem = [scores[student.id][p.key] for p in key.problems]
-        rows.append([student.id, student.name, student.section, *per_problem, sum(per_problem),
-                     possible(key, student.id)])
+        rows.append([student.id, student.name, student.section, *per_problem, sum(per_problem), student.possible])
     return _csv(rows)
 
 
@@ -66,7 +65,7 @@ def canvas_csv(graded: Graded) -> str:
     assignment, and its ``Points Possible`` row."""
     key = graded.key
     scores = totals(graded)
-    most = max((possible(key, s.id) for s in key.students), default=0.0)
+    most = max((s.possible for s in key.students), default=0.0)
     rows: list[list[object]] = [["Student", "ID", "SIS User ID", "SIS Login ID", "Section", key.title],
                                 ["Points Possible", "", "", "", "", most]]
     rows += [[s.name, "", s.id, s.email, s.section, sum(scores[s.id].values())] for s in key.students]

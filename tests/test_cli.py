@@ -134,3 +134,16 @@ def test_list_json_names_every_template(capsys: pytest.CaptureFixture[str]) -> N
     _, out, _ = run(capsys, "list", "--json")
     records = {json.loads(line)["id"]: json.loads(line) for line in out.splitlines()}
     assert records["car-collision"]["answers"] == ["vA", "vB", "vA_ratio", "vB_ratio"]
+
+
+def test_list_and_help_do_not_pay_for_heavy_libraries() -> None:
+    """`grader list` and `--help` import the CLI and load the bank: no scipy, sympy, pint or typst
+    (importing scipy through the effects once tripled their start-up)."""
+    import subprocess
+    import sys
+
+    code = ("import sys; from grader.cli import build_parser; from grader.bank.template import load_bank; "
+            "build_parser(); load_bank(); "
+            "print(sorted(m for m in ('scipy', 'sympy', 'pint', 'typst', 'matplotlib') if m in sys.modules))")
+    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60, check=True)
+    assert result.stdout.strip() == "[]", result.stdout

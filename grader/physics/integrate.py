@@ -28,8 +28,6 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
-from scipy.integrate import solve_ivp
-from scipy.optimize import brentq
 
 from grader.errors import GraderError
 
@@ -233,12 +231,16 @@ def _sizes(mode: Mode, t: float, y: Any) -> Any:
 
 def _locate(mode: Mode, method: str, t: float, y: Any, dt: float) -> float:
     """The fraction of the step at which the event crosses zero, on the method's own partial step."""
+    from scipy.optimize import brentq  # here, not at the top: every command imports the effects
+
     return float(brentq(lambda f: mode.event(_step(method, mode.rhs, t, y, f * dt)), 0.0, 1.0,
                         xtol=1e-15, rtol=8.9e-16))
 
 
 def _adaptive(mode: Mode, t: float, y: Any, rtol: float, path: Path, dense: bool,
               budget: Budget) -> tuple[float, Any]:
+    from scipy.integrate import solve_ivp  # here, not at the top: every command imports the effects
+
     # Time in units of the mode's own scale and each state component in units of its own size:
     # the event is located to a tolerance relative to the contact's duration (a 1 ns contact
     # survives), and the error of a 1e-300 m/s motion is measured against itself, with no

@@ -61,10 +61,15 @@ def decode_text(data: bytes, path: Path) -> str:
         line = data[:error.start].count(b"\n") + 1
         raise GraderError(f"{path}: line {line}: expected UTF-8 text, got the byte 0x{data[error.start]:02x} "
                           "(save the file as UTF-8)") from None
+    _refuse_nul(text, path)
+    return text
+
+
+def _refuse_nul(text: str, path: Path) -> None:
+    """A NUL character is binary data, in whatever encoding."""
     if "\0" in text:
         line = text[:text.index("\0")].count("\n") + 1
         raise GraderError(f"{path}: line {line}: expected text, got a NUL byte (is this a binary file?)")
-    return text
 
 
 def decode_export(data: bytes, path: Path) -> tuple[str, str]:
@@ -101,9 +106,7 @@ def decode_export(data: bytes, path: Path) -> tuple[str, str]:
                                   f"UTF-8 or UTF-16 text, got the byte 0x{data[offset]:02x} (save the file as "
                                   '"CSV UTF-8")') from None
             text, encoding = legacy, "Windows-1252"
-    if "\0" in text:
-        line = text[:text.index("\0")].count("\n") + 1
-        raise GraderError(f"{path}: line {line}: expected text, got a NUL byte (is this a binary file?)")
+    _refuse_nul(text, path)
     return text, encoding
 
 

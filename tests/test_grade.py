@@ -184,3 +184,26 @@ def test_a_key_whose_student_lacks_a_part_is_refused(tmp_path: Path, capsys: pyt
     (tmp_path / "a.csv").write_text("student_id,label,answer\n", encoding="utf-8")
     code, _, err = run(capsys, "grade", "--key", tmp_path / "key.json", tmp_path / "a.csv", "--out", tmp_path / "g")
     assert code == 2 and "a missing or malformed entry" in err and not (tmp_path / "g").exists()
+
+
+def test_the_assignments_tolerance_mode_and_grading_section_reach_the_verdicts(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """`tolerance: {e: {decimals: 2}}` and `grading: {numeric_expressions: false}` go through the key to grading."""
+    (tmp_path / "a.yaml").write_text("title: HW\ncourse: C\nseed: s\ngrading: {numeric_expressions: false}\n"
+                                     "problems:\n  - template: drop-rebound\n    tolerance: {e: {decimals: 2}}\n",
+                                     encoding="utf-8")
+    assert main(["generate", str(tmp_path / "a.yaml"), "--roster", str(sample_dir() / "roster.csv"), "--out",
+                 str(tmp_path / "hw"), "--no-pdf"]) == 0
+    key = tmp_path / "hw" / "key.json"
+    student = key_document(key)["students"][0]
+    e = student["problems"][0]["answers"]["e"]
+    assert e["tolerance"] == {"mode": "decimals", "digits": 2}
+    loss = student["problems"][0]["answers"]["loss_pct"]["value"]
+    rows = [(student["id"], "1a", f"{e['value']:.2f}"), (student["id"], "1b", f"sqrt({loss ** 2})")]
+    (tmp_path / "s.csv").write_text(long_csv(rows), encoding="utf-8")
+    capsys.readouterr()
+    run(capsys, "grade", "--key", key, tmp_path / "s.csv", "--out", tmp_path / "g")
+    details = {row["label"]: row for row in read(tmp_path / "g" / "details.csv")
+               if row["student_id"] == student["id"]}
+    assert details["1a"]["verdict"] == "correct" and details["1a"]["tolerance"] == "2 decimal places"
+    assert details["1b"]["verdict"] == "invalid"  # arithmetic is refused when numeric_expressions is false

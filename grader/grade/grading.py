@@ -24,7 +24,7 @@ from grader.grade.cells import (
 from grader.grade.compare import Tolerance, equivalent, errors, feedback, is_correct
 from grader.grade.key import Key, KeyPart
 from grader.grade.submissions import Answer, RowProblem, Submissions
-from grader.model.expr import parse
+from grader.model.expr import Node, parse
 
 VERDICTS = ("correct", "incorrect", "invalid", "missing")
 
@@ -128,7 +128,7 @@ def _symbolic(graded: _Part, text: str, delimiter: str, key: Key) -> Verdict:
         return graded.verdict("missing", 0.0, "the answer was blank")
     if isinstance(cell, CellInvalid):
         return graded.verdict("invalid", 0.0, f"could not read this answer: {cell.reason}")
-    same = _equivalent(cell.text, str(part.value), tuple(sorted(part.symbols.items())), f"{key.title}/{part.label}")
+    same = equivalent(cell.tree, _key_tree(str(part.value)), part.symbols, seed=f"{key.title}/{part.label}")
     if isinstance(same, str):
         return graded.verdict("invalid", 0.0, f"could not compare this expression: {same}", cell.text)
     names = " and ".join(symbols)
@@ -148,10 +148,10 @@ def _expression(text: str, symbols: tuple[str, ...], delimiter: str) -> CellBlan
     return read_expression(text, symbols, delimiter=delimiter)
 
 
-@lru_cache(maxsize=65536)
-def _equivalent(student: str, expected: str, domains: tuple[tuple[str, tuple[float, float]], ...],
-                seed: str) -> bool | str:
-    return equivalent(parse(student), parse(expected), dict(domains), seed=seed)
+@lru_cache(maxsize=4096)
+def _key_tree(text: str) -> Node:
+    """The key's expression, parsed once per distinct text (comparisons are cached in compare)."""
+    return parse(text)
 
 
 def _expected(part: KeyPart) -> str:

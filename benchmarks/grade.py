@@ -1,0 +1,207 @@
+"""Grading benchmark: `grader grade` end to end against what a competent user would do instead.
+
+Run: ``python benchmarks/grade.py [--students N] [--runs R]`` (defaults 100,000 and 3). It writes
+``benchmarks/results/grade.md``.
+
+- **Numeric**: a key for N students x 10 numeric parts (the sample's drop-rebound, pile-driver,
+  ball-plate and oblique-spheres problems, from ``grader generate --no-pdf``) and a long-format
+  submissions CSV with one answer per part: most within tolerance, some with units (``165 cm/s``),
+  some wrong, some invalid. Timed from process start: ``grader grade`` (parsing, units, tolerance,
+  feedback, four report files) beside a minimal script that reads the same CSV and key with the
+  csv and json modules, converts with ``float`` (no units: a cell that does not parse scores 0) and
+  compares with ``numpy.isclose(rtol=0.01)``, writing one grades CSV. Interleaved, median of R.
+  Targets: ``grader grade`` within 2x the minimal script; peak memory under 2 GiB.
+- **Symbolic**: 20,000 answers to the car-collision expressions (5,000 distinct texts), compared by
+  ``grader.grade.compare.equivalent`` (random points, cached) beside per-answer
+  ``sympy.simplify(student - expected) == 0`` (timed on 200 answers and extrapolated: at tens of
+  milliseconds each it would take minutes). Target: at least 100x faster than sympy.
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import json
+import os
+import platform
+import random
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+RESULTS = ROOT / "benchmarks" / "results"
+GRADER = [sys.executable, "-m", "grader"]
+
+ASSIGNMENT = """title: Grading benchmark
+course: Benchmarks
+seed: bench
+problems:
+  - {key: "1", template: drop-rebound}
+  - {key: "2", template: pile-driver}
+  - {key: "3", template: ball-plate}
+  - {key: "4", template: oblique-spheres}
+"""
+
+MINIMAL = '''
+import csv, json, sys
+import numpy as np
+key = json.load(open(sys.argv[1], encoding="utf-8"))
+expected = {}
+for s in key["students"]:
+    for p in s["problems"]:
+        for a in p["answers"].values():
+            expected[(s["id"], a["label"])] = a["value"] if a["value"] is not None else float("nan")
+ids, labels, submitted, wanted = [], [], [], []
+with open(sys.argv[2], encoding="utf-8", newline="") as f:
+    for row in csv.DictReader(f):
+        try:
+            value = float(row["answer"])
+        except ValueError:
+            value = float("nan")
+        ids.append(row["student_id"]); labels.append(row["label"]); submitted.append(value)
+        wanted.append(expected.get((row["student_id"], row["label"]), float("nan")))
+ok = np.isclose(np.array(submitted), np.array(wanted), rtol=0.01, atol=0.0)
+totals = {}
+for i, good in zip(ids, ok):
+    totals[i] = totals.get(i, 0) + int(good)
+with open(sys.argv[3], "w", encoding="utf-8", newline="") as f:
+    w = csv.writer(f); w.writerow(["student_id", "total"])
+    for i, t in totals.items():
+        w.writerow([i, t])
+'''
+
+
+def make_inputs(folder: Path, students: int, rng: random.Random) -> tuple[Path, Path, int]:
+    """The key (via grader generate) and a long submissions CSV; returns them and the cell count."""
+    roster = folder / "roster.csv"
+    with open(roster, "w", encoding="utf-8", newline="") as stream:
+        writer = csv.writer(stream)
+        writer.writerow(["id", "name", "email", "section"])
+        writer.writerows([f"s{i:06d}", f"Student {i}", f"s{i}@example.edu", "1"] for i in range(students))
+    (folder / "assignment.yaml").write_text(ASSIGNMENT, encoding="utf-8")
+    subprocess.run([*GRADER, "generate", str(folder / "assignment.yaml"), "--roster", str(roster), "--out",
+                    str(folder / "hw"), "--no-pdf"], check=True, capture_output=True)
+    key = folder / "hw" / "key.json"
+    cells = 0
+    with open(folder / "answers.csv", "w", encoding="utf-8", newline="") as stream:
+        writer = csv.writer(stream)
+        writer.writerow(["student_id", "label", "answer"])
+        for student in json.loads(key.read_text(encoding="utf-8"))["students"]:
+            for problem in student["problems"]:
+                for answer in problem["answers"].values():
+                    writer.writerow([student["id"], answer["label"], _typed(answer, rng)])
+                    cells += 1
+    return key, folder / "answers.csv", cells
+
+
+def _typed(answer: dict[str, object], rng: random.Random) -> str:
+    value = answer["value"]
+    if value is None:
+        return ""
+    assert isinstance(value, float)
+    draw = rng.random()
+    if draw < 0.70:
+        return f"{value:.3g}"
+    if draw < 0.80 and answer["unit"] == "m/s":
+        return f"{value * 100:.4g} cm/s"
+    if draw < 0.85:
+        return f"{value:.3g} {answer['unit']}".strip()
+    if draw < 0.95:
+        return f"{value * rng.choice([0.5, 1.2, 2.0]):.3g}"
+    return rng.choice(["", "six", "6.2 or 6.3", "1,234", "nan"])
+
+
+def timed(command: list[str]) -> tuple[float, float]:
+    """Wall time from process start, and the process's own peak memory (MiB)."""
+    started = time.perf_counter()
+    process = subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    _, _, usage = os.wait4(process.pid, 0)
+    return time.perf_counter() - started, usage.ru_maxrss / 1024  # Linux: kB
+
+
+def numeric(students: int, runs: int) -> dict[str, object]:
+    rng = random.Random(7)
+    with tempfile.TemporaryDirectory() as tmp:
+        folder = Path(tmp)
+        key, answers, cells = make_inputs(folder, students, rng)
+        (folder / "minimal.py").write_text(MINIMAL, encoding="utf-8")
+        ours, theirs, peaks = [], [], []
+        for run in range(runs):  # interleaved: the machine's state affects both alike
+            theirs.append(timed([sys.executable, str(folder / "minimal.py"), str(key), str(answers),
+                                 str(folder / f"minimal-{run}.csv")])[0])
+            seconds, peak = timed([*GRADER, "grade", "--key", str(key), str(answers), "--out", str(folder / f"g{run}")])
+            ours.append(seconds)
+            peaks.append(peak)
+    return {"cells": cells, "ours": statistics.median(ours), "theirs": statistics.median(theirs),
+            "peak_mib": max(peaks)}
+
+
+def symbolic(answers: int = 20_000, distinct: int = 5_000, sympy_sample: int = 200) -> dict[str, object]:
+    import sympy
+
+    from grader.grade.cells import CellExpression, read_expression
+    from grader.grade.compare import equivalent
+    from grader.model.expr import parse
+
+    rng = random.Random(11)
+    expected_text = "v*(1 - 0.21*p)/(p + 1)"
+    forms = []
+    for i in range(distinct):  # equivalent and wrong forms, each with its own constant
+        c = 1 + i / 1000
+        forms.append(rng.choice([f"{c}*v*(1 - 0.21*p)/(p + 1)/{c}", f"v({c} - 0.21*{c}*p)/({c}*(1 + p))",
+                                 f"v*(1 - 0.2*p)/(p + {c})"]))
+    texts = [rng.choice(forms) for _ in range(answers)]
+    domains = {"p": (0.1, 10.0), "v": (1.0, 10.0)}
+    expected = parse(expected_text)
+    started = time.perf_counter()
+    for text in texts:
+        cell = read_expression(text, ("p", "v"))
+        assert isinstance(cell, CellExpression)
+        equivalent(cell.tree, expected, domains, seed="bench")
+    ours = time.perf_counter() - started
+    p, v = sympy.symbols("p v")
+    target = sympy.sympify(expected_text, locals={"p": p, "v": v})
+    started = time.perf_counter()
+    for text in texts[:sympy_sample]:
+        student = sympy.sympify(text.replace("v(", "v*("), locals={"p": p, "v": v})
+        bool(sympy.simplify(student - target) == 0)
+    per_answer = (time.perf_counter() - started) / sympy_sample
+    return {"answers": answers, "distinct": distinct, "ours": ours, "sympy": per_answer * answers}
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0] if __doc__ else None)
+    parser.add_argument("--students", type=int, default=100_000)
+    parser.add_argument("--runs", type=int, default=3)
+    args = parser.parse_args()
+    started = time.perf_counter()
+    num = numeric(args.students, args.runs)
+    sym = symbolic()
+    ratio = float(num["ours"]) / float(num["theirs"])  # type: ignore[arg-type]
+    speedup = float(sym["sympy"]) / float(sym["ours"])  # type: ignore[arg-type]
+    lines = [
+        "# Grading benchmark", "",
+        f"Python {platform.python_version()}, {os.cpu_count()} CPUs. `python benchmarks/grade.py --students "
+        f"{args.students} --runs {args.runs}`; whole commands from process start, interleaved, median of "
+        f"{args.runs}.", "",
+        "| what | grader | baseline | ratio | target |", "| --- | --: | --: | --: | --- |",
+        f"| {num['cells']:,} numeric cells, `grader grade` vs csv + float + numpy.isclose | {num['ours']:.2f} s "
+        f"| {num['theirs']:.2f} s | {ratio:.1f}x | within 2x: {'met' if ratio <= 2 else 'not met'} |",
+        f"| {sym['answers']:,} symbolic answers ({sym['distinct']:,} distinct), in process | {sym['ours']:.2f} s "
+        f"| {sym['sympy']:.0f} s (sympy.simplify per answer, extrapolated from 200) | {speedup:,.0f}x faster "
+        f"| >= 100x: {'met' if speedup >= 100 else 'not met'} |",
+        f"| peak memory of `grader grade` | {num['peak_mib']:.0f} MiB | | | < 2 GiB: "
+        f"{'met' if float(num['peak_mib']) < 2048 else 'not met'} |",  # type: ignore[arg-type]
+        "", f"Total benchmark time {time.perf_counter() - started:.0f} s.",
+    ]
+    RESULTS.mkdir(exist_ok=True)
+    (RESULTS / "grade.md").write_text("\n".join(lines) + "\n", encoding="utf-8")
+    print("\n".join(lines))
+
+
+if __name__ == "__main__":
+    main()

@@ -89,6 +89,30 @@ def build_parser() -> argparse.ArgumentParser:
                          help="replace an output folder an earlier run wrote (as its .grader-manifest.json says)")
     grading.add_argument("--json", action="store_true", help="print a summary object on stdout")
 
+    checking = commands.add_parser(
+        "check", help="grade one answer as grader grade would: against a key's part, or a given value",
+        description="Grade one answer: against a student's part of a key (--key, --student, --label), or against "
+                    "--expected with --unit, a tolerance and, for an expression, --symbols and --domain. "
+                    "--batch reads one JSON object a line and prints one result a line.")
+    checking.add_argument("answer", nargs="?", metavar="ANSWER", help="what the student typed, e.g. \"6.3 m/s\"")
+    checking.add_argument("--key", type=Path, metavar="DIR/key.json", help="the key grader generate wrote")
+    checking.add_argument("--student", metavar="ID", help="a student id (or email) of the key")
+    checking.add_argument("--label", metavar="LABEL", help="the part as printed on the sheet, e.g. 1a")
+    checking.add_argument("--expected", metavar="VALUE", help="the right answer: a number, or an expression")
+    checking.add_argument("--unit", metavar="UNIT", help="the expected answer's unit (default: none)")
+    checking.add_argument("--rtol", type=float, metavar="X", help="relative tolerance (default 0.01)")
+    checking.add_argument("--atol", type=float, metavar="X", help="absolute tolerance, in --unit (default 0)")
+    checking.add_argument("--sigfigs", type=int, metavar="N", help="correct to N significant figures")
+    checking.add_argument("--decimals", type=int, metavar="N", help="correct to N decimal places")
+    checking.add_argument("--symbols", metavar="NAMES", help="an expression's names, e.g. p,v (default: those "
+                                                                   "--expected uses)")
+    checking.add_argument("--domain", action="append", default=[], metavar="NAME=LOW:HIGH", dest="domains",
+                          help="where a symbol is sampled (repeatable; default 1:10)")
+    checking.add_argument("--json", action="store_true", help="print the result as one JSON object")
+    checking.add_argument("--batch", type=Path, metavar="FILE.jsonl",
+                          help="one JSON object a line: submitted, expected, unit, tolerance, symbols, domains "
+                               "(or, with --key, submitted, student, label); - reads standard input")
+
     demo = commands.add_parser("demo", help="the whole job on shipped sample data (5 problems, 30 students)")
     demo.add_argument("--out", type=Path, default=Path("grader-demo"), metavar="DIR",
                       help="output folder (default: ./grader-demo)")
@@ -529,5 +553,108 @@ def _grade(arguments: argparse.Namespace) -> int:
     return EXIT_REFUSED if summary.rows_not_graded else EXIT_OK
 
 
+def _check(arguments: argparse.Namespace) -> int:
+    from grader.grade import check
+    from grader.grade.key import load_key
+
+    _check_arguments(arguments)
+    key = load_key(arguments.key) if arguments.key is not None else None
+    if arguments.batch is not None:
+        failed = 0
+        for result in check.batch(_batch_lines(arguments.batch), key):
+            failed += "error" in result
+            print(json.dumps(result, ensure_ascii=False, allow_nan=False))
+        return EXIT_REFUSED if failed else EXIT_OK
+    if key is not None:
+        against = check.from_key(key, arguments.student, arguments.label)
+    else:
+        tolerance = {name: getattr(arguments, name) for name in ("rtol", "atol")
+                     if getattr(arguments, name) is not None}
+        for mode in ("sigfigs", "decimals"):
+            if getattr(arguments, mode) is not None:
+                tolerance = {"mode": mode, "digits": getattr(arguments, mode)}
+        symbols = None if arguments.symbols is None else [s.strip() for s in arguments.symbols.split(",")]
+        expected, unit = _expected_quantity(arguments.expected, arguments.unit)
+        against = check.expectation(expected, unit=unit,
+                                    tolerance=tolerance, symbols=symbols,
+                                    domains=dict(check.domain(text) for text in arguments.domains))
+    result = check.check(arguments.answer, against)
+    if arguments.json:
+        print(json.dumps(result, ensure_ascii=False, allow_nan=False))
+    else:
+        _print_check(result)
+    return EXIT_OK
+
+
+def _check_arguments(arguments: argparse.Namespace) -> None:
+    """The two ways to call ``grader check``, and ``--batch``; a mix of them is refused with the reason."""
+    given = [f"--{name}" for name in ("expected", "unit", "rtol", "atol", "sigfigs", "decimals", "symbols")
+             if getattr(arguments, name) is not None] + (["--domain"] if arguments.domains else [])
+    chosen = [f"--{name}" for name in ("student", "label") if getattr(arguments, name) is not None]
+    if arguments.batch is not None:
+        if arguments.answer is not None or given or chosen:
+            raise UsageError("--batch takes every answer and expectation from its lines; give it alone "
+                             "(with --key when the lines name a student and label)")
+        return
+    if arguments.answer is None:
+        raise UsageError("expected the answer to check, e.g. grader check \"6.3 m/s\" --expected 6.26 --unit m/s")
+    modes = [flag for flag in ("--sigfigs", "--decimals") if flag in given]
+    if len(modes) > 1 or (modes and {"--rtol", "--atol"} & set(given)):
+        raise UsageError(f"{' and '.join(modes + sorted({'--rtol', '--atol'} & set(given)))}: choose one tolerance "
+                         "mode (--rtol/--atol, --sigfigs or --decimals)")
+    if arguments.key is not None:
+        if given:
+            raise UsageError(f"{', '.join(given)}: with --key the expected answer, unit and tolerance come from "
+                             "the key")
+        if len(chosen) < 2:
+            raise UsageError("--key needs --student ID and --label LABEL (the part as printed, e.g. 1a)")
+    elif chosen or arguments.expected is None:
+        raise UsageError("expected --expected VALUE (and --unit), or --key with --student and --label")
+
+
+def _expected_quantity(text: str, unit: str | None) -> tuple[float | str, str]:
+    """``--expected``: a number (``6.26``, or ``6.26 m/s`` when ``--unit`` is not given) or an expression."""
+    quantity = split_quantity(text)
+    if quantity is None:
+        return text, unit or ""  # an expression
+    value, written = quantity
+    if written:
+        try:
+            parse_unit(written)
+        except GraderError:
+            return text, unit or ""  # 2v: an expression
+        if unit is not None and unit.strip() != written:
+            raise UsageError(f"--expected {text} and --unit {unit}: give the unit once")
+        return value, written
+    return value, unit or ""
+
+
+def _batch_lines(path: Path) -> list[str]:
+    from grader.inputs import decode_text, read_bytes
+
+    limit = 1 << 30
+    if str(path) == "-":
+        data = sys.stdin.buffer.read(limit + 1)
+        if len(data) > limit:
+            raise UsageError(f"standard input: more than {limit:,} bytes; split the batch")
+        return decode_text(data, Path("standard input")).splitlines()
+    return decode_text(read_bytes(path, limit), path).splitlines()
+
+
+def _print_check(result: dict[str, Any]) -> None:
+    def amount(value: object) -> str:
+        return "" if value is None else f"{value:.6g} {result['unit']}".rstrip() if isinstance(value, float) \
+            else str(value)
+
+    rows = [("verdict", f"{result['verdict']} (credit {result['credit']:g})"), ("read as", amount(result["parsed"])),
+            ("expected", "undefined" if result["expected"] is None else amount(result["expected"])),
+            ("error", "" if result["abs_error"] is None else
+             f"{amount(result['abs_error'])} ({100 * result['rel_error']:.2g} %)"),
+            ("tolerance", result["tolerance"]), ("feedback", result["feedback"])]
+    for name, text in rows:
+        if text:
+            print(f"{name:<10} {_printable(text)}")
+
+
 _COMMANDS = {"list": _list, "show": _show, "solve": _solve, "simulate": _simulate, "generate": _generate,
-             "demo": _demo, "grade": _grade}
+             "demo": _demo, "grade": _grade, "check": _check}

@@ -62,7 +62,7 @@ INVALID = [
      "expected a name of letters, digits and _, not g"),
     ("mass", set_in("bodies/ball/mass", "m_unknown"), "bodies.ball.mass: expected parameters or symbols only"),
     ("body-spec", set_in("bodies/floor", {"fixed": True, "mass": "m"}), "either a mass or fixed: true"),
-    ("tolerance", set_in("answers/e/tolerance", {"rtol": -1}), "answers.e.tolerance.rtol: expected a number >= 0"),
+    ("tolerance", set_in("answers/e/tolerance", {"rtol": -1}), "answers.e.tolerance.rtol: expected a number from 0"),
 ]
 
 

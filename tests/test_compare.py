@@ -18,8 +18,6 @@ from hypothesis import strategies as st
 from grader.errors import GraderError
 from grader.grade.compare import (
     LARGEST,
-    Tolerance,
-    ToleranceError,
     _equivalent,
     equivalent,
     errors,
@@ -27,6 +25,7 @@ from grader.grade.compare import (
     is_correct,
 )
 from grader.model.expr import parse
+from grader.model.tolerance import Tolerance, ToleranceError
 
 
 def exact(value: float) -> Fraction:
@@ -241,7 +240,9 @@ def test_json_reads_key_version_1() -> None:
     assert Tolerance.from_json({"rtol": 0.02}) == Tolerance(rtol=0.02)
     assert Tolerance.from_json({"atol": 1}) == Tolerance(atol=1.0)
     assert Tolerance.from_json({}) == Tolerance()
-    assert Tolerance().to_json() == {"rtol": 0.01, "atol": 0.0}
+    assert Tolerance().to_json() == {"mode": "rtol", "rtol": 0.01, "atol": 0.0}
+    assert Tolerance.from_json({"sigfigs": 2}) == Tolerance("sigfigs", digits=2)
+    assert Tolerance.from_json({"decimals": 0}) == Tolerance("decimals", digits=0)
 
 
 BAD_JSON = [

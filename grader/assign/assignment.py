@@ -17,9 +17,10 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from grader.bank.template import Interval, Template, Tolerance
+from grader.bank.template import Interval, Template, tolerance_in
 from grader.errors import GraderError, TemplateError, shown
 from grader.inputs import read_csv, read_yaml
+from grader.model.tolerance import FORMS
 
 _KEY = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_-]{0,15}$")
 _ROSTER_COLUMNS = ("id", "name", "email", "section")
@@ -36,7 +37,7 @@ class ProblemSpec:
     points: Mapping[str, float]
     fixed: Mapping[str, float]
     narrowed: Mapping[str, tuple[float, float]]
-    tolerances: Mapping[str, Tolerance]
+    tolerances: Mapping[str, Mapping[str, Any]]  # answer name -> the override as written
 
 
 @dataclass(frozen=True)
@@ -147,20 +148,13 @@ def _problem(raw: Any, index: int, where: str) -> ProblemSpec:
                        tolerance_specs)
 
 
-def _tolerance(raw: Any, where: str, key: str) -> Tolerance:
-    """``{rtol: X, atol: Y}`` (either may be left to the template: -1 marks it), ``{sigfigs: N}`` or
-    ``{decimals: N}`` (PrairieLearn's rules)."""
-    expected = "{rtol: X, atol: Y}, {sigfigs: N} or {decimals: N}"
-    if isinstance(raw, Mapping) and len(raw) == 1 and set(raw) <= {"sigfigs", "decimals"}:
-        mode, digits = next(iter(raw.items()))
-        least = 1 if mode == "sigfigs" else 0
-        if isinstance(digits, bool) or not isinstance(digits, int) or not least <= digits <= 15:
-            raise TemplateError(where, f"{key}.{mode}", f"a whole number from {least} to 15", shown(digits))
-        return Tolerance(-1.0, -1.0, mode, digits)
-    if not (isinstance(raw, Mapping) and raw and set(raw) <= {"rtol", "atol"}
-            and all(_number(x) and 0 <= x < 1e300 for x in raw.values())):
-        raise TemplateError(where, key, expected, shown(raw))
-    return Tolerance(float(raw.get("rtol", -1)), float(raw.get("atol", -1)))
+def _tolerance(raw: Any, where: str, key: str) -> Mapping[str, Any]:
+    """An answer's override as written, checked: ``{rtol: X, atol: Y}`` (either alone keeps the template's
+    other), ``{sigfigs: N}`` or ``{decimals: N}`` (PrairieLearn's rules)."""
+    if not isinstance(raw, Mapping) or not raw:
+        raise TemplateError(where, key, FORMS, shown(raw))
+    tolerance_in(raw, where, key)
+    return dict(raw)
 
 
 def _number(value: Any) -> bool:

@@ -134,7 +134,7 @@ def key_csv(generation: Generation) -> str:
     stream = io.StringIO()
     writer = csv.writer(stream, lineterminator="\n")
     writer.writerow(["student_id", "name", "section", "problem", "template", "label", "answer", "value", "unit",
-                     "points", "rtol", "atol", "parameters"])
+                     "points", "tolerance", "parameters"])
     for entry in generation.students:
         for variant in entry.problems:
             given = "; ".join(f"{name}={text}" for name, text in variant.printed.items())
@@ -143,5 +143,5 @@ def key_csv(generation: Generation) -> str:
                 writer.writerow([safe_cell(entry.student.id), safe_cell(entry.student.name),
                                  safe_cell(entry.student.section), variant.key, variant.template, part.label,
                                  part.name, value if isinstance(value, float) else safe_cell(str(value)), part.unit,
-                                 part.points, part.tolerance.rtol, part.tolerance.atol, given])
+                                 part.points, part.tolerance.describe(part.unit), given])
     return stream.getvalue()

@@ -24,9 +24,10 @@ from typing import Any
 import numpy as np
 
 from grader.assign.assignment import Assignment, ProblemSpec, Student
-from grader.bank.template import Parameter, Template, Tolerance
+from grader.bank.template import Parameter, Template
 from grader.errors import GraderError
 from grader.model.expr import Sym
+from grader.model.tolerance import Tolerance
 from grader.solve.cache import compiled_for
 from grader.solve.compiled import Compiled
 from grader.solve.evaluate import Columns, answer_at, solve_columns
@@ -165,7 +166,7 @@ class _Problem:
         for name, values in result.values.items():
             defined = ok & np.array([reason is None for reason in result.undefined[name]])
             typical[name] = float(np.median(np.abs(values[defined]))) if defined.any() else 0.0
-            if ok.any() and typical[name] == 0 and tolerance(self.problem, self.template, name).atol == 0:
+            if ok.any() and typical[name] == 0 and _relative(tolerance(self.problem, self.template, name)):
                 what = "undefined" if not defined.any() else "0"
                 raise GraderError(f"{self.where}: answer {name} is {what} for every variant the fixed and narrowed "
                                   "parameters allow, so it cannot be graded with a relative tolerance; expected "
@@ -246,15 +247,15 @@ def _blank_parts(problem: ProblemSpec, template: Template) -> list[AnswerPart]:
     return parts
 
 
+def _relative(tolerance: Tolerance) -> bool:
+    """Whether the band shrinks to nothing at a key of 0 (only ``rtol`` mode without ``atol``)."""
+    return tolerance.mode == "rtol" and tolerance.atol == 0
+
+
 def tolerance(problem: ProblemSpec, template: Template, name: str) -> Tolerance:
-    """An answer's tolerance: the template's, with the assignment's overrides (a negative field: not overridden)."""
+    """An answer's tolerance: the template's, with the assignment's override (checked when it was read)."""
     spec, override = template.answers[name].tolerance, problem.tolerances.get(name)
-    if override is None:
-        return spec
-    if override.mode != "rtol":
-        return Tolerance(0.0, 0.0, override.mode, override.digits)
-    return Tolerance(override.rtol if override.rtol >= 0 else spec.rtol,
-                     override.atol if override.atol >= 0 else spec.atol)
+    return spec if override is None else Tolerance.from_json(override, base=spec)
 
 
 def _answer_parts(blanks: Sequence[AnswerPart], template: Template, compiled: Compiled, result: Columns,

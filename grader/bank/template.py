@@ -22,6 +22,7 @@ from grader.errors import ExpressionError, GraderError, TemplateError, shown
 from grader.inputs import YAML_BYTES, parse_yaml, read_bytes
 from grader.model.expr import Node, Op, Sym, names, parse, to_text
 from grader.model.scene import Gravity, Scene
+from grader.model.tolerance import Tolerance, ToleranceError
 from grader.model.units import MASS, Dimension, Unit, dimension_from, dimension_name, dimension_of, parse_unit
 from grader.physics.effects import CATALOGUE
 from grader.resources import bank_dir
@@ -99,23 +100,6 @@ class SymbolSpec:
     name: str
     unit: Unit
     description: str
-
-
-@dataclass(frozen=True)
-class Tolerance:
-    """Grading tolerance. ``rtol`` mode: ``|s - t| <= atol + rtol*|t|`` (atol in the answer's unit);
-    ``sigfigs``/``decimals`` modes: PrairieLearn's rules with ``digits`` figures or places."""
-
-    rtol: float
-    atol: float
-    mode: str = "rtol"
-    digits: int = 0
-
-    def to_json(self) -> dict[str, Any]:
-        """The key's form: ``{"mode": "rtol", "rtol", "atol"}`` or ``{"mode": "sigfigs", "digits"}``."""
-        if self.mode == "rtol":
-            return {"mode": "rtol", "rtol": self.rtol, "atol": self.atol}
-        return {"mode": self.mode, "digits": self.digits}
 
 
 @dataclass(frozen=True)
@@ -214,7 +198,7 @@ def parse_template(raw: Mapping[str, Any], where: str, source_hash: str, stem: s
     if both:
         raise TemplateError(where, "symbols", "names not also parameters", ", ".join(sorted(both)))
     scene = parse_scene(raw, where, gravity)
-    default = _tolerance(raw.get("tolerance", {}), where, "tolerance", Tolerance(0.01, 0.0))
+    default = tolerance_in(raw.get("tolerance", {}), where, "tolerance")
     answers = {name: _answer(name, spec, where, default) for name, spec in _mapping(raw, "answers", where).items()}
     template = Template(
         id=template_id, title=_text(raw, "title", where), version=version, where=where,
@@ -415,14 +399,13 @@ def _symbol(name: str, spec: Any, where: str) -> SymbolSpec:
                       str(spec.get("description", name)))
 
 
-def _tolerance(spec: Any, where: str, key: str, default: Tolerance) -> Tolerance:
-    if not isinstance(spec, Mapping) or set(spec) - {"rtol", "atol"}:
-        raise TemplateError(where, key, "{rtol: X, atol: Y}", shown(spec))
-    values = {k: spec.get(k, getattr(default, k)) for k in ("rtol", "atol")}
-    for k, value in values.items():
-        if isinstance(value, bool) or not isinstance(value, (int, float)) or not 0 <= value < 1e300:
-            raise TemplateError(where, f"{key}.{k}", "a number >= 0", shown(value))
-    return Tolerance(float(values["rtol"]), float(values["atol"]))
+def tolerance_in(spec: Any, where: str, key: str, base: Tolerance | None = None) -> Tolerance:
+    """A tolerance written in a template or an assignment (fields left out come from ``base``)."""
+    try:
+        return Tolerance.from_json(spec, base=base)
+    except ToleranceError as error:
+        raise TemplateError(where, f"{key}.{error.field}" if error.field else key, error.expected,
+                            error.got) from None
 
 
 def _answer(name: str, spec: Any, where: str, default: Tolerance) -> AnswerSpec:
@@ -435,7 +418,7 @@ def _answer(name: str, spec: Any, where: str, default: Tolerance) -> AnswerSpec:
         raise TemplateError(where, f"{key}.symbolic", "a list of names", shown(symbolic))
     return AnswerSpec(name, _parse(spec["value"], where, f"{key}.value"),
                       _unit(spec.get("unit"), where, f"{key}.unit"), str(spec.get("description", name)),
-                      _tolerance(spec.get("tolerance", {}), where, f"{key}.tolerance", default), tuple(symbolic))
+                      tolerance_in(spec.get("tolerance", {}), where, f"{key}.tolerance", default), tuple(symbolic))
 
 
 def _constraint(index: int, spec: Any, where: str) -> Constraint:

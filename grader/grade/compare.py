@@ -31,122 +31,20 @@ from dataclasses import dataclass, field
 from decimal import Decimal
 from fractions import Fraction
 from functools import lru_cache
-from typing import Any, Literal
 
 import numpy as np
 from numpy.typing import ArrayLike
 
-from grader.errors import GraderError, shown
+from grader.errors import shown
 from grader.model.expr import Node, names, to_text
 from grader.model.kernel import evaluate
-
-Mode = Literal["rtol", "sigfigs", "decimals"]
-MODES: tuple[Mode, ...] = ("rtol", "sigfigs", "decimals")
-MAX_DIGITS = 17
-"""float64 carries 17 significant digits; more cannot be told apart."""
+from grader.model.tolerance import Tolerance, with_unit
 
 LARGEST = float(np.finfo(np.float64).max)
 """What :func:`errors` reports for an error too large for float64 (and for input that is not finite)."""
 
 _PERIOD = {"deg": 360.0, "rad": 2 * math.pi}
 _PRAIRIELEARN_HALF = Fraction(51, 100)  # half a unit in the last place, and a little more
-
-
-class ToleranceError(GraderError, ValueError):
-    """A tolerance that is not one of the accepted forms; the message names the field."""
-
-
-@dataclass(frozen=True)
-class Tolerance:
-    """How close a submitted number must be to the key.
-
-    Values that do not apply to the mode (``digits`` in ``rtol`` mode, ``rtol``/``atol`` in the digit
-    modes) must stay at their defaults, so two tolerances are equal exactly when they grade alike.
-
-    >>> Tolerance().describe(), Tolerance(atol=0.05).describe("m/s")
-    ('±1 %', '±1 % + 0.05 m/s')
-    >>> Tolerance("sigfigs", digits=3).describe(), Tolerance("decimals", digits=1).describe()
-    ('3 significant figures', '1 decimal place')
-    >>> Tolerance("sigfigs", digits=0)
-    Traceback (most recent call last):
-    ...
-    grader.grade.compare.ToleranceError: tolerance.digits: expected a whole number from 1 to 17, got 0
-    """
-
-    mode: Mode = "rtol"
-    rtol: float = 0.01
-    atol: float = 0.0
-    digits: int = 3
-
-    def __post_init__(self) -> None:
-        if self.mode not in MODES:
-            _refuse("mode", "'rtol', 'sigfigs' or 'decimals'", self.mode)
-        for name in ("rtol", "atol"):
-            value = getattr(self, name)
-            if isinstance(value, bool) or not isinstance(value, (int, float)) or not 0 <= value < 1e300:
-                _refuse(name, "a number from 0 to 1e300", value)
-            object.__setattr__(self, name, float(value))
-        lowest = 1 if self.mode == "sigfigs" else 0
-        if isinstance(self.digits, bool) or not isinstance(self.digits, int) or not lowest <= self.digits <= MAX_DIGITS:
-            _refuse("digits", f"a whole number from {lowest} to {MAX_DIGITS}", self.digits)
-        if self.mode == "rtol" and self.digits != 3:
-            _refuse("digits", "no digits in rtol mode (digits count only for sigfigs and decimals)", self.digits)
-        if self.mode != "rtol" and (self.rtol, self.atol) != (0.01, 0.0):
-            _refuse("rtol", f"no rtol or atol in {self.mode} mode (they count only in rtol mode)",
-                    {"rtol": self.rtol, "atol": self.atol})
-
-    def describe(self, unit: str = "") -> str:
-        """What is accepted, in words; ``atol`` is in the answer's ``unit``."""
-        if self.mode == "sigfigs":
-            return _count(self.digits, "significant figure")
-        if self.mode == "decimals":
-            return _count(self.digits, "decimal place")
-        relative = f"{_plain(self.rtol * 100)} %"
-        if not self.atol:
-            return f"±{relative}"
-        absolute = _with_unit(_plain(self.atol), unit)
-        return f"±{relative} + {absolute}" if self.rtol else f"±{absolute}"
-
-    @classmethod
-    def from_json(cls, data: Mapping[str, Any]) -> Tolerance:
-        """Read ``{"rtol": .., "atol": ..}`` (key version 1; both optional) or ``{"mode": .., "digits": ..}``.
-
-        >>> Tolerance.from_json({"mode": "sigfigs", "digits": 2}) == Tolerance("sigfigs", digits=2)
-        True
-        >>> Tolerance.from_json({"rtol": 0.02, "digits": 3})
-        Traceback (most recent call last):
-        ...
-        grader.grade.compare.ToleranceError: tolerance: expected only the keys atol, mode, rtol in rtol mode, got digits
-        """
-        if not isinstance(data, Mapping):
-            raise ToleranceError(f"tolerance: expected a mapping like {{'rtol': 0.01}}, got {shown(data)}")
-        mode = data.get("mode", "rtol")
-        if mode not in MODES:
-            _refuse("mode", "'rtol', 'sigfigs' or 'decimals'", mode)
-        allowed = {"mode", "rtol", "atol"} if mode == "rtol" else {"mode", "digits"}
-        extra = [str(key) for key in data if key not in allowed]
-        if extra:
-            raise ToleranceError(f"tolerance: expected only the keys {', '.join(sorted(allowed))} in {mode} mode, "
-                                 f"got {shown(', '.join(sorted(extra)))[1:-1]}")
-        return cls(**{str(key): value for key, value in data.items()})
-
-    def to_json(self) -> dict[str, Any]:
-        """The JSON form; ``rtol`` mode keeps key version 1's ``{"rtol", "atol"}`` exactly.
-
-        >>> Tolerance().to_json(), Tolerance("decimals", digits=2).to_json()
-        ({'rtol': 0.01, 'atol': 0.0}, {'mode': 'decimals', 'digits': 2})
-        """
-        if self.mode == "rtol":
-            return {"rtol": self.rtol, "atol": self.atol}
-        return {"mode": self.mode, "digits": self.digits}
-
-
-def _refuse(name: str, expected: str, got: Any) -> None:
-    raise ToleranceError(f"tolerance.{name}: expected {expected}, got {shown(got)}")
-
-
-def _count(n: int, noun: str) -> str:
-    return f"{n} {noun}" + ("" if n == 1 else "s")
 
 
 # ---- verdicts -------------------------------------------------------------------------------------
@@ -289,16 +187,16 @@ def feedback(submitted: float, expected: float, unit: str, tolerance: Tolerance,
     unit = unit or {"deg": "°", "rad": "rad"}.get(angle_unit or "", "")
     if not math.isfinite(expected):
         return "this answer has no finite value in the key; please ask your instructor to check it"
-    key = _with_unit(_shown(expected), unit)
+    key = with_unit(_shown(expected), unit)
     if not math.isfinite(submitted):
         return f"{_shown(submitted)} is not a finite number, so it cannot match {key}"
     distance = float(_difference(np.array([submitted], dtype=float), np.array([expected], dtype=float), period)[0])
-    subject = _with_unit(_shown(submitted, full=True), unit)
+    subject = with_unit(_shown(submitted, full=True), unit)
     if period is not None and abs((submitted - expected) - distance) > 1e-9 * period:
         # The student's direction, written within a half turn of the key.
         if distance == 0 and tolerance.mode == "rtol":
             return f"{subject} is the same direction as {key}{_clause(tolerance, unit, correct)}"
-        subject = f"{subject} is the same direction as {_with_unit(_shown(expected + distance), unit)}, which"
+        subject = f"{subject} is the same direction as {with_unit(_shown(expected + distance), unit)}, which"
     return f"{subject} {_comparison(distance, expected, unit, tolerance, correct)}"
 
 
@@ -308,14 +206,14 @@ def _comparison(distance: float, expected: float, unit: str, tolerance: Toleranc
     if tolerance.mode != "rtol":
         n = tolerance.digits
         key = _shown(expected, digits=n) if tolerance.mode == "sigfigs" else f"{expected + 0.0:.{n}f}"
-        words = f"{_with_unit(key, unit)} to {tolerance.describe()}"
+        words = f"{with_unit(key, unit)} to {tolerance.describe()}"
         if correct:
             return f"matches {words}"
-        return f"does not match {words} (it is {_with_unit(_shown(abs(distance)), unit)} {side})"
-    key = _with_unit(_shown(expected), unit)
+        return f"does not match {words} (it is {with_unit(_shown(abs(distance)), unit)} {side})"
+    key = with_unit(_shown(expected), unit)
     if distance == 0:
         return f"equals {key}{_clause(tolerance, unit, correct)}"
-    absolute = _with_unit(_shown(abs(distance)), unit)
+    absolute = with_unit(_shown(abs(distance)), unit)
     percent = f"{_percent(abs(distance) / abs(expected))} %" if expected else ""
     if not tolerance.rtol or not percent:
         size = absolute
@@ -328,12 +226,6 @@ def _comparison(distance: float, expected: float, unit: str, tolerance: Toleranc
 
 def _clause(tolerance: Tolerance, unit: str, correct: bool) -> str:
     return f"; {'within' if correct else 'only'} {tolerance.describe(unit)} is accepted"
-
-
-def _with_unit(text: str, unit: str) -> str:
-    if unit in ("deg", "degree", "degrees", "°"):
-        return f"{text}°"
-    return f"{text} {unit}" if unit else text
 
 
 def _shown(value: float, *, full: bool = False, digits: int = 6) -> str:
@@ -355,11 +247,6 @@ def _percent(ratio: float) -> str:
     if 10 <= percent < 1e6:
         return f"{percent:.0f}"
     return _shown(float(f"{percent:.2g}"))
-
-
-def _plain(value: float) -> str:
-    """A tolerance figure without float noise: ``0.07*100`` prints as ``7``."""
-    return _shown(float(f"{value:.12g}"), digits=12)
 
 
 # ---- symbolic answers ----------------------------------------------------------------------------

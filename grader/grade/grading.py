@@ -21,10 +21,11 @@ from grader.grade.cells import (
     read_number,
     undefined_word,
 )
-from grader.grade.compare import Tolerance, equivalent, errors, feedback, is_correct
+from grader.grade.compare import equivalent, errors, feedback, is_correct
 from grader.grade.key import Key, KeyPart
 from grader.grade.submissions import Answer, RowProblem, Submissions
 from grader.model.expr import Node, parse
+from grader.model.tolerance import Tolerance
 
 VERDICTS = ("correct", "incorrect", "invalid", "missing")
 

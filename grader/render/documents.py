@@ -179,24 +179,6 @@ def _unit_text(unit: str) -> str:
     return {"deg": "degrees", "": "(no unit)"}.get(unit, unit.replace("^2", "²").replace("^3", "³").replace("*", "·"))
 
 
-def tolerance_text(part: AnswerPart) -> str:
-    """``±1%``, ``±0.05 m/s``, or both: ``±(0.05 m/s + 1%)``.
-
-    >>> from grader.bank.template import Tolerance
-    >>> tolerance_text(AnswerPart("e", "1a", 0.5, "", 1.0, Tolerance(0.01, 0.0), "e"))
-    '±1%'
-    """
-    if part.tolerance.mode == "sigfigs":
-        return f"{part.tolerance.digits} significant figures"
-    if part.tolerance.mode == "decimals":
-        return f"{part.tolerance.digits} decimal places"
-    relative = f"{part.tolerance.rtol * 100:.3g}%" if part.tolerance.rtol else ""
-    absolute = f"{part.tolerance.atol:g} {part.unit}".strip() if part.tolerance.atol else ""
-    if relative and absolute:
-        return f"±({absolute} + {relative})"
-    return f"±{relative or absolute}" if relative or absolute else "exact"
-
-
 def paragraphs(text_: str) -> list[str]:
     """Text split at blank lines, each paragraph on one line."""
     return [" ".join(p.split()) for p in re.split(r"\n\s*\n", text_) if p.strip()]
@@ -309,7 +291,7 @@ def _key_answer(template: Template, part: AnswerPart) -> KeyAnswer:
         value = Typ(f"${source}$ {text('undefined: ' + (part.undefined or 'no value'))}")
     else:
         value = _math(f"display({source} = {answer_math(part.value, part.unit)})")
-    return KeyAnswer(part.label, part.description, value, f"{part.points:g}", tolerance_text(part))
+    return KeyAnswer(part.label, part.description, value, f"{part.points:g}", part.tolerance.describe(part.unit))
 
 
 # --- statements ---------------------------------------------------------------------------------
@@ -369,7 +351,8 @@ def key_source(documents: _Documents, indices: Sequence[int], overview: bool = T
     assignment = documents.assignment
     first = documents.generation.students[indices[0]]
     summary = [(p.key, documents.bank[p.template].title,
-                [(a.label, a.description, _unit_text(a.unit), f"{a.points:g}", tolerance_text(a)) for a in p.answers])
+                [(a.label, a.description, _unit_text(a.unit), f"{a.points:g}", a.tolerance.describe(a.unit))
+                 for a in p.answers])
                for p in first.problems]
     return _environment().get_template("key.typ.j2").render(
         assignment=_assignment_view(assignment), paper=PAPER, overview=overview, summary=summary,

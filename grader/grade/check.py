@@ -1,0 +1,220 @@
+"""``grader check``: one answer graded exactly as ``grader grade`` grades it.
+
+Against a part of a key (``--key``, ``--student``, ``--label``), or against a value or expression
+given on the command line or in a JSON line, with its unit, tolerance and symbols. The verdict comes
+from :func:`grader.grade.grading.grade_part`, the function ``grader grade`` uses for every cell.
+
+>>> result = check("626 cm/s", expectation(6.26, unit="m/s"))
+>>> result["verdict"], result["parsed"], result["tolerance"]
+('correct', 6.26, '±1 %')
+>>> check("6.4", expectation(6.26, unit="m/s", tolerance={"mode": "sigfigs", "digits": 2}))["feedback"]
+'6.4 m/s does not match 6.3 m/s to 2 significant figures (it is 0.14 m/s above)'
+>>> check("0.1p v", expectation("v*p/10", symbols=["p", "v"]))["verdict"]
+'correct'
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import re
+from collections.abc import Iterator, Mapping, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+from grader.errors import GraderError, UsageError, shown
+from grader.grade.cells import MAX_CELL
+from grader.grade.grading import Verdict, grade_part
+from grader.grade.key import SYMBOL_RANGE, Key, KeyPart
+from grader.grade.notation import ReadError, tree_of, value_of
+from grader.grade.submissions import Answer
+from grader.model.expr import CONSTANTS, FUNCTIONS, names, to_text
+from grader.model.tolerance import Tolerance
+from grader.model.units import parse_unit
+
+_GIVEN = Key(where="the command line", version=2, title="grader check", numeric_expressions=True,
+             problems=(), students=())
+"""The context of an answer checked against a given value: arithmetic allowed, as by default."""
+
+FIELDS = ("verdict", "credit", "parsed", "expected", "unit", "abs_error", "rel_error", "tolerance", "feedback")
+"""The fields of a result, in order (``--json`` and ``--batch``)."""
+
+_BATCH_FIELDS = {"submitted", "expected", "unit", "tolerance", "symbols", "domains", "student", "label"}
+
+
+@dataclass(frozen=True)
+class Expectation:
+    """What an answer is checked against: a part, and the key it belongs to (for the assignment's
+    grading settings and the seed of symbolic comparisons)."""
+
+    part: KeyPart
+    key: Key
+
+
+def from_key(key: Key, student: str, label: str) -> Expectation:
+    """The part ``label`` of the key's student ``student`` (an id, or an email as in the roster)."""
+    found = [s for s in key.students if s.id == student] or \
+            [s for s in key.students if s.email and s.email.lower() == student.strip().lower()]
+    if not found:
+        unpadded = [s.id for s in key.students if s.id.lstrip("0") == student.lstrip("0")]
+        hint = f"; did you mean {unpadded[0]}?" if len(unpadded) == 1 else ""
+        raise UsageError(f"{key.where}: no student {shown(student)} (by id or email){hint}")
+    parts = found[0].parts
+    if label not in parts:
+        raise UsageError(f"{key.where}: no part {shown(label)}; the parts are {', '.join(key.labels)}")
+    return Expectation(parts[label], key)
+
+
+def expectation(expected: float | str | None, *, unit: str = "", tolerance: Mapping[str, Any] | None = None,
+                symbols: Sequence[str] | None = None,
+                domains: Mapping[str, tuple[float, float]] | None = None) -> Expectation:
+    """A part made from given values: a number, an expression (symbolic), or None (no value exists).
+
+    ``expected`` as text is a number or arithmetic (``sqrt(2*9.81*2)``) unless it has names: then it is
+    an expression in ``symbols`` (default: the names it uses), each drawn from ``domains`` or [1, 10].
+    """
+    try:
+        parse_unit(unit)  # the units a key can hold: a typing error is refused here, not blamed on the student
+    except GraderError as error:
+        raise UsageError(f"unit: {error}") from None
+    rule = Tolerance.from_json({} if tolerance is None else tolerance)
+    value, ranges = _expected(expected, symbols, domains or {})
+    return Expectation(KeyPart(problem="", name="", label="answer", value=value, unit=unit, points=1.0,
+                               tolerance={"mode": rule.mode, **rule.to_json()},
+                               undefined=None if value is not None else "given as undefined", symbols=ranges),
+                       _GIVEN)
+
+
+def _expected(expected: float | str | None, symbols: Sequence[str] | None,
+              domains: Mapping[str, tuple[float, float]]) -> tuple[float | str | None,
+                                                                   dict[str, tuple[float, float]]]:
+    if expected is None or (isinstance(expected, float | int) and not isinstance(expected, bool)):
+        if expected is not None and not math.isfinite(expected):
+            raise UsageError(f"expected: expected a finite number, got {expected!r}")
+        if symbols or domains:
+            raise UsageError("symbols and domains are for an expected expression, not a number")
+        return None if expected is None else float(expected), {}
+    if not isinstance(expected, str):
+        raise UsageError(f"expected: expected a number, an expression or null, got {shown(expected)}")
+    try:
+        tree = tree_of(expected, tuple(symbols) if symbols is not None else _names_in(expected))
+    except (ReadError, GraderError) as error:
+        raise UsageError(f"expected {shown(expected)}: {error}") from None
+    used = sorted(names(tree))
+    if not used:
+        if domains:
+            raise UsageError("domains are for an expected expression, not a number")
+        try:
+            return value_of(tree), {}
+        except ReadError as error:
+            raise UsageError(f"expected {shown(expected)}: {error}") from None
+    listed = list(symbols) if symbols is not None else used
+    unknown = sorted(set(domains) - set(listed))
+    if unknown:
+        raise UsageError(f"a domain for {', '.join(unknown)}, which the expression's symbols "
+                         f"({', '.join(listed)}) do not include")
+    return to_text(tree), {name: domains.get(name, SYMBOL_RANGE) for name in listed}
+
+
+def _names_in(text: str) -> tuple[str, ...]:
+    """The names an expected expression uses, as its symbols when none are given (``2v`` uses v)."""
+    return tuple(sorted(set(re.findall(r"[A-Za-z_]\w*", text[:MAX_CELL])) - set(FUNCTIONS) - set(CONSTANTS)))
+
+
+def domain(text: str) -> tuple[str, tuple[float, float]]:
+    """``p=0.1:10`` as a name and its range (a command-line ``--domain``).
+
+    >>> domain("p=0.1:10")
+    ('p', (0.1, 10.0))
+    """
+    name, _, bounds = text.partition("=")
+    low, _, high = bounds.partition(":")
+    try:
+        return name.strip(), _range(name.strip(), [float(low), float(high)])
+    except ValueError:
+        raise UsageError(f"--domain {shown(text)}: expected NAME=LOW:HIGH, like p=0.1:10") from None
+
+
+def _range(name: str, bounds: Any) -> tuple[float, float]:
+    if not name.isidentifier():
+        raise UsageError(f"domain: expected a name like p, got {shown(name)}")
+    if (not isinstance(bounds, list) or len(bounds) != 2
+            or not all(isinstance(b, float | int) and not isinstance(b, bool) and math.isfinite(b) for b in bounds)
+            or not bounds[0] < bounds[1]):
+        raise UsageError(f"domain of {name}: expected two finite numbers LOW < HIGH, got {shown(bounds)}")
+    return float(bounds[0]), float(bounds[1])
+
+
+def check(submitted: str, against: Expectation) -> dict[str, Any]:
+    """Grade one answer; the result has the fields of :data:`FIELDS`."""
+    answer = Answer("the command line", 0, "", against.part.label, submitted, ",", None)
+    return result(grade_part(against.part, "", answer, against.key), against.part)
+
+
+def result(verdict: Verdict, part: KeyPart) -> dict[str, Any]:
+    """A verdict as the JSON object ``grader check`` prints: numbers as numbers, absent ones as null."""
+    parsed: float | str | None = verdict.parsed or None
+    if parsed is not None and not part.symbolic:
+        parsed = float(parsed)
+    return {"verdict": verdict.verdict, "credit": verdict.credit, "parsed": parsed, "expected": part.value,
+            "unit": part.unit, "abs_error": verdict.abs_error, "rel_error": verdict.rel_error,
+            "tolerance": verdict.tolerance, "feedback": verdict.feedback}
+
+
+def batch(lines: Sequence[str], key: Key | None) -> Iterator[dict[str, Any]]:
+    """One result per line that is not blank, in order; a line that cannot be checked gives
+    ``{"line": n, "error": reason}`` and the others go on."""
+    for number, line in enumerate(lines, start=1):
+        if not line.strip():
+            continue
+        try:
+            yield _line(line, key)
+        except (GraderError, ValueError, RecursionError) as error:
+            yield {"line": number, "error": str(error)}
+
+
+def _line(line: str, key: Key | None) -> dict[str, Any]:
+    try:
+        item = json.loads(line, parse_constant=_refuse_constant)
+    except ValueError as error:
+        raise UsageError(f"expected a JSON object, got invalid JSON ({error})") from None
+    if not isinstance(item, dict):
+        raise UsageError(f"expected a JSON object, got {shown(item)}")
+    extra = sorted(str(name) for name in item if name not in _BATCH_FIELDS)
+    if extra:
+        raise UsageError(f"unknown field {shown(', '.join(extra))[1:-1]}; expected {', '.join(sorted(_BATCH_FIELDS))}")
+    submitted = item.get("submitted")
+    if isinstance(submitted, float | int) and not isinstance(submitted, bool):
+        submitted = repr(submitted)
+    if not isinstance(submitted, str):
+        raise UsageError(f"submitted: expected the answer as text, got {shown(submitted)}")
+    if "student" in item or "label" in item:
+        if key is None:
+            raise UsageError("student and label need --key")
+        return check(submitted, from_key(key, _text(item, "student"), _text(item, "label")))
+    if "expected" not in item:
+        raise UsageError("expected: missing (a number, an expression or null)" +
+                         ("; or give student and label" if key is not None else ""))
+    symbols = item.get("symbols")
+    if symbols is not None and not (isinstance(symbols, list) and all(isinstance(s, str) for s in symbols)):
+        raise UsageError(f"symbols: expected a list of names like [\"p\", \"v\"], got {shown(symbols)}")
+    ranges = item.get("domains", {})
+    if not isinstance(ranges, dict):
+        raise UsageError(f"domains: expected an object like {{\"p\": [0.1, 10]}}, got {shown(ranges)}")
+    unit = item.get("unit", "")
+    if not isinstance(unit, str):
+        raise UsageError(f"unit: expected text like \"m/s\", got {shown(unit)}")
+    against = expectation(item["expected"], unit=unit, tolerance=item.get("tolerance"), symbols=symbols,
+                          domains={str(name): _range(str(name), bounds) for name, bounds in ranges.items()})
+    return check(submitted, against)
+
+
+def _text(item: Mapping[str, Any], name: str) -> str:
+    value = item.get(name)
+    if not isinstance(value, str):
+        raise UsageError(f"{name}: expected text, got {shown(value)}")
+    return value
+
+
+def _refuse_constant(name: str) -> float:
+    raise ValueError(f"{name} is not a number JSON allows")

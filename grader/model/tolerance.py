@@ -1,0 +1,146 @@
+"""How close an answer must be to the key: one tolerance, from the template to the verdict.
+
+A template sets ``{rtol, atol}``; an assignment may override it per answer with ``{rtol, atol}``
+(either alone keeps the other), ``{sigfigs: N}`` or ``{decimals: N}``; the key stores it in its JSON
+form (``{"mode": "rtol", "rtol", "atol"}`` or ``{"mode": "sigfigs", "digits"}``, and key version 1's
+bare ``{"rtol", "atol"}``); ``grader check --batch`` takes either form. The comparison rules live in
+:mod:`grader.grade.compare`; this is the data and its words.
+
+>>> Tolerance.from_json({"sigfigs": 3}) == Tolerance("sigfigs", digits=3)
+True
+>>> Tolerance.from_json({"atol": 0.05}, base=Tolerance(rtol=0.02)).describe("m/s")
+'±2 % + 0.05 m/s'
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any, Literal
+
+from grader.errors import GraderError, shown
+
+Mode = Literal["rtol", "sigfigs", "decimals"]
+MODES: tuple[Mode, ...] = ("rtol", "sigfigs", "decimals")
+MAX_DIGITS = 17
+"""float64 carries 17 significant digits; more cannot be told apart."""
+
+FORMS = "{rtol: X, atol: Y}, {sigfigs: N} or {decimals: N}"
+"""The forms an instructor writes, for messages."""
+
+
+class ToleranceError(GraderError, ValueError):
+    """A tolerance that is not one of the accepted forms; ``field`` names the entry (``""``: the whole),
+    ``got`` is what came, as shown in the message."""
+
+    def __init__(self, field: str, expected: str, got: str) -> None:
+        self.field, self.expected, self.got = field, expected, got
+        super().__init__(f"tolerance{'.' + field if field else ''}: expected {expected}, got {got}")
+
+
+@dataclass(frozen=True)
+class Tolerance:
+    """How close a submitted number must be to the key.
+
+    ``rtol`` mode: ``|s - t| <= atol + rtol*|t|`` (``atol`` in the answer's unit); ``sigfigs`` and
+    ``decimals`` modes: PrairieLearn's rules with ``digits`` figures or places. Values that do not apply
+    to the mode must stay at their defaults, so two tolerances are equal exactly when they grade alike.
+
+    >>> Tolerance().describe(), Tolerance(atol=0.05).describe("m/s"), Tolerance(rtol=0, atol=0.5).describe("deg")
+    ('±1 %', '±1 % + 0.05 m/s', '±0.5°')
+    >>> Tolerance("sigfigs", digits=3).describe(), Tolerance("decimals", digits=1).describe()
+    ('3 significant figures', '1 decimal place')
+    >>> Tolerance("sigfigs", digits=0)
+    Traceback (most recent call last):
+    ...
+    grader.model.tolerance.ToleranceError: tolerance.digits: expected a whole number from 1 to 17, got 0
+    """
+
+    mode: Mode = "rtol"
+    rtol: float = 0.01
+    atol: float = 0.0
+    digits: int = 3
+
+    def __post_init__(self) -> None:
+        if self.mode not in MODES:
+            raise ToleranceError("mode", "'rtol', 'sigfigs' or 'decimals'", shown(self.mode))
+        for name in ("rtol", "atol"):
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, (int, float)) or not 0 <= value < 1e300:
+                raise ToleranceError(name, "a number from 0 to 1e300", shown(value))
+            object.__setattr__(self, name, float(value))
+        lowest = 1 if self.mode == "sigfigs" else 0
+        if isinstance(self.digits, bool) or not isinstance(self.digits, int) or not lowest <= self.digits <= MAX_DIGITS:
+            raise ToleranceError("digits", f"a whole number from {lowest} to {MAX_DIGITS}", shown(self.digits))
+        if self.mode == "rtol" and self.digits != 3:
+            raise ToleranceError("digits", "no digits in rtol mode (digits count only for sigfigs and decimals)",
+                                 shown(self.digits))
+        if self.mode != "rtol" and (self.rtol, self.atol) != (0.01, 0.0):
+            raise ToleranceError("rtol", f"no rtol or atol in {self.mode} mode (they count only in rtol mode)",
+                                 shown({"rtol": self.rtol, "atol": self.atol}))
+
+    def describe(self, unit: str = "") -> str:
+        """What is accepted, in words; ``atol`` is in the answer's ``unit``."""
+        if self.mode != "rtol":
+            noun = "significant figure" if self.mode == "sigfigs" else "decimal place"
+            return f"{self.digits} {noun}" + ("" if self.digits == 1 else "s")
+        relative = f"{_plain(self.rtol * 100)} %"
+        if not self.atol:
+            return f"±{relative}"
+        absolute = with_unit(_plain(self.atol), unit)
+        return f"±{relative} + {absolute}" if self.rtol else f"±{absolute}"
+
+    @classmethod
+    def from_json(cls, data: Any, *, base: Tolerance | None = None) -> Tolerance:
+        """Read any written form: ``{"rtol", "atol"}`` (either may be left out: it comes from ``base``,
+        else the default), ``{"sigfigs": N}``, ``{"decimals": N}``, or the key's ``{"mode", ...}``.
+
+        >>> Tolerance.from_json({"mode": "decimals", "digits": 2}) == Tolerance("decimals", digits=2)
+        True
+        >>> Tolerance.from_json({"rtol": 0.02, "digits": 3})
+        Traceback (most recent call last):
+        ...
+        grader.model.tolerance.ToleranceError: tolerance: expected only the keys atol, mode, rtol in rtol mode, ...
+        """
+        if not isinstance(data, Mapping):
+            raise ToleranceError("", f"a mapping like {FORMS}", shown(data))
+        shorthand: list[Mode] = [mode for mode in ("sigfigs", "decimals") if mode in data]
+        if shorthand:
+            if len(data) != 1:
+                raise ToleranceError("", f"{FORMS}, one of them", shown(dict(data)))
+            return cls(shorthand[0], digits=data[shorthand[0]])
+        mode = data.get("mode", "rtol")
+        if mode not in MODES:
+            raise ToleranceError("mode", "'rtol', 'sigfigs' or 'decimals'", shown(mode))
+        allowed = {"mode", "rtol", "atol"} if mode == "rtol" else {"mode", "digits"}
+        extra = sorted(str(key) for key in data if key not in allowed)
+        if extra:
+            raise ToleranceError("", f"only the keys {', '.join(sorted(allowed))} in {mode} mode",
+                                 shown(", ".join(extra))[1:-1])
+        if mode != "rtol":
+            return cls(mode, digits=data.get("digits", 3))
+        start = base if base is not None and base.mode == "rtol" else cls()
+        return cls(rtol=data.get("rtol", start.rtol), atol=data.get("atol", start.atol))
+
+    def to_json(self) -> dict[str, Any]:
+        """The key's form, with the mode named.
+
+        >>> Tolerance().to_json(), Tolerance("decimals", digits=2).to_json()
+        ({'mode': 'rtol', 'rtol': 0.01, 'atol': 0.0}, {'mode': 'decimals', 'digits': 2})
+        """
+        if self.mode == "rtol":
+            return {"mode": "rtol", "rtol": self.rtol, "atol": self.atol}
+        return {"mode": self.mode, "digits": self.digits}
+
+
+def with_unit(text: str, unit: str) -> str:
+    """A number's text with its unit: ``6.26 m/s``, ``30°``."""
+    if unit in ("deg", "degree", "degrees", "°"):
+        return f"{text}°"
+    return f"{text} {unit}" if unit else text
+
+
+def _plain(value: float) -> str:
+    """A tolerance figure without float noise: ``0.07*100`` prints as ``7``."""
+    mantissa, _, power = f"{value + 0.0:.12g}".partition("e")
+    return f"{mantissa}e{int(power)}" if power else mantissa

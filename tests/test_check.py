@@ -1,0 +1,183 @@
+"""`grader check`: one answer graded as `grader grade` grades it, against a key's part or a given value.
+
+Expected values are written here by hand (the boundaries are PrairieLearn's rules worked out on paper).
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from grader.cli import main
+from grader.grade.check import FIELDS
+
+KEY = {
+    "schema": "grader-key", "version": 2,
+    "assignment": {"title": "HW 3", "grading": {"numeric_expressions": True}},
+    "problems": [{"key": "1", "title": "Pile", "answers": [
+        {"name": "v", "label": "1a", "unit": "m/s", "points": 2},
+        {"name": "theta", "label": "1b", "unit": "deg", "points": 1},
+        {"name": "vA", "label": "1c", "unit": "m/s", "points": 1, "symbols": {"p": [0.1, 10], "v": [1, 10]}}]}],
+    "students": [{"id": "00123", "name": "Ana", "email": "Ana@Example.edu", "section": "1", "problems": [{
+        "key": "1", "answers": {
+            "v": {"value": 6.26, "unit": "m/s", "label": "1a", "points": 2, "tolerance": {"rtol": 0.01, "atol": 0}},
+            "theta": {"value": None, "unit": "deg", "label": "1b", "points": 1,
+                      "tolerance": {"mode": "decimals", "digits": 1}, "undefined": "the ball stops"},
+            "vA": {"value": "v*(1 - 0.1*p)/(1 + p)", "unit": "m/s", "label": "1c", "points": 1,
+                   "tolerance": {"rtol": 0.01, "atol": 0}}}}]}],
+}
+
+
+@pytest.fixture
+def key_path(tmp_path: Path) -> Path:
+    path = tmp_path / "key.json"
+    path.write_text(json.dumps(KEY), encoding="utf-8")
+    return path
+
+
+def run(capsys: pytest.CaptureFixture[str], *argv: object) -> tuple[int, str, str]:
+    code = main(["check", *(str(a) for a in argv)])
+    captured = capsys.readouterr()
+    return code, captured.out, captured.err
+
+
+def checked(capsys: pytest.CaptureFixture[str], *argv: object) -> dict[str, Any]:
+    code, out, err = run(capsys, *argv, "--json")
+    assert code == 0, err
+    result = json.loads(out)
+    assert tuple(result) == FIELDS
+    return result  # type: ignore[no-any-return]
+
+
+def test_an_answer_with_another_unit_against_a_given_value(capsys: pytest.CaptureFixture[str]) -> None:
+    result = checked(capsys, "626 cm/s", "--expected", "6.26", "--unit", "m/s")
+    assert result == {"verdict": "correct", "credit": 1.0, "parsed": 6.26, "expected": 6.26, "unit": "m/s",
+                      "abs_error": 0.0, "rel_error": 0.0, "tolerance": "±1 %",
+                      "feedback": "6.26 m/s equals 6.26 m/s; within ±1 % is accepted"}
+    wrong = checked(capsys, "6.26 kg", "--expected", "6.26 m/s")
+    assert (wrong["verdict"], wrong["feedback"]) == ("incorrect", "expected a speed (m/s), got a mass (kg)")
+
+
+@pytest.mark.parametrize(("answer", "mode", "verdict"), [
+    ("6.3226", ["--rtol", "0.01"], "correct"),  # exactly 1 % above
+    ("6.3227", ["--rtol", "0.01"], "incorrect"),
+    ("6.36", ["--rtol", "0", "--atol", "0.1"], "correct"),  # on the absolute bound
+    ("6.3601", ["--rtol", "0", "--atol", "0.1"], "incorrect"),
+    ("6.265", ["--sigfigs", "3"], "correct"),  # 0.005 < 0.51e-2
+    ("6.2652", ["--sigfigs", "3"], "incorrect"),  # 0.0052 > 0.0051
+    ("6.3", ["--sigfigs", "2"], "correct"),  # 0.04 < 0.51e-1
+    ("6.2", ["--sigfigs", "2"], "incorrect"),  # 0.06 > 0.051
+    ("6.31", ["--decimals", "1"], "correct"),  # 0.05 < 0.051
+    ("6.312", ["--decimals", "1"], "incorrect"),  # 0.052
+])
+def test_each_tolerance_mode_at_its_boundary(capsys: pytest.CaptureFixture[str], answer: str, mode: list[str],
+                                             verdict: str) -> None:
+    assert checked(capsys, answer, "--expected", "6.26", *mode)["verdict"] == verdict
+
+
+def test_angles_and_expressions(capsys: pytest.CaptureFixture[str]) -> None:
+    assert checked(capsys, "-19.1", "--expected", "340.9", "--unit", "deg")["verdict"] == "correct"
+    same = checked(capsys, "(1+p)v", "--expected", "v + p v", "--domain", "p=0.1:10", "--domain", "v=1:30")
+    assert (same["verdict"], same["parsed"], same["expected"]) == ("correct", "(1 + p)*v", "v + p*v")
+    other = checked(capsys, "v(1-p)", "--expected", "v*(1+p)", "--symbols", "p,v")
+    assert other["verdict"] == "incorrect"
+    unknown = checked(capsys, "2m", "--expected", "2v", "--symbols", "p,v")
+    assert (unknown["verdict"], unknown["feedback"]) == ("invalid", "could not read this answer: unknown name m; "
+                                                                    "use p and v")
+
+
+def test_against_a_students_part_of_a_key(capsys: pytest.CaptureFixture[str], key_path: Path) -> None:
+    by_id = checked(capsys, "--key", key_path, "--student", "00123", "--label", "1a", "6,3 m/s")
+    assert (by_id["verdict"], by_id["parsed"], by_id["expected"]) == ("correct", 6.3, 6.26)
+    by_email = checked(capsys, "--key", key_path, "--student", "ana@example.EDU", "--label", "1c", "0.9v/(1+p)")
+    assert by_email["verdict"] == "incorrect"
+    symbolic = checked(capsys, "--key", key_path, "--student", "00123", "--label", "1c", "v(1-0.1p)/(1+p)")
+    assert symbolic["verdict"] == "correct"
+    human = run(capsys, "--key", key_path, "--student", "00123", "--label", "1a", "6.5")
+    assert human[0] == 0 and "incorrect (credit 0)" in human[1] and "6.5 m/s is 3.8 % above 6.26 m/s" in human[1]
+
+
+@pytest.mark.parametrize(("answer", "verdict"), [("", "correct"), ("undefined", "correct"), ("0", "incorrect")])
+def test_an_undefined_key_value_accepts_a_blank_or_undefined(capsys: pytest.CaptureFixture[str], key_path: Path,
+                                                             answer: str, verdict: str) -> None:
+    result = checked(capsys, "--key", key_path, "--student", "00123", "--label", "1b", answer)
+    assert result["verdict"] == verdict and result["expected"] is None and "the ball stops" in result["feedback"]
+
+
+def test_check_agrees_with_grade_cell_for_cell(tmp_path: Path, capsys: pytest.CaptureFixture[str],
+                                               key_path: Path) -> None:
+    answers = {"1a": "≈ 6.1 m/s", "1b": "12.5", "1c": "v(1 - p/10)/(p+1)"}
+    stream = io.StringIO()
+    csv.writer(stream, lineterminator="\n").writerows([["student_id", "label", "answer"],
+                                                       *(["00123", label, text] for label, text in answers.items())])
+    (tmp_path / "answers.csv").write_text(stream.getvalue(), encoding="utf-8")
+    assert main(["grade", "--key", str(key_path), str(tmp_path / "answers.csv"), "--out", str(tmp_path / "g")]) == 0
+    capsys.readouterr()
+    with open(tmp_path / "g" / "details.csv", encoding="utf-8", newline="") as file:
+        details = {row["label"]: row for row in csv.DictReader(file)}
+    for label, text in answers.items():
+        result = checked(capsys, "--key", key_path, "--student", "00123", "--label", label, text)
+        row = details[label]
+        assert (result["verdict"], result["tolerance"], result["feedback"]) == \
+               (row["verdict"], row["tolerance"], row["feedback"])
+    assert [details[label]["verdict"] for label in answers] == ["incorrect", "incorrect", "correct"]
+
+
+def test_a_batch_gives_one_line_per_line_in_order(tmp_path: Path, capsys: pytest.CaptureFixture[str],
+                                                  key_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    lines = [
+        {"submitted": "626 cm/s", "expected": 6.26, "unit": "m/s"},
+        {"submitted": "6.4", "expected": 6.26, "tolerance": {"mode": "decimals", "digits": 1}},
+        "not json",
+        {"submitted": "0.1pv", "expected": "p*v/10", "symbols": ["p", "v"], "domains": {"p": [0.1, 10]}},
+        {"submitted": "", "expected": None},
+        {"submitted": "1", "expected": 1, "tolerance": {"rtol": -1}},
+        {"submitted": "6.26", "student": "00123", "label": "1a"},
+        {"submitted": "1", "expected": 1, "domains": {"p": [2, 1]}},
+    ]
+    batch = tmp_path / "answers.jsonl"
+    batch.write_text("\n".join(line if isinstance(line, str) else json.dumps(line) for line in lines) + "\n\n",
+                     encoding="utf-8")
+    code, out, _ = run(capsys, "--batch", batch)
+    results = [json.loads(line) for line in out.splitlines()]
+    assert code == 3 and len(results) == len(lines)
+    assert [r.get("verdict") for r in results] == ["correct", "incorrect", None, "correct", "correct", None, None,
+                                                   None]
+    errors = {r["line"]: r["error"] for r in results if "error" in r}
+    assert set(errors) == {3, 6, 7, 8}
+    assert "invalid JSON" in errors[3] and "tolerance.rtol" in errors[6] and "need --key" in errors[7]
+    assert "LOW < HIGH" in errors[8]
+    monkeypatch.setattr("sys.stdin", io.TextIOWrapper(io.BytesIO(batch.read_bytes())))
+    code, out, _ = run(capsys, "--batch", "-", "--key", key_path)
+    assert json.loads(out.splitlines()[6])["verdict"] == "correct"
+    good = tmp_path / "good.jsonl"
+    good.write_text(json.dumps(lines[0]) + "\n", encoding="utf-8")
+    assert run(capsys, "--batch", good)[0] == 0
+
+
+@pytest.mark.parametrize(("argv", "message"), [
+    (["6.3"], "expected --expected VALUE"),
+    (["--expected", "6.26"], "expected the answer to check"),
+    (["6.3", "--expected", "6.26", "--sigfigs", "3", "--rtol", "0.1"], "choose one tolerance mode"),
+    (["6.3", "--expected", "6.26", "--unit", "furlongs"], "unit: unknown unit 'furlongs'"),
+    (["6.3", "--expected", "6.26 m/s", "--unit", "ft/s"], "give the unit once"),
+    (["6.3", "--expected", "6.26", "--sigfigs", "0"], "tolerance.digits"),
+    (["6.3", "--expected", "__import__('os')"], "expected \"__import__('os')\""),
+    (["6.3", "--expected", "v", "--domain", "v=3:1"], "LOW < HIGH"),
+    (["6.3", "--expected", "v", "--domain", "p=1:3"], "a domain for p"),
+    (["6.3", "--expected", "v", "--domain", "v"], "expected NAME=LOW:HIGH"),
+    (["6.3", "--key", "KEY", "--label", "1a"], "--key needs --student"),
+    (["6.3", "--key", "KEY", "--student", "00123", "--label", "1a", "--unit", "m/s"], "come from the key"),
+    (["6.3", "--key", "KEY", "--student", "123", "--label", "1a"], "did you mean 00123?"),
+    (["6.3", "--key", "KEY", "--student", "00123", "--label", "9z"], "the parts are 1a, 1b, 1c"),
+    (["6.3", "--batch", "x.jsonl"], "give it alone"),
+])
+def test_requests_that_cannot_be_carried_out_exit_2(capsys: pytest.CaptureFixture[str], key_path: Path,
+                                                    argv: list[str], message: str) -> None:
+    code, out, err = run(capsys, *(str(key_path) if a == "KEY" else a for a in argv))
+    assert code == 2 and out == "" and message in err

@@ -158,6 +158,20 @@ def test_an_excused_student_and_a_second_row_of_one_student_keep_the_exports_cel
                                       "score kept")]
 
 
+def test_a_row_with_more_cells_than_the_header_is_left_out_and_said_so(folder: Path,
+                                                                      capsys: pytest.CaptureFixture[str]) -> None:
+    EXPORT.write_text("Student;ID;SIS User ID;SIS Login ID;Section;Homework 3 (12345)\n"
+                      '"Doe, Jane";4321;00123;jdoe;Section 1;\n'
+                      '"Wei, Li";4322;;s2002;Section 1;3,50;extra\n'
+                      '"Stranger; Sam";4330;99999;sstranger;Section 2;7,50\n', encoding="utf-8")
+    assert grade(capsys)[0] == 0
+    assert [row[0] for row in cells(folder / "g" / "canvas.csv")[2:]] == ["Doe, Jane", "Stranger; Sam"]
+    assert cells(folder / "g" / "canvas.csv")[-1][-1] == "7,50"  # a decimal comma Canvas' import reads
+    assert cells(folder / "g" / "problems.csv")[1] == [
+        "export.csv", "3", "s2002", "", "7 cells, but the header has 6 columns; expected one cell per column: left "
+                                        "out of canvas.csv"]
+
+
 @pytest.mark.parametrize(("header", "row"), [
     ("LastName,FirstName,ID,SIS Login ID,Section", "Doe,Jane,4321,jane.doe@uni.edu,Section 1"),
     ("Student,ID,SIS User ID,SIS Login ID,Integration ID,Root Account,Section",

@@ -85,6 +85,9 @@ def build_parser() -> argparse.ArgumentParser:
     grading.add_argument("--format", choices=("auto", "long", "wide"), default="auto",
                          help="long: a row per answer (student, label, answer); wide: a row per submission, a "
                               "column per label; auto (default): told apart from the header")
+    grading.add_argument("--canvas", type=Path, metavar="EXPORT.csv",
+                         help="a Canvas gradebook export (Grades > Export): canvas.csv then has its students, names "
+                              "and ids, and its 'Title (id)' column of the assignment")
     grading.add_argument("--force", action="store_true",
                          help="replace an output folder an earlier run wrote (as its .grader-manifest.json says)")
     grading.add_argument("--json", action="store_true", help="print a summary object on stdout")
@@ -539,7 +542,8 @@ def _print_summary(summary: Any) -> None:
 def _grade(arguments: argparse.Namespace) -> int:
     from grader.grade.run import run as run_grading
 
-    summary = run_grading(arguments.key, arguments.submissions, arguments.out, arguments.format, arguments.force)
+    summary = run_grading(arguments.key, arguments.submissions, arguments.out, arguments.format, arguments.force,
+                          arguments.canvas)
     verdicts = ", ".join(f"{n} {kind}" for kind, n in summary.verdicts.items() if n)
     rows = f"{summary.rows_not_graded} row{'' if summary.rows_not_graded == 1 else 's'}"
     print(f"{summary.students} students ({summary.submitted} submitted), {summary.parts} parts graded ({verdicts}); "

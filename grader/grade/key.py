@@ -92,6 +92,11 @@ class Key:
         """Every part's label, in the order of the sheet."""
         return tuple(label for problem in self.problems for label in problem.labels)
 
+    @property
+    def possible(self) -> float:
+        """The most points a student can earn (Canvas' "points possible" of the assignment)."""
+        return max((student.possible for student in self.students), default=0.0)
+
 
 def load_key(path: Path) -> Key:
     """Read and check a key file; a file that is not a grader key is refused with the reason."""

@@ -15,15 +15,17 @@ from pathlib import Path
 
 from grader.assign.keyfile import safe_cell
 from grader.files import write_atomic
+from grader.grade.canvas import CanvasExport
 from grader.grade.grading import Graded, totals
 
 GRADES, DETAILS, PROBLEMS, CANVAS = "grades.csv", "details.csv", "problems.csv", "canvas.csv"
 
 
-def write_reports(graded: Graded, folder: Path) -> list[Path]:
-    """Write the four files into ``folder``; returns their paths."""
-    files = {GRADES: grades_csv(graded), DETAILS: details_csv(graded), PROBLEMS: problems_csv(graded),
-             CANVAS: canvas_csv(graded)}
+def write_reports(graded: Graded, folder: Path, export: CanvasExport | None = None) -> list[Path]:
+    """Write the four files into ``folder`` (``canvas.csv`` after a Canvas ``export`` when one is
+    given); returns their paths."""
+    files = {GRADES: grades_csv(graded), DETAILS: details_csv(graded), PROBLEMS: problems_csv(graded, export),
+             CANVAS: canvas_csv(graded, export)}
     for name, text in files.items():
         write_atomic(folder / name, text)
     return [folder / name for name in files]
@@ -53,23 +55,29 @@ def details_csv(graded: Graded) -> str:
     return _csv(rows)
 
 
-def problems_csv(graded: Graded) -> str:
-    """Every input row not graded, or graded with a caveat, with the reason."""
+def problems_csv(graded: Graded, export: CanvasExport | None = None) -> str:
+    """Every input row not graded, or graded with a caveat, with the reason; then the Canvas
+    export's caveats (line empty: a key student the export lacks)."""
     rows: list[list[object]] = [["file", "line", "student_id", "label", "reason"]]
-    rows += [[p.file, p.line, p.student_id, p.label, p.reason] for p in graded.problems]
+    rows += [[p.file, p.line or None, p.student_id, p.label, p.reason]
+             for p in (*graded.problems, *(export.problems if export else ()))]
     return _csv(rows)
 
 
-def canvas_csv(graded: Graded) -> str:
-    """A Canvas gradebook import: the student columns Canvas wants, one column titled with the
-    assignment, and its ``Points Possible`` row."""
+def canvas_csv(graded: Graded, export: CanvasExport | None = None) -> str:
+    """A Canvas gradebook import: the student columns Canvas wants, one column of the assignment, and
+    its ``Points Possible`` row. Without an ``export``, a row per student of the key, named as the key
+    names them; with one, its student rows and columns as exported, and its ``Title (id)`` header."""
     key = graded.key
-    scores = totals(graded)
-    most = max((s.possible for s in key.students), default=0.0)
-    rows: list[list[object]] = [["Student", "ID", "SIS User ID", "SIS Login ID", "Section", key.title],
-                                ["Points Possible", "", "", "", "", most]]
-    rows += [[s.name, "", s.id, s.email, s.section, sum(scores[s.id].values())] for s in key.students]
-    return _csv(rows)
+    scores = {student_id: sum(by_problem.values()) for student_id, by_problem in totals(graded).items()}
+    columns: tuple[str, ...]
+    if export is None:
+        columns, title = ("Student", "ID", "SIS User ID", "SIS Login ID", "Section"), key.title
+        body: list[list[object]] = [[s.name, "", s.id, s.email, s.section, scores[s.id]] for s in key.students]
+    else:
+        columns, title = export.columns, export.assignment
+        body = [[*row.identity, row.kept if row.key_id is None else scores[row.key_id]] for row in export.rows]
+    return _csv([[*columns, title], ["Points Possible", *[""] * (len(columns) - 1), key.possible], *body])
 
 
 def _csv(rows: Iterable[Sequence[object]]) -> str:

@@ -14,6 +14,7 @@ from pathlib import Path
 from typing import Literal
 
 from grader.files import output_folder
+from grader.grade.canvas import read_export
 from grader.grade.grading import counts, grade
 from grader.grade.key import load_key
 from grader.grade.report import write_reports
@@ -42,15 +43,23 @@ class GradeSummary:
 
 
 def run(key_path: Path, paths: Sequence[Path], out: Path, fmt: Literal["auto", "long", "wide"] = "auto",
-        force: bool = False) -> GradeSummary:
-    """Grade the submission files against the key into ``out``."""
+        force: bool = False, canvas: Path | None = None) -> GradeSummary:
+    """Grade the submission files against the key into ``out``; ``canvas``: a Canvas gradebook export
+    whose students, names and ids ``canvas.csv`` then carries.
+
+    ``rows_not_graded`` counts submission rows only: the export's mismatches are caveats (see
+    :mod:`grader.grade.canvas`).
+    """
     started = time.perf_counter()
     key = load_key(key_path)
+    export = read_export(canvas, key) if canvas is not None else None
     submissions = read_submissions(paths, [StudentRef(s.id, s.email) for s in key.students], key.labels, fmt)
     graded = grade(key, submissions)
-    with output_folder(out, command="grader grade", inputs=(key_path, *paths), force=force) as staging:
-        write_reports(graded, staging)
+    inputs = (key_path, *paths, *([canvas] if canvas is not None else []))
+    with output_folder(out, command="grader grade", inputs=inputs, force=force) as staging:
+        write_reports(graded, staging, export)
     answered = {v.student_id for v in graded.verdicts if v.submitted is not None}
     return GradeSummary(out, len(key.students), len(answered), len(graded.verdicts),
                         sum(not problem.caveat for problem in graded.problems), counts(graded.verdicts),
-                        submissions.ignored_columns, submissions.notes, time.perf_counter() - started)
+                        submissions.ignored_columns, (*submissions.notes, *(export.notes if export else ())),
+                        time.perf_counter() - started)

@@ -114,7 +114,7 @@ def read_submissions(paths: Sequence[Path], students: Sequence[StudentRef], labe
     Raises :class:`GraderError` for a file that cannot be used as a whole (unreadable, neither UTF-8
     nor UTF-16 nor clean Windows-1252, no recognisable header); a bad row is a :class:`RowProblem`.
     """
-    roster = _Roster(students)
+    roster = Roster(students)
     rows: list[_Row] = []
     problems: list[RowProblem] = []
     ignored: dict[str, None] = {}
@@ -139,7 +139,7 @@ def read_submissions(paths: Sequence[Path], students: Sequence[StudentRef], labe
                        tuple(ignored), tuple(notes))
 
 
-class _Roster:
+class Roster:
     """The key's students, found by id (exact, or once leading zeros are restored) or by email."""
 
     def __init__(self, students: Sequence[StudentRef]) -> None:
@@ -172,11 +172,11 @@ class _Roster:
 
 
 _CANVAS_ROWS = ("points possible", "manual posting", "muted")
-_TEST_STUDENTS = ("student, test", "test student")
+TEST_STUDENTS = ("student, test", "test student")  # Canvas' test student, as its name is exported
 
 
 def _read_row(file: str, index: int, row: CsvRow, table: CsvTable, layout: Layout, labels: Sequence[str],
-              roster: _Roster, rows: list[_Row], problems: list[RowProblem]) -> None:
+              roster: Roster, rows: list[_Row], problems: list[RowProblem]) -> None:
     """Append ``row`` to ``rows`` (with its caveats to ``problems``), or its problem to ``problems``."""
     who = row.cells[layout.student]
     label = ""
@@ -223,7 +223,7 @@ def _not_a_student(row: CsvRow, layout: Layout) -> str:
         value = " ".join(row.cells.get(column, "").split()).lower()
         if value in _CANVAS_ROWS:
             return f"not a student row (Canvas' {shown(row.cells[column].strip())} row)"
-        if value in _TEST_STUDENTS:
+        if value in TEST_STUDENTS:
             return "not a student row (Canvas' test student)"
     return ""
 

@@ -13,11 +13,13 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Literal
 
-from grader.files import output_folder
-from grader.grade.grading import counts, grade
+from grader.files import output_folder, write_manifest
+from grader.grade.grading import Graded, counts, grade
 from grader.grade.key import load_key
 from grader.grade.report import write_reports
 from grader.grade.submissions import StudentRef, read_submissions
+
+COMMAND = "grader grade"
 
 
 @dataclass(frozen=True)
@@ -45,12 +47,33 @@ def run(key_path: Path, paths: Sequence[Path], out: Path, fmt: Literal["auto", "
         force: bool = False) -> GradeSummary:
     """Grade the submission files against the key into ``out``."""
     started = time.perf_counter()
-    key = load_key(key_path)
-    submissions = read_submissions(paths, [StudentRef(s.id, s.email) for s in key.students], key.labels, fmt)
-    graded = grade(key, submissions)
-    with output_folder(out, command="grader grade", inputs=(key_path, *paths), force=force) as staging:
+    graded = _graded(key_path, paths, fmt, ())
+    with output_folder(out, command=COMMAND, inputs=(key_path, *paths), force=force) as staging:
         write_reports(graded, staging)
+    return _summary(graded, out, started)
+
+
+def grade_into(folder: Path, key_path: Path, paths: Sequence[Path], out: Path, names: Sequence[str]) -> GradeSummary:
+    """Grade into ``folder``, a part of an output folder still being written (the demo's ``grades/``), as
+    ``grader grade --out out`` would, with the files named as in ``names`` (where they will be) and the
+    manifest ``grader grade`` writes, so that ``grader grade --out out --force`` may replace it later."""
+    started = time.perf_counter()
+    graded = _graded(key_path, paths, "auto", names)
+    write_reports(graded, folder)
+    write_manifest(folder, COMMAND)
+    return _summary(graded, out, started)
+
+
+def _graded(key_path: Path, paths: Sequence[Path], fmt: Literal["auto", "long", "wide"],
+            names: Sequence[str]) -> Graded:
+    key = load_key(key_path)
+    submissions = read_submissions(paths, [StudentRef(s.id, s.email) for s in key.students], key.labels, fmt,
+                                   names)
+    return grade(key, submissions)
+
+
+def _summary(graded: Graded, out: Path, started: float) -> GradeSummary:
     answered = {v.student_id for v in graded.verdicts if v.submitted is not None}
-    return GradeSummary(out, len(key.students), len(answered), len(graded.verdicts),
+    return GradeSummary(out, len(graded.key.students), len(answered), len(graded.verdicts),
                         sum(not problem.caveat for problem in graded.problems), counts(graded.verdicts),
-                        submissions.ignored_columns, submissions.notes, time.perf_counter() - started)
+                        graded.ignored_columns, graded.notes, time.perf_counter() - started)

@@ -12,12 +12,13 @@ import json
 import math
 import os
 import re
+import shlex
 import signal
 import sys
 import threading
 from collections.abc import Sequence
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from grader import __version__
 from grader.bank.template import Parameter, Template, load_bank
@@ -25,6 +26,9 @@ from grader.errors import GraderError, UsageError, shown
 from grader.files import describe_os_error
 from grader.inputs import read_csv
 from grader.model.units import parse_unit, split_quantity
+
+if TYPE_CHECKING:  # imported when used: `grader list` must not pay for numpy
+    from grader.grade.run import GradeSummary
 
 EXIT_OK, EXIT_USAGE, EXIT_REFUSED, EXIT_INTERRUPTED = 0, 2, 3, 130
 _CONTROL = re.compile(r"[\x00-\x1f\x7f-\x9f\u202a-\u202e\u2066-\u2069]")
@@ -514,15 +518,24 @@ def _generate(arguments: argparse.Namespace) -> int:
 
 
 def _demo(arguments: argparse.Namespace) -> int:
-    from grader.render.generate import demo
+    from grader.demo import GRADES, KEY, SUBMISSIONS, demo
 
     _check_jobs(arguments.jobs)
     summary = demo(arguments.out, _bank(arguments), jobs=arguments.jobs, force=arguments.force,
                    font_dirs=tuple(arguments.font_dirs))
-    _print_summary(summary)
-    print(f"The assignment and roster it used are in {summary.out}: edit them and run\n"
-          f"  grader generate {summary.out / 'assignment.yaml'} --roster {summary.out / 'roster.csv'} --out OTHER")
+    _print_summary(summary.generated)
+    out = summary.generated.out
+    print(f"{SUBMISSIONS} (simulated answers) graded: {_graded_line(summary.graded)}")
+    print(f"The assignment and roster it used are in {out}: edit them and run\n"
+          f"  grader generate {_quoted(out / 'assignment.yaml')} --roster {_quoted(out / 'roster.csv')} --out OTHER\n"
+          f"Grade the submissions again, or your own file, with\n"
+          f"  grader grade --key {_quoted(out / KEY)} {_quoted(out / SUBMISSIONS)} --out {_quoted(out / GRADES)} "
+          "--force")
     return EXIT_OK
+
+
+def _quoted(path: Path) -> str:
+    return shlex.quote(str(path))
 
 
 def _check_jobs(jobs: int) -> None:
@@ -544,10 +557,7 @@ def _grade(arguments: argparse.Namespace) -> int:
 
     summary = run_grading(arguments.key, arguments.submissions, arguments.out, arguments.format, arguments.force,
                           arguments.canvas)
-    verdicts = ", ".join(f"{n} {kind}" for kind, n in summary.verdicts.items() if n)
-    rows = f"{summary.rows_not_graded} row{'' if summary.rows_not_graded == 1 else 's'}"
-    print(f"{summary.students} students ({summary.submitted} submitted), {summary.parts} parts graded ({verdicts}); "
-          f"{rows} not graded (see problems.csv) -> {summary.out}", file=sys.stderr)
+    print(_graded_line(summary), file=sys.stderr)
     if summary.ignored_columns:
         print(f"columns ignored: {_some(list(summary.ignored_columns))}", file=sys.stderr)
     for note in summary.notes:
@@ -555,6 +565,14 @@ def _grade(arguments: argparse.Namespace) -> int:
     if arguments.json:
         print(json.dumps(summary.to_json(), allow_nan=False))
     return EXIT_REFUSED if summary.rows_not_graded else EXIT_OK
+
+
+def _graded_line(summary: GradeSummary) -> str:
+    """``30 students (29 submitted), 450 parts graded (...); 1 row not graded (see problems.csv) -> OUT``."""
+    verdicts = ", ".join(f"{n} {kind}" for kind, n in summary.verdicts.items() if n)
+    rows = f"{summary.rows_not_graded} row{'' if summary.rows_not_graded == 1 else 's'}"
+    return (f"{summary.students} students ({summary.submitted} submitted), {summary.parts} parts graded ({verdicts}); "
+            f"{rows} not graded (see problems.csv) -> {summary.out}")
 
 
 def _check(arguments: argparse.Namespace) -> int:

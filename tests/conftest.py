@@ -1,4 +1,4 @@
-"""Shared fixtures: the bank, compiled templates, and a private compile cache for the run."""
+"""Shared fixtures: the bank, compiled templates, a private compile cache for the run, and the demo's output."""
 
 from __future__ import annotations
 
@@ -14,6 +14,7 @@ os.environ["GRADER_CACHE_DIR"] = tempfile.mkdtemp(prefix="grader-test-cache-")
 from grader.bank.template import Template, load_bank
 from grader.solve.cache import compiled_for
 from grader.solve.compiled import Compiled
+from tests.demo_output import DemoRun, run_demo
 
 
 @pytest.fixture(scope="session")
@@ -35,3 +36,9 @@ def workdir(tmp_path: pytest.TempPathFactory) -> Iterator[str]:
     os.chdir(tmp_path)  # type: ignore[arg-type]
     yield str(tmp_path)
     os.chdir(old)
+
+
+@pytest.fixture(scope="session")
+def demo_run(tmp_path_factory: pytest.TempPathFactory) -> DemoRun:
+    """The demo, run once per test session (PDFs included); tests that change its output work on a copy."""
+    return run_demo(tmp_path_factory.mktemp("demo"))

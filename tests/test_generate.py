@@ -5,6 +5,7 @@ from __future__ import annotations
 import errno
 import json
 import os
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -20,6 +21,7 @@ from grader.files import MANIFEST
 from grader.resources import sample_dir
 from grader.solve.compiled import Compiled
 from grader.solve.evaluate import solve_one
+from tests.demo_output import DemoRun
 
 ASSIGNMENT = sample_dir() / "assignment.yaml"
 ROSTER = sample_dir() / "roster.csv"
@@ -177,20 +179,21 @@ def test_key_csv_neutralizes_formulas_in_text_cells(tmp_path: Path, bank: dict[s
     assert "'=cmd|' /C calc'!A0" in csv_text
 
 
-def test_demo_writes_its_inputs_and_generate_from_them_reproduces_it(tmp_path: Path,
+def test_demo_writes_its_inputs_and_generate_from_them_reproduces_it(tmp_path: Path, demo_run: DemoRun,
                                                                      capsys: pytest.CaptureFixture[str]) -> None:
     """`grader demo --out DIR` then `grader generate DIR/assignment.yaml --roster DIR/roster.csv --out OTHER`
     give the same key and the same PDFs, byte for byte."""
-    demo, other = tmp_path / "demo", tmp_path / "other"
-    code, out, _ = run(capsys, "demo", "--out", demo)
-    assert code == 0 and "30 students x 5 problems" in out
+    demo, other = demo_run.out, tmp_path / "other"
+    assert demo_run.code == 0 and "30 students x 5 problems" in demo_run.stdout
     assert run(capsys, "generate", demo / "assignment.yaml", "--roster", demo / "roster.csv", "--out", other)[0] == 0
     produced = sorted(p.relative_to(demo) for p in demo.rglob("*") if p.is_file())
     assert {"key.json", "key.csv", "class.pdf", "answer-key.pdf"} <= {str(p) for p in produced}
     assert len([p for p in produced if str(p).startswith("students")]) == 30
-    for path in produced:
-        if path.name not in ("assignment.yaml", "roster.csv", MANIFEST):  # the demo lists its inputs too
-            assert (demo / path).read_bytes() == (other / path).read_bytes(), path
+    generated = [p for p in produced if p.parts[0] not in ("assignment.yaml", "roster.csv", MANIFEST,
+                                                           "submissions.csv", "grades")]  # the demo's own
+    assert generated == sorted(p.relative_to(other) for p in other.rglob("*") if p.is_file() and p.name != MANIFEST)
+    for path in generated:
+        assert (demo / path).read_bytes() == (other / path).read_bytes(), path
 
 
 def test_a_failure_while_rendering_leaves_nothing_behind(tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
@@ -306,15 +309,10 @@ def _one_line_error(code: int, out: str, err: str) -> str:
 
 
 def test_force_does_not_delete_the_inputs_of_the_demo_folder(tmp_path: Path, capsys: pytest.CaptureFixture[str],
-                                                             bank: dict[str, Template]) -> None:
-    """`demo --out d`, then `generate d/assignment.yaml --roster d/roster.csv --out d --force`: refused, d kept.
-    (d is made as the demo makes it, without PDFs to keep the test fast; its manifest lists the inputs.)"""
-    from grader.render.generate import Job
-    from grader.render.generate import run as generate_into
-
+                                                             demo_run: DemoRun) -> None:
+    """`demo --out d`, then `generate d/assignment.yaml --roster d/roster.csv --out d --force`: refused, d kept."""
     demo = tmp_path / "d"
-    generate_into(Job(ASSIGNMENT, ROSTER, demo, pdf=False), bank, {"assignment.yaml": ASSIGNMENT,
-                                                                   "roster.csv": ROSTER})
+    shutil.copytree(demo_run.out, demo)
     assert "roster.csv" in json.loads((demo / MANIFEST).read_text(encoding="utf-8"))["files"]
     before = _tree(demo)
     err = _one_line_error(*run(capsys, "generate", demo / "assignment.yaml", "--roster", demo / "roster.csv",

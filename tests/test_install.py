@@ -58,5 +58,6 @@ def test_wheel_installed_in_a_fresh_venv_runs_from_another_folder(tmp_path: Path
                           capture_output=True, text=True, timeout=300)
     assert demo.returncode == 0, demo.stderr
     assert (elsewhere / "demo" / "answer-key.pdf").stat().st_size > 10_000
+    assert (elsewhere / "demo" / "grades" / "details.csv").read_text(encoding="utf-8").count("\n") == 30 * 15 + 1
     assert len(list((elsewhere / "demo" / "students").glob("*.pdf"))) == 30
     assert (elsewhere / "demo" / "assignment.yaml").is_file() and (elsewhere / "demo" / "roster.csv").is_file()

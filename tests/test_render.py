@@ -400,13 +400,13 @@ def test_a_name_no_font_has_is_warned_about_naming_the_student(tmp_path: Path, c
                                                               assignment: Assignment, bank: dict[str, Template],
                                                               few: Generation) -> None:
     """Without the font, a warning on stderr names the student; the PDFs are still written."""
-    from grader.render.generate import Job, _write
+    from grader.render.generate import Job, write_outputs
 
     entry = few.students[0]
     odd = Generation((dataclasses.replace(entry, student=dataclasses.replace(entry.student, name="Amun 𓀀")),),
                      few.collisions)
     job = Job(sample_dir() / "assignment.yaml", sample_dir() / "roster.csv", tmp_path)
-    assert _write(job, assignment, odd, bank, tmp_path) == 5
+    assert write_outputs(job, assignment, odd, bank, tmp_path) == 5
     err = capsys.readouterr().err
     assert f"warning: student {entry.student.id} (Amun 𓀀): no font has 𓀀 (U+13000)" in err
 
@@ -417,14 +417,14 @@ def test_cjk_and_hangul_names_print_with_the_system_noto_font(tmp_path: Path, ca
                                                              assignment: Assignment, bank: dict[str, Template],
                                                              few: Generation) -> None:
     """With fonts-noto-cjk, 李华 and 김민준 are text in the PDF, not boxes, and nobody is warned about."""
-    from grader.render.generate import Job, _write
+    from grader.render.generate import Job, write_outputs
 
     entry = few.students[0]
     name = "李华 김민준"
     cjk = Generation((dataclasses.replace(entry, student=dataclasses.replace(entry.student, name=name)),),
                      few.collisions)
-    _write(Job(sample_dir() / "assignment.yaml", sample_dir() / "roster.csv", tmp_path), assignment, cjk, bank,
-           tmp_path)
+    job = Job(sample_dir() / "assignment.yaml", sample_dir() / "roster.csv", tmp_path)
+    write_outputs(job, assignment, cjk, bank, tmp_path)
     assert "warning" not in capsys.readouterr().err
     assert name in pdf_text(tmp_path / "students" / f"{entry.student.id}.pdf")
     assert not uncovered([name], font_paths(()))

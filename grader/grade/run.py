@@ -13,12 +13,14 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Literal
 
-from grader.files import output_folder
-from grader.grade.canvas import read_export
-from grader.grade.grading import counts, grade
-from grader.grade.key import load_key
+from grader.files import output_folder, write_manifest
+from grader.grade.canvas import CanvasExport, read_export
+from grader.grade.grading import Graded, counts, grade
+from grader.grade.key import Key, load_key
 from grader.grade.report import write_reports
 from grader.grade.submissions import StudentRef, read_submissions
+
+COMMAND = "grader grade"
 
 
 @dataclass(frozen=True)
@@ -53,13 +55,33 @@ def run(key_path: Path, paths: Sequence[Path], out: Path, fmt: Literal["auto", "
     started = time.perf_counter()
     key = load_key(key_path)
     export = read_export(canvas, key) if canvas is not None else None
-    submissions = read_submissions(paths, [StudentRef(s.id, s.email) for s in key.students], key.labels, fmt)
-    graded = grade(key, submissions)
+    graded = _graded(key, paths, fmt, ())
     inputs = (key_path, *paths, *([canvas] if canvas is not None else []))
-    with output_folder(out, command="grader grade", inputs=inputs, force=force) as staging:
+    with output_folder(out, command=COMMAND, inputs=inputs, force=force) as staging:
         write_reports(graded, staging, export)
+    return _summary(graded, out, started, export)
+
+
+def grade_into(folder: Path, key_path: Path, paths: Sequence[Path], out: Path, names: Sequence[str]) -> GradeSummary:
+    """Grade into ``folder``, a part of an output folder still being written (the demo's ``grades/``), as
+    ``grader grade --out out`` would, with the files named as in ``names`` (where they will be) and the
+    manifest ``grader grade`` writes, so that ``grader grade --out out --force`` may replace it later."""
+    started = time.perf_counter()
+    graded = _graded(load_key(key_path), paths, "auto", names)
+    write_reports(graded, folder)
+    write_manifest(folder, COMMAND)
+    return _summary(graded, out, started, None)
+
+
+def _graded(key: Key, paths: Sequence[Path], fmt: Literal["auto", "long", "wide"], names: Sequence[str]) -> Graded:
+    submissions = read_submissions(paths, [StudentRef(s.id, s.email) for s in key.students], key.labels, fmt,
+                                   names)
+    return grade(key, submissions)
+
+
+def _summary(graded: Graded, out: Path, started: float, export: CanvasExport | None) -> GradeSummary:
     answered = {v.student_id for v in graded.verdicts if v.submitted is not None}
-    return GradeSummary(out, len(key.students), len(answered), len(graded.verdicts),
+    return GradeSummary(out, len(graded.key.students), len(answered), len(graded.verdicts),
                         sum(not problem.caveat for problem in graded.problems), counts(graded.verdicts),
-                        submissions.ignored_columns, (*submissions.notes, *(export.notes if export else ())),
+                        graded.ignored_columns, (*graded.notes, *(export.notes if export else ())),
                         time.perf_counter() - started)

@@ -108,8 +108,9 @@ class _Row:
 
 
 def read_submissions(paths: Sequence[Path], students: Sequence[StudentRef], labels: Sequence[str],
-                     fmt: Literal["auto", "long", "wide"] = "auto") -> Submissions:
+                     fmt: Literal["auto", "long", "wide"] = "auto", names: Sequence[str] = ()) -> Submissions:
     """Every answer of ``paths`` to one of ``labels`` by one of ``students``, the latest of each.
+    Answers and problems name their file as in ``names`` when given (one per path), else by its path.
 
     Raises :class:`GraderError` for a file that cannot be used as a whole (unreadable, neither UTF-8
     nor UTF-16 nor clean Windows-1252, no recognisable header); a bad row is a :class:`RowProblem`.
@@ -119,21 +120,22 @@ def read_submissions(paths: Sequence[Path], students: Sequence[StudentRef], labe
     problems: list[RowProblem] = []
     ignored: dict[str, None] = {}
     notes: list[str] = []
-    for index, path in enumerate(paths):
+    shown_as = list(names) or [str(path) for path in paths]
+    for index, (path, name) in enumerate(zip(paths, shown_as, strict=True)):
         table = read_csv(path, exports=True)
         layout = find_layout(table, labels, fmt, roster.known)
         ignored.update(dict.fromkeys(layout.ignored))
         if table.encoding == "Windows-1252":
-            notes.append(f"{path}: not UTF-8; read as Windows-1252 (Latin-1): check accented text, or save the "
+            notes.append(f"{name}: not UTF-8; read as Windows-1252 (Latin-1): check accented text, or save the "
                          'file as "CSV UTF-8"')
         for row in table.rows:
-            _read_row(str(path), index, row, table, layout, labels, roster, rows, problems)
+            _read_row(name, index, row, table, layout, labels, roster, rows, problems)
     stamps = [row.timestamp for row in rows if row.timestamp is not None]
     if any(s.tzinfo is None for s in stamps) and any(s.tzinfo is not None for s in stamps):
         notes.append("some timestamps have a time zone and some do not: those without were taken as UTC "
                      "to compare them")
     answers = _latest(rows, problems, labels)
-    order = {str(path): index for index, path in enumerate(paths)}
+    order = {name: index for index, name in enumerate(shown_as)}
     return Submissions(tuple(sorted(answers, key=lambda a: (order[a.file], a.line, labels.index(a.label)))),
                        tuple(sorted(problems, key=lambda p: (order[p.file], p.line, p.caveat, p.label))),
                        tuple(ignored), tuple(notes))

@@ -1,4 +1,5 @@
-"""``grader generate`` and ``grader demo``: an assignment and a roster become a key and PDFs.
+"""``grader generate``: an assignment and a roster become a key and PDFs (``grader demo`` too, in
+:mod:`grader.demo`).
 
 Everything is written into a work folder beside the output and moved into place at the end, with a
 manifest of what was written (:func:`grader.files.output_folder`): a failed run leaves nothing behind,
@@ -7,7 +8,6 @@ a previous output stays untouched, and ``--force`` replaces only what an earlier
 
 from __future__ import annotations
 
-import shutil
 import sys
 import time
 from collections.abc import Callable, Iterator, Mapping
@@ -15,12 +15,11 @@ from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 
-from grader.assign.assignment import Assignment, check_against_bank, load_assignment, load_roster
+from grader.assign.assignment import Assignment, Student, check_against_bank, load_assignment, load_roster
 from grader.assign.keyfile import key_csv, key_document, key_json
 from grader.assign.variants import Generation, generate
 from grader.bank.template import Template
 from grader.files import output_folder, write_atomic
-from grader.resources import sample_dir
 
 
 @dataclass(frozen=True)
@@ -49,9 +48,20 @@ class Summary:
     seconds: float
 
 
-def run(job: Job, bank: Mapping[str, Template], extra: Mapping[str, Path] | None = None) -> Summary:
-    """Generate into ``job.out``; ``extra`` files (name -> source) are copied in too (the demo's inputs)."""
+def run(job: Job, bank: Mapping[str, Template]) -> Summary:
+    """Generate into ``job.out``."""
     started = time.perf_counter()
+    assignment, roster = load_inputs(job, bank)
+    with output_folder(job.out, command="grader generate", inputs=(job.assignment, job.roster),
+                       force=job.force) as staging:
+        generation = generate(assignment, roster, bank)
+        written = write_outputs(job, assignment, generation, bank, staging)
+    return Summary(job.out, len(roster), len(assignment.problems), generation.collisions, written,
+                   time.perf_counter() - started)
+
+
+def load_inputs(job: Job, bank: Mapping[str, Template]) -> tuple[Assignment, tuple[Student, ...]]:
+    """The assignment and roster, checked against the bank (and the font folders), before any work."""
     assignment = load_assignment(job.assignment)
     roster = load_roster(job.roster)
     check_against_bank(assignment, bank)
@@ -59,33 +69,18 @@ def run(job: Job, bank: Mapping[str, Template], extra: Mapping[str, Path] | None
         from grader.render.typeset import font_paths
 
         font_paths(job.font_dirs)  # refuses a --font-dir that is not a folder before any work
-    with output_folder(job.out, command="grader generate", inputs=(job.assignment, job.roster),
-                       force=job.force) as staging:
-        generation = generate(assignment, roster, bank)
-        for name, source in (extra or {}).items():
-            shutil.copyfile(source, staging / name)
-        written = _write(job, assignment, generation, bank, staging)
-    return Summary(job.out, len(roster), len(assignment.problems), generation.collisions, written,
-                   time.perf_counter() - started)
+    return assignment, roster
 
 
-def demo(out: Path, bank: Mapping[str, Template], jobs: int = 1, force: bool = False,
-         font_dirs: tuple[Path, ...] = ()) -> Summary:
-    """The whole job on the shipped sample; the assignment and roster it used are written beside it."""
-    samples = sample_dir()
-    job = Job(samples / "assignment.yaml", samples / "roster.csv", out, jobs=jobs, force=force, font_dirs=font_dirs)
-    return run(job, bank, {"assignment.yaml": samples / "assignment.yaml", "roster.csv": samples / "roster.csv"})
-
-
-def _write(job: Job, assignment: Assignment, generation: Generation, bank: Mapping[str, Template],
-           staging: Path) -> int:
+def write_outputs(job: Job, assignment: Assignment, generation: Generation, bank: Mapping[str, Template],
+                  staging: Path) -> int:
+    """Write the key files and, unless ``job.pdf`` is off, the PDFs into ``staging``; returns how many."""
     write_atomic(staging / "key.json", key_json(key_document(assignment, generation, bank)))
     write_atomic(staging / "key.csv", key_csv(generation))
     written = 2
     if job.pdf:
         from grader.render.documents import render_all
         from grader.render.typeset import font_paths, missing_glyph_warnings
-
 
         people = [(s.student.id, s.student.name) for s in generation.students]
         for warning in missing_glyph_warnings(people, font_paths(job.font_dirs)):

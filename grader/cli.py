@@ -568,11 +568,17 @@ def _grade(arguments: argparse.Namespace) -> int:
 
 
 def _graded_line(summary: GradeSummary) -> str:
-    """``30 students (29 submitted), 450 parts graded (...); 1 row not graded (see problems.csv) -> OUT``."""
+    """``30 students (29 submitted), 450 parts graded (...); 1 row set aside (superseded or not a student),
+    0 rows not graded (see problems.csv) -> OUT``."""
     verdicts = ", ".join(f"{n} {kind}" for kind, n in summary.verdicts.items() if n)
-    rows = f"{summary.rows_not_graded} row{'' if summary.rows_not_graded == 1 else 's'}"
+    aside = f"{_rows(summary.rows_set_aside)} set aside (superseded or not a student), " if summary.rows_set_aside \
+        else ""
     return (f"{summary.students} students ({summary.submitted} submitted), {summary.parts} parts graded ({verdicts}); "
-            f"{rows} not graded (see problems.csv) -> {summary.out}")
+            f"{aside}{_rows(summary.rows_not_graded)} not graded (see problems.csv) -> {summary.out}")
+
+
+def _rows(n: int) -> str:
+    return f"{n} row{'' if n == 1 else 's'}"
 
 
 def _check(arguments: argparse.Namespace) -> int:

@@ -57,7 +57,8 @@ def test_the_demo_exits_0_and_says_how_the_class_graded_and_how_to_grade_again(d
     lines = demo_run.stdout.splitlines()
     assert lines[0].startswith("30 students x 5 problems -> grader-demo (42 files, ")
     assert lines[1] == ("submissions.csv (simulated answers) graded: 30 students (29 submitted), 450 parts graded "
-                        "(370 correct, 46 incorrect, 1 invalid, 33 missing); 1 row not graded (see problems.csv) "
+                        "(370 correct, 46 incorrect, 1 invalid, 33 missing); 1 row set aside (superseded or not a student), "
+                        "0 rows not graded (see problems.csv) "
                         "-> grader-demo/grades")
     assert lines[-2:] == ["Grade the submissions again, or your own file, with", f"  {REGRADE}"]
     assert sorted(p.name for p in (demo_run.out / "grades").iterdir()) == [
@@ -169,7 +170,7 @@ def test_demo_force_then_the_readme_regrade_then_demo_force_again_change_nothing
     capsys.readouterr()
     command = _readme_regrade()
     assert command == REGRADE
-    assert main(shlex.split(command)[1:]) == 3  # the superseded row was not graded
+    assert main(shlex.split(command)[1:]) == 0  # a superseded row is set aside by rule: nothing for anyone to do
     assert capsys.readouterr().err.splitlines() == _readme_block_after(command)
     assert tree(tmp_path / "grader-demo") == before
     assert main(["demo", "--out", "grader-demo", "--force"]) == 0

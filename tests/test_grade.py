@@ -119,6 +119,26 @@ def test_every_row_is_accounted_for_and_nobody_is_lost(tmp_path: Path, capsys: p
     assert [(p["student_id"], p["line"]) for p in problems] == [("nobody", str(len(kept) + 1))]
 
 
+def test_rows_set_aside_by_rule_are_listed_but_end_the_run_with_0(tmp_path: Path, capsys: pytest.CaptureFixture[str],
+                                                                   key_path: Path) -> None:
+    """A resubmission and Canvas' points-possible row are listed in problems.csv and counted apart; only a
+    row someone should look at (here none) makes the exit code 3."""
+    rows = key_answers(key_path)
+    student, label, text = rows[0]
+    (tmp_path / "a.csv").write_text(long_csv([(student, label, "999"), *rows, ("Points Possible", "", "")]),
+                                    encoding="utf-8")
+    code, out, err = run(capsys, "grade", "--key", key_path, tmp_path / "a.csv", "--out", tmp_path / "g", "--json")
+    assert code == 0, err
+    summary = json.loads(out)
+    assert (summary["rows_not_graded"], summary["rows_set_aside"]) == (0, 2)
+    assert "2 rows set aside (superseded or not a student), 0 rows not graded" in err
+    problems = read(tmp_path / "g" / "problems.csv")
+    assert [(p["line"], p["reason"].split(" (")[0]) for p in problems] == [
+        ("2", f"superseded by {tmp_path / 'a.csv'} line {rows.index((student, label, text)) + 3}"),
+        (str(len(rows) + 3), "not a student row")]
+    assert {row["verdict"] for row in read(tmp_path / "g" / "details.csv")} == {"correct"}
+
+
 def test_reruns_are_byte_identical(tmp_path: Path, capsys: pytest.CaptureFixture[str], key_path: Path) -> None:
     (tmp_path / "a.csv").write_text(long_csv(key_answers(key_path, ".2g")), encoding="utf-8")
     for out in ("g1", "g2"):

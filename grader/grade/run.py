@@ -31,7 +31,8 @@ class GradeSummary:
     students: int
     submitted: int  # students with at least one answer
     parts: int
-    rows_not_graded: int
+    rows_not_graded: int  # answers not graded for a reason someone should look at (exit code 3)
+    rows_set_aside: int  # superseded by a later submission, or rows that are no student's
     verdicts: Mapping[str, int]
     ignored_columns: tuple[str, ...]
     notes: tuple[str, ...]
@@ -40,7 +41,8 @@ class GradeSummary:
     def to_json(self) -> dict[str, object]:
         """The ``--json`` summary object."""
         return {"out": str(self.out), "students": self.students, "submitted": self.submitted, "parts": self.parts,
-                "rows_not_graded": self.rows_not_graded, "verdicts": dict(self.verdicts),
+                "rows_not_graded": self.rows_not_graded, "rows_set_aside": self.rows_set_aside,
+                "verdicts": dict(self.verdicts),
                 "ignored_columns": list(self.ignored_columns), "notes": list(self.notes)}
 
 
@@ -82,6 +84,7 @@ def _graded(key: Key, paths: Sequence[Path], fmt: Literal["auto", "long", "wide"
 def _summary(graded: Graded, out: Path, started: float, export: CanvasExport | None) -> GradeSummary:
     answered = {v.student_id for v in graded.verdicts if v.submitted is not None}
     return GradeSummary(out, len(graded.key.students), len(answered), len(graded.verdicts),
-                        sum(not problem.caveat for problem in graded.problems), counts(graded.verdicts),
+                        sum(problem.not_graded for problem in graded.problems),
+                        sum(problem.routine for problem in graded.problems), counts(graded.verdicts),
                         graded.ignored_columns, (*graded.notes, *(export.notes if export else ())),
                         time.perf_counter() - started)

@@ -70,7 +70,9 @@ class Answer:
 @dataclass(frozen=True)
 class RowProblem:
     """Why a row (``label == ""``) or one answer of it was not used; ``caveat``: the row's answers
-    were used all the same, and this is said so that nobody is surprised."""
+    were used all the same, and this is said so that nobody is surprised; ``routine``: not used by rule,
+    with nothing for anyone to do (superseded by the same student's later answer, or one of Canvas' rows
+    that are no student's), so it does not make a run end with "rows not graded"."""
 
     file: str
     line: int
@@ -78,6 +80,12 @@ class RowProblem:
     label: str
     reason: str
     caveat: bool = False
+    routine: bool = False
+
+    @property
+    def not_graded(self) -> bool:
+        """Whether a submitted answer went ungraded for a reason someone should look at."""
+        return not self.caveat and not self.routine
 
 
 @dataclass(frozen=True)
@@ -189,7 +197,8 @@ def _read_row(file: str, index: int, row: CsvRow, table: CsvTable, layout: Layou
         return
     student_id, why = roster.find(who, layout.by_email) if who else (None, "no student given")
     if student_id is None:
-        problems.append(RowProblem(file, row.line, who, label, _not_a_student(row, layout) or why))
+        nobody = _not_a_student(row, layout)
+        problems.append(RowProblem(file, row.line, who, label, nobody or why, routine=bool(nobody)))
         return
     if why:
         problems.append(RowProblem(file, row.line, student_id, "", why, caveat=True))
@@ -304,7 +313,7 @@ def _latest(rows: list[_Row], problems: list[RowProblem], labels: Sequence[str])
             if row.wide:
                 row.lost.append((label, why))
             else:
-                problems.append(RowProblem(row.file, row.line, student_id, label, why))
+                problems.append(RowProblem(row.file, row.line, student_id, label, why, routine=True))
     for row in contenders:
         if row.wide and row.lost:
             problems.extend(_lost_answers(row, labels))
@@ -336,4 +345,4 @@ def _lost_answers(row: _Row, labels: Sequence[str]) -> list[RowProblem]:
     if len(lost) < len(row.answers):
         return [RowProblem(row.file, row.line, row.student_id, label, why, caveat=True) for label, why in lost]
     whys = "; ".join(f"{label}: {why}" for label, why in lost)
-    return [RowProblem(row.file, row.line, row.student_id, "", f"every answer superseded ({whys})")]
+    return [RowProblem(row.file, row.line, row.student_id, "", f"every answer superseded ({whys})", routine=True)]

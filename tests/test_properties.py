@@ -233,6 +233,7 @@ def _widened(template: Template, name: str) -> st.SearchStrategy[float]:
 
 @pytest.mark.parametrize("template_id", [
     "ball-plate", "car-collision", "drop-rebound", "oblique-spheres", "pile-driver",
+    "head-on",
 ])
 @PROPERTY
 @given(data=st.data())

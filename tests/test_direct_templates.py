@@ -18,9 +18,11 @@ import pytest
 from grader.solve.evaluate import solve_one
 
 RTOL = 1e-9
+KMH = Fraction(1000, 3600)  # km/h in m/s
 ISSUE = {  # ids, parameters and answers exactly as issue 13's table names them
     "head-on": (["m1", "m2", "v1", "v2", "e"], ["v1_out", "v2_out", "loss_pct"]),
     "head-on-inverse": (["m1", "m2", "v1", "v2", "v1_out"], ["v2_out", "e", "loss_pct"]),
+    "coupling": (["m_A", "m_B", "v_A", "v_B"], ["v_common", "energy_lost", "loss_pct"]),
 }
 
 
@@ -52,9 +54,18 @@ def ref_head_on_inverse(m1, m2, v1, v2, v1_out):
     return {"v2_out": w2, "e": (w2 - w1) / (v1 - v2), "loss_pct": 100 * (before - after) / before}
 
 
+def ref_coupling(m_A, m_B, v_A, v_B):  # noqa: N803 (the template's names)
+    common, _ = after_impact(m_A, m_B, v_A, v_B, 0)  # they move on together: e = 0
+    masses = (Fraction(m_A) * 1000, Fraction(m_B) * 1000)  # Mg -> kg
+    before = energy((masses[0], Fraction(v_A) * KMH), (masses[1], Fraction(v_B) * KMH))
+    after = energy((masses[0] + masses[1], common * KMH))
+    return {"v_common": common, "energy_lost": (before - after) / 1000, "loss_pct": 100 * (before - after) / before}
+
+
 REFERENCES = {
     "head-on": ref_head_on,
     "head-on-inverse": ref_head_on_inverse,
+    "coupling": ref_coupling,
 }
 
 
@@ -91,6 +102,8 @@ def test_ids_parameters_and_answers_are_the_issues(bank):
     # the same impact read backwards: J = 2(4 + 1.76) = 11.52, v2' = -2 + 11.52/3
     ("head-on-inverse", {"m1": 2, "m2": 3, "v1": 4, "v2": -2, "v1_out": -1.76},
      {"v2_out": 1.84, "e": 0.6, "loss_pct": 62.84}),
+    # (60(8) + 40(-2))/100 = 4 km/h; lost 1/2 (24 000 kg)(10/3.6 m/s)^2 = 92.59 kJ of 154.3 kJ
+    ("coupling", {"m_A": 60, "m_B": 40, "v_A": 8, "v_B": -2}, {"v_common": 4, "energy_lost": 92.59, "loss_pct": 60}),
 ])
 def test_known_answers(bank, compiled, template_id, params, answers):
     """The hand-worked values to four figures, and the reference to 1e-9."""
@@ -126,6 +139,14 @@ def test_head_on_inverse(bank, compiled, params):
     check(bank, compiled, "head-on-inverse", params)
 
 
+@pytest.mark.parametrize("masses", [(1e-6, 1.0), (60.0, 40.0), (1e6, 1.0)], ids=["1e-6", "1.5", "1e6"])
+@pytest.mark.parametrize("speeds", [(8.0, -2.0), (8.0, 3.0), (10.000001, 10.0)],
+                         ids=["toward", "chasing", "nearly-equal"])
+def test_coupling(bank, compiled, masses, speeds):
+    """Two cars at nearly equal speeds keep full accuracy in the energy lost and its percentage."""
+    check(bank, compiled, "coupling", {"m_A": masses[0], "m_B": masses[1], "v_A": speeds[0], "v_B": speeds[1]})
+
+
 # ---- refusals name the reason -----------------------------------------------------------------
 @pytest.mark.parametrize("template_id, params, reason", [
     ("head-on", {"m1": 2, "m2": 3, "v1": 1, "v2": 2, "e": 0.5}, "the carts never meet"),
@@ -133,6 +154,7 @@ def test_head_on_inverse(bank, compiled, params):
      "restitution is -0.444444; it cannot be negative (the bodies would pass through each other)"),
     ("head-on-inverse", {"m1": 2, "m2": 3, "v1": 4, "v2": -2, "v1_out": -4},
      "restitution is 1.22222; above 1 the impact would create energy"),
+    ("coupling", {"m_A": 60, "m_B": 40, "v_A": 3, "v_B": 3}, "the cars never meet"),
 ])
 def test_unphysical_input_is_refused_with_the_reason(bank, compiled, template_id, params, reason):
     solution = solve_one(bank[template_id], compiled[template_id], params)

@@ -235,6 +235,7 @@ def _widened(template: Template, name: str) -> st.SearchStrategy[float]:
     "ball-plate", "car-collision", "drop-rebound", "oblique-spheres", "pile-driver",
     "head-on",
     "head-on-inverse",
+    "coupling",
 ])
 @PROPERTY
 @given(data=st.data())

@@ -18,11 +18,13 @@ import pytest
 from grader.solve.evaluate import solve_one
 
 RTOL = 1e-9
+G = mp.mpf(9.81)  # the bank's g, as the float the kernels use
 KMH = Fraction(1000, 3600)  # km/h in m/s
 ISSUE = {  # ids, parameters and answers exactly as issue 13's table names them
     "head-on": (["m1", "m2", "v1", "v2", "e"], ["v1_out", "v2_out", "loss_pct"]),
     "head-on-inverse": (["m1", "m2", "v1", "v2", "v1_out"], ["v2_out", "e", "loss_pct"]),
     "coupling": (["m_A", "m_B", "v_A", "v_B"], ["v_common", "energy_lost", "loss_pct"]),
+    "moving-plate": (["h", "u", "e"], ["v_out", "h_out"]),
 }
 
 
@@ -62,10 +64,18 @@ def ref_coupling(m_A, m_B, v_A, v_B):  # noqa: N803 (the template's names)
     return {"v_common": common, "energy_lost": (before - after) / 1000, "loss_pct": 100 * (before - after) / before}
 
 
+def ref_moving_plate(h, u, e):
+    v = mp.sqrt(2 * G * mp.mpf(h))  # down, just before the impact
+    relative = v + mp.mpf(u)  # the ball approaches the plate at this speed, seen from the plate
+    v_out = mp.mpf(u) + mp.mpf(e) * relative  # and leaves it at e times that, upward
+    return {"v_out": v_out, "h_out": v_out**2 / (2 * G)}
+
+
 REFERENCES = {
     "head-on": ref_head_on,
     "head-on-inverse": ref_head_on_inverse,
     "coupling": ref_coupling,
+    "moving-plate": ref_moving_plate,
 }
 
 
@@ -104,6 +114,8 @@ def test_ids_parameters_and_answers_are_the_issues(bank):
      {"v2_out": 1.84, "e": 0.6, "loss_pct": 62.84}),
     # (60(8) + 40(-2))/100 = 4 km/h; lost 1/2 (24 000 kg)(10/3.6 m/s)^2 = 92.59 kJ of 154.3 kJ
     ("coupling", {"m_A": 60, "m_B": 40, "v_A": 8, "v_B": -2}, {"v_common": 4, "energy_lost": 92.59, "loss_pct": 60}),
+    # v = sqrt(2(9.81)(1.2)) = 4.852; v' = 1.5 + 0.6(4.852 + 1.5) = 5.311; h' = 5.311^2/19.62
+    ("moving-plate", {"h": 1.2, "u": 1.5, "e": 0.6}, {"v_out": 5.311, "h_out": 1.438}),
 ])
 def test_known_answers(bank, compiled, template_id, params, answers):
     """The hand-worked values to four figures, and the reference to 1e-9."""
@@ -147,6 +159,19 @@ def test_coupling(bank, compiled, masses, speeds):
     check(bank, compiled, "coupling", {"m_A": masses[0], "m_B": masses[1], "v_A": speeds[0], "v_B": speeds[1]})
 
 
+@pytest.mark.parametrize("h, u, e", [
+    pytest.param(1.2, 0.0, 1.0, id="e1-plate-at-rest"),
+    pytest.param(1.2, 1.5, 1.0, id="e1-plate-up"),
+    pytest.param(1.2, 0.0, 1e-12, id="tiny-e"),
+    pytest.param(2.0, -1.0, 0.9, id="plate-down"),
+    pytest.param(1e-6, 10.0, 0.5, id="fast-plate"),
+    pytest.param(1e-150, 1e-76, 0.5, id="tiny-height"),
+    pytest.param(1e150, 1e74, 0.5, id="large-height"),
+])
+def test_moving_plate(bank, compiled, h, u, e):
+    check(bank, compiled, "moving-plate", {"h": h, "u": u, "e": e})
+
+
 # ---- refusals name the reason -----------------------------------------------------------------
 @pytest.mark.parametrize("template_id, params, reason", [
     ("head-on", {"m1": 2, "m2": 3, "v1": 1, "v2": 2, "e": 0.5}, "the carts never meet"),
@@ -155,6 +180,8 @@ def test_coupling(bank, compiled, masses, speeds):
     ("head-on-inverse", {"m1": 2, "m2": 3, "v1": 4, "v2": -2, "v1_out": -4},
      "restitution is 1.22222; above 1 the impact would create energy"),
     ("coupling", {"m_A": 60, "m_B": 40, "v_A": 3, "v_B": 3}, "the cars never meet"),
+    ("moving-plate", {"h": 1.2, "u": -5, "e": 0.6}, "ball and plate are not approaching"),
+    ("moving-plate", {"h": 1.2, "u": -2, "e": 0.3}, "ball must move up (v_out >= 0)"),
 ])
 def test_unphysical_input_is_refused_with_the_reason(bank, compiled, template_id, params, reason):
     solution = solve_one(bank[template_id], compiled[template_id], params)

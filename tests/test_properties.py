@@ -236,6 +236,7 @@ def _widened(template: Template, name: str) -> st.SearchStrategy[float]:
     "head-on",
     "head-on-inverse",
     "coupling",
+    "moving-plate",
 ])
 @PROPERTY
 @given(data=st.data())

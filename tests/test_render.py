@@ -456,3 +456,14 @@ def test_other_templates_pages_render_to_pngs(others: tuple[Assignment, Generati
     key = render_page_png(extra, generation, bank, 0, key=True)
     assert png_size(key) == (935, 1210)
     (ARTIFACTS / "answer-key-other-templates.png").write_bytes(key)
+
+
+def test_an_asked_height_is_not_drawn_to_scale(assignment: Assignment, bank: dict[str, Template]) -> None:
+    """moving-plate asks how high the ball rises: two variants that differ only in e (so in that
+    height) get the same figure, which would otherwise give the answer away."""
+    def drawn(e: float) -> str:
+        spec = ProblemSpec("1", "moving-plate", {"*": 1.0}, {"h": 1.2, "u": 1.5, "e": e}, {}, {})
+        one = dataclasses.replace(assignment, problems=(spec,))
+        variant = generate(one, (Student("s1", "Sam", "", ""),), bank).students[0].problems[0]
+        return figure(bank["moving-plate"], variant, worked(bank["moving-plate"], variant).values)
+    assert drawn(0.5) == drawn(0.9)

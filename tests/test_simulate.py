@@ -392,3 +392,10 @@ def test_a_scene_the_solver_finds_coupled_is_simulated_by_one_search() -> None:
     template = parse_template(raw, "test:coupled", "coupled")
     result = simulate(template, {"h_drop": 2.0, "h2": 2.0 * 0.8**4, "J": 0.5}, ADAPTIVE)
     assert result.answers["e"] == pytest.approx(0.8, rel=1e-9)
+
+
+def test_a_plate_moving_at_constant_velocity_keeps_it_through_the_contact(bank: dict[str, Template]) -> None:
+    """The plate is a fixed (infinite-mass) body moving up at u: the ball leaves at u + e (v + u)."""
+    result = simulate(bank["moving-plate"], {"h": 1.2, "u": 1.5, "e": 0.6}, ADAPTIVE)
+    v = math.sqrt(2 * 9.81 * 1.2)
+    assert result.answers["v_out"] == pytest.approx(1.5 + 0.6 * (v + 1.5), rel=1e-8)

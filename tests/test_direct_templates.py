@@ -25,6 +25,7 @@ ISSUE = {  # ids, parameters and answers exactly as issue 13's table names them
     "head-on-inverse": (["m1", "m2", "v1", "v2", "v1_out"], ["v2_out", "e", "loss_pct"]),
     "coupling": (["m_A", "m_B", "v_A", "v_B"], ["v_common", "energy_lost", "loss_pct"]),
     "moving-plate": (["h", "u", "e"], ["v_out", "h_out"]),
+    "three-balls": (["m1", "m2", "m3", "v", "e"], ["v1_out", "v2_out", "v3_out"]),
 }
 
 
@@ -71,11 +72,18 @@ def ref_moving_plate(h, u, e):
     return {"v_out": v_out, "h_out": v_out**2 / (2 * G)}
 
 
+def ref_three_balls(m1, m2, m3, v, e):
+    w1, between = after_impact(m1, m2, v, 0, e)
+    w2, w3 = after_impact(m2, m3, between, 0, e)
+    return {"v1_out": w1, "v2_out": w2, "v3_out": w3}
+
+
 REFERENCES = {
     "head-on": ref_head_on,
     "head-on-inverse": ref_head_on_inverse,
     "coupling": ref_coupling,
     "moving-plate": ref_moving_plate,
+    "three-balls": ref_three_balls,
 }
 
 
@@ -116,6 +124,9 @@ def test_ids_parameters_and_answers_are_the_issues(bank):
     ("coupling", {"m_A": 60, "m_B": 40, "v_A": 8, "v_B": -2}, {"v_common": 4, "energy_lost": 92.59, "loss_pct": 60}),
     # v = sqrt(2(9.81)(1.2)) = 4.852; v' = 1.5 + 0.6(4.852 + 1.5) = 5.311; h' = 5.311^2/19.62
     ("moving-plate", {"h": 1.2, "u": 1.5, "e": 0.6}, {"v_out": 5.311, "h_out": 1.438}),
+    # 1 -> 2: v1' = 4(0.5 - 1.6)/2.5 = -1.76, v_b = 4(1.8)(0.5)/2.5 = 1.44; 2 -> 3: (2 - 0.64)/2.8, 1.8(2)/2.8
+    ("three-balls", {"m1": 0.5, "m2": 2, "m3": 0.8, "v": 4, "e": 0.8},
+     {"v1_out": -1.76, "v2_out": 0.6994, "v3_out": 1.851}),
 ])
 def test_known_answers(bank, compiled, template_id, params, answers):
     """The hand-worked values to four figures, and the reference to 1e-9."""
@@ -172,6 +183,15 @@ def test_moving_plate(bank, compiled, h, u, e):
     check(bank, compiled, "moving-plate", {"h": h, "u": u, "e": e})
 
 
+@pytest.mark.parametrize("m1, m2, m3", [(1.0, 1.0, 1.0), (1e-6, 1.0, 1e-6), (1e6, 1.0, 1e6), (1.0, 1e6, 1.0),
+                                        (0.5, 2.0, 0.8)], ids=["equal", "1e-6", "1e6", "heavy-middle", "example"])
+@pytest.mark.parametrize("e", [1.0, 0.5, 1e-12])
+@pytest.mark.parametrize("v", [4.0, 1e-150, 1e170])
+def test_three_balls(bank, compiled, m1, m2, m3, v, e):
+    """Equal masses with e = 1 pass the velocity on (1 and 2 stop exactly)."""
+    check(bank, compiled, "three-balls", {"m1": m1, "m2": m2, "m3": m3, "v": v, "e": e})
+
+
 # ---- refusals name the reason -----------------------------------------------------------------
 @pytest.mark.parametrize("template_id, params, reason", [
     ("head-on", {"m1": 2, "m2": 3, "v1": 1, "v2": 2, "e": 0.5}, "the carts never meet"),
@@ -182,6 +202,7 @@ def test_moving_plate(bank, compiled, h, u, e):
     ("coupling", {"m_A": 60, "m_B": 40, "v_A": 3, "v_B": 3}, "the cars never meet"),
     ("moving-plate", {"h": 1.2, "u": -5, "e": 0.6}, "ball and plate are not approaching"),
     ("moving-plate", {"h": 1.2, "u": -2, "e": 0.3}, "ball must move up (v_out >= 0)"),
+    ("three-balls", {"m1": 1, "m2": 1, "m3": 1, "v": 4, "e": 0}, "e = 0 is outside its domain (0, 1]"),
 ])
 def test_unphysical_input_is_refused_with_the_reason(bank, compiled, template_id, params, reason):
     solution = solve_one(bank[template_id], compiled[template_id], params)

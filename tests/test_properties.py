@@ -237,6 +237,7 @@ def _widened(template: Template, name: str) -> st.SearchStrategy[float]:
     "head-on-inverse",
     "coupling",
     "moving-plate",
+    "three-balls",
 ])
 @PROPERTY
 @given(data=st.data())

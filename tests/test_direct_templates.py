@@ -26,6 +26,7 @@ ISSUE = {  # ids, parameters and answers exactly as issue 13's table names them
     "coupling": (["m_A", "m_B", "v_A", "v_B"], ["v_common", "energy_lost", "loss_pct"]),
     "moving-plate": (["h", "u", "e"], ["v_out", "h_out"]),
     "three-balls": (["m1", "m2", "m3", "v", "e"], ["v1_out", "v2_out", "v3_out"]),
+    "two-rebounds": (["h1", "h2"], ["e", "h0", "loss_pct"]),
 }
 
 
@@ -78,12 +79,22 @@ def ref_three_balls(m1, m2, m3, v, e):
     return {"v1_out": w1, "v2_out": w2, "v3_out": w3}
 
 
+def ref_two_rebounds(h1, h2):
+    h1, h2 = mp.mpf(h1), mp.mpf(h2)
+    e = mp.sqrt(2 * G * h2) / mp.sqrt(2 * G * h1)  # second bounce: up at sqrt(2 g h2) after falling h1
+    v0 = mp.sqrt(2 * G * h1) / e  # first bounce: it left at sqrt(2 g h1) = e times its impact speed
+    h0 = v0**2 / (2 * G)
+    start, end = v0**2 / 2, 2 * G * h2 / 2  # per unit mass: before the first impact, after the second
+    return {"e": e, "h0": h0, "loss_pct": 100 * (start - end) / start}
+
+
 REFERENCES = {
     "head-on": ref_head_on,
     "head-on-inverse": ref_head_on_inverse,
     "coupling": ref_coupling,
     "moving-plate": ref_moving_plate,
     "three-balls": ref_three_balls,
+    "two-rebounds": ref_two_rebounds,
 }
 
 
@@ -127,6 +138,8 @@ def test_ids_parameters_and_answers_are_the_issues(bank):
     # 1 -> 2: v1' = 4(0.5 - 1.6)/2.5 = -1.76, v_b = 4(1.8)(0.5)/2.5 = 1.44; 2 -> 3: (2 - 0.64)/2.8, 1.8(2)/2.8
     ("three-balls", {"m1": 0.5, "m2": 2, "m3": 0.8, "v": 4, "e": 0.8},
      {"v1_out": -1.76, "v2_out": 0.6994, "v3_out": 1.851}),
+    # e = sqrt(0.75/1.2) = 0.7906, h0 = 1.2^2/0.75 = 1.92, lost 1 - 0.75/1.92 of it
+    ("two-rebounds", {"h1": 1.2, "h2": 0.75}, {"e": 0.7906, "h0": 1.92, "loss_pct": 60.94}),
 ])
 def test_known_answers(bank, compiled, template_id, params, answers):
     """The hand-worked values to four figures, and the reference to 1e-9."""
@@ -192,6 +205,18 @@ def test_three_balls(bank, compiled, m1, m2, m3, v, e):
     check(bank, compiled, "three-balls", {"m1": m1, "m2": m2, "m3": m3, "v": v, "e": e})
 
 
+@pytest.mark.parametrize("h1, h2", [
+    pytest.param(1.2, 1.2, id="e1"),
+    pytest.param(3.7, 3.7 * (1 - 1e-12), id="e1-1e-12"),
+    pytest.param(1.0, 1e-12, id="e1e-6"),
+    pytest.param(1e-150, 3e-151, id="tiny"),
+    pytest.param(1e170, 6e169, id="large"),
+    pytest.param(1e170, 1e170 * (1 - 1e-12), id="large-e1-1e-12"),
+])
+def test_two_rebounds(bank, compiled, h1, h2):
+    check(bank, compiled, "two-rebounds", {"h1": h1, "h2": h2})
+
+
 # ---- refusals name the reason -----------------------------------------------------------------
 @pytest.mark.parametrize("template_id, params, reason", [
     ("head-on", {"m1": 2, "m2": 3, "v1": 1, "v2": 2, "e": 0.5}, "the carts never meet"),
@@ -203,6 +228,8 @@ def test_three_balls(bank, compiled, m1, m2, m3, v, e):
     ("moving-plate", {"h": 1.2, "u": -5, "e": 0.6}, "ball and plate are not approaching"),
     ("moving-plate", {"h": 1.2, "u": -2, "e": 0.3}, "ball must move up (v_out >= 0)"),
     ("three-balls", {"m1": 1, "m2": 1, "m3": 1, "v": 4, "e": 0}, "e = 0 is outside its domain (0, 1]"),
+    ("two-rebounds", {"h1": 1.2, "h2": 1.3}, "cannot rise higher after the second impact"),
+    ("two-rebounds", {"h1": 1.2, "h2": 0}, "h2 = 0 m is outside its domain (0, inf)"),
 ])
 def test_unphysical_input_is_refused_with_the_reason(bank, compiled, template_id, params, reason):
     solution = solve_one(bank[template_id], compiled[template_id], params)

@@ -238,6 +238,7 @@ def _widened(template: Template, name: str) -> st.SearchStrategy[float]:
     "coupling",
     "moving-plate",
     "three-balls",
+    "two-rebounds",
 ])
 @PROPERTY
 @given(data=st.data())

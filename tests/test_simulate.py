@@ -382,6 +382,16 @@ def test_simulate_never_prints_minus_zero(capsys: pytest.CaptureFixture[str]) ->
     assert not re.search(r"(?<![\w.])-0(?![.\d]*[1-9])", out + json_out), out + json_out
 
 
+def test_two_unknowns_are_found_one_at_a_time(bank: dict[str, Template], compiled: dict[str, Compiled]) -> None:
+    """two-rebounds gives neither e nor the drop height: e is found from the second bounce (the only
+    outcome it alone reaches), then h0 from the first; both as the closed form has them."""
+    params = {"h1": 1.2, "h2": 0.75}
+    result = simulate(bank["two-rebounds"], params, ADAPTIVE)
+    assert list(result.fitted) == ["e", "h0"]
+    assert result.fitted["h0"] == pytest.approx(1.2**2 / 0.75, rel=1e-9)
+    assert max(_compare(bank["two-rebounds"], compiled["two-rebounds"], params, ADAPTIVE).values()) < 1e-8
+
+
 def test_a_scene_the_solver_finds_coupled_is_simulated_by_one_search() -> None:
     """Given only the drop and the second bounce, e sits in both impacts with h1 between them: the
     step chain refuses it (tests/test_solver.py), yet one search for e reaches the second bounce."""

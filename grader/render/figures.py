@@ -418,7 +418,8 @@ def _direct(canvas: Canvas, scene: _Scene, impacts: Sequence[Stage]) -> bool:
               if scene.template.scene.bodies[b].mass is not None}
     finite = [m for m in masses.values() if _m.isfinite(m) and m > 0]
     mean = _m.exp(sum(_m.log(m) for m in finite) / len(finite)) if finite else 1.0
-    sides = {b: 1.1 * min(2.0, max(0.5, _m.sqrt(m / mean))) if _m.isfinite(m) and m > 0 else 1.1
+    # Sides clamped to 0.77..2.2 cm: the smallest still holds its name, the largest fits the column.
+    sides = {b: 1.1 * min(2.0, max(0.7, _m.sqrt(m / mean))) if _m.isfinite(m) and m > 0 else 1.1
              for b, m in masses.items()}
     speeds = [abs(scene.value(v.n)) for v in before.values() if v is not None]
     fastest = max((v for v in speeds if _m.isfinite(v)), default=0.0)

@@ -492,9 +492,12 @@ def _print_simulation(template: Template, record: dict[str, Any]) -> None:
     for contact in record["contacts"]:
         print(f"{contact['impact']}: Kelvin-Voigt contact of {contact['duration'] * 1e3:g} ms, zeta = "
               f"{contact['zeta']:.4f}, measured e = separation/approach = {contact['measured_e']:.10g}")
+    from grader.model.expr import to_text
+
+    restitutions = {to_text(s.fields["restitution"]) for s in template.scene.stages if s.effect == "impact"}
     for name, value in record["fitted"].items():
-        print(f"{name} not given: contact law calibrated to {name} = {value:.10g}, found so that the simulated "
-              "outcome matches the given one")
+        found = f"contact law calibrated to {name}" if name in restitutions else name
+        print(f"{name} not given: {found} = {value:.10g}, found so that the simulated outcome matches the given one")
     if record["nominal"]:
         print("symbols set to 1 for the simulation: " + ", ".join(record["nominal"]))
     print(_table(("answer", "simulated", "closed form", "rel. diff"), [

@@ -18,3 +18,28 @@ answers:
   a2: {value: a2, unit: m/s}
 statement: Two bodies collide.
 """
+
+TWO_BOUNCES = """
+id: two-bounces
+title: A ball bounces twice
+version: 1
+gravity: 9.81 m/s^2
+bodies: {ball: {mass: m}, floor: {fixed: true}}
+symbols: {m: {unit: kg}}
+parameters:
+  h_drop: {unit: m, domain: "(0, inf)", sample: {uniform: [1, 2]}, decimals: 2}
+  e: {unit: "", domain: "[0, 1]", sample: {uniform: [0.5, 0.9]}, decimals: 2}
+  J: {unit: m, domain: "[0, 1]", sample: {uniform: [0, 1]}, decimals: 2, description: "named like an impulse"}
+stages:
+  - {effect: free_fall, body: ball, height: h_drop, speed: v1}
+  - {effect: impact, bodies: [ball, floor], restitution: e, before: {ball: v1}, after: {ball: w1}}
+  - {effect: rise, body: ball, speed: -w1, height: h1}
+  - {effect: free_fall, body: ball, height: h1, speed: v2}
+  - {effect: impact, bodies: [ball, floor], restitution: e, before: {ball: v2}, after: {ball: w2}, loss_fraction: f2}
+  - {effect: rise, body: ball, speed: -w2, height: h2}
+answers:
+  h2: {value: h2, unit: m}
+  f2: {value: f2, unit: ""}
+  J_plus_h2: {value: J + h2, unit: m}
+statement: Dropped from {{ h_drop }} m with e = {{ e }}.
+"""

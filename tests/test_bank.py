@@ -62,6 +62,8 @@ INVALID = [
      "expected a name of letters, digits and _, not g"),
     ("mass", set_in("bodies/ball/mass", "m_unknown"), "bodies.ball.mass: expected parameters or symbols only"),
     ("body-spec", set_in("bodies/floor", {"fixed": True, "mass": "m"}), "either a mass or fixed: true"),
+    ("fixed-after", set_in("stages/1/after", {"ball": "v_after", "floor": "w"}),
+     "stages[1].after.floor: expected no velocity after the impact for a fixed body (it keeps the velocity given"),
     ("tolerance", set_in("answers/e/tolerance", {"rtol": -1}), "answers.e.tolerance.rtol: expected a number from 0"),
 ]
 

@@ -107,7 +107,7 @@ ROSTER_TEXT = ROSTER.read_text(encoding="utf-8")
 
 @pytest.mark.parametrize(("change", "roster", "message"), [
     ({"template": "drop-rebond"}, None, "problems[0].template: expected a template id of the bank (did you mean "
-                                        "drop-rebound?)"),
+                                        "drop-rebound or two-rebounds?)"),
     ({"fixed": {"h_drop": -5}}, None, "problems[0].fixed.h_drop: expected a value in the parameter's domain (0, inf)"),
     ({"fixed": {"height": 5}}, None, "problems[0].fixed: expected parameters of drop-rebound"),
     ({"fixed": {"h_drop": 1000, "h_rebound": 1500}}, None, "problem 1 (drop-rebound): no valid variant for student "),

@@ -46,6 +46,16 @@ def few(generation: Generation) -> Generation:
 
 
 @pytest.fixture(scope="module")
+def others(assignment: Assignment, bank: dict[str, Template]) -> tuple[Assignment, Generation]:
+    """One problem per template of the bank that the sample assignment does not use, six students."""
+    used = {problem.template for problem in assignment.problems}
+    problems = tuple(ProblemSpec(str(index + 1), template, {"*": 1.0}, {}, {}, {})
+                     for index, template in enumerate(sorted(set(bank) - used)))
+    extra = dataclasses.replace(assignment, problems=problems)
+    return extra, generate(extra, load_roster(sample_dir() / "roster.csv")[:6], bank)
+
+
+@pytest.fixture(scope="module")
 def rendered(tmp_path_factory: pytest.TempPathFactory, assignment: Assignment, bank: dict[str, Template],
              few: Generation) -> tuple[Path, list[Path], list[int]]:
     out = tmp_path_factory.mktemp("render")
@@ -252,9 +262,11 @@ def test_a_key_page_renders_to_a_png(assignment: Assignment, few: Generation, ba
         render_page_png(assignment, few, bank, index, page=99)
 
 
-def test_figures_fit_their_column(assignment: Assignment, generation: Generation, bank: dict[str, Template]) -> None:
-    """No figure of any student is wider than 7.7 cm or taller than 8 cm."""
-    for entry in generation.students:
+def test_figures_fit_their_column(assignment: Assignment, generation: Generation, bank: dict[str, Template],
+                                  others: tuple[Assignment, Generation]) -> None:
+    """No figure of any student, of the sample's problems or the other templates', is wider than
+    7.7 cm or taller than 8 cm."""
+    for entry in (*generation.students, *others[1].students):
         for variant in entry.problems:
             template = bank[variant.template]
             drawn = figure(template, variant, worked(template, variant).values)
@@ -428,3 +440,30 @@ def test_cjk_and_hangul_names_print_with_the_system_noto_font(tmp_path: Path, ca
     assert "warning" not in capsys.readouterr().err
     assert name in pdf_text(tmp_path / "students" / f"{entry.student.id}.pdf")
     assert not uncovered([name], font_paths(()))
+
+
+def test_other_templates_pages_render_to_pngs(others: tuple[Assignment, Generation],
+                                              bank: dict[str, Template]) -> None:
+    """Each template's page, and a page of the answer key, written to tests/artifacts/ to look at."""
+    extra, generation = others
+    ARTIFACTS.mkdir(exist_ok=True)
+    for position, problem in enumerate(extra.problems):
+        single = dataclasses.replace(extra, problems=(problem,))
+        one = Generation(tuple(StudentVariants(s.student, (s.problems[position],)) for s in generation.students), {})
+        png = render_page_png(single, one, bank, 0, ppi=110)
+        assert png_size(png) == (935, 1210) and len(png) > 30_000
+        (ARTIFACTS / f"{problem.template}.png").write_bytes(png)
+    key = render_page_png(extra, generation, bank, 0, key=True)
+    assert png_size(key) == (935, 1210)
+    (ARTIFACTS / "answer-key-other-templates.png").write_bytes(key)
+
+
+def test_an_asked_height_is_not_drawn_to_scale(assignment: Assignment, bank: dict[str, Template]) -> None:
+    """moving-plate asks how high the ball rises: two variants that differ only in e (so in that
+    height) get the same figure, which would otherwise give the answer away."""
+    def drawn(e: float) -> str:
+        spec = ProblemSpec("1", "moving-plate", {"*": 1.0}, {"h": 1.2, "u": 1.5, "e": e}, {}, {})
+        one = dataclasses.replace(assignment, problems=(spec,))
+        variant = generate(one, (Student("s1", "Sam", "", ""),), bank).students[0].problems[0]
+        return figure(bank["moving-plate"], variant, worked(bank["moving-plate"], variant).values)
+    assert drawn(0.5) == drawn(0.9)

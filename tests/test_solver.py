@@ -13,31 +13,7 @@ from grader.model.expr import names
 from grader.solve.compiled import Compiled
 from grader.solve.evaluate import solve_one
 from grader.solve.solver import compile_template
-
-TWO_BOUNCES = """
-id: two-bounces
-title: A ball bounces twice
-version: 1
-gravity: 9.81 m/s^2
-bodies: {ball: {mass: m}, floor: {fixed: true}}
-symbols: {m: {unit: kg}}
-parameters:
-  h_drop: {unit: m, domain: "(0, inf)", sample: {uniform: [1, 2]}, decimals: 2}
-  e: {unit: "", domain: "[0, 1]", sample: {uniform: [0.5, 0.9]}, decimals: 2}
-  J: {unit: m, domain: "[0, 1]", sample: {uniform: [0, 1]}, decimals: 2, description: "named like an impulse"}
-stages:
-  - {effect: free_fall, body: ball, height: h_drop, speed: v1}
-  - {effect: impact, bodies: [ball, floor], restitution: e, before: {ball: v1}, after: {ball: w1}}
-  - {effect: rise, body: ball, speed: -w1, height: h1}
-  - {effect: free_fall, body: ball, height: h1, speed: v2}
-  - {effect: impact, bodies: [ball, floor], restitution: e, before: {ball: v2}, after: {ball: w2}, loss_fraction: f2}
-  - {effect: rise, body: ball, speed: -w2, height: h2}
-answers:
-  h2: {value: h2, unit: m}
-  f2: {value: f2, unit: ""}
-  J_plus_h2: {value: J + h2, unit: m}
-statement: Dropped from {{ h_drop }} m with e = {{ e }}.
-"""
+from tests.scenes import TWO_BOUNCES
 
 
 @pytest.fixture(scope="module")

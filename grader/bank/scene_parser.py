@@ -115,8 +115,10 @@ def _parse_velocities(value: Any, where: str, key: str, bodies: Mapping[str, Bod
     for body, given in value.items():
         if body not in bodies:
             raise TemplateError(where, f"{key}.{body}", f"one of the bodies ({', '.join(bodies)})", shown(body))
-        if bodies[body].mass is None:
-            raise TemplateError(where, f"{key}.{body}", "no velocity for a fixed body (it stays at rest)", shown(given))
+        if bodies[body].mass is None and not key.endswith(".before"):
+            # A fixed surface (infinite mass) may move at a constant velocity, which no impact changes.
+            raise TemplateError(where, f"{key}.{body}", "no velocity after the impact for a fixed body (it keeps "
+                                "the velocity given under 'before', or stays at rest)", shown(given))
         if isinstance(given, Mapping):
             if set(given) - {"n", "t"} or "n" not in given:
                 raise TemplateError(where, f"{key}.{body}", "{n: EXPR, t: EXPR}", shown(given))

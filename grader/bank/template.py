@@ -1,8 +1,8 @@
 """The problem bank: YAML templates parsed into frozen, validated :class:`Template` objects.
 
 >>> bank = load_bank()
->>> sorted(bank)
-['ball-plate', 'car-collision', 'drop-rebound', 'oblique-spheres', 'pile-driver']
+>>> sorted(bank)[:2]
+['ball-plate', 'car-collision']
 >>> bank["drop-rebound"].parameters["h_drop"].unit.text
 'mm'
 """

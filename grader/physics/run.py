@@ -10,7 +10,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
-from grader.model.expr import Node, Sym, names
+from grader.model.expr import Node, Op, Sym, names, to_text
 from grader.model.kernel import evaluate
 from grader.model.scene import Scene
 from grader.physics.integrate import TIME_LIMIT, Budget, Mode, Path, Settings, SimulationError, integrate
@@ -71,6 +71,7 @@ class Run:
     problems: list[str] = field(default_factory=list)
     contacts: list[ContactRecord] = field(default_factory=list)
     undefined: dict[str, str] = field(default_factory=dict)  # quantity -> why it has no value
+    waiting: dict[int, str] = field(default_factory=dict)  # stage index -> a quantity it needs that nothing gave
     budget: Budget = field(default_factory=Budget)
     steps: int = 0
     speed_scale: float = 0.0  # the largest speed an impact of this run involved (SI)
@@ -100,11 +101,14 @@ class Run:
         return names(node) <= set(self.values)
 
     def output(self, node: Node, value: float) -> None:
-        """Give a simulated quantity: a new name is assigned; a known one is an observation."""
+        """Give a simulated quantity: a new name is assigned (``-v`` assigns ``v``); a known one is an
+        observation."""
         if isinstance(node, Sym) and node.name not in self.values:
             self.values[node.name] = value
+        elif (negated := _negated(node)) is not None and negated not in self.values:  # a name with its sign turned
+            self.values[negated] = -value
         elif self.known(node):
-            self.observed[str(node)] = (value, self.value(node))
+            self.observed[to_text(node)] = (value, self.value(node))
         else:
             raise SimulationError(f"{self.scene.where}: cannot simulate: '{node}' is an expression of "
                                   "quantities nothing has produced yet")
@@ -126,6 +130,13 @@ class Run:
         """Keep a phase's path for plots and count its steps."""
         self.phases.append(PhaseRecord(label, state_names, path))
         self.steps += path.steps
+
+
+def _negated(node: Node) -> str | None:
+    """``v`` for the field ``-v``, else None."""
+    if isinstance(node, Op) and node.op == "neg" and isinstance(node.args[0], Sym):
+        return node.args[0].name
+    return None
 
 
 class UnknownQuantityError(Exception):

@@ -246,9 +246,12 @@ class Context:
         return base
 
     def velocity(self, stage: Stage, body: str, when: str, axis: str) -> Any:
-        """A velocity component of a body in an impact: 0 for a fixed body or one at rest."""
-        if self.scene.bodies[body].mass is None or (axis == "t" and not stage.is_oblique):
+        """A velocity component of a body in an impact: 0 for a body at rest; a fixed body (infinite
+        mass) keeps the velocity it is given before the impact (a plate moving at constant speed)."""
+        if axis == "t" and not stage.is_oblique:
             return sp.Integer(0)
+        if self.scene.bodies[body].mass is None:
+            when = "before"
         given = stage.fields.get(when, {}).get(body)
         if given is not None and getattr(given, axis) is not None:
             return self.sym(getattr(given, axis))

@@ -3,215 +3,38 @@
 The kind of figure follows from the scene's structure, never from the template's id:
 
 * a body falls (``free_fall``) onto a fixed surface or onto a second body, maybe rising again after
-  the impact: the surface (or a pile, drawn under a block), the body at its drop height and, dashed,
-  at its rebound height, with dimension lines; heights to scale;
+  the impact: the surface (a plate moving at constant velocity with its arrow, or a pile, drawn under
+  a block), the body at its drop height and, dashed, at its rebound height, with dimension lines;
+  given heights to scale, an asked one drawn but not to scale (it would give the answer away);
+* a body falls onto a fixed surface and rebounds more than once: its path as arcs, each height
+  dimensioned, given ones to scale;
 * an oblique ``impact`` (a ``velocity`` stage gives the components) with a fixed body: the surface,
   the incoming and rebound velocity arrows at their angles, lengths proportional to the speeds;
 * an oblique impact of two bodies: two touching circles, the line of centres n and the tangent t,
   the incoming velocity at its angle to n;
-* a direct impact of two bodies: two blocks whose areas follow the mass ratio, the velocity arrows
-  of the moving bodies, the bodies at rest marked so;
+* direct impacts of bodies in a line (two, or a chain: 1 strikes 2, 2 strikes 3): blocks whose areas
+  follow the masses, above each the velocity before it is struck, an arrow the way it moves with
+  lengths in the ratio of the speeds, the bodies at rest marked so;
 * anything else: the bodies in a row, labelled.
 
-Geometry is built in centimetres with y up, then shifted so the drawing's bounding box (labels
-included, by an estimate of their size) starts at the origin, and flipped for Typst.
-
->>> canvas = Canvas()
->>> canvas.line((0, 0), (2, 1))
->>> canvas.typst().startswith("fig-canvas(2.10, 1.10")
-True
+The drawing primitives are :class:`grader.render.canvas.Canvas`'s.
 """
 
 from __future__ import annotations
 
 import math as _m
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
 from grader.assign.variants import ProblemVariant
 from grader.bank.template import Template
-from grader.model.expr import Node, Sym, names
+from grader.model.expr import Node, Op, Sym, names
 from grader.model.kernel import evaluate
 from grader.model.scene import Stage, Velocity
+from grader.render.canvas import Canvas, Point
 from grader.render.worked import Typ, math, name, string
-
-Point = tuple[float, float]
-PAD = 0.05
-MAX_WIDTH = 7.6
-CHAR = 0.15  # cm per character of a label at the figure's text size, an estimate for the bounding box
-LINE = 0.42  # cm per line of a label
-
-
-def _fmt(value: float) -> str:
-    return f"{value:.2f}"
-
-
-@dataclass
-class Canvas:
-    """Drawing calls with their coordinates (cm, y up), what they cover, and what labels must avoid."""
-
-    calls: list[tuple[str, list[Point], float, str]] = field(default_factory=list)
-    points: list[Point] = field(default_factory=list)
-    labels: list[tuple[Point, tuple[float, float, float, float]]] = field(default_factory=list)
-    occupied: list[tuple[float, float, float, float]] = field(default_factory=list)
-    strokes: list[tuple[Point, Point]] = field(default_factory=list)
-
-    def _add(self, kind: str, points: Sequence[Point], options: str = "", radius: float = 0.0) -> None:
-        for x, y in points:
-            self.points += [(x - radius, y - radius), (x + radius, y + radius)]
-        self.calls.append((kind, list(points), radius, options))
-
-    def line(self, a: Point, b: Point, width: float = 0.6, dash: str | None = None, gray: bool = False) -> None:
-        """A straight line."""
-        self._add("fig-line", [a, b], _stroke(width, dash, gray))
-
-    def path(self, points: Sequence[Point], width: float = 0.6, dash: str | None = None) -> None:
-        """An open polyline."""
-        self._add("fig-path", points, _stroke(width, dash, False))
-
-    def polygon(self, points: Sequence[Point], gray: bool = False) -> None:
-        """A filled polygon."""
-        self._add("fig-poly", points, "fill: luma(150)" if gray else "")
-
-    def circle(self, center: Point, radius: float, dash: str | None = None, fill: bool = True) -> None:
-        """A circle (a body)."""
-        self._add("fig-circle", [center], f"{_stroke(0.8, dash, False)}{', fill: luma(235)' if fill else ''}", radius)
-
-    def rect(self, low: Point, high: Point, dash: str | None = None, fill: str = "luma(235)") -> None:
-        """A rectangle between two corners (a block, a plate)."""
-        self._add("fig-rect", [(low[0], high[1]), (high[0], low[1])], f"{_stroke(0.8, dash, False)}, fill: {fill}")
-        self.occupied.append((low[0], low[1], high[0], high[1]))
-
-    def _label_box(self, at: Point, anchor: str, lines: Sequence[str]) -> tuple[float, float, float, float]:
-        width = max(_visible(line) for line in lines) * CHAR
-        height = LINE * len(lines)
-        fx = 0.0 if "w" in anchor else 1.0 if "e" in anchor else 0.5
-        fy = 0.0 if "n" in anchor else 1.0 if "s" in anchor else 0.5
-        left, top = at[0] - fx * width, at[1] + fy * height
-        return left, top - height, left + width, top
-
-    def fits(self, at: Point, anchor: str, lines: Sequence[str]) -> bool:
-        """Whether a label placed so would stay clear of the labels and blocks drawn so far."""
-        box = self._label_box(at, anchor, lines)
-        x0, y0, x1, y1 = box
-        return not any(x0 < b[2] and b[0] < x1 and y0 < b[3] and b[1] < y1 for b in self.occupied) and \
-            not any(_crosses(box, a, b) for a, b in self.strokes)
-
-    def label(self, at: Point, anchor: str, lines: Sequence[str]) -> None:
-        """Math lines stacked, placed so that ``anchor`` (c, n, s, e, w, ne, nw, se, sw) of the
-        label is at ``at``."""
-        box = self._label_box(at, anchor, lines)
-        self.labels.append((at, (box[0] - at[0], box[1] - at[1], box[2] - at[0], box[3] - at[1])))
-        self.occupied.append(box)
-        body = ", ".join(f"${line}$" for line in lines)
-        self.calls.append(("fig-label", [at], 0.0, f"{string(anchor)}, ({body},)"))
-
-    def arrow(self, tail: Point, tip: Point, width: float = 0.9, head: float = 0.22) -> None:
-        """An arrow: a line and a triangular head."""
-        dx, dy = tip[0] - tail[0], tip[1] - tail[1]
-        length = _m.hypot(dx, dy) or 1.0
-        ux, uy = dx / length, dy / length
-        base = (tip[0] - ux * head, tip[1] - uy * head)
-        self.strokes.append((tail, tip))
-        self.line(tail, (tip[0] - ux * head * 0.8, tip[1] - uy * head * 0.8), width)
-        self.polygon([tip, (base[0] - uy * head * 0.38, base[1] + ux * head * 0.38),
-                      (base[0] + uy * head * 0.38, base[1] - ux * head * 0.38)])
-
-    def arc(self, center: Point, radius: float, start: float, end: float) -> None:
-        """A circular arc between two angles (radians, counter-clockwise from +x)."""
-        steps = max(4, int(abs(end - start) / 0.08))
-        self.path([(center[0] + radius * _m.cos(start + (end - start) * i / steps),
-                    center[1] + radius * _m.sin(start + (end - start) * i / steps)) for i in range(steps + 1)],
-                  width=0.5)
-
-    def ground(self, x0: float, x1: float, y: float, below: bool = True) -> None:
-        """A fixed surface: a line hatched on the side of the body."""
-        self.line((x0, y), (x1, y), width=1.0)
-        sign = -1 if below else 1
-        x = x0 + 0.1
-        while x < x1:
-            self.line((x, y), (x - 0.16, y + sign * 0.16), width=0.4)
-            x += 0.18
-
-    def dimension(self, low: Point, high: Point, lines: Sequence[str], side: str) -> None:
-        """A vertical dimension line from ``low`` to ``high`` with arrows, labelled on ``side``."""
-        x = low[0]
-        length = high[1] - low[1]
-        if length > 0.6:
-            self.arrow((x, (low[1] + high[1]) / 2), (x, high[1]), width=0.5, head=0.15)
-            self.arrow((x, (low[1] + high[1]) / 2), (x, low[1]), width=0.5, head=0.15)
-        else:  # too short for arrows inside: they point in from outside
-            self.arrow((x, high[1] + 0.4), (x, high[1]), width=0.5, head=0.15)
-            self.arrow((x, low[1] - 0.4), (x, low[1]), width=0.5, head=0.15)
-            if length > 0:
-                self.line(low, high, width=0.5)
-        middle = (x + (-0.15 if side == "left" else 0.15), (low[1] + high[1]) / 2)
-        # "h = 1.20 m" as two lines, "h" over "= 1.20 m": narrower beside a tall figure
-        split = [part for line in lines for part in ([line] if " = " not in line else
-                                                      [line.split(" = ", 1)[0], "= " + line.split(" = ", 1)[1]])]
-        self.label(middle, "e" if side == "left" else "w", split)
-
-    def _extent(self, scale: float) -> tuple[float, float, float, float]:
-        """The bounding box with the geometry scaled by ``scale`` and the labels at their size."""
-        xs = [x * scale for x, _ in self.points] + [a[0] * scale + d for a, box in self.labels for d in box[::2]]
-        ys = [y * scale for _, y in self.points] + [a[1] * scale + d for a, box in self.labels for d in box[1::2]]
-        return (min(xs), min(ys), max(xs), max(ys)) if xs else (0.0, 0.0, 0.0, 0.0)
-
-    def typst(self) -> Typ:
-        """A ``fig-canvas`` call drawing everything, shifted to start at the origin; a drawing wider
-        than ``MAX_WIDTH`` has its geometry (not its labels) scaled down until it fits."""
-        scale = 1.0
-        while scale > 0.5 and self._extent(scale)[2] - self._extent(scale)[0] + 2 * PAD > MAX_WIDTH:
-            scale -= 0.05
-        x0, y0, x1, y1 = self._extent(scale)
-
-        def place(point: Point) -> str:
-            return f"({_fmt(point[0] * scale - x0 + PAD)}, {_fmt(y1 - point[1] * scale + PAD)})"
-        body = []
-        for kind, points, radius, options in self.calls:
-            arguments = [place(p) for p in points] + ([_fmt(radius * scale)] if radius else []) + \
-                ([options] if options else [])
-            body.append(f"  {kind}({', '.join(arguments)})")
-        return Typ(f"fig-canvas({_fmt(x1 - x0 + 2 * PAD)}, {_fmt(y1 - y0 + 2 * PAD)}, {{\n" + "\n".join(body) + "\n})")
-
-
-def _crosses(box: tuple[float, float, float, float], a: Point, b: Point) -> bool:
-    """Whether the segment from ``a`` to ``b`` passes through the box (Liang-Barsky clipping)."""
-    dx, dy = b[0] - a[0], b[1] - a[1]
-    low, high = 0.0, 1.0
-    for p, q in ((-dx, a[0] - box[0]), (dx, box[2] - a[0]), (-dy, a[1] - box[1]), (dy, box[3] - a[1])):
-        if p == 0:
-            if q < 0:
-                return False
-            continue
-        t = q / p
-        if p < 0:
-            low = max(low, t)
-        else:
-            high = min(high, t)
-        if low > high:
-            return False
-    return True
-
-
-def _stroke(width: float, dash: str | None, gray: bool) -> str:
-    parts = [f"w: {width}pt"]
-    if dash:
-        parts.append(f"dash: {string(dash)}")
-    if gray:
-        parts.append("paint: luma(140)")
-    return ", ".join(parts)
-
-
-def _visible(line: str) -> int:
-    """A rough count of the characters a math line shows (for the bounding box)."""
-    shown = line.replace('"', "").replace(" thin ", " ").replace(" degree", "°").replace("_", "")
-    for word in ("theta", "alpha", "beta", "phi", "omega", "mu"):
-        shown = shown.replace(word, "x")
-    return len(shown)
-
 
 # --- what the scene says ------------------------------------------------------------------------
 
@@ -240,6 +63,11 @@ class _Scene:
             shown = " degree" if unit == "deg" else f" thin {string(unit)}" if unit else ""
             return [f"{name(node.name)} = {printed}{shown}"]
         return [math(node)]
+
+    def is_given(self, node: Node) -> bool:
+        """Whether the statement gives this quantity (only parameters and numbers in it): what is
+        asked is never drawn to scale."""
+        return names(node) <= set(self.template.parameters)
 
     def mass_value(self, body: str) -> list[str]:
         """A body's mass as its printed value and unit (``1.5 kg``) when a parameter gives it."""
@@ -297,15 +125,18 @@ def figure(template: Template, variant: ProblemVariant, values: Mapping[str, flo
         return canvas.typst()
     first, second = impact.fields["bodies"]
     fall = _stage(stages, "free_fall", before=impact.index, body=first)
+    rises = [s for s in stages if s.effect == "rise" and s.index > impact.index and s.fields["body"] == first]
     drawn = False
-    if fall is not None:
-        drawn = _drop(canvas, scene, fall, impact, _stage(stages, "rise", after=impact.index, body=first))
+    if fall is not None and len(rises) > 1 and template.scene.bodies[second].mass is None:
+        drawn = _bounces(canvas, scene, fall, rises, second)
+    elif fall is not None:
+        drawn = _drop(canvas, scene, fall, impact, rises[0] if rises else None)
     elif impact.is_oblique and template.scene.bodies[second].mass is None:
         drawn = _surface(canvas, scene, impact)
     elif impact.is_oblique:
         drawn = _spheres(canvas, scene, impact)
     else:
-        drawn = _direct(canvas, scene, impact)
+        drawn = _direct(canvas, scene, [s for s in stages if s.effect == "impact" and not s.is_oblique])
     if not drawn:
         canvas = Canvas()
         _row(canvas, scene)
@@ -321,6 +152,8 @@ def _drop(canvas: Canvas, scene: _Scene, fall: Stage, impact: Stage | None, rise
     second = impact.fields["bodies"][1] if impact is not None else None
     drop = scene.value(fall.fields["height"])
     rebound = scene.value(rise.fields["height"]) if rise is not None else _m.nan
+    if rise is not None and not scene.is_given(rise.fields["height"]) and _m.isfinite(rebound):
+        rebound = 0.6 * drop  # an asked height is drawn, not to scale: the figure must not give it away
     heights = [h for h in (drop, rebound) if _m.isfinite(h) and h > 0]
     if not (_m.isfinite(drop) and drop > 0):
         return False
@@ -348,7 +181,12 @@ def _drop(canvas: Canvas, scene: _Scene, fall: Stage, impact: Stage | None, rise
             canvas.arrow((x_ghost, rebound * scale * 0.45), (x_ghost, rebound * scale * 0.55), width=0.4, head=0.16)
         canvas.dimension((4.75, 0), (4.75, rebound * scale), scene.given(rise.fields["height"]), "right")
         canvas.line((x_ghost + 0.35, rebound * scale), (4.9, rebound * scale), width=0.3)
-    if fixed:
+    moving = impact.fields["before"].get(second) if impact is not None and second is not None else None
+    if fixed and moving is not None:  # a driven plate: a slab, with its velocity (n points down)
+        canvas.rect((0.9, -0.35), (5.2, 0.0), fill="luma(215)")
+        canvas.label((3.3, -0.4), "n", [str(string(second))])
+        _vertical_velocity(canvas, scene, (5.75, -0.2), -scene.value(moving.n), moving.n)
+    elif fixed:
         canvas.ground(0.9, 5.2, 0.0)
         canvas.label((3.3, -0.3), "n", [str(string(second or "ground"))])
     else:  # a pile: its top is the impact surface, driven into the ground
@@ -357,6 +195,59 @@ def _drop(canvas: Canvas, scene: _Scene, fall: Stage, impact: Stage | None, rise
         canvas.ground(x_body + 0.45, 5.0, -0.45)
         canvas.line((x_body + 0.45, 0.0), (4.9, 0.0), width=0.3, dash="dashed")
         canvas.label((x_body + 0.6, -1.05), "w", [str(string(second)), *scene.mass(str(second))])
+    return True
+
+
+def _vertical_velocity(canvas: Canvas, scene: _Scene, at: Point, upward: float, given: Node) -> None:
+    """An arrow through ``at`` the way a surface moves (up or down), labelled with what gives its velocity."""
+    if not _m.isfinite(upward) or upward == 0:
+        canvas.label(at, "w", [*scene.given(_parameter_of(given)), "(at rest)"])
+        return
+    sign = 1.0 if upward > 0 else -1.0
+    canvas.arrow((at[0], at[1] - 0.45 * sign), (at[0], at[1] + 0.45 * sign), width=0.9)
+    canvas.label((at[0] + 0.15, at[1]), "w", scene.given(_parameter_of(given)))
+
+
+def _parameter_of(node: Node) -> Node:
+    """``u`` for ``-u``: a velocity given with its sign turned (an axis pointing the other way) is
+    labelled with the parameter, whose positive sense the statement names."""
+    return node.args[0] if isinstance(node, Op) and node.op == "neg" else node
+
+
+def _bounces(canvas: Canvas, scene: _Scene, fall: Stage, rises: Sequence[Stage], surface: str) -> bool:
+    """A body dropped onto a fixed surface and rebounding again and again: its path as arcs, the
+    given heights to scale, an asked one drawn (not to scale) and labelled with its name only."""
+    first = fall.fields["body"]
+    heights = [fall.fields["height"], *(rise.fields["height"] for rise in rises)]
+    values = [scene.value(h) for h in heights]
+    known = [v for h, v in zip(heights, values, strict=True) if scene.is_given(h) and _m.isfinite(v) and v > 0]
+    if not known:
+        return False
+    scale = 4.2 / max(known)
+    drawn = []
+    for index, (height, value) in enumerate(zip(heights, values, strict=True)):
+        if scene.is_given(height) and _m.isfinite(value) and value >= 0:
+            drawn.append(value * scale)
+        else:  # asked: above the first rebound for the drop, between its neighbours for a rebound
+            drawn.append(5.5 if index == 0 else 0.6 * drawn[-1])
+    x, radius = 1.2, 0.3
+    canvas.circle((x, drawn[0] + radius), radius)
+    canvas.label((x, drawn[0] + 2 * radius + 0.15), "s", [str(string(first)), *scene.mass(first)])
+    canvas.line((x, 0.0), (x, drawn[0]), width=0.4, dash="dashed", gray=True)
+    canvas.arrow((x, drawn[0] * 0.55), (x, drawn[0] * 0.45), width=0.4, head=0.16)
+    canvas.dimension((0.4, 0.0), (0.4, drawn[0]), scene.given(heights[0]), "left")
+    canvas.line((0.25, drawn[0]), (x - 0.35, drawn[0]), width=0.3)
+    for height, top in zip(heights[1:], drawn[1:], strict=True):
+        width = 1.6 + 0.6 * _m.sqrt(top)
+        apex = x + width / 2
+        canvas.path([(x + width * i / 24, top * (1 - (2 * i / 24 - 1) ** 2)) for i in range(25)], width=0.4,
+                    dash="dashed")
+        canvas.circle((apex, top + radius), radius, "dashed", fill=False)
+        canvas.dimension((apex, 0.0), (apex, top), [], "right")
+        canvas.label((apex + radius + 0.1, top + radius), "w", scene.given(height))
+        x += width
+    canvas.ground(0.0, x + 0.4, 0.0)
+    canvas.label(((x + 1.2) / 2, -0.3), "n", [str(string(surface))])
     return True
 
 
@@ -509,20 +400,35 @@ def _spheres(canvas: Canvas, scene: _Scene, impact: Stage) -> bool:
     return True
 
 
-def _direct(canvas: Canvas, scene: _Scene, impact: Stage) -> bool:
-    """Two blocks on a line, areas in the ratio of the masses; the moving ones with an arrow."""
-    first, second = impact.fields["bodies"]
-    masses = {b: scene.value(scene.template.scene.bodies[b].mass) for b in (first, second)}
-    fixed = scene.template.scene.bodies[second].mass is None
-    mean = _m.sqrt(masses[first] * masses[second]) if not fixed else masses[first]
-    sides = {b: 1.1 * min(2.0, max(0.5, _m.sqrt(m / mean))) if _m.isfinite(m) and m > 0 and mean > 0 else 1.1
+def _line_of_bodies(impacts: Sequence[Stage]) -> list[str]:
+    """The bodies of direct impacts in the order they are struck: ``[1, 2]`` then ``[2, 3]`` is 1, 2, 3."""
+    order: list[str] = []
+    for stage in impacts:
+        order += [body for body in stage.fields["bodies"] if body not in order]
+    return order
+
+
+def _direct(canvas: Canvas, scene: _Scene, impacts: Sequence[Stage]) -> bool:
+    """Bodies on a line in the order they are struck, blocks whose areas follow the masses (a fixed
+    one a wall); above each its velocity before it is first struck, an arrow the way it moves with
+    lengths in the ratio of the speeds, or ``v = 0``."""
+    bodies = _line_of_bodies(impacts)
+    before = {body: stage.fields["before"].get(body) for stage in reversed(impacts) for body in stage.fields["bodies"]}
+    masses = {b: scene.value(scene.template.scene.bodies[b].mass) for b in bodies
+              if scene.template.scene.bodies[b].mass is not None}
+    finite = [m for m in masses.values() if _m.isfinite(m) and m > 0]
+    mean = _m.exp(sum(_m.log(m) for m in finite) / len(finite)) if finite else 1.0
+    # Sides clamped to 0.77..2.2 cm: the smallest still holds its name, the largest fits the column.
+    sides = {b: 1.1 * min(2.0, max(0.7, _m.sqrt(m / mean))) if _m.isfinite(m) and m > 0 else 1.1
              for b, m in masses.items()}
+    speeds = [abs(scene.value(v.n)) for v in before.values() if v is not None]
+    fastest = max((v for v in speeds if _m.isfinite(v)), default=0.0)
+    gap = 2.2 if len(bodies) < 3 else 1.9
     x = 0.0
-    canvas.line((-0.3, 0.0), (sides[first] + 2.2 + (0 if fixed else sides[second] + 0.3), 0.0), width=1.0)
-    for index, body in enumerate((first, second)):
-        if index == 1:
-            x += 2.2
-        if fixed and body == second:  # a wall, hatched on its far side
+    for index, body in enumerate(bodies):
+        if index:
+            x += gap
+        if body not in masses:  # a wall, hatched on its far side
             canvas.line((x, 0.0), (x, 1.8), width=1.0)
             for y in (0.15, 0.4, 0.65, 0.9, 1.15, 1.4, 1.65):
                 canvas.line((x, y), (x + 0.16, y + 0.16), width=0.4)
@@ -532,15 +438,24 @@ def _direct(canvas: Canvas, scene: _Scene, impact: Stage) -> bool:
         canvas.rect((x, 0.0), (x + side, side))
         canvas.label((x + side / 2, side / 2), "c", [str(string(body))])
         canvas.label((x + side / 2, -0.12), "n", scene.mass(body))
-        velocity = impact.fields["before"].get(body)
-        if velocity is None:
-            canvas.label((x + side / 2, side + 0.1), "s", ["v = 0"])
-        else:
-            start = (x + side + 0.1, side / 2)
-            canvas.arrow(start, (start[0] + 1.6, start[1]))
-            canvas.label((start[0] + 0.8, side / 2 + 0.12), "s", scene.given(velocity.n or Sym("v")))
+        _horizontal_velocity(canvas, scene, (x + side / 2, side + 0.3), before[body], fastest)
         x += side
+    canvas.line((-0.3, 0.0), (x + 0.3, 0.0), width=1.0)
     return True
+
+
+def _horizontal_velocity(canvas: Canvas, scene: _Scene, at: Point, velocity: Velocity | None,
+                         fastest: float) -> None:
+    """Above a body: an arrow centred on ``at`` the way it moves, 1.6 cm for the fastest body of the
+    figure (at least 0.5 cm), labelled with its velocity as given; ``v = 0`` for a body at rest."""
+    given = velocity.n if velocity is not None else None
+    value = scene.value(given) if given is not None else 0.0
+    if given is None or not (_m.isfinite(value) and value != 0 and fastest > 0):
+        canvas.label((at[0], at[1] - 0.2), "s", ["v = 0"] if given is None else scene.given(given))
+        return
+    half = max(0.25, 0.8 * abs(value) / fastest) * (1 if value > 0 else -1)
+    canvas.arrow((at[0] - half, at[1]), (at[0] + half, at[1]))
+    canvas.label((at[0], at[1] + 0.2), "s", scene.given(given))
 
 
 def _row(canvas: Canvas, scene: _Scene) -> None:

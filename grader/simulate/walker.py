@@ -1,11 +1,13 @@
 """Re-derive a template's answers in the time domain, simulating only the effects its scene declares.
 
-The stages run forward in order, each through its effect's own phase (gravity for flight, a
-compliant contact for an impact, kinematics for a velocity). A template that gives a measured
-outcome instead of an input (a rebound height instead of ``e``) is solved by root finding on
-the simulation itself: ``e`` is adjusted until the simulated rebound matches, so no closed form
-is used. Symbols without a value (a mass that cancels, the speed ``v``) are set to 1 in their
-unit; only answers that do not depend on them are compared.
+The stages run in the order their quantities flow (as written, unless a stage waits for one a later
+stage gives), each through its effect's own phase (gravity for flight, a compliant contact for an
+impact, kinematics for a velocity). A template that gives a measured outcome instead of an input
+(a rebound height instead of ``e``) is solved by root finding on the simulation itself: ``e`` is
+adjusted until the simulated rebound matches, so no closed form is used. Several such unknowns are
+found one at a time (two rebound heights: ``e`` from the second bounce, then the drop height).
+Symbols without a value (a mass that cancels, the speed ``v``) are set to 1 in their unit; only
+answers that do not depend on them are compared.
 
 >>> from grader.bank.template import load_bank
 >>> template = load_bank()["pile-driver"]
@@ -98,17 +100,38 @@ def _si_values(template: Template, params: Mapping[str, float]) -> dict[str, flo
 
 
 def _walk(template: Template, options: Options, values: dict[str, float], budget: Budget) -> Run:
+    """Simulate every stage whose inputs are known, in the order the quantities flow: a stage that
+    needs a quantity a later stage produces (or a search must find) waits for it. The run's
+    ``waiting`` names, per stage left over, the first quantity it still needs. An effect's force law
+    reads its inputs before it simulates anything, so a stage that cannot start leaves no trace."""
     run = Run(template.scene, options, dict(values), budget=budget)
-    for stage in template.scene.stages:
-        simulator = CATALOGUE[stage.effect].simulate
-        assert simulator is not None  # checked by _check_force_laws
-        simulator(stage, run)
+    waiting = list(template.scene.stages)
+    while waiting:
+        for stage in waiting:
+            simulator = CATALOGUE[stage.effect].simulate
+            assert simulator is not None  # checked by _check_force_laws
+            try:
+                simulator(stage, run)
+            except UnknownQuantityError as missing:
+                run.waiting[stage.index] = missing.name
+                continue
+            run.waiting.pop(stage.index, None)
+            waiting.remove(stage)
+            break
+        else:
+            break
     return run
 
 
-# Passes a search for e makes: two ends, brentq's iterations (about 10 to 20 on these scenes at
-# xtol 1e-15), the final run; the bound is what the fixed-step work is estimated with.
+# Passes a search for one unknown makes: two ends, brentq's iterations (about 10 to 20 on these scenes
+# at xtol 1e-15), the final run; the bound is what the fixed-step work is estimated with.
 SEARCH_PASSES = 25
+# What a search may find, by the stage field that needs it: a restitution in [0, 1]; a fall height in
+# [0, inf), bracketed by growing an upper end from the size of the outcome it must match.
+_SEARCHABLE = {("impact", "restitution"): ("coefficient of restitution", 0.0, 1.0),
+               ("free_fall", "height"): ("fall height", 0.0, math.inf)}
+_PROBE = 0.5  # a value of the unknown that shows which outcome it leads to
+_GROWTH, _MAX_GROWTH = 4.0, 120  # an open upper end grows 4x at a time, at most 120 times (4**120 ~ 1e72)
 
 
 def _check_work(template: Template, options: Options, passes: int) -> None:
@@ -120,56 +143,107 @@ def _check_work(template: Template, options: Options, passes: int) -> None:
     estimate = settings.steps * 2 * len(template.scene.stages) * passes
     if estimate > MAX_STEPS:
         most = MAX_STEPS // (2 * len(template.scene.stages) * passes)
-        search = f" x {passes} passes of the search for the unknown restitution" if passes > 1 else ""
+        search = f" x {passes} passes of the search for what is not given" if passes > 1 else ""
         raise SimulationError(f"{settings.method} with {settings.steps} steps per contact would take up to "
                               f"{estimate:,} steps ({len(template.scene.stages)} stages{search}), above the limit of "
                               f"{MAX_STEPS:,}; use at most {most} steps per contact, or the adaptive method")
 
 
+@dataclass(frozen=True)
+class _Unknown:
+    """A quantity no parameter gives and no stage produces: the stage that needs it, what it is and
+    the range searched, and the one measured outcome (an observation's key) it must reproduce."""
+
+    name: str
+    stage: Stage
+    what: str
+    low: float
+    high: float
+    outcome: str
+
+
 def _solve_for_unknowns(template: Template, options: Options, base: dict[str, float],
                         budget: Budget) -> tuple[Run, dict[str, float]]:
-    """Walk the stages; a restitution nothing gives is found so the simulated observation matches."""
+    """Walk the stages; each quantity nothing gives (a restitution, a fall height) is found, one at a
+    time, so that the one measured outcome it leads to is reproduced: the simulation's own "one
+    equation, one unknown". Two rebound heights give e from the second bounce, then the drop height."""
     _check_work(template, options, 1)
-    try:
-        return _walk(template, options, base, budget), {}
-    except UnknownQuantityError as missing:
-        name = missing.name
-    stage = _restitution_stage(template, name)
-    _check_work(template, options, SEARCH_PASSES)
+    fitted: dict[str, float] = {}
+    while True:
+        run = _walk(template, options, {**base, **fitted}, budget)
+        if not run.waiting:
+            return run, fitted
+        _check_work(template, options, SEARCH_PASSES * (len(fitted) + 1))
+        unknown = _next_unknown(template, options, {**base, **fitted}, budget, run)
+        fitted[unknown.name] = _search(template, options, {**base, **fitted}, budget, unknown)
 
-    def mismatch(e: float) -> float:
-        run = _walk(template, options, {**base, name: e}, budget)
-        observed = list(run.observed.values())
-        if len(observed) != 1:
-            raise SimulationError(f"cannot simulate: finding {name} needs exactly one measured outcome, the scene "
-                                  f"has {len(observed)}")
-        simulated, given = observed[0]
-        return simulated - given
 
-    low, high = mismatch(0.0), mismatch(1.0)
-    if low == 0:
-        return _walk(template, options, {**base, name: 0.0}, budget), {name: 0.0}
-    if low * high > 0:
-        raise SimulationError(f"no coefficient of restitution in [0, 1] reproduces the given outcome of "
-                              f"stages[{stage.index}] (with e = {1 if high < 0 else 0} the simulated value is still "
-                              f"{'below' if high < 0 else 'above'} it)")
-    found = brentq(mismatch, 0.0, 1.0, xtol=1e-15, rtol=8.9e-16, maxiter=200)
-    run = _walk(template, options, {**base, name: found}, budget)
-    if run.problems and mismatch(found) < 0:
+def _next_unknown(template: Template, options: Options, values: dict[str, float], budget: Budget,
+                  stalled: Run) -> _Unknown:
+    """Of the quantities the waiting stages need, the first that can be searched for now: with a trial
+    value, the stages it unblocks reach exactly one new measured outcome."""
+    tried: list[tuple[str, int]] = []  # searchable quantities that reached no single outcome, and how many
+    for index, name in sorted(stalled.waiting.items()):
+        stage = template.scene.stages[index]
+        kind = next((_SEARCHABLE[(stage.effect, key)] for key, value in stage.fields.items()
+                     if (stage.effect, key) in _SEARCHABLE and value == Sym(name)), None)
+        if kind is None or name in (u for u, _ in tried):
+            continue
+        probe = _walk(template, options, {**values, name: _PROBE}, budget)
+        outcomes = sorted(set(probe.observed) - set(stalled.observed))
+        if len(outcomes) == 1:
+            return _Unknown(name, stage, *kind, outcomes[0])
+        tried.append((name, len(outcomes)))
+    if not tried:
+        name = stalled.waiting[min(stalled.waiting)]
+        raise SimulationError(f"cannot simulate: '{name}' is neither given nor produced by an earlier stage")
+    name, count = tried[0]
+    raise SimulationError(f"cannot simulate: finding {name} needs exactly one measured outcome that it alone "
+                          f"leads to, the scene has {count}")
+
+
+def _search(template: Template, options: Options, values: dict[str, float], budget: Budget,
+            unknown: _Unknown) -> float:
+    """The value of the unknown at which the simulated outcome equals the given one (brentq)."""
+    name = unknown.name
+
+    def outcome(x: float) -> tuple[float, float]:
+        return _walk(template, options, {**values, name: x}, budget).observed[unknown.outcome]
+
+    low, high = unknown.low, unknown.high
+    simulated, given = outcome(low)
+    at_low = simulated - given
+    if at_low == 0:
+        return low
+
+    def mismatch(x: float) -> float:
+        return outcome(x)[0] - given
+
+    if math.isinf(high):  # an upper end grown from the size of the outcome until it brackets the root
+        high = abs(given) or 1.0
+        for _ in range(_MAX_GROWTH):
+            at_high = mismatch(high)
+            if at_high * at_low <= 0:
+                break
+            high *= _GROWTH
+        span = f"[{low:g}, inf)"
+    else:
+        at_high = mismatch(high)
+        span = f"[{low:g}, {high:g}]"
+    if at_low * at_high > 0:
+        raise SimulationError(f"no {unknown.what} in {span} reproduces the given {unknown.outcome} (with {name} = "
+                              f"{high if at_high < 0 else low:g} the simulated {unknown.outcome} is still "
+                              f"{'below' if at_high < 0 else 'above'} it)")
+    xtol, rtol = 1e-15 * high, 8.9e-16
+    found = brentq(mismatch, low, high, xtol=xtol, rtol=rtol, maxiter=200)
+    if _walk(template, options, {**values, name: found}, budget).problems and mismatch(found) * at_low > 0:
         # brentq returns a point within its tolerance of the root, on either side. Where the
         # outcome is a body that just stops (a rebound of 0), the low side leaves it moving on down
         # by a rounding: the root is then just above, within the tolerance.
-        upper = min(1.0, found + 2 * (1e-15 + 8.9e-16 * found))
-        if mismatch(upper) >= 0:
-            found, run = upper, _walk(template, options, {**base, name: upper}, budget)
-    return run, {name: found}
-
-
-def _restitution_stage(template: Template, name: str) -> Stage:
-    for stage in template.scene.stages:
-        if stage.effect == "impact" and stage.fields["restitution"] == Sym(name):
-            return stage
-    raise SimulationError(f"cannot simulate: '{name}' is neither given nor produced by an earlier stage")
+        upper = min(high, found + 2 * (xtol + rtol * found))
+        if mismatch(upper) * at_low <= 0:
+            found = upper
+    return float(found)
 
 
 def _why_undefined(template: Template, run: Run, name: str) -> str | None:

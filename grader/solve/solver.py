@@ -29,7 +29,7 @@ from grader.physics.effects import CATALOGUE, Relation
 from grader.physics.symbolic import INNER as _INNER
 from grader.physics.symbolic import Context, cosd, from_node, sind, to_node
 from grader.solve.compiled import Check, Compiled, CompiledAnswer, Step, Undefined
-from grader.solve.stable import stabilize
+from grader.solve.stable import numeric_order, stabilize
 
 
 @dataclass(frozen=True)
@@ -76,6 +76,8 @@ def derive(relations: list[Relation], knowns: Iterable[Any], given: Iterable[Any
 def _solve(relation: Relation, unknown: Any) -> Any:
     if unknown in relation.solutions:
         return relation.solutions[unknown]
+    if -unknown in relation.solutions:  # a quantity named with its sign turned (an upward v_out along a downward n)
+        return -relation.solutions[-unknown]
     if not relation.general:
         return None
     # The side without the unknown is solved for as a whole, so sqrt(2*g*h) stays as the
@@ -93,10 +95,12 @@ def _solve(relation: Relation, unknown: Any) -> Any:
 
 
 def _stable(relation: Relation, unknown: Any, display: Any, known: set[Any], given: set[Any]) -> Any:
-    for form in relation.stable.get(unknown, ()):
+    forms = [(1, form) for form in relation.stable.get(unknown, ())] + \
+        [(-1, form) for form in relation.stable.get(-unknown, ())]
+    for sign, form in forms:
         needs_given = set().union(*(sp.sympify(g).free_symbols for g in form.given)) if form.given else set()
         if sp.sympify(form.expr).free_symbols <= known and needs_given <= given:
-            return form.expr
+            return sign * form.expr
     return display
 
 
@@ -206,7 +210,7 @@ class _Compiler:
         if stray:
             raise TemplateError(self.template.where, f"answers.{name}", "a number once the parameters are given",
                                 f"an expression that still depends on {', '.join(sorted(map(str, stray)))}")
-        return to_node(stable)
+        return numeric_order(to_node(stable))
 
     def _user_units(self, expr: Any) -> Any:
         """Rewrite an SI expression over SI-valued names into one over values in template units."""
@@ -251,7 +255,7 @@ class _Compiler:
         difference = stabilize(holds.lhs - holds.rhs, self.degree_angles)
         # Against zero, a positive factor changes nothing: 381*v*x/1250 > 0 is x > 0.
         kept = [f for f in sp.Mul.make_args(difference) if not f.is_positive]
-        return to_node(type(holds)(sp.Mul(*kept), 0))
+        return numeric_order(to_node(type(holds)(sp.Mul(*kept), 0)))
 
 
 def _si_factor(unit: Unit) -> Any:

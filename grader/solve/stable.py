@@ -1,7 +1,9 @@
 """Rewrites that keep a composed expression accurate in float64 (DESIGN.md, Numerics).
 
 Each rewrite is an identity; together they make sure differences of nearly equal inputs are
-formed first and that no intermediate product overflows where the answer does not.
+formed first and that no intermediate product overflows where the answer does not. Most work on
+sympy expressions (:func:`stabilize`); two on the numeric tree, whose evaluation order sympy
+would not keep (:func:`numeric_order`).
 
 >>> import sympy as sp
 >>> a, b, g = sp.symbols("a b g", positive=True)
@@ -17,10 +19,12 @@ a*(1 + m/M)
 from __future__ import annotations
 
 from collections.abc import Iterable
+from fractions import Fraction
 from typing import Any
 
 import sympy as sp
 
+from grader.model.expr import Node, Num, Op, Sym
 from grader.physics.symbolic import common_positive_factor, cosd, sind
 
 
@@ -113,3 +117,110 @@ def drop_common_factors(expr: Any) -> Any:
         common = common_positive_factor(*node.args)
         return sp.atan2(node.args[0] / common, node.args[1] / common) if common != 1 else node
     return expr.replace(lambda e: isinstance(e, sp.atan2), simpler)
+
+
+# --- the numeric tree ---------------------------------------------------------------------------
+
+def numeric_order(node: Node) -> Node:
+    """A compiled tree with both rewrites below applied, innermost first.
+
+    >>> from grader.model.expr import parse
+    >>> numeric_order(parse("h1**2/h2")) == parse("(h1/h2)*h1")
+    True
+    >>> numeric_order(parse("v1 + w - 2*v2 - x")) == parse("((v1 - v2) + (w - v2)) - x")
+    True
+    """
+    if not isinstance(node, Op):
+        return node
+    node = Op(node.op, tuple(numeric_order(arg) for arg in node.args))
+    if node.op == "div":
+        return balance_quotient(node)
+    if node.op in ("add", "sub"):
+        return differences_first(node)
+    return node
+
+
+def _factors(node: Node, powers: bool = True) -> list[Node]:
+    """The factors of a product tree; with ``powers``, a power of a name written out (``h**2*x``:
+    ``[h, h, x]``)."""
+    if isinstance(node, Op) and node.op == "mul":
+        return _factors(node.args[0], powers) + _factors(node.args[1], powers)
+    if powers and isinstance(node, Op) and node.op == "pow" and isinstance(node.args[0], Sym) \
+            and isinstance(node.args[1], Num) and node.args[1].value in (2, 3, 4):
+        return [node.args[0]] * int(node.args[1].value)
+    return [node]
+
+
+def balance_quotient(node: Op) -> Node:
+    """A quotient that holds a power of a name (``h1**2/h2``) as a product of ratios (``(h1/h2)*h1``),
+    so that no partial product over- or underflows where the quotient does not (``h1 = 1e170``:
+    ``h1**2`` overflows, the quotient ``1.7e170`` does not).
+
+    >>> from grader.model.expr import parse, to_text
+    >>> to_text(balance_quotient(parse("100*x*h2/h1**2")))
+    '100*(x/h1)*(h2/h1)'
+    """
+    if all(len(_factors(side)) == len(_factors(side, powers=False)) for side in node.args):
+        return node
+    above, below = _factors(node.args[0]), _factors(node.args[1])
+    numbers = [f for f in above if isinstance(f, Num)]
+    above = [f for f in above if not isinstance(f, Num)]
+    factors: list[Node] = [*numbers, *(Op("div", (a, b)) for a, b in zip(above, below, strict=False))]
+    factors += above[len(below):] + [Op("div", (Num(Fraction(1)), b)) for b in below[len(above):]]
+    result = factors[0]
+    for factor in factors[1:]:
+        result = Op("mul", (result, factor))
+    return result
+
+
+def _terms(node: Node, sign: int = 1) -> list[tuple[int, Node]]:
+    """The signed terms of a sum tree."""
+    if isinstance(node, Op) and node.op in ("add", "sub"):
+        return _terms(node.args[0], sign) + _terms(node.args[1], sign if node.op == "add" else -sign)
+    if isinstance(node, Op) and node.op == "neg":
+        return _terms(node.args[0], -sign)
+    return [(sign, node)]
+
+
+def _multiple(sign: int, term: Node) -> tuple[Fraction, str] | None:
+    """``(c, x)`` for a term ``c*x`` of a name ``x`` and an exact number ``c``."""
+    if isinstance(term, Sym):
+        return Fraction(sign), term.name
+    if isinstance(term, Op) and term.op == "mul" and isinstance(term.args[0], Num) \
+            and isinstance(term.args[0].value, Fraction) and isinstance(term.args[1], Sym):
+        return sign * term.args[0].value, term.args[1].name
+    return None
+
+
+def differences_first(node: Node) -> Node:
+    """A sum whose multiples of names have coefficients adding up to zero (``v1 + w - 2*v2``, which
+    sympy writes for ``(v1 - v2) + (w - v2)``; ``x*y + v1 - w``) as differences against one name, added
+    first: each is exact when the inputs are close (two cars at nearly equal speeds), and the sum
+    then keeps full accuracy.
+
+    >>> from grader.model.expr import parse
+    >>> differences_first(parse("a + b - c")) == parse("a + b - c")  # 1 + 1 - 1 is not 0
+    True
+    >>> differences_first(parse("x*y + v1 - w")) == parse("(v1 - w) + x*y")
+    True
+    """
+    terms = _terms(node)
+    multiples = [(index, found) for index, (sign, term) in enumerate(terms)
+                 if (found := _multiple(sign, term)) is not None]
+    if len(multiples) < 2 or len(multiples) == len(terms) == 2 or sum(c for _, (c, _) in multiples) != 0:
+        return node
+    reference = min(multiples, key=lambda item: item[1][0])[1][1]  # the most negative: v1 + w - 2*v2 -> v2
+    parts: list[tuple[int, Node]] = []
+    for _, (coefficient, name) in multiples:
+        if name == reference:
+            continue
+        difference: Node = Op("sub", (Sym(name), Sym(reference)))
+        if abs(coefficient) != 1:
+            difference = Op("mul", (Num(abs(coefficient)), difference))
+        parts.append((1 if coefficient > 0 else -1, difference))
+    used = {index for index, _ in multiples}
+    parts += [term for index, term in enumerate(terms) if index not in used]
+    result = parts[0][1] if parts[0][0] > 0 else Op("neg", (parts[0][1],))
+    for sign, term in parts[1:]:
+        result = Op("add" if sign > 0 else "sub", (result, term))
+    return result

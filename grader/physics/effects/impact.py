@@ -1,5 +1,8 @@
 """Direct and oblique central impact of two bodies, or of a body against a fixed surface.
 
+A fixed surface has infinite mass: it is at rest, or moves at the constant velocity given for it
+under ``before`` (a plate driven up and down), which the impact does not change.
+
 Axes: n along the line of impact, pointing from the first body into the second; t along the
 common tangent. Surfaces are smooth: no impulse along t. Numbers follow DESIGN.md: impulse form
 with inverse masses ``w = 1/m`` (``w = 0`` for a fixed surface); after-impact velocities in the
@@ -219,7 +222,7 @@ def _inverse_mass(run: Run, body: str) -> float:
 def _component(run: Run, stage: Stage, body: str, when: str, axis: str) -> float:
     given = stage.fields.get(when, {}).get(body)
     part = None if given is None else getattr(given, axis)
-    return 0.0 if part is None or run.scene.bodies[body].mass is None else run.value(part)
+    return 0.0 if part is None else run.value(part)
 
 
 def _output_energies(stage: Stage, run: Run, inverse: tuple[float, float], before: list[float],
@@ -240,7 +243,7 @@ def _output_energies(stage: Stage, run: Run, inverse: tuple[float, float], befor
     scaled_lost = max(0.0, (approach - separation) * (approach + separation) / (2 * (inverse[0] + inverse[1])))
     measured = {"energy_before": scaled_before * unit * unit, "energy_after": scaled_after * unit * unit,
                 "energy_lost": scaled_lost * unit * unit,
-                "loss_fraction": scaled_lost / scaled_before,
+                "loss_fraction": scaled_lost / scaled_before if scaled_before else math.nan,  # nothing moved
                 "impulse": (before[0] - after[0]) / inverse[0]}
     for key, value in measured.items():
         if key in stage.fields:
@@ -255,8 +258,8 @@ IMPACT = Effect(
     (
         Field("bodies", "bodies", doc="[first, second]: n points from the first into the second"),
         Field("restitution", "expr", doc="coefficient of restitution e, 0..1", dimension=PURE),
-        Field("before", "velocities", doc="per body: n-velocity, or {n: .., t: ..}; omitted = at rest",
-              dimension=SPEED),
+        Field("before", "velocities", doc="per body: n-velocity, or {n: .., t: ..}; omitted = at rest; a fixed body "
+              "keeps it", dimension=SPEED),
         Field("after", "velocities", required=False, doc="per body: names for the velocities after",
               dimension=SPEED),
         Field("impulse", "name", required=False, doc="name for the normal impulse J",

@@ -124,20 +124,27 @@ def _grade_column(cells: Sequence[tuple[KeyPart, Answer | None]], key: Key) -> l
         else:
             rows[index] = _row(part, answer, _expected(part), "equal expressions" if part.symbolic else known[1],
                                *outcome)
-    for (tolerance_id, unit), (members, submitted, expected) in groups.items():
-        tolerance, words = tolerances[tolerance_id]
-        angle = unit if unit in ("deg", "rad") else None
-        right = is_correct(submitted, expected, tolerance, angle_unit=angle)
-        absolute, relative = errors(submitted, expected, angle_unit=angle)
-        said = feedbacks(submitted, expected, unit, tolerance, right, angle_unit=angle)
-        shown: dict[float, str] = {}  # the numbers a class typed: a few thousand
-        for index, value, key_value, ok, sentence, error, ratio in zip(
-                members, submitted, expected, right.tolist(), said, absolute.tolist(), relative.tolist(), strict=True):
-            part, answer = cells[index]
-            parsed = shown.get(value) or shown.setdefault(value, _show(value))
-            rows[index] = _row(part, answer, _show(key_value), words, "correct" if ok else "incorrect",
-                               1.0 if ok else 0.0, sentence, parsed, error, ratio)
-    return rows  # type: ignore[return-value]  # every index is filled above
+    for (tolerance_id, unit), group in groups.items():
+        _compare(cells, group, *tolerances[tolerance_id], unit, rows)
+    return rows  # type: ignore[return-value]  # every index is filled above, or by _compare
+
+
+def _compare(cells: Sequence[tuple[KeyPart, Answer | None]], group: tuple[list[int], list[float], list[float]],
+             tolerance: Tolerance, words: str, unit: str, rows: list[Row | None]) -> None:
+    """The rows of a group of cells (their indices, the numbers read, the key's) of one tolerance and
+    unit: verdicts, errors and sentences, each in one pass over the group."""
+    members, submitted, expected = group
+    angle = unit if unit in ("deg", "rad") else None
+    right = is_correct(submitted, expected, tolerance, angle_unit=angle)
+    absolute, relative = errors(submitted, expected, angle_unit=angle)
+    said = feedbacks(submitted, expected, unit, tolerance, right, angle_unit=angle)
+    shown: dict[float, str] = {}  # the numbers a class typed: a few thousand
+    for index, value, key_value, ok, sentence, error, ratio in zip(
+            members, submitted, expected, right.tolist(), said, absolute.tolist(), relative.tolist(), strict=True):
+        part, answer = cells[index]
+        parsed = shown.get(value) or shown.setdefault(value, _show(value))
+        rows[index] = _row(part, answer, _show(key_value), words, "correct" if ok else "incorrect", 1.0 if ok else 0.0,
+                           sentence, parsed, error, ratio)
 
 
 def _outcome(part: KeyPart, answer: Answer | None, key: Key) -> Outcome | CellNumber:

@@ -22,7 +22,6 @@ import re
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
-from types import MappingProxyType
 from typing import Any, TypeVar
 
 from grader.errors import GraderError, shown
@@ -264,20 +263,20 @@ def _student(raw: Mapping[str, Any], symbols: Mapping[str, Mapping[str, tuple[fl
 def _part(problem: str, name: str, raw: Mapping[str, Any],
           symbols: Mapping[str, Mapping[str, tuple[float, float]]], shared: dict[Any, Any]) -> KeyPart:
     value = raw["value"]
-    if isinstance(value, bool) or not (value is None or isinstance(value, (int, float, str))):
-        raise ValueError(f"answer {name}: a value that is no number, expression or null")
-    if isinstance(value, (int, float)) and not math.isfinite(value):
+    if type(value) is not float:  # a float is the usual value, and needs only the check below
+        if isinstance(value, bool) or not (value is None or isinstance(value, (int, float, str))):
+            raise ValueError(f"answer {name}: a value that is no number, expression or null")
+        value = float(value) if isinstance(value, (int, float)) else value
+    if isinstance(value, float) and not math.isfinite(value):
         raise ValueError(f"answer {name}: a value that is not finite")
-    label = _one(shared, str(raw["label"]))
-    domains = symbols.get(label) or _NO_SYMBOLS
+    label, unit, points = _one(shared, str(raw["label"])), _one(shared, str(raw.get("unit", ""))), _one(
+        shared, float(raw["points"]))
+    domains = symbols.get(label, {})  # the label's own: one mapping for the whole class
     if isinstance(value, str) and not domains:
-        domains = shared.setdefault(("symbols", value), dict.fromkeys(sorted(names(parse(value))), SYMBOL_RANGE))
-    return KeyPart(problem, name, label, float(value) if isinstance(value, (int, float)) else value,
-                   _one(shared, str(raw.get("unit", ""))), _one(shared, float(raw["points"])),
-                   _tolerance(raw["tolerance"], shared), raw.get("undefined"), domains)
-
-
-_NO_SYMBOLS: Mapping[str, tuple[float, float]] = MappingProxyType({})
+        domains = shared.get(("symbols", value)) or shared.setdefault(
+            ("symbols", value), dict.fromkeys(sorted(names(parse(value))), SYMBOL_RANGE))
+    return KeyPart(problem, name, label, value, unit, points, _tolerance(raw["tolerance"], shared),
+                   raw.get("undefined"), domains)
 
 
 def _one(shared: dict[Any, Any], value: _T) -> _T:

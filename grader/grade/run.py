@@ -63,11 +63,15 @@ def run(key_path: Path, paths: Sequence[Path], out: Path, fmt: Literal["auto", "
 def _collector_paused() -> Iterator[None]:
     """Python's cycle collector paused while a run builds its objects: a big class makes millions
     (keys, rows, verdicts) and no cycles worth collecting, and each collection walks all of them
-    (with it, reading 1.1 million answers took twice as long)."""
+    (with it, reading 1.1 million answers took twice as long). At the end what the run made counts
+    as old (``freeze`` then ``unfreeze`` moves it to the oldest generation), or the first collection
+    after it would walk it all once more."""
     enabled = gc.isenabled()
     gc.disable()
     try:
         yield
     finally:
+        gc.freeze()
+        gc.unfreeze()
         if enabled:
             gc.enable()

@@ -33,7 +33,7 @@ import json
 import os
 import shutil
 import tempfile
-from collections.abc import Iterator, Sequence
+from collections.abc import Iterable, Iterator, Sequence
 from contextlib import contextmanager, suppress
 from pathlib import Path
 from typing import Any
@@ -56,9 +56,9 @@ def usual_mode(path: Path, folder: bool = False) -> None:
     os.chmod(path, (0o777 if folder else 0o666) & ~UMASK)
 
 
-def write_atomic(path: Path, text: str | bytes) -> None:
-    """Write ``text`` (UTF-8) or bytes to ``path`` atomically. An ``OSError`` it raises names a path
-    (a failed ``write()``, say on a full disk, names none by itself)."""
+def write_atomic(path: Path, text: str | bytes | Iterable[str]) -> None:
+    """Write ``text`` (UTF-8), bytes, or text in pieces (written as they come) to ``path`` atomically.
+    An ``OSError`` it raises names a path (a failed ``write()``, say on a full disk, names none by itself)."""
     path.parent.mkdir(parents=True, exist_ok=True)
     try:
         handle, temporary = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
@@ -66,7 +66,11 @@ def write_atomic(path: Path, text: str | bytes) -> None:
         raise OSError(error.errno, error.strerror, str(path)) from None
     try:
         with os.fdopen(handle, "wb") as stream:
-            stream.write(text.encode("utf-8") if isinstance(text, str) else text)
+            if isinstance(text, (str, bytes)):
+                stream.write(text.encode("utf-8") if isinstance(text, str) else text)
+            else:
+                for piece in text:
+                    stream.write(piece.encode("utf-8"))
         usual_mode(Path(temporary))
         os.replace(temporary, path)
     except BaseException as error:

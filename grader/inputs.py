@@ -261,7 +261,7 @@ def _yaml_problem(error: yaml.YAMLError) -> str:
 
 # --- CSV ----------------------------------------------------------------------------------------
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, slots=True)
 class CsvRow:
     """One data row: the line it starts on, its cells by header name (stripped), and what is wrong
     with the row as a whole (more cells than columns), for the caller to refuse the row or the file."""
@@ -306,12 +306,15 @@ def read_csv(path: Path, *, exports: bool = False) -> CsvTable:
     """
     data = read_bytes(path, CSV_BYTES)
     text, encoding = decode_export(data, path) if exports else (decode_text(data, path), "UTF-8")
-    lines = text.split("\n")
-    first = next((i for i, line in enumerate(lines) if line.strip()), None)
-    if first is None:
+    text_starts = len(text) - len(text.lstrip())  # on the first line that is not blank
+    if text_starts == len(text):
         raise GraderError(f"{path}: empty file; expected a header line")
-    delimiter = max(",;\t", key=lambda candidate: _count_outside_quotes(lines[first], candidate))
-    records = _records(io.StringIO("\n".join(lines[first:])), path, delimiter, first)
+    first = text.count("\n", 0, text_starts)
+    start = text.rfind("\n", 0, text_starts) + 1
+    end = text.find("\n", text_starts)
+    header_text = text[start:] if end < 0 else text[start:end]
+    delimiter = max(",;\t", key=lambda candidate: _count_outside_quotes(header_text, candidate))
+    records = _records(io.StringIO(text[start:]), path, delimiter, first)
     first_record = next(records, None)
     if first_record is None:  # only quotes or delimiters: no cell has text
         raise GraderError(f"{path}: no header line with text; expected a header line")
@@ -319,18 +322,20 @@ def read_csv(path: Path, *, exports: bool = False) -> CsvTable:
     _check_cell_lengths(header_cells, path, header_line)
     header = _header(header_cells, path, header_line)
     rows = []
+    width = len(header)
     for line, cells in records:
         problem = None
-        if not exports:
-            _check_cell_lengths(cells, path, line)
-        elif any(len(c) > CELL_CHARS for c in cells):
-            problem = (f"line {line}: a cell of {max(map(len, cells)):,} characters; expected at most "
-                       f"{CELL_CHARS}")
-        if len(cells) > len(header) and any(c.strip() for c in cells[len(header):]):
-            problem = (f"line {line}: {len(cells)} cells, but the header has {len(header)} column"
-                       f"{'s' if len(header) > 1 else ''}; expected one cell per column")
-        rows.append(CsvRow(line, {name: (cells[i].strip() if i < len(cells) else "")
-                                  for i, name in enumerate(header)}, problem))
+        longest = max(map(len, cells))
+        if longest > CELL_CHARS:
+            if not exports:
+                _check_cell_lengths(cells, path, line)
+            problem = f"line {line}: a cell of {longest:,} characters; expected at most {CELL_CHARS}"
+        if len(cells) > width and any(map(str.strip, cells[width:])):
+            problem = (f"line {line}: {len(cells)} cells, but the header has {width} column"
+                       f"{'s' if width > 1 else ''}; expected one cell per column")
+        if len(cells) != width:  # cells beyond the header's are dropped, missing ones are empty
+            cells = (cells + [""] * width)[:width]
+        rows.append(CsvRow(line, dict(zip(header, map(str.strip, cells), strict=True)), problem))
     return CsvTable(path, header, tuple(rows), header_line, delimiter, encoding)
 
 
@@ -359,7 +364,7 @@ def _records(stream: io.StringIO, path: Path, delimiter: str, offset: int) -> It
                       else f"{error} (check the quotes)")
             raise GraderError(f"{path}: line {offset + reader.line_num}: {reason}; expected CSV") from None
         end = reader.line_num
-        if not any(cell.strip() for cell in cells):
+        if not any(map(str.strip, cells)):
             continue
         yield offset + start, cells
 

@@ -22,6 +22,7 @@ from grader.grade.compare import (
     equivalent,
     errors,
     feedback,
+    feedbacks,
     is_correct,
 )
 from grader.model.expr import parse
@@ -365,3 +366,20 @@ def test_near_misses_agree_with_the_exact_rule(t: float, offset: float, toleranc
     distance = abs(exact(s) - exact(t))
     expected = distance <= width if tolerance.mode == "rtol" else distance < width
     assert bool(is_correct(s, t, tolerance)) is expected
+
+
+@given(st.lists(st.tuples(anything, anything, st.booleans()), min_size=1, max_size=20), tolerances,
+       st.sampled_from(["", "m/s", "deg", "rad", "%"]))
+def test_a_class_of_sentences_reads_as_each_alone(answers: list[tuple[float, float, bool]], tolerance: Tolerance,
+                                                  unit: str) -> None:
+    """`feedbacks` on a whole column says of each answer what `feedback` says of it alone (one pass of
+    numpy for the distances, the words worked out once, typed numbers remembered)."""
+    angle_unit = unit if unit in ("deg", "rad") else None
+    s, t, right = (list(column) for column in zip(*answers, strict=True))
+    assert feedbacks(s, t, unit, tolerance, right, angle_unit=angle_unit) == [
+        feedback(a, b, unit, tolerance, ok, angle_unit=angle_unit) for a, b, ok in answers]
+
+
+def test_feedbacks_refuses_columns_of_different_lengths() -> None:
+    with pytest.raises(ValueError, match="one length"):
+        feedbacks([1.0, 2.0], [1.0], "", Tolerance(), [True, True])

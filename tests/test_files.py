@@ -6,6 +6,7 @@ import errno
 import hashlib
 import json
 import os
+from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
@@ -82,6 +83,22 @@ def test_write_atomic_on_a_full_disk_names_the_file_and_leaves_no_temporary(tmp_
     monkeypatch.undo()
     assert (caught.value.errno, caught.value.filename) == (errno.ENOSPC, str(tmp_path / "key.json"))
     assert list(tmp_path.iterdir()) == []
+
+
+def test_write_atomic_writes_text_in_pieces_and_nothing_when_they_fail(tmp_path: Path) -> None:
+    """Text in pieces (details.csv of a big class) is written as it comes, as UTF-8; a failure while the
+    pieces come leaves the file as it was and no temporary beside it."""
+    write_atomic(tmp_path / "details.csv", iter(["a,±1 %\n", "", "b,2\n"]))
+    assert (tmp_path / "details.csv").read_bytes() == "a,±1 %\nb,2\n".encode()
+
+    def broken() -> Iterator[str]:
+        yield "c,3\n"
+        raise RuntimeError("a bug while writing")
+
+    with pytest.raises(RuntimeError):
+        write_atomic(tmp_path / "details.csv", broken())
+    assert [p.name for p in tmp_path.iterdir()] == ["details.csv"]
+    assert (tmp_path / "details.csv").read_text(encoding="utf-8") == "a,±1 %\nb,2\n"
 
 
 def test_describe_os_error_says_where_why_and_what_to_do() -> None:

@@ -6,12 +6,17 @@ from __future__ import annotations
 import csv
 import io
 import json
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
 import pytest
 
 from grader.cli import main
+from grader.errors import GraderError
+from grader.grade.grading import grade, grade_part
+from grader.grade.key import load_key
+from grader.grade.submissions import StudentRef, read_submissions
 from grader.resources import sample_dir
 
 
@@ -227,3 +232,50 @@ def test_the_assignments_tolerance_mode_and_grading_section_reach_the_verdicts(
                if row["student_id"] == student["id"]}
     assert details["1a"]["verdict"] == "correct" and details["1a"]["tolerance"] == "2 decimal places"
     assert details["1b"]["verdict"] == "invalid"  # arithmetic is refused when numeric_expressions is false
+
+
+def test_one_answer_graded_alone_is_graded_as_in_its_class(tmp_path: Path, key_path: Path) -> None:
+    """`grade_part` (one answer, as `grader check` grades it) gives the verdict that grading the whole
+    class by columns gives: right, wrong, with units, blank, unreadable, symbolic, undefined."""
+    rows = key_answers(key_path, ".3g")
+    forms = ["{}", "{} m/s", "{} ft", "", "six", "=1+1", "-{}", "{}e1"]
+    rows = [(student, label, forms[index % len(forms)].format(text) if index % 3 else text)
+            for index, (student, label, text) in enumerate(rows) if index % 11]
+    (tmp_path / "a.csv").write_text(long_csv(rows), encoding="utf-8")
+    key = load_key(key_path)
+    submissions = read_submissions([tmp_path / "a.csv"], [StudentRef(s.id, s.email) for s in key.students],
+                                   key.labels)
+    graded = grade(key, submissions)
+    answers = {(a.student_id, a.label): a for a in submissions.answers}
+    parts = {(s.id, label): part for s in key.students for label, part in s.parts.items()}
+    verdicts = graded.verdicts
+    assert len(verdicts) == len(parts) and {v.verdict for v in verdicts} == {"correct", "incorrect", "invalid",
+                                                                             "missing"}
+    for verdict in verdicts:
+        where = (verdict.student_id, verdict.label)
+        assert grade_part(parts[where], verdict.student_id, answers.get(where), key) == verdict
+
+
+def test_a_key_laid_out_otherwise_reads_the_same(tmp_path: Path, key_path: Path) -> None:
+    """Students are read as they are decoded from a key laid out as grader writes it; any other valid
+    JSON (indented, students first, a name given twice: the last one counts) reads the same."""
+    document = key_document(key_path)
+    reordered = {"students": document["students"], **{k: v for k, v in document.items() if k != "students"}}
+    (tmp_path / "indented.json").write_text(json.dumps(reordered, indent=2), encoding="utf-8")
+    text = key_path.read_text(encoding="utf-8")
+    (tmp_path / "twice.json").write_text('{"students": [], ' + text.lstrip()[1:], encoding="utf-8")
+    usual = replace(load_key(key_path), where="")
+    assert replace(load_key(tmp_path / "indented.json"), where="") == usual
+    assert replace(load_key(tmp_path / "twice.json"), where="") == usual
+
+
+def test_a_cut_key_is_refused_with_what_json_says(tmp_path: Path, key_path: Path) -> None:
+    """A key cut off among its students: the same reason as json.loads gives, where it gives it."""
+    text = key_path.read_text(encoding="utf-8")
+    cut = text[:len(text) * 2 // 3]
+    (tmp_path / "key.json").write_text(cut, encoding="utf-8")
+    with pytest.raises(json.JSONDecodeError) as expected:
+        json.loads(cut)
+    with pytest.raises(GraderError) as caught:
+        load_key(tmp_path / "key.json")
+    assert f"got invalid JSON ({expected.value})" in str(caught.value)

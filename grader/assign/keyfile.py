@@ -42,7 +42,7 @@ from grader.bank.template import Template
 
 SCHEMA, VERSION = "grader-key", 2
 SYMBOL_RANGE = (1.0, 10.0)  # where a symbol with no sampled range (a speed v) is drawn to compare expressions
-_FORMULA_START = ("=", "+", "-", "@", "\t", "\r", "\n")
+_GUARDED_START = frozenset("=+-@\t\r\n'")  # a formula's first characters, and the guard's own
 
 
 def safe_cell(text: str) -> str:
@@ -53,7 +53,7 @@ def safe_cell(text: str) -> str:
     >>> safe_cell("=HYPERLINK(1)"), safe_cell("Ana"), safe_cell("'quoted")
     ("'=HYPERLINK(1)", 'Ana', "''quoted")
     """
-    return "'" + text if text.startswith((*_FORMULA_START, "'")) else text
+    return "'" + text if text[:1] in _GUARDED_START else text
 
 
 def original_cell(cell: str) -> str:

@@ -73,8 +73,8 @@ def find_layout(table: CsvTable, labels: Sequence[str], fmt: Literal["auto", "lo
         raise GraderError(f"{table.path}: line {table.header_line}: no recognisable header; expected "
                           f"{_EXPECTED.format(labels=', '.join(labels[:4]))}; got {', '.join(table.header)}")
     by_email = not named["student"]
-    student = max(student_columns, key=lambda column: (sum(known(row.cells[column], by_email) for row in table.rows),
-                                                       -student_columns.index(column)))
+    student = student_columns[0] if len(student_columns) == 1 else max(student_columns, key=lambda column: (
+        sum(known(row.cells[column], by_email) for row in table.rows), -student_columns.index(column)))
     used = {student, *(named[kind][0] for kind in ("timestamp",) + (() if wide else ("label", "answer"))
                        if named[kind])}
     if wide:

@@ -2,7 +2,10 @@
 
 A verdict records what was typed, what it was read as (in the expected unit), what was expected,
 the errors, the tolerance that decided it in words, the credit and a sentence that explains it.
-Cells are read once per distinct text (a class types the same few forms).
+Grading is columnar: a part's answers are graded for the whole class at once, each distinct text
+read once and the numbers compared in one vectorised call per tolerance and unit; the verdicts are
+kept as rows of plain values (a class of 100,000 has a million) and become :class:`Verdict` objects
+only when asked for. :func:`grade_part` grades one answer the same way.
 """
 
 from __future__ import annotations
@@ -21,7 +24,7 @@ from grader.grade.cells import (
     read_number,
     undefined_word,
 )
-from grader.grade.compare import equivalent, errors, feedback, is_correct
+from grader.grade.compare import equivalent, errors, feedbacks, is_correct
 from grader.grade.key import Key, KeyPart
 from grader.grade.submissions import Answer, RowProblem, Submissions
 from grader.model.expr import Node, parse
@@ -55,87 +58,140 @@ class Verdict:
         return self.credit * self.points
 
 
+Row = tuple[str | None, str, float, float, str, str, str, float | None, float | None, str, str, str]
+"""A verdict's fields after ``student_id`` and ``label``, in :class:`Verdict`'s order."""
+
+
 @dataclass(frozen=True)
 class Graded:
-    """A grading run: a verdict per (student in the key, part), and every row not graded."""
+    """A grading run: per part label, in the key's order, a verdict row for every student of the key,
+    in its order; and every row not graded."""
 
     key: Key
-    verdicts: tuple[Verdict, ...]
+    columns: Mapping[str, Sequence[Row]]
     problems: tuple[RowProblem, ...]
     ignored_columns: tuple[str, ...]
     notes: tuple[str, ...]
 
+    @property
+    def verdicts(self) -> tuple[Verdict, ...]:
+        """Every verdict, student by student, part by part (built on each call: the reports read the rows)."""
+        labels = self.key.labels
+        return tuple(Verdict(student.id, label, *self.columns[label][index])
+                     for index, student in enumerate(self.key.students) for label in labels)
+
 
 def grade(key: Key, submissions: Submissions) -> Graded:
     """Grade every student of the key; a part nobody answered is ``missing``."""
-    submitted = {(a.student_id, a.label): a for a in submissions.answers}
-    verdicts = tuple(grade_part(part, student.id, submitted.get((student.id, part.label)), key)
-                     for student in key.students for part in (student.parts[label] for label in key.labels))
-    return Graded(key, verdicts, submissions.problems, submissions.ignored_columns, submissions.notes)
-
-
-@dataclass(frozen=True)
-class _Part:
-    """One part being graded: what the verdict needs besides its outcome."""
-
-    part: KeyPart
-    student_id: str
-    text: str | None
-    source: str
-    tolerance: Tolerance
-
-    def verdict(self, kind: str, credit: float, said: str, parsed: str = "",
-                errs: tuple[float | None, float | None] = (None, None)) -> Verdict:
-        words = "equal expressions" if self.part.symbolic else self.tolerance.describe()
-        return Verdict(self.student_id, self.part.label, self.text, kind, credit, self.part.points,
-                       _expected(self.part), parsed, self.part.unit, errs[0], errs[1], words, said, self.source)
+    by_label: dict[str, dict[str, Answer]] = {label: {} for label in key.labels}
+    for answer in submissions.answers:
+        by_label[answer.label][answer.student_id] = answer
+    columns = {}
+    for label in key.labels:
+        answers = by_label.pop(label)
+        columns[label] = _grade_column([(student.parts[label], answers.get(student.id)) for student in key.students],
+                                       key)
+    return Graded(key, columns, submissions.problems, submissions.ignored_columns, submissions.notes)
 
 
 def grade_part(part: KeyPart, student_id: str, answer: Answer | None, key: Key) -> Verdict:
     """One part: the key's expectation against the answer (None: nothing submitted)."""
+    return Verdict(student_id, part.label, *_grade_column([(part, answer)], key)[0])
+
+
+Outcome = tuple[str, float, str, str]
+"""A verdict decided without comparing numbers: its kind, credit, sentence and what was read."""
+
+
+def _grade_column(cells: Sequence[tuple[KeyPart, Answer | None]], key: Key) -> list[Row]:
+    """A row for each (part, answer): outcomes decided cell by cell, numbers compared by group."""
+    rows: list[Row | None] = [None] * len(cells)
+    tolerances: dict[int, tuple[Tolerance, str]] = {}  # by id of the key's mapping (the key shares equal ones)
+    groups: dict[tuple[int, str], tuple[list[int], list[float], list[float]]] = {}
+    for index, (part, answer) in enumerate(cells):
+        known = tolerances.get(id(part.tolerance))
+        if known is None:
+            tolerance = Tolerance.from_json(part.tolerance)
+            known = tolerances[id(part.tolerance)] = (tolerance, tolerance.describe())
+        outcome = _outcome(part, answer, key)
+        if isinstance(outcome, CellNumber):
+            group = groups.get((id(part.tolerance), part.unit))
+            if group is None:
+                group = groups[id(part.tolerance), part.unit] = ([], [], [])
+            members, submitted, expected = group
+            members.append(index)
+            submitted.append(outcome.value)
+            expected.append(float(part.value))  # type: ignore[arg-type]  # a number: not symbolic, not None
+        else:
+            rows[index] = _row(part, answer, _expected(part), "equal expressions" if part.symbolic else known[1],
+                               *outcome)
+    for (tolerance_id, unit), group in groups.items():
+        _compare(cells, group, *tolerances[tolerance_id], unit, rows)
+    return rows  # type: ignore[return-value]  # every index is filled above, or by _compare
+
+
+def _compare(cells: Sequence[tuple[KeyPart, Answer | None]], group: tuple[list[int], list[float], list[float]],
+             tolerance: Tolerance, words: str, unit: str, rows: list[Row | None]) -> None:
+    """The rows of a group of cells (their indices, the numbers read, the key's) of one tolerance and
+    unit: verdicts, errors and sentences, each in one pass over the group."""
+    members, submitted, expected = group
+    angle = unit if unit in ("deg", "rad") else None
+    right = is_correct(submitted, expected, tolerance, angle_unit=angle)
+    absolute, relative = errors(submitted, expected, angle_unit=angle)
+    said = feedbacks(submitted, expected, unit, tolerance, right, angle_unit=angle)
+    shown: dict[float, str] = {}  # the numbers a class typed: a few thousand
+    for index, value, key_value, ok, sentence, error, ratio in zip(
+            members, submitted, expected, right.tolist(), said, absolute.tolist(), relative.tolist(), strict=True):
+        part, answer = cells[index]
+        parsed = shown.get(value) or shown.setdefault(value, _show(value))
+        rows[index] = _row(part, answer, _show(key_value), words, "correct" if ok else "incorrect", 1.0 if ok else 0.0,
+                           sentence, parsed, error, ratio)
+
+
+def _outcome(part: KeyPart, answer: Answer | None, key: Key) -> Outcome | CellNumber:
+    """The verdict of a part that needs no comparison of numbers, or the number to compare."""
     text = None if answer is None else answer.text
-    graded = _Part(part, student_id, text, "" if answer is None else f"{answer.file}:{answer.line}",
-                   Tolerance.from_json(part.tolerance))
     if part.value is None:
         if text is None or undefined_word(text):
-            return graded.verdict("correct", 1.0, f"right: there is no value here ({part.undefined})")
-        return graded.verdict("incorrect", 0.0, f"there is no value here ({part.undefined}); expected a blank "
-                                                "or 'undefined'")
+            return "correct", 1.0, f"right: there is no value here ({part.undefined})", ""
+        return "incorrect", 0.0, f"there is no value here ({part.undefined}); expected a blank or 'undefined'", ""
     if text is None or answer is None:
-        return graded.verdict("missing", 0.0, "no answer was submitted")
+        return "missing", 0.0, "no answer was submitted", ""
     if part.symbolic:
-        return _symbolic(graded, text, answer.delimiter, key)
+        return _symbolic(part, text, answer.delimiter, key)
     cell = _number(text, part.unit, answer.delimiter, key.numeric_expressions, (part.name, part.label))
     if isinstance(cell, CellBlank):
-        return graded.verdict("missing", 0.0, "the answer was blank")
+        return "missing", 0.0, "the answer was blank", ""
     if isinstance(cell, CellInvalid):
-        return graded.verdict("invalid", 0.0, f"could not read this answer: {cell.reason}")
+        return "invalid", 0.0, f"could not read this answer: {cell.reason}", ""
     if isinstance(cell, CellWrongUnit):
-        return graded.verdict("incorrect", 0.0, cell.reason)
-    expected = float(part.value)
-    angle = part.unit if part.unit in ("deg", "rad") else None
-    right = bool(is_correct([cell.value], [expected], graded.tolerance, angle_unit=angle)[0])
-    absolute, relative = (float(e[0]) for e in errors([cell.value], [expected], angle_unit=angle))
-    said = feedback(cell.value, expected, part.unit, graded.tolerance, right, angle_unit=angle)
-    return graded.verdict("correct" if right else "incorrect", 1.0 if right else 0.0, said, _show(cell.value),
-                          (absolute, relative))
+        return "incorrect", 0.0, cell.reason, ""
+    return cell
 
 
-def _symbolic(graded: _Part, text: str, delimiter: str, key: Key) -> Verdict:
-    part = graded.part
+def _row(part: KeyPart, answer: Answer | None, expected: str, words: str, kind: str, credit: float, said: str,
+         parsed: str = "", absolute: float | None = None, relative: float | None = None) -> Row:
+    """The verdict's fields; ``expected``: what the key holds, in words; ``words``: the tolerance that decided it."""
+    if answer is None:
+        return None, kind, credit, part.points, expected, parsed, part.unit, absolute, relative, words, said, ""
+    return (answer.text, kind, credit, part.points, expected, parsed, part.unit, absolute, relative, words, said,
+            f"{answer.file}:{answer.line}")
+
+
+def _symbolic(part: KeyPart, text: str, delimiter: str, key: Key) -> Outcome:
     symbols = tuple(part.symbols)
     cell = _expression(text, symbols, delimiter)
     if isinstance(cell, CellBlank):
-        return graded.verdict("missing", 0.0, "the answer was blank")
+        return "missing", 0.0, "the answer was blank", ""
     if isinstance(cell, CellInvalid):
-        return graded.verdict("invalid", 0.0, f"could not read this answer: {cell.reason}")
+        return "invalid", 0.0, f"could not read this answer: {cell.reason}", ""
     same = equivalent(cell.tree, _key_tree(str(part.value)), part.symbols, seed=f"{key.title}/{part.label}")
     if isinstance(same, str):
-        return graded.verdict("invalid", 0.0, f"could not compare this expression: {same}", cell.text)
+        return "invalid", 0.0, f"could not compare this expression: {same}", cell.text
     names = " and ".join(symbols)
     said = (f"equal to the expected expression at every sampled value of {names}" if same else
             f"not equal to the expected expression: they differ at sampled values of {names}")
-    return graded.verdict("correct" if same else "incorrect", 1.0 if same else 0.0, said, cell.text)
+    return "correct" if same else "incorrect", 1.0 if same else 0.0, said, cell.text
 
 
 @lru_cache(maxsize=65536)
@@ -167,15 +223,21 @@ def _show(value: float) -> str:
 
 
 def totals(graded: Graded) -> Mapping[str, Mapping[str, float]]:
-    """Per student, per problem key: the score."""
-    problem_of = {label: problem.key for problem in graded.key.problems for label in problem.labels}
-    result: dict[str, dict[str, float]] = {s.id: dict.fromkeys((p.key for p in graded.key.problems), 0.0)
-                                           for s in graded.key.students}
-    for verdict in graded.verdicts:
-        result[verdict.student_id][problem_of[verdict.label]] += verdict.score
-    return result
+    """Per student, per problem key: the score (its parts' scores added in the key's order)."""
+    key = graded.key
+    sums: dict[str, list[float]] = {}
+    for problem in key.problems:
+        scores = sums.setdefault(problem.key, [0.0] * len(key.students))
+        for label in problem.labels:  # row[2] * row[3]: credit * points, the verdict's score
+            scores[:] = [total + row[2] * row[3] for total, row in zip(scores, graded.columns[label], strict=True)]
+    return {student.id: {problem: scores[index] for problem, scores in sums.items()}
+            for index, student in enumerate(key.students)}
 
 
-def counts(verdicts: Sequence[Verdict]) -> dict[str, int]:
+def counts(graded: Graded) -> dict[str, int]:
     """How many verdicts of each kind."""
-    return {kind: sum(v.verdict == kind for v in verdicts) for kind in VERDICTS}
+    found = dict.fromkeys(VERDICTS, 0)
+    for rows in graded.columns.values():
+        for row in rows:
+            found[row[1]] += 1  # the verdict
+    return found

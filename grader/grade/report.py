@@ -10,7 +10,7 @@ from __future__ import annotations
 import csv
 import io
 import math
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable, Iterator, Sequence
 from pathlib import Path
 
 from grader.assign.keyfile import safe_cell
@@ -43,16 +43,37 @@ def grades_csv(graded: Graded) -> str:
     return _csv(rows)
 
 
-def details_csv(graded: Graded) -> str:
-    """One row per (student, part): what was submitted, the verdict and why."""
-    rows: list[list[object]] = [["student_id", "label", "submitted", "verdict", "credit", "points", "score",
-                                 "expected", "parsed", "unit", "abs_error", "rel_error", "tolerance", "feedback",
-                                 "source"]]
-    for v in graded.verdicts:
-        rows.append([v.student_id, v.label, "" if v.submitted is None else v.submitted, v.verdict, v.credit,
-                     v.points, v.score, v.expected, v.parsed, v.unit, v.abs_error, v.rel_error, v.tolerance,
-                     v.feedback, v.source])
-    return _csv(rows)
+DETAILS_HEADER = ("student_id", "label", "submitted", "verdict", "credit", "points", "score", "expected", "parsed",
+                  "unit", "abs_error", "rel_error", "tolerance", "feedback", "source")
+
+
+def details_csv(graded: Graded, students_per_piece: int = 2000) -> Iterator[str]:
+    """One row per (student, part): what was submitted, the verdict and why. The text comes in pieces
+    of ``students_per_piece`` students, to be written as it comes (a class of 100,000 has a million rows).
+
+    Each cell is what :func:`_cell` makes of the verdict's field (the loop knows the field's type).
+    """
+    stream = io.StringIO()
+    writer = csv.writer(stream, lineterminator="\n")
+    writer.writerow(DETAILS_HEADER)
+    columns = [(safe_cell(label), graded.columns[label]) for label in graded.key.labels]
+    numbers = _Cells()  # credits, points and scores: a few values
+    words = _Cells()  # verdicts, units, tolerances: a few texts
+    for index, student in enumerate(graded.key.students):
+        who = safe_cell(student.id)
+        for label, rows in columns:
+            (submitted, verdict, credit, points, expected, parsed, unit, abs_error, rel_error, tolerance, feedback,
+             source) = rows[index]
+            writer.writerow((who, label, "" if submitted is None else safe_cell(submitted), words[verdict],
+                             numbers[credit], numbers[points], numbers[credit * points], safe_cell(expected),
+                             safe_cell(parsed), words[unit], "" if abs_error is None else _number(abs_error),
+                             "" if rel_error is None else _number(rel_error), words[tolerance], safe_cell(feedback),
+                             safe_cell(source)))
+        if index % students_per_piece == students_per_piece - 1:
+            yield stream.getvalue()
+            stream.seek(0)
+            stream.truncate()
+    yield stream.getvalue()
 
 
 def problems_csv(graded: Graded, export: CanvasExport | None = None) -> str:
@@ -93,9 +114,21 @@ def _cell(value: object) -> str:
     if value is None:
         return ""
     if isinstance(value, float):
-        if not math.isfinite(value):
-            raise ValueError("a report cell is not a finite number")  # a bug: verdicts never hold one
-        return repr(value + 0.0).removesuffix(".0") if value.is_integer() and abs(value) < 1e15 else repr(value)
+        return _number(value)
     if isinstance(value, int):
         return str(value)
     return safe_cell(str(value))
+
+
+def _number(value: float) -> str:
+    if not math.isfinite(value):
+        raise ValueError("a report cell is not a finite number")  # a bug: verdicts never hold one
+    return repr(value + 0.0).removesuffix(".0") if value.is_integer() and abs(value) < 1e15 else repr(value)
+
+
+class _Cells(dict[object, str]):
+    """:func:`_cell` of each value, worked out once: for the columns that hold a few distinct values."""
+
+    def __missing__(self, value: object) -> str:
+        self[value] = _cell(value)
+        return self[value]

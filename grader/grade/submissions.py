@@ -34,7 +34,7 @@ from __future__ import annotations
 import re
 from collections import defaultdict
 from collections.abc import Iterable, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from datetime import UTC, datetime, timedelta, timezone
 from pathlib import Path
 from typing import Literal
@@ -52,7 +52,7 @@ class StudentRef:
     email: str
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, slots=True)
 class Answer:
     """One answer a student gave: where it came from (``line``: the line its row starts on, the
     header being line 1, blank lines counted), and the file's ``delimiter`` (with ``;`` or a tab,
@@ -99,20 +99,30 @@ class Submissions:
     notes: tuple[str, ...]
 
 
-@dataclass
+@dataclass(slots=True)
 class _Row:
-    """One data row that names a known student, with its non-empty answers by label (a long row's
-    one answer may be empty: a blank submitted)."""
+    """One data row that names a known student, with its non-empty answers as (label, text) pairs (a
+    long row's one answer may be empty: a blank submitted). A class of 100,000 has a million rows:
+    they hold no more than they need."""
 
     file: str
+    index: int  # of the file, in argument order
     line: int
-    order: tuple[int, int]
     student_id: str
-    answers: dict[str, str]
+    answers: tuple[tuple[str, str], ...]
     timestamp: datetime | None
     delimiter: str
     wide: bool
-    lost: list[tuple[str, str]] = field(default_factory=list)  # (label, why) taken by a later long row
+    lost: list[tuple[str, str]] | None = None  # (label, why) taken by a later long row
+
+    @property
+    def order(self) -> tuple[int, int]:
+        """Where the row is: argument order, then file order."""
+        return self.index, self.line
+
+    def text(self, label: str) -> str:
+        """The row's answer to ``label``."""
+        return dict(self.answers)[label]
 
 
 def read_submissions(paths: Sequence[Path], students: Sequence[StudentRef], labels: Sequence[str],
@@ -138,13 +148,16 @@ def read_submissions(paths: Sequence[Path], students: Sequence[StudentRef], labe
                          'file as "CSV UTF-8"')
         for row in table.rows:
             _read_row(name, index, row, table, layout, labels, roster, rows, problems)
+        del table  # its rows are read: the next file's need not wait beside them
     stamps = [row.timestamp for row in rows if row.timestamp is not None]
     if any(s.tzinfo is None for s in stamps) and any(s.tzinfo is not None for s in stamps):
         notes.append("some timestamps have a time zone and some do not: those without were taken as UTC "
                      "to compare them")
     answers = _latest(rows, problems, labels)
+    del rows
     order = {name: index for index, name in enumerate(shown_as)}
-    return Submissions(tuple(sorted(answers, key=lambda a: (order[a.file], a.line, labels.index(a.label)))),
+    position = {label: index for index, label in enumerate(labels)}
+    return Submissions(tuple(sorted(answers, key=lambda a: (order[a.file], a.line, position[a.label]))),
                        tuple(sorted(problems, key=lambda p: (order[p.file], p.line, p.caveat, p.label))),
                        tuple(ignored), tuple(notes))
 
@@ -203,7 +216,7 @@ def _read_row(file: str, index: int, row: CsvRow, table: CsvTable, layout: Layou
     if why:
         problems.append(RowProblem(file, row.line, student_id, "", why, caveat=True))
     if layout.wide:
-        answers = {label: row.cells[column] for column, label in layout.labels.items() if row.cells[column]}
+        answers = tuple((label, row.cells[column]) for column, label in layout.labels.items() if row.cells[column])
         if not answers:
             problems.append(RowProblem(file, row.line, student_id, "", "no answers in this row"))
             return
@@ -212,12 +225,12 @@ def _read_row(file: str, index: int, row: CsvRow, table: CsvTable, layout: Layou
                                    f"unknown label {shown(label)} (expected one of {', '.join(labels)})"))
         return
     else:
-        answers = {label: row.cells[layout.answer or ""]}
+        answers = ((label, row.cells[layout.answer or ""]),)
     stamp = _timestamp(row.cells[layout.timestamp]) if layout.timestamp else None
     if isinstance(stamp, str):
         problems.append(RowProblem(file, row.line, student_id, "", stamp, caveat=True))
         stamp = None
-    rows.append(_Row(file, row.line, (index, row.line), student_id, answers, stamp, table.delimiter, layout.wide))
+    rows.append(_Row(file, index, row.line, student_id, answers, stamp, table.delimiter, layout.wide))
 
 
 def _find_label(text: str, labels: Sequence[str]) -> str | None:
@@ -299,21 +312,26 @@ def _latest(rows: list[_Row], problems: list[RowProblem], labels: Sequence[str])
     for group in by_student.values():
         winner, losers, why = _pick(group)
         contenders.append(winner)
-        problems.extend(RowProblem(row.file, row.line, row.student_id, "", why) for row in losers)
-    by_answer: dict[tuple[str, str], list[_Row]] = defaultdict(list)
+        problems.extend(RowProblem(row.file, row.line, row.student_id, "", why, routine=True) for row in losers)
+    first: dict[tuple[str, str], tuple[_Row, str]] = {}  # most answers have one row: no list for them
+    more: dict[tuple[str, str], list[_Row]] = {}
     for row in contenders:
-        for label in row.answers:
-            by_answer[row.student_id, label].append(row)
+        for label, text in row.answers:
+            found = first.setdefault((row.student_id, label), (row, text))[0]
+            if found is not row:
+                more.setdefault((row.student_id, label), [found]).append(row)
     answers = []
-    for (student_id, label), group in by_answer.items():
-        winner, losers, why = _pick(group)
-        answers.append(Answer(winner.file, winner.line, student_id, label, winner.answers[label], winner.delimiter,
-                              winner.timestamp))
-        for row in losers:
-            if row.wide:
-                row.lost.append((label, why))
-            else:
-                problems.append(RowProblem(row.file, row.line, student_id, label, why, routine=True))
+    for (student_id, label), (winner, text) in first.items():
+        if (student_id, label) in more:
+            winner, losers, why = _pick(more[student_id, label])
+            text = winner.text(label)
+            for row in losers:
+                if row.wide:
+                    row.lost = row.lost or []
+                    row.lost.append((label, why))
+                else:
+                    problems.append(RowProblem(row.file, row.line, student_id, label, why, routine=True))
+        answers.append(Answer(winner.file, winner.line, student_id, label, text, winner.delimiter, winner.timestamp))
     for row in contenders:
         if row.wide and row.lost:
             problems.extend(_lost_answers(row, labels))
@@ -341,7 +359,7 @@ def _instant(when: datetime | None) -> datetime:
 def _lost_answers(row: _Row, labels: Sequence[str]) -> list[RowProblem]:
     """A winning wide row some of whose answers a later long row replaced: a caveat per answer, or,
     when it kept none, one problem for the row."""
-    lost = sorted(row.lost, key=lambda pair: labels.index(pair[0]))
+    lost = sorted(row.lost or (), key=lambda pair: labels.index(pair[0]))
     if len(lost) < len(row.answers):
         return [RowProblem(row.file, row.line, row.student_id, label, why, caveat=True) for label, why in lost]
     whys = "; ".join(f"{label}: {why}" for label, why in lost)

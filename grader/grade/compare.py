@@ -26,7 +26,7 @@ from __future__ import annotations
 
 import hashlib
 import math
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from decimal import Decimal
 from fractions import Fraction
@@ -187,12 +187,15 @@ def feedback(submitted: float, expected: float, unit: str, tolerance: Tolerance,
 
 
 def feedbacks(submitted: ArrayLike, expected: ArrayLike, unit: str, tolerance: Tolerance, correct: ArrayLike, *,
-              angle_unit: str | None = None) -> list[str]:
+              angle_unit: str | None = None, typed: Sequence[str | None] | None = None) -> list[str]:
     """:func:`feedback` for each element of equally long sequences (a class's answers to one part):
-    the distances in one numpy pass, the words that do not depend on the numbers once.
+    the distances in one numpy pass, the words that do not depend on the numbers once. ``typed``: for an
+    answer given in another unit, what the student wrote, said before its value in ``unit``.
 
     >>> feedbacks([6.32, 6.5], [6.26, 6.26], "m/s", Tolerance(), [True, False])[1]
     '6.5 m/s is 3.8 % above 6.26 m/s; only ±1 % is accepted'
+    >>> feedbacks([17 * 0.44704 / 0.3048], [24.95], "ft/s", Tolerance(), [True], typed=["17.0 mph"])[0]
+    '17.0 mph = 24.9333 ft/s is 0.067 % below 24.95 ft/s; within ±1 % is accepted'
     """
     s, t = np.asarray(submitted, dtype=float).ravel(), np.asarray(expected, dtype=float).ravel()
     right = np.asarray(correct, dtype=bool).ravel()
@@ -201,7 +204,8 @@ def feedbacks(submitted: ArrayLike, expected: ArrayLike, unit: str, tolerance: T
     words = _Words(tolerance, unit or {"deg": "°", "rad": "rad"}.get(angle_unit or "", ""), _period(angle_unit))
     with np.errstate(all="ignore"):
         distances = _difference(s, t, words.period)
-    return list(map(words.sentence, s.tolist(), t.tolist(), distances.tolist(), right.tolist()))
+    return list(map(words.sentence, s.tolist(), t.tolist(), distances.tolist(), right.tolist(),
+                    typed if typed is not None else [None] * s.size))
 
 
 class _Words:
@@ -214,16 +218,21 @@ class _Words:
         self.clauses = {verdict: _clause(tolerance, unit, verdict) for verdict in (True, False)}
         self.to_digits = f" to {tolerance.describe()}"
 
-    def sentence(self, submitted: float, expected: float, distance: float, correct: bool) -> str:
-        """The sentence for one answer; ``distance`` is ``_difference(submitted, expected)``."""
+    def sentence(self, submitted: float, expected: float, distance: float, correct: bool,
+                 typed: str | None = None) -> str:
+        """The sentence for one answer; ``distance`` is ``_difference(submitted, expected)``; ``typed``: the
+        student's text, for an answer given in another unit."""
         suffix, period = self.suffix, self.period
         if not math.isfinite(expected):
             return "this answer has no finite value in the key; please ask your instructor to check it"
         key = _shown(expected) + suffix
         if not math.isfinite(submitted):
             return f"{_shown(submitted)} is not a finite number, so it cannot match {key}"
-        subject = self.subjects.get(submitted) or self.subjects.setdefault(submitted, _shown(submitted, full=True)
-                                                                           + suffix)
+        if typed is not None:
+            subject = f"{typed} = {_shown(submitted)}{suffix}"
+        else:
+            subject = self.subjects.get(submitted) or self.subjects.setdefault(submitted, _shown(submitted, full=True)
+                                                                               + suffix)
         if period is not None and abs((submitted - expected) - distance) > 1e-9 * period:
             # The student's direction, written within a half turn of the key.
             if distance == 0 and self.tolerance.mode == "rtol":

@@ -26,6 +26,7 @@ from grader.grade.cells import (
 )
 from grader.grade.compare import equivalent, errors, feedbacks, is_correct
 from grader.grade.key import Key, KeyPart
+from grader.grade.notation import cut
 from grader.grade.submissions import Answer, RowProblem, Submissions
 from grader.model.expr import Node, parse
 from grader.model.tolerance import Tolerance
@@ -107,7 +108,7 @@ def _grade_column(cells: Sequence[tuple[KeyPart, Answer | None]], key: Key) -> l
     """A row for each (part, answer): outcomes decided cell by cell, numbers compared by group."""
     rows: list[Row | None] = [None] * len(cells)
     tolerances: dict[int, tuple[Tolerance, str]] = {}  # by id of the key's mapping (the key shares equal ones)
-    groups: dict[tuple[int, str], tuple[list[int], list[float], list[float]]] = {}
+    groups: dict[tuple[int, str], tuple[list[int], list[float], list[float], list[str | None]]] = {}
     for index, (part, answer) in enumerate(cells):
         known = tolerances.get(id(part.tolerance))
         if known is None:
@@ -117,11 +118,12 @@ def _grade_column(cells: Sequence[tuple[KeyPart, Answer | None]], key: Key) -> l
         if isinstance(outcome, CellNumber):
             group = groups.get((id(part.tolerance), part.unit))
             if group is None:
-                group = groups[id(part.tolerance), part.unit] = ([], [], [])
-            members, submitted, expected = group
+                group = groups[id(part.tolerance), part.unit] = ([], [], [], [])
+            members, submitted, expected, typed = group
             members.append(index)
             submitted.append(outcome.value)
             expected.append(float(part.value))  # type: ignore[arg-type]  # a number: not symbolic, not None
+            typed.append(_converted(outcome, part, answer))
         else:
             rows[index] = _row(part, answer, _expected(part), "equal expressions" if part.symbolic else known[1],
                                *outcome)
@@ -130,15 +132,23 @@ def _grade_column(cells: Sequence[tuple[KeyPart, Answer | None]], key: Key) -> l
     return rows  # type: ignore[return-value]  # every index is filled above, or by _compare
 
 
-def _compare(cells: Sequence[tuple[KeyPart, Answer | None]], group: tuple[list[int], list[float], list[float]],
+def _converted(cell: CellNumber, part: KeyPart, answer: Answer | None) -> str | None:
+    """What the student typed, when its unit is not the sheet's (``17.0 mph`` for ft/s), for the feedback."""
+    if answer is None or cell.unit_given is None or cell.unit_given == part.unit:
+        return None
+    return cut(" ".join(answer.text.split()), 40)
+
+
+def _compare(cells: Sequence[tuple[KeyPart, Answer | None]],
+             group: tuple[list[int], list[float], list[float], list[str | None]],
              tolerance: Tolerance, words: str, unit: str, rows: list[Row | None]) -> None:
-    """The rows of a group of cells (their indices, the numbers read, the key's) of one tolerance and
-    unit: verdicts, errors and sentences, each in one pass over the group."""
-    members, submitted, expected = group
+    """The rows of a group of cells (their indices, the numbers read, the key's, what was typed in another
+    unit) of one tolerance and unit: verdicts, errors and sentences, each in one pass over the group."""
+    members, submitted, expected, typed = group
     angle = unit if unit in ("deg", "rad") else None
     right = is_correct(submitted, expected, tolerance, angle_unit=angle)
     absolute, relative = errors(submitted, expected, angle_unit=angle)
-    said = feedbacks(submitted, expected, unit, tolerance, right, angle_unit=angle)
+    said = feedbacks(submitted, expected, unit, tolerance, right, angle_unit=angle, typed=typed)
     shown: dict[float, str] = {}  # the numbers a class typed: a few thousand
     for index, value, key_value, ok, sentence, error, ratio in zip(
             members, submitted, expected, right.tolist(), said, absolute.tolist(), relative.tolist(), strict=True):

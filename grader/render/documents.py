@@ -435,6 +435,14 @@ def _join_pdfs(parts: Sequence[Path], target: Path) -> None:
         writer.write(stream)
 
 
+def sources(assignment: Assignment, generation: Generation, bank: Mapping[str, Template],
+            indices: Sequence[int]) -> tuple[str, str]:
+    """The Typst sources of the listed students' sheets (statements, figures) and of their answer key
+    (worked solutions, without the class overview)."""
+    documents = _Documents(assignment, generation, bank)
+    return student_source(documents, indices), key_source(documents, indices, overview=False)
+
+
 def render_page_png(assignment: Assignment, generation: Generation, bank: Mapping[str, Template],
                     student_index: int, *, key: bool = False, page: int = 0, ppi: int = 110,
                     font_dirs: Sequence[Path] = ()) -> bytes:

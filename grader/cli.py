@@ -276,11 +276,14 @@ def _show(arguments: argparse.Namespace) -> int:
 
     from grader.model.expr import to_text
     from grader.render.preview import example_printed, example_statement
+    from grader.render.readable import readable
+    from grader.render.worked import reader_names
     from grader.solve.cache import compiled_for
     from grader.solve.evaluate import solve_one
 
     template = _template(arguments)
     compiled = compiled_for(template)
+    names = reader_names(template, compiled)
     printed = example_printed(template)
     example = solve_one(template, compiled, {n: float(v) for n, v in printed.items()})
     if arguments.json:
@@ -293,7 +296,7 @@ def _show(arguments: argparse.Namespace) -> int:
                            for n, p in template.parameters.items()},
             "answers": {n: {"unit": a.unit.text, "description": a.description, "symbolic": list(a.symbolic)}
                         for n, a in template.answers.items()},
-            "steps": [{"unknown": s.unknown, "relation": s.relation, "solved": to_text(s.solved)}
+            "steps": [{"unknown": s.unknown, "relation": s.relation, "solved": to_text(readable(s.solved, names))}
                       for s in compiled.steps]}))
         return EXIT_OK
     scene = template.scene
@@ -317,9 +320,8 @@ def _show(arguments: argparse.Namespace) -> int:
     lines += [f"  {n:<10} {a.unit.text or '-':<6} {a.description}" for n, a in template.answers.items()]
     lines += ["", "Step chain (one equation, one unknown):"]
     for number, step in enumerate(compiled.steps, 1):
-        lhs, rhs = (to_text(side) for side in step.equation)
-        lines += [f"  {number}. {step.relation}", f"       {lhs} = {rhs}",
-                  f"       => {step.unknown} = {to_text(step.solved)}"]
+        lhs, rhs, solved = (to_text(readable(side, names)) for side in (*step.equation, step.solved))
+        lines += [f"  {number}. {step.relation}", f"       {lhs} = {rhs}", f"       => {step.unknown} = {solved}"]
     print("\n".join(lines))
     return EXIT_OK
 

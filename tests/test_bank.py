@@ -162,37 +162,9 @@ def test_a_topic_outside_the_list_is_refused_naming_the_choices() -> None:
 
 
 def test_a_statement_that_fills_in_an_answer_is_refused_saying_so() -> None:
-    with pytest.raises(TemplateError, match=r"statement: expected only parameters, symbols and g .* got the answer "
+    with pytest.raises(TemplateError, match=r"statement: expected only parameters, symbols and g, got the answer "
                                             r"e, which the student finds"):
         parse_template(mutated(set_in("statement", "It bounces with e = {{ e }}.")), "x.yaml", "hash")
-
-
-@pytest.mark.parametrize("statement", [
-    "Dropped from {{ h_drop }} mm, bounces to {{h_rebound}} mm.\n", "{{ h_drop }}{{ h_rebound }}",
-    "Sets {x} and {{ h_drop }} } {{ h_rebound }}}", "Dropped from {{ h_drop | round(1) }} mm to {{ h_rebound }}",
-    "{{{ h_drop }}} {{ h_rebound }}", "Is it {{ none }}? {{ h_drop }} {{ h_rebound }}",
-])
-def test_a_plain_statement_is_filled_in_exactly_as_jinja2_fills_it(statement: str) -> None:
-    """The fast path (no Jinja2 import, for `grader list`) agrees with the sandbox wherever it applies."""
-    from grader.bank.statement import _compiled, fill_statement
-    from grader.bank.statement_text import plain_fill
-
-    values = {"h_drop": "2100", "h_rebound": "1100"}
-    try:
-        jinja = "".join(_compiled(statement).generate(values)).strip()
-    except Exception:  # a statement Jinja2 refuses must not be plain either
-        jinja = None
-    plain = plain_fill(statement, values)
-    assert plain is None or plain == jinja
-    if jinja is not None:
-        assert fill_statement(statement, values) == jinja
-
-
-def test_every_shipped_statement_is_plain() -> None:
-    """So `grader list` never imports Jinja2 for the shipped bank."""
-    from grader.bank.statement_text import plain_names
-
-    assert all(plain_names(t.statement) is not None for t in load_bank().values())
 
 
 # --- several bank folders -------------------------------------------------------------------------

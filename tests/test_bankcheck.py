@@ -48,8 +48,8 @@ def broken(folder: Path, name: str, old: str = "", new: str = "", source: str = 
 
 BROKEN = {
     "unknown-name": ("{{ h_rebound }} mm.", "{{ h_rebound }} mm, {{ h_bounce }} mm.",
-                     "FAIL  load: {folder}/unknown-name.yaml: statement: expected only parameters, symbols and g "
-                     "(values the page gives), got unknown h_bounce"),
+                     "FAIL  load: {folder}/unknown-name.yaml: statement: expected only parameters, symbols and g, "
+                     "got unknown h_bounce"),
     "zero-answer": ("sample: {uniform: [500, 1400]}", "sample: {choice: [0, 600, 900, 1200]}",
                     "FAIL  degenerate draws: 52 of the 200 answered draws sit at a degenerate point, e.g. answer e = 0 "
                     "is too close to zero to grade with a relative tolerance at h_drop = 1914 mm, h_rebound = 0 mm; "

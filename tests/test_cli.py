@@ -247,3 +247,17 @@ def test_the_compile_cache_keeps_same_id_templates_of_two_folders_apart(
     assert set(answers["ours"]) == set(answers["ours again"]) == {"e", "loss_pct"}
     assert answers["theirs"]["h_apex"]["value"] == pytest.approx(2.1)
     assert len(list(cache_dir().glob("drop-rebound-*.json"))) >= 2
+
+
+def test_generate_draws_an_instructors_template_beside_the_shipped_ones(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str], workdir: str) -> None:
+    """An assignment naming a template of the instructor's own folder and a shipped one."""
+    mine = _own_bank(tmp_path, "mine", "my-drop", "Before a game", "Before the final")
+    Path("a.yaml").write_text("title: HW\ncourse: C\nseed: s\nproblems:\n  - template: my-drop\n"
+                              "  - template: pile-driver\n", encoding="utf-8")
+    Path("r.csv").write_text("id,name,email,section\n1,Ann,a@x.org,A\n", encoding="utf-8")
+    code, _, err = run(capsys, "generate", "a.yaml", "--roster", "r.csv", "--out", "out", "--no-pdf",
+                       "--bank", str(mine))
+    assert code == 0, err
+    key = json.loads(Path("out/key.json").read_text(encoding="utf-8"))
+    assert [p["template"] for p in key["problems"]] == ["my-drop", "pile-driver"]

@@ -12,15 +12,16 @@ Templates may come from colleagues, so a statement is untrusted twice over:
   ``eval``, ``std``) or could loop or vary (``#for``, ``#range``, ``#datetime``) is refused.
   (The compiler's root is an empty private folder too, so nothing outside could be read anyway.)
 
-A statement that is plain text and ``{{ name }}`` is filled in without Jinja2
-(:mod:`grader.bank.statement_text`, with the Typst rules), exactly as the sandbox would fill it.
-
 >>> fill_statement("Dropped from {{ h }} mm", {"h": "2100"})
 'Dropped from 2100 mm'
 >>> fill_statement("{{ h * 3 }}", {"h": "2.50"})
 Traceback (most recent call last):
 ...
-grader.bank.statement_text.StatementRefused: arithmetic (values are filled in as printed text; ...
+grader.bank.statement.StatementRefused: arithmetic (values are filled in as printed text; ...
+>>> typst_file_access('See #read("secret.txt") here')
+'read("secret.txt")'
+>>> typst_file_access("Find $v_A'$ #h(1em) and read the figure") is None
+True
 """
 
 from __future__ import annotations
@@ -34,19 +35,12 @@ import jinja2.nodes as nodes
 import jinja2.sandbox
 from jinja2.exceptions import SecurityError
 
-from grader.bank.statement_text import (
-    MAX_OUTPUT,
-    StatementRefused,
-    plain_fill,
-    plain_names,
-    typst_code,
-    typst_file_access,
-    typst_refusal,
-)
+# The Typst rules live beside the plain-statement reader, which needs no Jinja2 (loading a template
+# must not import it); they are imported here for the modules that fill statements in.
+from grader.bank.markup import MAX_OUTPUT, typst_code, typst_file_access, typst_refusal
 
-# A statement's rules in one place for its users: the Typst ones live in statement_text (no Jinja2).
-__all__ = ["FILTERS", "MAX_OUTPUT", "MAX_VALUE", "StatementRefused", "check_jinja", "fill_statement", "plain_fill",
-           "plain_names", "statement_names", "typst_code", "typst_file_access", "typst_refusal"]
+__all__ = ["MAX_OUTPUT", "StatementRefused", "check_jinja", "fill_statement", "typst_code", "typst_file_access",
+           "typst_refusal"]
 
 MAX_VALUE = 10_000  # characters of a string, digits of a number, inside a statement
 FILTERS = ("abs", "round", "int", "float", "string", "lower", "upper", "title", "capitalize", "trim", "default")
@@ -70,6 +64,10 @@ _REFUSED: dict[type[nodes.Node], str] = {
                      nodes.Pos), _ARITHMETIC),
     **dict.fromkeys((nodes.If, nodes.CondExpr, nodes.Compare, nodes.And, nodes.Or, nodes.Not), _CONDITION),
 }
+
+
+class StatementRefused(Exception):  # noqa: N818 (a reason, turned into a TemplateError by the caller)
+    """A statement that is not allowed; the message says what was found."""
 
 
 class _BoundedSandbox(jinja2.sandbox.ImmutableSandboxedEnvironment):
@@ -146,28 +144,9 @@ def _compiled(source: str) -> jinja2.Template:
     return _environment().from_string(source)
 
 
-def statement_names(source: str) -> set[str]:
-    """The names a statement fills in; :class:`StatementRefused` for anything not allowed
-    (``jinja2.TemplateSyntaxError`` passes through).
-
-    >>> sorted(statement_names("{{ h | round(1) }} and {{ h2 }}"))
-    ['h', 'h2']
-    """
-    plain = plain_names(source)
-    if plain is not None:
-        return plain
-    import jinja2.meta
-
-    return set(jinja2.meta.find_undeclared_variables(check_jinja(source)))
-
-
 def fill_statement(source: str, values: Mapping[str, Any]) -> str:
-    """The statement with the values filled in (a plain one directly, any other in the bounded
-    sandbox); :class:`StatementRefused` for anything not allowed or that fails
-    (``jinja2.TemplateSyntaxError`` passes through)."""
-    plain = plain_fill(source, values)
-    if plain is not None:
-        return plain
+    """The statement with the values filled in, in the bounded sandbox; :class:`StatementRefused`
+    for anything not allowed or that fails (``jinja2.TemplateSyntaxError`` passes through)."""
     try:
         pieces, length = [], 0
         for piece in _compiled(source).generate(dict(values)):

@@ -18,7 +18,6 @@ from pathlib import Path
 from typing import Any
 
 from grader.bank.scene_parser import IDENTIFIER, parse_scene
-from grader.bank.statement_text import StatementRefused, plain_fill, plain_names, typst_refusal
 from grader.errors import ExpressionError, GraderError, TemplateError, UsageError, shown
 from grader.inputs import YAML_BYTES, parse_yaml, read_bytes
 from grader.model.expr import Node, Op, Sym, names, parse, to_text
@@ -333,43 +332,43 @@ def _expect(node: Node, expected: Dimension, known: dict[str, Dimension], where:
 
 
 def _check_statement(template: Template, given: set[str]) -> None:
-    """The statement fills in only parameters, symbols and g, and is text and math once filled in.
-    A plain statement (text and ``{{ name }}``) is checked without importing Jinja2."""
-    try:
-        used = plain_names(template.statement)
-        if used is None:
-            used = _jinja_names(template)
-        # A trial fill (parameters and g as "1", symbols as their names, as a sheet shows them) refuses
-        # what would be too costly for every student alike, and Typst code assembled from pieces.
-        unknown = used - given - {"g"}
-        if unknown:
-            asked = sorted(unknown & set(template.answers))
-            raise TemplateError(template.where, "statement", "only parameters, symbols and g (values the page gives)",
-                                f"the answer {', '.join(asked)}, which the student finds" if asked
-                                else f"unknown {', '.join(sorted(unknown))}")
-        values = {**dict.fromkeys([*template.parameters, "g"], "1"), **{n: n for n in template.symbols}}
-        filled = plain_fill(template.statement, values)
-        if filled is None:
-            from grader.bank.statement import fill_statement
+    from grader.bank.markup import plain_fill, typst_refusal
 
-            filled = fill_statement(template.statement, values)
-    except StatementRefused as error:
-        raise TemplateError(template.where, "statement", "values filled in, not code", str(error)) from None
+    # A trial fill (parameters and g as "1", symbols as their names, as a sheet shows them) refuses
+    # what would be too costly for every student alike, and Typst code assembled from pieces.
+    values = {**dict.fromkeys([*template.parameters, "g"], "1"), **{n: n for n in template.symbols}}
+    filled = plain_fill(template.statement, values)  # text and {{ name }}: no Jinja2 needed
+    if filled is None:
+        filled = _jinja_fill(template, given, values)
     refusal = typst_refusal(template.statement) or typst_refusal(filled)
     if refusal is not None:
         raise TemplateError(template.where, "statement", "text and math only", refusal)
 
 
-def _jinja_names(template: Template) -> set[str]:
-    """The names of a statement that is not plain, read by Jinja2 (imported only then)."""
+def _jinja_fill(template: Template, given: set[str], values: dict[str, str]) -> str:
+    """A statement that is more than text and ``{{ name }}``, read by Jinja2: refused unless it only
+    fills in values (with filters) of the template's names."""
     import jinja2
+    import jinja2.meta
 
-    from grader.bank.statement import statement_names
+    from grader.bank.statement import StatementRefused, check_jinja, fill_statement
 
     try:
-        return statement_names(template.statement)
+        syntax = check_jinja(template.statement)
     except jinja2.TemplateSyntaxError as error:
         raise TemplateError(template.where, "statement", "a valid Jinja2 snippet", error.message) from None
+    except StatementRefused as error:
+        raise TemplateError(template.where, "statement", "values filled in, not code", str(error)) from None
+    unknown = jinja2.meta.find_undeclared_variables(syntax) - given - {"g"}
+    if unknown:
+        asked = sorted(unknown & set(template.answers))
+        raise TemplateError(template.where, "statement", "only parameters, symbols and g",
+                            f"the answer {', '.join(asked)}, which the student finds" if asked
+                            else f"unknown {', '.join(sorted(unknown))}")
+    try:
+        return fill_statement(template.statement, values)
+    except StatementRefused as error:
+        raise TemplateError(template.where, "statement", "values filled in, not code", str(error)) from None
 
 
 def _text(raw: Mapping[str, Any], key: str, where: str) -> str:

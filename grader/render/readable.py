@@ -194,17 +194,27 @@ def _one_root(factors: list[Node], names: Names) -> list[Node]:
     return [f for f in factors if not _is_root(f)] + [Op("sqrt", (readable(radicand, names),))]
 
 
-def _powers(factors: list[Node]) -> list[Node]:
-    """Equal factors as one power: ``v v`` is ``v²``."""
-    counted: list[tuple[Node, int]] = []
+def counted(factors: Sequence[Node]) -> list[tuple[Node, int]]:
+    """Each distinct factor, in order of first appearance, with how often it occurs.
+
+    >>> from grader.model.expr import parse
+    >>> [(to_text(f), n) for f, n in counted([parse("v"), parse("m"), parse("v")])]
+    [('v', 2), ('m', 1)]
+    """
+    result: list[tuple[Node, int]] = []
     for factor in factors:
-        for index, (seen, count) in enumerate(counted):
+        for index, (seen, count) in enumerate(result):
             if seen == factor:
-                counted[index] = (seen, count + 1)
+                result[index] = (seen, count + 1)
                 break
         else:
-            counted.append((factor, 1))
-    return [factor if count == 1 else Op("pow", (factor, Num(Fraction(count)))) for factor, count in counted]
+            result.append((factor, 1))
+    return result
+
+
+def _powers(factors: list[Node]) -> list[Node]:
+    """Equal factors as one power: ``v v`` is ``v²``."""
+    return [factor if count == 1 else Op("pow", (factor, Num(Fraction(count)))) for factor, count in counted(factors)]
 
 
 def _unsquared(factor: Node, names: Names) -> Node:

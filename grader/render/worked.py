@@ -35,7 +35,7 @@ from grader.assign.variants import ProblemVariant
 from grader.bank.template import Template
 from grader.model.expr import FUNCTIONS, Node, Num, Op, Sym, format_number, parse
 from grader.model.kernel import evaluate
-from grader.render.readable import Names, readable
+from grader.render.readable import Names, counted, readable
 from grader.solve.cache import compiled_for
 from grader.solve.compiled import Compiled, Step
 
@@ -171,16 +171,8 @@ class _Math:
         return [node]
 
     def _product(self, node: Op) -> str:
-        counted: list[tuple[Node, int]] = []
-        for factor in self._factors(node):
-            for index, (seen, count) in enumerate(counted):
-                if seen == factor:
-                    counted[index] = (seen, count + 1)
-                    break
-            else:
-                counted.append((factor, 1))
         pieces: list[tuple[str, bool]] = []
-        for factor, count in counted:
+        for factor, count in counted(self._factors(node)):
             if count > 1:
                 pieces.append((self._power(factor, str(count)), self.convert(factor)[2]))
                 continue

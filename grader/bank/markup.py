@@ -1,65 +1,50 @@
-r"""A statement's text, checked without Jinja2: its Typst (text and math only, no file access, no
-code but a few markup calls), and the common case of a statement that is plain text with
-``{{ name }}`` placeholders, filled in here exactly as Jinja2 would fill it.
+"""What a statement's Typst may contain, and statements that are plain text and ``{{ name }}``.
 
-``grader list`` loads every template and checks every statement; most statements are plain, so
-it never pays for importing Jinja2 (:mod:`grader.bank.statement` handles the rest).
+Both read text with regular expressions only: loading a template checks its statement without
+importing Jinja2 when the statement is plain (as every shipped one is), which keeps ``grader list``
+and ``grader solve`` quick to start; anything else is read by Jinja2 in :mod:`grader.bank.statement`.
 
->>> sorted(plain_names("Dropped from {{ h }} mm onto {{h2}} mm"))
-['h', 'h2']
->>> plain_names("{{ h * 3 }}") is None, plain_names("{% for x in y %}") is None
-(True, True)
->>> plain_fill("Dropped from {{ h }} mm.\n", {"h": "2100"})
-'Dropped from 2100 mm.'
->>> typst_file_access('See #read("secret.txt") here')
-'read("secret.txt")'
->>> typst_file_access("Find $v_A'$ #h(1em) and read the figure") is None
+>>> plain_fill("Dropped from {{ h }} mm, {{g}} m/s^2.", {"h": "2100", "g": "9.81"})
+'Dropped from 2100 mm, 9.81 m/s^2.'
+>>> plain_fill("{{ h * 3 }}", {"h": "1"}) is None  # not plain: Jinja2 reads it (and refuses it)
 True
 """
 
 from __future__ import annotations
 
+import keyword
 import re
 from collections.abc import Iterator, Mapping
-from typing import Any
 
 MAX_OUTPUT = 20_000  # characters a filled-in statement may have
 
-# A placeholder of the plain form; Jinja2's literals (none, true, ...) are not names.
+# --- plain statements ---------------------------------------------------------------------------
+
+# Where Jinja2's lexer (default settings) leaves text: at {{, {% and {#. It also turns \r\n into \n.
+_JINJA = re.compile(r"\{[{%#]|\r")
 _PLACEHOLDER = re.compile(r"\{\{\s*([A-Za-z_][A-Za-z0-9_]*)\s*\}\}")
-_LITERALS = {"none", "None", "true", "True", "false", "False"}
+# Names Jinja2 reads as something other than a value from the context.
+_SPECIAL = {*keyword.kwlist, "true", "false", "none", "self", "loop", "caller", "varargs", "kwargs", "super"}
 
 
-class StatementRefused(Exception):  # noqa: N818 (a reason, turned into a TemplateError by the caller)
-    """A statement that is not allowed; the message says what was found."""
+def plain_fill(source: str, values: Mapping[str, str]) -> str | None:
+    """``source`` filled in as :func:`grader.bank.statement.fill_statement` fills it, when it is
+    text and ``{{ name }}`` of names in ``values`` only; None for anything else (Jinja2 reads it).
 
-
-def plain_names(source: str) -> set[str] | None:
-    """The names of a statement that is plain text and ``{{ name }}`` placeholders, or None when it
-    holds anything else Jinja2 would read (a filter, a tag, a comment, ``{{{``)."""
-    found = list(_PLACEHOLDER.finditer(source))
-    if any(m.group(1) in _LITERALS or source[m.start() - 1:m.start()] == "{" for m in found):
+    The filled text is never longer than ``source`` when every value is shorter than its
+    placeholder, so a statement within ``MAX_OUTPUT`` needs no check of the output's length.
+    """
+    if len(source) > MAX_OUTPUT or any(len(value) > 4 + len(name) for name, value in values.items()):
         return None
-    rest = _PLACEHOLDER.sub("\x00", source)
-    if "{{" in rest or "{%" in rest or "{#" in rest:
-        return None
-    return {m.group(1) for m in found}
-
-
-def plain_fill(source: str, values: Mapping[str, Any]) -> str | None:
-    """A plain statement (see :func:`plain_names`) with the values filled in, as Jinja2 would (the
-    text around them unchanged, then stripped), or None for a statement that is not plain.
-    :class:`StatementRefused` for a name without a value or an output over ``MAX_OUTPUT``."""
-    used = plain_names(source)
-    if used is None:
-        return None
-    missing = sorted(used - set(values))
-    if missing:
-        raise StatementRefused(f"a statement that cannot be filled in ('{missing[0]}' is undefined)")
-    filled = _PLACEHOLDER.sub(lambda m: str(values[m.group(1)]), source)
-    if len(filled) > MAX_OUTPUT:
-        raise StatementRefused(f"more than {MAX_OUTPUT} characters of output")
-    return filled.strip()
+    pieces, position = [], 0
+    while (start := _JINJA.search(source, position)) is not None:
+        placeholder = _PLACEHOLDER.match(source, start.start())
+        if placeholder is None or placeholder.group(1) not in values or placeholder.group(1) in _SPECIAL:
+            return None
+        pieces += [source[position:start.start()], values[placeholder.group(1)]]
+        position = placeholder.end()
+    pieces.append(source[position:])
+    return "".join(pieces).strip()
 
 
 # --- Typst --------------------------------------------------------------------------------------

@@ -16,12 +16,12 @@ import shlex
 import signal
 import sys
 import threading
-from collections.abc import Sequence
+from collections.abc import Iterable, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from grader import __version__
-from grader.bank.template import Parameter, Template, load_bank
+from grader.bank.template import TOPICS, Parameter, Template, load_banks
 from grader.errors import GraderError, UsageError, shown
 from grader.files import describe_os_error
 from grader.inputs import read_csv
@@ -38,17 +38,21 @@ def build_parser() -> argparse.ArgumentParser:
     """The argument parser, with one subparser per command."""
     parser = argparse.ArgumentParser(prog="grader", description="Impact-problem generator and auto-grader.")
     parser.add_argument("--version", action="version", version=f"grader {__version__}")
-    parser.add_argument("--bank", type=Path, help="folder of problem templates (default: the shipped bank)")
+    _bank_options(parser, "_global")
     commands = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
-    listing = commands.add_parser("list", help="list the templates in the bank")
+    listing = commands.add_parser("list", help="list the templates in the bank, by topic")
+    _bank_options(listing)
     listing.add_argument("--json", action="store_true", help="one JSON object per template")
 
-    show = commands.add_parser("show", help="one template: scene, parameters, derived step chain")
+    show = commands.add_parser("show", help="one template: its statement with example numbers, scene, parameters, "
+                                            "derived step chain")
+    _bank_options(show)
     show.add_argument("template", metavar="ID")
     show.add_argument("--json", action="store_true", help="print JSON")
 
     solve = commands.add_parser("solve", help="answers for one parameter set or a CSV of them")
+    _bank_options(solve)
     solve.add_argument("template", metavar="ID")
     given = solve.add_mutually_exclusive_group(required=True)
     given.add_argument("--set", action="append", metavar="NAME=VALUE", dest="assignments",
@@ -57,6 +61,7 @@ def build_parser() -> argparse.ArgumentParser:
     solve.add_argument("--json", action="store_true", help="JSON output (one object per line for --batch)")
 
     simulate = commands.add_parser("simulate", help="re-derive the answers in the time domain, beside the closed form")
+    _bank_options(simulate)
     simulate.add_argument("template", metavar="ID")
     simulate.add_argument("--set", action="append", metavar="NAME=VALUE", dest="assignments", required=True,
                           help="a parameter value in the template's unit, or with its own unit")
@@ -73,6 +78,7 @@ def build_parser() -> argparse.ArgumentParser:
     simulate.add_argument("--plot", type=Path, metavar="FILE.png", help="draw position, velocity and force")
 
     generate = commands.add_parser("generate", help="per-student variants, key and PDFs for an assignment")
+    _bank_options(generate)
     generate.add_argument("assignment", type=Path, metavar="ASSIGNMENT.yaml")
     generate.add_argument("--roster", type=Path, required=True, metavar="ROSTER.csv",
                           help="columns id, name, email, section")
@@ -121,10 +127,29 @@ def build_parser() -> argparse.ArgumentParser:
                                "(or, with --key, submitted, student, label); - reads standard input")
 
     demo = commands.add_parser("demo", help="the whole job on shipped sample data (5 problems, 30 students)")
+    _bank_options(demo)
     demo.add_argument("--out", type=Path, default=Path("grader-demo"), metavar="DIR",
                       help="output folder (default: ./grader-demo)")
     _output_options(demo)
+
+    checking_bank = commands.add_parser(
+        "check-bank", help="check every template of a bank, for authors: loads, samples, solves, simulates, renders",
+        description="Check every template: it loads; 200 sampled variants each solve or are refused by a "
+                    "constraint; no answer of a valid draw sits near zero; the statement fills in; the simulation "
+                    "agrees with the closed form on 4 variants; the figure and worked solution typeset. One line "
+                    "per template; exit code 2 when any fails.")
+    _bank_options(checking_bank)
+    checking_bank.add_argument("--json", action="store_true", help="one JSON object per template")
     return parser
+
+
+def _bank_options(command: argparse.ArgumentParser, where: str = "") -> None:
+    """``--bank DIR`` (repeatable) and ``--no-shipped-bank``, before or after the command's name
+    (separate destinations: argparse would let a subcommand's defaults replace the main parser's)."""
+    command.add_argument("--bank", type=Path, action="append", default=[], metavar="DIR", dest=f"banks{where}",
+                         help="also use the templates in DIR (repeatable; the shipped bank is included)")
+    command.add_argument("--no-shipped-bank", action="store_true", dest=f"no_shipped_bank{where}",
+                         help="leave out the shipped templates (then give --bank DIR)")
 
 
 def _output_options(command: argparse.ArgumentParser) -> None:
@@ -208,7 +233,8 @@ def _discard_stdout() -> None:
 
 
 def _bank(arguments: argparse.Namespace) -> dict[str, Template]:
-    return load_bank(arguments.bank)
+    folders = [*arguments.banks_global, *arguments.banks]
+    return load_banks(folders, shipped=not (arguments.no_shipped_bank_global or arguments.no_shipped_bank))
 
 
 def _template(arguments: argparse.Namespace) -> Template:
@@ -221,35 +247,67 @@ def _template(arguments: argparse.Namespace) -> Template:
 
 
 def _list(arguments: argparse.Namespace) -> int:
-    bank = _bank(arguments)
+    by_topic = _by_topic(_bank(arguments).values())
     if arguments.json:
-        for template in bank.values():
-            print(json.dumps({"id": template.id, "title": template.title, "version": template.version,
+        for template in by_topic:
+            print(json.dumps({"id": template.id, "title": template.title, "topic": template.topic,
+                              "version": template.version, "file": template.where,
                               "parameters": list(template.parameters), "answers": list(template.answers)}))
         return EXIT_OK
-    rows = [(t.id, t.title, ", ".join(t.parameters), ", ".join(t.answers)) for t in bank.values()]
-    print(_table(("id", "title", "parameters", "answers"), rows))
+    rows = [("  " + t.id, t.title, ", ".join(t.parameters), ", ".join(t.answers)) for t in by_topic]
+    lines = _table(("  id", "title", "parameters", "answers"), rows).splitlines()
+    output, topic = [lines[0], "  " + lines[1][2:]], None
+    for template, line in zip(by_topic, lines[2:], strict=True):
+        if template.topic != topic:
+            topic = template.topic
+            output.append(f"{topic[0].upper()}{topic[1:]}")
+        output.append(line)
+    print("\n".join(output))
     return EXIT_OK
 
 
+def _by_topic(templates: Iterable[Template]) -> list[Template]:
+    """Templates grouped by topic, in the order of :data:`TOPICS`, each group by id."""
+    return sorted(templates, key=lambda t: (TOPICS.index(t.topic), t.id))
+
+
 def _show(arguments: argparse.Namespace) -> int:
+    import textwrap
+
     from grader.model.expr import to_text
+    from grader.render.preview import example_printed, example_statement
+    from grader.render.readable import readable
+    from grader.render.worked import reader_names
     from grader.solve.cache import compiled_for
+    from grader.solve.evaluate import solve_one
 
     template = _template(arguments)
     compiled = compiled_for(template)
+    names = reader_names(template, compiled)
+    printed = example_printed(template)
+    example = solve_one(template, compiled, {n: float(v) for n, v in printed.items()})
     if arguments.json:
         print(json.dumps({
-            "id": template.id, "title": template.title, "version": template.version,
+            "id": template.id, "title": template.title, "topic": template.topic, "version": template.version,
+            "file": template.where, "statement": example_statement(template), "example": printed,
+            "example_answers": None if example.answers is None else
+            {name: value.to_json() for name, value in example.answers.items()},
             "parameters": {n: {"unit": p.unit.text, "domain": str(p.domain), "description": p.description}
                            for n, p in template.parameters.items()},
             "answers": {n: {"unit": a.unit.text, "description": a.description, "symbolic": list(a.symbolic)}
                         for n, a in template.answers.items()},
-            "steps": [{"unknown": s.unknown, "relation": s.relation, "solved": to_text(s.solved)}
+            "steps": [{"unknown": s.unknown, "relation": s.relation, "solved": to_text(readable(s.solved, names))}
                       for s in compiled.steps]}))
         return EXIT_OK
     scene = template.scene
-    lines = [f"{template.id} (version {template.version}): {template.title}", "", "Bodies:"]
+    lines = [f"{template.id} (version {template.version}): {template.title}",
+             f"topic: {template.topic}; file: {template.where}", "", "Statement, with example numbers:"]
+    for paragraph in example_statement(template).split("\n\n"):
+        lines += [*textwrap.wrap(paragraph, 100, initial_indent="  ", subsequent_indent="  "), ""]
+    print("\n".join(lines))
+    print("Answers for these numbers:")
+    _print_solution(template, example.params, example.answers, example.error, False, None)
+    lines = ["", "Bodies:"]
     lines += [f"  {b.name}: {'fixed surface' if b.mass is None else 'mass ' + to_text(b.mass)}"
               for b in scene.bodies.values()]
     lines += ["", "Stages:"]
@@ -262,9 +320,8 @@ def _show(arguments: argparse.Namespace) -> int:
     lines += [f"  {n:<10} {a.unit.text or '-':<6} {a.description}" for n, a in template.answers.items()]
     lines += ["", "Step chain (one equation, one unknown):"]
     for number, step in enumerate(compiled.steps, 1):
-        lhs, rhs = (to_text(side) for side in step.equation)
-        lines += [f"  {number}. {step.relation}", f"       {lhs} = {rhs}",
-                  f"       => {step.unknown} = {to_text(step.solved)}"]
+        lhs, rhs, solved = (to_text(readable(side, names)) for side in (*step.equation, step.solved))
+        lines += [f"  {number}. {step.relation}", f"       {lhs} = {rhs}", f"       => {step.unknown} = {solved}"]
     print("\n".join(lines))
     return EXIT_OK
 
@@ -687,5 +744,28 @@ def _print_check(result: dict[str, Any]) -> None:
             print(f"{name:<10} {_printable(text)}")
 
 
+def _check_bank(arguments: argparse.Namespace) -> int:
+    from grader.bank.template import bank_folders, template_files
+    from grader.bankcheck import check_bank
+
+    folders = [*arguments.banks_global, *arguments.banks]
+    shipped = not (arguments.no_shipped_bank_global or arguments.no_shipped_bank)
+    width = max(len(path.stem) for folder in bank_folders(folders, shipped) for path in template_files(folder))
+    failed = total = 0
+    for report in check_bank(folders, shipped):
+        total += 1
+        failed += report.problem is not None
+        if arguments.json:
+            print(json.dumps(report.to_json(), allow_nan=False), flush=True)
+        else:
+            verdict = f"ok    {report.checked} ({report.seconds:.1f} s)" if report.problem is None \
+                else f"FAIL  {_printable(report.problem)}"
+            print(f"{report.template:<{width}}  {verdict}", flush=True)
+    if not arguments.json:
+        print(f"{total} template{'' if total == 1 else 's'}: " +
+              (f"{failed} failed" if failed else "all passed"))
+    return EXIT_USAGE if failed else EXIT_OK
+
+
 _COMMANDS = {"list": _list, "show": _show, "solve": _solve, "simulate": _simulate, "generate": _generate,
-             "demo": _demo, "grade": _grade, "check": _check}
+             "demo": _demo, "grade": _grade, "check": _check, "check-bank": _check_bank}

@@ -132,3 +132,79 @@ def test_shipped_bank_has_the_five_seed_templates_with_their_names() -> None:
         "oblique-spheres": (["v1", "theta", "e", "m1", "m2"], ["v1_out", "v2_out", "theta1_out", "loss_pct"]),
     }
     assert {t: (list(bank[t].parameters), list(bank[t].answers)) for t in expected} == expected
+
+
+# --- topics ---------------------------------------------------------------------------------------
+
+TOPIC_OF = {
+    "car-collision": "direct impact", "coupling": "direct impact", "head-on": "direct impact",
+    "head-on-inverse": "direct impact", "three-balls": "direct impact",
+    "ball-plate": "oblique impact", "oblique-spheres": "oblique impact",
+    "drop-rebound": "drops and rebounds", "moving-plate": "drops and rebounds", "pile-driver": "drops and rebounds",
+    "two-rebounds": "drops and rebounds",
+}
+
+
+@pytest.mark.parametrize(("template_id", "topic"), TOPIC_OF.items())
+def test_each_template_has_its_topic_and_the_scene_would_give_the_same(template_id: str, topic: str) -> None:
+    """The topic a shipped template declares is also what its scene says without the key (so a template
+    written without one is grouped where it belongs)."""
+    raw = yaml.safe_load((bank_dir() / f"{template_id}.yaml").read_text(encoding="utf-8"))
+    assert load_bank()[template_id].topic == topic
+    del raw["topic"]
+    assert parse_template(raw, f"{template_id}.yaml", "hash", template_id).topic == topic
+
+
+def test_a_topic_outside_the_list_is_refused_naming_the_choices() -> None:
+    with pytest.raises(TemplateError, match=r"topic: expected one of direct impact, oblique impact, drops and "
+                                            r"rebounds .*got 'impacts'"):
+        parse_template(mutated(set_in("topic", "impacts")), "x.yaml", "hash")
+
+
+def test_a_statement_that_fills_in_an_answer_is_refused_saying_so() -> None:
+    with pytest.raises(TemplateError, match=r"statement: expected only parameters, symbols and g, got the answer "
+                                            r"e, which the student finds"):
+        parse_template(mutated(set_in("statement", "It bounces with e = {{ e }}.")), "x.yaml", "hash")
+
+
+# --- several bank folders -------------------------------------------------------------------------
+
+def own_folder(tmp_path: Path, name: str, template_id: str, change: Callable[[str], str] = lambda s: s) -> Path:
+    """A folder holding a copy of drop-rebound under ``template_id``, its text passed through ``change``."""
+    folder = tmp_path / name
+    folder.mkdir()
+    text = (bank_dir() / "drop-rebound.yaml").read_text(encoding="utf-8").replace(
+        "id: drop-rebound", f"id: {template_id}")
+    (folder / f"{template_id}.yaml").write_text(change(text), encoding="utf-8")
+    return folder
+
+
+def test_an_instructors_folder_sits_beside_the_shipped_bank(tmp_path: Path) -> None:
+    from grader.bank.template import load_banks
+
+    mine, more = own_folder(tmp_path, "mine", "my-drop"), own_folder(tmp_path, "more", "my-other-drop")
+    bank = load_banks([mine, more])
+    assert set(bank) == set(load_bank()) | {"my-drop", "my-other-drop"}
+    assert bank["my-drop"].where == str(mine / "my-drop.yaml")
+    assert set(load_banks([mine], shipped=False)) == {"my-drop"}
+    assert set(load_banks([mine, mine / ".", bank_dir()])) == set(bank) - {"my-other-drop"}  # a folder counts once
+
+
+def test_two_templates_with_one_id_are_refused_naming_both_files(tmp_path: Path) -> None:
+    from grader.bank.template import load_banks
+
+    mine, theirs = own_folder(tmp_path, "mine", "my-drop"), own_folder(tmp_path, "theirs", "my-drop")
+    with pytest.raises(GraderError) as error:
+        load_banks([mine, theirs])
+    assert f"two templates have the id 'my-drop': {mine / 'my-drop.yaml'} and {theirs / 'my-drop.yaml'}" \
+        in str(error.value)
+    with pytest.raises(GraderError, match=f"id 'drop-rebound': {bank_dir() / 'drop-rebound.yaml'} and "):
+        load_banks([own_folder(tmp_path, "copy", "drop-rebound")])
+
+
+def test_no_bank_at_all_is_a_usage_error() -> None:
+    from grader.bank.template import load_banks
+    from grader.errors import UsageError
+
+    with pytest.raises(UsageError, match=r"without the shipped bank .*give --bank DIR"):
+        load_banks([], shipped=False)

@@ -137,13 +137,127 @@ def test_list_json_names_every_template(capsys: pytest.CaptureFixture[str]) -> N
 
 
 def test_list_and_help_do_not_pay_for_heavy_libraries() -> None:
-    """`grader list` and `--help` import the CLI and load the bank: no scipy, sympy, pint or typst
-    (importing scipy through the effects once tripled their start-up)."""
+    """`grader list` and `--help` import the CLI and load the bank: no scipy, sympy, pint, typst, jinja2 or
+    matplotlib (importing scipy through the effects once tripled their start-up; the shipped statements are
+    plain, so checking them needs no Jinja2)."""
     import subprocess
     import sys
 
-    code = ("import sys; from grader.cli import build_parser; from grader.bank.template import load_bank; "
-            "build_parser(); load_bank(); "
-            "print(sorted(m for m in ('scipy', 'sympy', 'pint', 'typst', 'matplotlib') if m in sys.modules))")
+    code = ("import contextlib, io, sys; from grader.cli import build_parser, main; build_parser(); "
+            "out = io.StringIO(); stdout = contextlib.redirect_stdout(out); stdout.__enter__(); "
+            "code = main(['list']); stdout.__exit__(None, None, None); assert code == 0 and 'two-rebounds' in "
+            "out.getvalue(); print(sorted(m for m in ('scipy', 'sympy', 'pint', 'typst', 'jinja2', 'matplotlib') "
+            "if m in sys.modules))")
     result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60, check=True)
     assert result.stdout.strip() == "[]", result.stdout
+
+
+def test_list_groups_the_bank_by_topic(capsys: pytest.CaptureFixture[str]) -> None:
+    """A heading per topic, in the order direct, oblique, drops and rebounds; each template under its own."""
+    from grader.bank.template import load_bank
+
+    code, out, _ = run(capsys, "list")
+    headings = [line for line in out.splitlines() if line and not line.startswith(" ")]
+    assert code == 0 and headings == ["Direct impact", "Oblique impact", "Drops and rebounds"]
+    under, heading = {}, ""
+    for line in out.splitlines()[2:]:
+        heading = line if not line.startswith(" ") else heading
+        if line.startswith("  "):
+            under[line.split()[0]] = heading.lower()
+    assert under == {t.id: t.topic for t in load_bank().values()}
+    _, out, _ = run(capsys, "list", "--json")
+    assert [json.loads(line)["topic"] for line in out.splitlines()][::4] == [
+        "direct impact", "direct impact", "drops and rebounds"]
+
+
+def test_show_prints_the_statement_with_the_example_numbers_and_their_answers(
+        capsys: pytest.CaptureFixture[str]) -> None:
+    code, out, _ = run(capsys, "show", "pile-driver")
+    assert code == 0
+    text = " ".join(out.split())
+    assert "The 800-kg ram of a pile driver is released from rest 2.00 m above the top of a 2400-kg pile." in text
+    assert "bounces back up 0.10 m." in text
+    assert "v_pile 2.555 m/s e 0.63148 loss_pct 45.093 %" in text
+    _, out, _ = run(capsys, "show", "pile-driver", "--json")
+    record = json.loads(out)
+    assert record["example"] == {"m_ram": "800", "m_pile": "2400", "h_drop": "2.00", "h_rebound": "0.10"}
+    assert record["topic"] == "drops and rebounds" and "2400-kg pile" in record["statement"]
+    assert record["example_answers"]["e"]["value"] == pytest.approx(0.63148, rel=1e-5)
+
+
+def _own_bank(tmp_path: Path, name: str, template_id: str, old: str = "", new: str = "") -> Path:
+    """A folder with drop-rebound copied as ``template_id`` (``old`` replaced by ``new``)."""
+    from grader.resources import bank_dir
+
+    folder = tmp_path / name
+    folder.mkdir()
+    text = (bank_dir() / "drop-rebound.yaml").read_text(encoding="utf-8").replace("id: drop-rebound",
+                                                                                 f"id: {template_id}")
+    (folder / f"{template_id}.yaml").write_text(text.replace(old, new), encoding="utf-8")
+    return folder
+
+
+@pytest.mark.parametrize("command", [
+    ["list"], ["show", "my-drop"], ["solve", "my-drop", "--set", "h_drop=2100", "--set", "h_rebound=1100"],
+    ["simulate", "my-drop", "--set", "h_drop=2100", "--set", "h_rebound=1100"], ["check-bank", "--no-shipped-bank"],
+])
+def test_every_command_reads_repeated_banks_before_or_after_its_name(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str], command: list[str]) -> None:
+    mine, more = _own_bank(tmp_path, "mine", "my-drop"), _own_bank(tmp_path, "more", "my-other-drop")
+    code, out, err = run(capsys, "--bank", str(mine), command[0], "--bank", str(more), *command[1:])
+    assert code == 0, err
+    assert "my-drop" in out
+    if command == ["list"]:
+        assert "my-other-drop" in out and "pile-driver" in out
+
+
+@pytest.mark.parametrize("command", [["list"], ["show", "drop-rebound"], ["demo", "--out", "demo-out"],
+                                     ["generate", "a.yaml", "--roster", "r.csv", "--out", "out"]])
+def test_a_template_id_in_two_banks_is_refused_by_every_command(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str], command: list[str], workdir: str) -> None:
+    """Exit 2 before any work, naming both files; nothing is written (check-bank reports it as one template's
+    failure: tests/test_bankcheck.py)."""
+    from grader.resources import bank_dir
+
+    copy = _own_bank(tmp_path, "copy", "drop-rebound")
+    code, out, err = run(capsys, command[0], "--bank", str(copy), *command[1:])
+    assert code == 2 and not out
+    assert f"two templates have the id 'drop-rebound': {bank_dir() / 'drop-rebound.yaml'} and " \
+           f"{copy / 'drop-rebound.yaml'}" in err
+    assert not (Path(workdir) / "demo-out").exists() and not (Path(workdir) / "out").exists()
+
+
+def test_the_compile_cache_keeps_same_id_templates_of_two_folders_apart(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """The cache is keyed by the template's content: a colleague's drop-rebound with g = 32.2 ft/s^2 is not
+    answered from the shipped one's compiled form, nor the other way round."""
+    from grader.solve.cache import cache_dir
+
+    theirs = _own_bank(tmp_path, "theirs", "drop-rebound", "gravity: 9.81 m/s^2", "gravity: 9.80 m/s^2")
+    theirs_text = (theirs / "drop-rebound.yaml").read_text(encoding="utf-8").replace(
+        "loss_fraction: f_loss", "loss_fraction: f_loss\n  - {effect: rise, body: ball, speed: v_impact, "
+        "height: h_apex}").replace("answers:\n", "answers:\n  h_apex: {value: h_apex, unit: m}\n")
+    (theirs / "drop-rebound.yaml").write_text(theirs_text, encoding="utf-8")
+    answers = {}
+    for name, argv in (("ours", []), ("theirs", ["--no-shipped-bank", "--bank", str(theirs)]), ("ours again", [])):
+        code, out, err = run(capsys, *argv, "solve", "drop-rebound", "--set", "h_drop=2100", "--set",
+                             "h_rebound=1100", "--json")
+        assert code == 0, err
+        answers[name] = json.loads(out)["answers"]
+    assert set(answers["ours"]) == set(answers["ours again"]) == {"e", "loss_pct"}
+    assert answers["theirs"]["h_apex"]["value"] == pytest.approx(2.1)
+    assert len(list(cache_dir().glob("drop-rebound-*.json"))) >= 2
+
+
+def test_generate_draws_an_instructors_template_beside_the_shipped_ones(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str], workdir: str) -> None:
+    """An assignment naming a template of the instructor's own folder and a shipped one."""
+    mine = _own_bank(tmp_path, "mine", "my-drop", "Before a game", "Before the final")
+    Path("a.yaml").write_text("title: HW\ncourse: C\nseed: s\nproblems:\n  - template: my-drop\n"
+                              "  - template: pile-driver\n", encoding="utf-8")
+    Path("r.csv").write_text("id,name,email,section\n1,Ann,a@x.org,A\n", encoding="utf-8")
+    code, _, err = run(capsys, "generate", "a.yaml", "--roster", "r.csv", "--out", "out", "--no-pdf",
+                       "--bank", str(mine))
+    assert code == 0, err
+    key = json.loads(Path("out/key.json").read_text(encoding="utf-8"))
+    assert [p["template"] for p in key["problems"]] == ["my-drop", "pile-driver"]

@@ -23,6 +23,8 @@ from grader.solve.compiled import Compiled
 from grader.solve.evaluate import solve_one
 from tests.demo_output import DemoRun
 
+ONLY = ("--no-shipped-bank", "--bank")  # a folder's drop-rebound in place of the shipped one, not beside it
+
 ASSIGNMENT = sample_dir() / "assignment.yaml"
 ROSTER = sample_dir() / "roster.csv"
 
@@ -275,7 +277,7 @@ def test_a_hostile_template_statement_is_refused_with_exit_2_before_anything_run
     bank_folder = hostile_bank(tmp_path, statement)
     monkeypatch.chdir(tmp_path)
     started = time.perf_counter()
-    code, _, err = run(capsys, "--bank", bank_folder, "generate", "a.yaml", "--roster", "roster.csv", "--out", "out")
+    code, _, err = run(capsys, *ONLY, bank_folder, "generate", "a.yaml", "--roster", "roster.csv", "--out", "out")
     assert time.perf_counter() - started < 1.0
     assert code == 2
     assert f"{bank_folder / 'drop-rebound.yaml'}: statement: expected" in err and got in err, err

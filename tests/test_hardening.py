@@ -20,6 +20,7 @@ from grader.resources import bank_dir, sample_dir
 
 ROSTER = sample_dir() / "roster.csv"
 ONE_PROBLEM = "title: HW\ncourse: C\nseed: s\nproblems:\n  - template: drop-rebound\n"
+ONLY = ("--no-shipped-bank", "--bank")  # a folder's drop-rebound in place of the shipped one, not beside it
 
 
 def run(capsys: pytest.CaptureFixture[str], *argv: object) -> tuple[int, str, str]:
@@ -51,7 +52,7 @@ def generate_refused(capsys: pytest.CaptureFixture[str], tmp_path: Path, assignm
     """``grader generate`` of these files is refused and writes no --out."""
     a = write(tmp_path / "a.yaml", assignment)
     r = write(tmp_path / "r.csv", roster) if roster is not None else ROSTER
-    argv = (["--bank", bank] if bank else []) + ["generate", a, "--roster", r, "--out", tmp_path / "out", "--no-pdf"]
+    argv = ([*ONLY, bank] if bank else []) + ["generate", a, "--roster", r, "--out", tmp_path / "out", "--no-pdf"]
     err = refused(capsys, *argv)
     assert not (tmp_path / "out").exists()
     return err
@@ -102,7 +103,7 @@ def test_duplicate_yaml_keys_are_refused_not_last_wins(tmp_path: Path, capsys: p
 
 def test_duplicate_keys_in_a_template_are_refused(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     folder = bank_with(tmp_path, "drop-rebound", "title:", "title: twice\ntitle:")
-    err = refused(capsys, "--bank", folder, "list")
+    err = refused(capsys, *ONLY, folder, "list")
     assert "drop-rebound.yaml: line 4: the key 'title' appears twice" in err  # the second title
 
 
@@ -112,7 +113,7 @@ def test_non_utf8_files_are_refused_with_the_line(tmp_path: Path, capsys: pytest
     folder = tmp_path / "bank"
     folder.mkdir()
     write(folder / "x.yaml", b"id: x\ntitle: \xff\n")
-    assert "x.yaml: line 2: expected UTF-8 text" in refused(capsys, "--bank", folder, "list")
+    assert "x.yaml: line 2: expected UTF-8 text" in refused(capsys, *ONLY, folder, "list")
 
 
 def test_yaml_1e308_without_a_dot_is_a_number(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
@@ -147,7 +148,7 @@ def test_400_digit_integers_in_an_assignment_are_refused(tmp_path: Path, capsys:
 def test_bad_template_values_are_refused_not_a_traceback(tmp_path: Path, capsys: pytest.CaptureFixture[str],
                                                           old: str, new: str, message: str) -> None:
     folder = bank_with(tmp_path, "drop-rebound", old, new)
-    assert message in refused(capsys, "--bank", folder, "list")
+    assert message in refused(capsys, *ONLY, folder, "list")
 
 
 @pytest.mark.parametrize(("restitution", "message"), [
@@ -160,13 +161,13 @@ def test_a_constant_restitution_that_is_impossible_or_overdetermines_is_refused(
     folder = bank_with(tmp_path, "drop-rebound", "restitution: e", f"restitution: {restitution}")
     text = (folder / "drop-rebound.yaml").read_text(encoding="utf-8")
     write(folder / "drop-rebound.yaml", text.replace("  e:\n    value: e\n", "  e_asked:\n    value: 0.5\n"))
-    err = refused(capsys, "--bank", folder, "solve", "drop-rebound", "--set", "h_drop=2000", "--set", "h_rebound=900")
+    err = refused(capsys, *ONLY, folder, "solve", "drop-rebound", "--set", "h_drop=2000", "--set", "h_rebound=900")
     assert message in err
 
 
 def test_an_empty_bank_folder_is_refused_not_an_empty_list(tmp_path: Path,
                                                             capsys: pytest.CaptureFixture[str]) -> None:
-    assert "no templates in this folder" in refused(capsys, "--bank", tmp_path, "list")
+    assert "no templates in this folder" in refused(capsys, *ONLY, tmp_path, "list")
 
 
 # --- CSV: headers, rows, ids, sizes, line numbers ---------------------------------------------------
@@ -403,7 +404,7 @@ def test_arbitrary_bytes_as_an_assignment(tmp_path: Path, capsys: pytest.Capture
 
 @pytest.mark.parametrize(("old", "new", "message"), [
     # YAML 1.1 read these keys as true, None, a number: a parameter named `on` is ordinary text now
-    ("  h_drop:", "  1:", "line 12: expected a key that is a name, got 1"),
+    ("  h_drop:", "  1:", "line 13: expected a key that is a name, got 1"),
     ("symbols:\n  m: {unit: kg, description: mass of the ball (it cancels)}", "symbols: m",
      "symbols: expected a mapping of names"),
     ("constraints:\n  - require: h_rebound <= h_drop\n    message: the ball cannot bounce higher than it was "
@@ -420,7 +421,7 @@ def test_arbitrary_bytes_as_an_assignment(tmp_path: Path, capsys: pytest.Capture
 def test_hostile_template_structures_are_refused_naming_the_file(tmp_path: Path, capsys: pytest.CaptureFixture[str],
                                                                  old: str, new: str, message: str) -> None:
     folder = bank_with(tmp_path, "drop-rebound", old, new)
-    err = refused(capsys, "--bank", folder, "solve", "drop-rebound", "--set", "h_drop=2000", "--set", "h_rebound=900",
+    err = refused(capsys, *ONLY, folder, "solve", "drop-rebound", "--set", "h_drop=2000", "--set", "h_rebound=900",
                   within=5)
     assert message in err, err
 
@@ -430,7 +431,7 @@ def test_a_parameter_named_on_is_a_name_not_true(tmp_path: Path, capsys: pytest.
     folder = tmp_path / "bank"
     folder.mkdir()
     write(folder / "drop-rebound.yaml", text.replace("h_drop", "on"))
-    code, out, err = run(capsys, "--bank", folder, "solve", "drop-rebound", "--set", "on=2100", "--set",
+    code, out, err = run(capsys, *ONLY, folder, "solve", "drop-rebound", "--set", "on=2100", "--set",
                          "h_rebound=1100", "--json")
     assert code == 0, err
     assert json.loads(out)["answers"]["e"]["value"] == pytest.approx((1100 / 2100) ** 0.5, rel=1e-12)
@@ -444,14 +445,14 @@ def test_expressions_the_solver_cannot_handle_are_template_errors(tmp_path: Path
                                                                   capsys: pytest.CaptureFixture[str],
                                                                   template: str, old: str, new: str) -> None:
     folder = bank_with(tmp_path, template, old, new)
-    err = refused(capsys, "--bank", folder, "solve", template, "--set", "v=1", "--set", "theta=30", "--set", "e=0.5",
+    err = refused(capsys, *ONLY, folder, "solve", template, "--set", "v=1", "--set", "theta=30", "--set", "e=0.5",
                   within=5)
     assert f"{template}.yaml: " in err and "expected" in err
 
 
 def test_a_constant_answer_beyond_float64_is_a_refused_row(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     folder = bank_with(tmp_path, "drop-rebound", "value: f_loss", "value: 1e308")
-    code, out, _ = run(capsys, "--bank", folder, "solve", "drop-rebound", "--set", "h_drop=2", "--set", "h_rebound=1")
+    code, out, _ = run(capsys, *ONLY, folder, "solve", "drop-rebound", "--set", "h_drop=2", "--set", "h_rebound=1")
     assert code == 3 and "answer loss_pct: a step of the solution is not a finite number" in out
 
 
@@ -459,7 +460,7 @@ def test_a_named_pipe_in_the_bank_is_refused_not_waited_on(tmp_path: Path, capsy
     import os
 
     os.mkfifo(tmp_path / "fifo.yaml")
-    assert "fifo.yaml: expected a template file, got a special file" in refused(capsys, "--bank", tmp_path, "list")
+    assert "fifo.yaml: expected a template file, got a special file" in refused(capsys, *ONLY, tmp_path, "list")
 
 
 def test_a_header_of_20000_columns_is_refused_quickly_with_a_short_message(tmp_path: Path,

@@ -147,8 +147,8 @@ def _restitution_answers(template: Template) -> set[str]:
             if isinstance(spec.value, Sym) and spec.value.name in derived}
 
 
-class _Problem:
-    """Draws and checks the variants of one problem."""
+class ProblemDraws:
+    """Draws and checks the variants of one problem (``grader check-bank`` samples through it too)."""
 
     def __init__(self, assignment: Assignment, problem: ProblemSpec, template: Template) -> None:
         self.assignment, self.problem, self.template = assignment, problem, template
@@ -159,8 +159,8 @@ class _Problem:
 
     def _typical_sizes(self) -> dict[str, float]:
         rng, _ = variant_generator(self.assignment.seed, self.problem.key, "\x00pilot")
-        rows = [self._draw_row(rng) for _ in range(PILOT)]
-        result = solve_columns(self.template, self.compiled, self._table(rows))
+        rows = [self.draw_row(rng) for _ in range(PILOT)]
+        result = solve_columns(self.template, self.compiled, self.table(rows))
         ok = np.array([reason is None for reason in result.refusals])
         typical = {}
         for name, values in result.values.items():
@@ -174,21 +174,25 @@ class _Problem:
                                   "an atol)")
         return typical
 
-    def _draw_row(self, rng: np.random.Generator) -> dict[str, str]:
+    def draw_row(self, rng: np.random.Generator) -> dict[str, str]:
+        """One draw: each parameter as printed."""
         try:
             return {name: _draw(p, self.problem, rng) for name, p in self.template.parameters.items()}
         except GraderError as error:
             raise GraderError(f"{self.where}: {error}") from None
 
-    def _table(self, rows: Sequence[Mapping[str, str]]) -> dict[str, Any]:
+    def table(self, rows: Sequence[Mapping[str, str]]) -> dict[str, Any]:
+        """Printed rows as the columns :func:`solve_columns` takes."""
         return {name: np.array([float(row[name]) for row in rows]) for name in self.template.parameters}
 
-    def _flaws(self, rows: Sequence[Mapping[str, str]]) -> list[str | None]:
-        result = solve_columns(self.template, self.compiled, self._table(rows))
-        flaws = list(result.refusals)
+    def degeneracies(self, result: Columns) -> list[str | None]:
+        """Per row of a result, why a draw the solver answered sits at a degenerate point (an answer too
+        close to zero to grade relatively, a derived ``e`` at 0 or 1), or None."""
+        flaws: list[str | None] = [None] * len(result.refusals)
         for name, values in result.values.items():
             for row, value in enumerate(values):
-                if flaws[row] is not None or result.undefined[name][row] is not None:
+                answered = result.refusals[row] is None and result.undefined[name][row] is None
+                if flaws[row] is not None or not answered:
                     continue
                 if abs(value) < NEAR_ZERO * self.typical.get(name, 0.0):
                     flaws[row] = f"answer {name} = {value:.3g} is too close to zero to grade with a relative tolerance"
@@ -197,11 +201,16 @@ class _Problem:
                                   "of 0 or 1 (a variant at a limit of e is a special case, not the problem asked)")
         return flaws
 
+    def _flaws(self, rows: Sequence[Mapping[str, str]]) -> list[str | None]:
+        result = solve_columns(self.template, self.compiled, self.table(rows))
+        return [refused or degenerate for refused, degenerate in zip(result.refusals, self.degeneracies(result),
+                                                                    strict=True)]
+
     def draw(self, students: Sequence[Student]) -> tuple[list[dict[str, str]], list[str]]:
         """Each student's parameters as printed, and each variant's seed."""
         keyed = {s.id: variant_generator(self.assignment.seed, self.problem.key, s.id) for s in students}
         generators = {student_id: pair[0] for student_id, pair in keyed.items()}
-        rows = {s.id: self._draw_row(generators[s.id]) for s in students}
+        rows = {s.id: self.draw_row(generators[s.id]) for s in students}
         pending = [s.id for s in students]
         for _ in range(MAX_DRAWS):
             flaws = self._flaws([rows[i] for i in pending])
@@ -210,7 +219,7 @@ class _Problem:
                 return [rows[s.id] for s in students], [keyed[s.id][1] for s in students]
             last = dict(zip(pending, [f for f in flaws if f is not None], strict=True))
             for student_id in pending:
-                rows[student_id] = self._draw_row(generators[student_id])
+                rows[student_id] = self.draw_row(generators[student_id])
         first = pending[0]
         raise GraderError(f"{self.where}: no valid variant for student {first} in {MAX_DRAWS} draws; the last was "
                           f"refused because {last[first]} (check fixed/narrowed parameters against the template's "
@@ -223,9 +232,9 @@ def generate(assignment: Assignment, roster: Sequence[Student], bank: Mapping[st
     collisions = {}
     for problem in assignment.problems:
         template = bank[problem.template]
-        maker = _Problem(assignment, problem, template)
+        maker = ProblemDraws(assignment, problem, template)
         rows, seeds = maker.draw(roster)
-        result = solve_columns(template, maker.compiled, maker._table(rows))
+        result = solve_columns(template, maker.compiled, maker.table(rows))
         blanks = _blank_parts(problem, template)
         variants = [ProblemVariant(problem.key, template.id, seed, {n: float(v) for n, v in row.items()}, dict(row),
                                    _answer_parts(blanks, template, maker.compiled, result, index))

@@ -12,13 +12,13 @@ from __future__ import annotations
 import hashlib
 import math
 import re
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 from grader.bank.scene_parser import IDENTIFIER, parse_scene
-from grader.errors import ExpressionError, GraderError, TemplateError, shown
+from grader.errors import ExpressionError, GraderError, TemplateError, UsageError, shown
 from grader.inputs import YAML_BYTES, parse_yaml, read_bytes
 from grader.model.expr import Node, Op, Sym, names, parse, to_text
 from grader.model.scene import Gravity, Scene
@@ -30,8 +30,13 @@ from grader.resources import bank_dir
 RESERVED = {"g", "pi"}
 _BOUND = r"(-?inf|[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)"
 _INTERVAL = re.compile(rf"^\s*([\[(])\s*{_BOUND}\s*,\s*{_BOUND}\s*([\])])\s*$")
-_TOP_KEYS = {"id", "title", "version", "gravity", "bodies", "stages", "symbols", "parameters",
+_TOP_KEYS = {"id", "title", "topic", "version", "gravity", "bodies", "stages", "symbols", "parameters",
              "constraints", "answers", "tolerance", "statement", "example"}
+
+TOPICS = ("direct impact", "oblique impact", "drops and rebounds")
+"""The topics ``grader list`` groups the bank by, in its order. A template names one (``topic:``), or
+its scene decides: an impact with t components (or a velocity from its components) is oblique; else
+a scene with a fall or a rise is drops and rebounds; else it is a direct impact."""
 
 
 @dataclass(frozen=True)
@@ -129,6 +134,7 @@ class Template:
 
     id: str
     title: str
+    topic: str
     version: int
     where: str
     source_hash: str
@@ -143,22 +149,64 @@ class Template:
 
 def load_bank(directory: Path | None = None) -> dict[str, Template]:
     """Load every ``*.yaml`` template of a folder (the shipped bank by default), keyed by id."""
-    folder = directory or bank_dir()
-    if not folder.is_dir():
-        raise GraderError(f"{folder}: problem bank folder not found")
-    paths = sorted(folder.glob("*.yaml"))
-    if not paths:
-        raise GraderError(f"{folder}: no templates in this folder; expected problem templates as *.yaml files")
     templates: dict[str, Template] = {}
-    for path in paths:
-        if not path.is_file():  # a named pipe would block the run, a folder cannot be read
-            kind = "a folder" if path.is_dir() else "a special file (a pipe or a device)"
-            raise GraderError(f"{path}: expected a template file, got {kind}")
+    for path in template_files(directory or bank_dir()):
         template = load_template(path)
         if template.id in templates:
             raise TemplateError(str(path), "id", "an id no other template uses", shown(template.id))
         templates[template.id] = template
     return templates
+
+
+def template_files(folder: Path) -> list[Path]:
+    """The ``*.yaml`` files of a bank folder, by name; a folder that is missing or has none is refused."""
+    if not folder.is_dir():
+        raise GraderError(f"{folder}: problem bank folder not found")
+    paths = sorted(folder.glob("*.yaml"))
+    if not paths:
+        raise GraderError(f"{folder}: no templates in this folder; expected problem templates as *.yaml files")
+    for path in paths:
+        if not path.is_file():  # a named pipe would block the run, a folder cannot be read
+            kind = "a folder" if path.is_dir() else "a special file (a pipe or a device)"
+            raise GraderError(f"{path}: expected a template file, got {kind}")
+    return paths
+
+
+def bank_folders(folders: Sequence[Path] = (), shipped: bool = True) -> list[Path]:
+    """The shipped bank's folder (unless ``shipped`` is false), then ``folders``, each once."""
+    sources, seen = [], set()
+    for folder in ([bank_dir()] if shipped else []) + list(folders):
+        if folder.resolve() not in seen:
+            seen.add(folder.resolve())
+            sources.append(folder)
+    if not sources:
+        raise UsageError("no problem bank: without the shipped bank (--no-shipped-bank), give --bank DIR")
+    return sources
+
+
+def load_banks(folders: Sequence[Path] = (), shipped: bool = True) -> dict[str, Template]:
+    """The shipped bank (unless ``shipped`` is false) and the templates of each folder, keyed by id.
+
+    A folder given twice (or the shipped bank named again) counts once. Two templates with one id
+    are refused, naming both files: an instructor's own templates sit beside the shipped ones, and a
+    template must not replace another silently.
+
+    >>> load_banks([bank_dir()]).keys() == load_bank().keys()
+    True
+    """
+    templates: dict[str, Template] = {}
+    for folder in bank_folders(folders, shipped):
+        for template_id, template in load_bank(folder).items():
+            if template_id in templates:
+                raise GraderError(same_id(templates[template_id], template))
+            templates[template_id] = template
+    return templates
+
+
+def same_id(first: Template, second: Template) -> str:
+    """Why two templates cannot be in one bank."""
+    return (f"two templates have the id '{first.id}': {first.where} and {second.where}; rename one (its id and "
+            "its file name), or leave out its folder (--no-shipped-bank leaves out the shipped bank)")
 
 
 def load_template(path: Path) -> Template:
@@ -201,7 +249,8 @@ def parse_template(raw: Mapping[str, Any], where: str, source_hash: str, stem: s
     default = tolerance_in(raw.get("tolerance", {}), where, "tolerance")
     answers = {name: _answer(name, spec, where, default) for name, spec in _mapping(raw, "answers", where).items()}
     template = Template(
-        id=template_id, title=_text(raw, "title", where), version=version, where=where,
+        id=template_id, title=_text(raw, "title", where), topic=_topic(raw.get("topic"), scene, where),
+        version=version, where=where,
         source_hash=source_hash, scene=scene, parameters=parameters, symbols=symbols,
         constraints=tuple(_constraint(i, c, where) for i, c in enumerate(_list(raw, "constraints", where))),
         answers=answers, statement=_text(raw, "statement", where),
@@ -283,10 +332,26 @@ def _expect(node: Node, expected: Dimension, known: dict[str, Dimension], where:
 
 
 def _check_statement(template: Template, given: set[str]) -> None:
+    from grader.bank.markup import plain_fill, typst_refusal
+
+    # A trial fill (parameters and g as "1", symbols as their names, as a sheet shows them) refuses
+    # what would be too costly for every student alike, and Typst code assembled from pieces.
+    values = {**dict.fromkeys([*template.parameters, "g"], "1"), **{n: n for n in template.symbols}}
+    filled = plain_fill(template.statement, values)  # text and {{ name }}: no Jinja2 needed
+    if filled is None:
+        filled = _jinja_fill(template, given, values)
+    refusal = typst_refusal(template.statement) or typst_refusal(filled)
+    if refusal is not None:
+        raise TemplateError(template.where, "statement", "text and math only", refusal)
+
+
+def _jinja_fill(template: Template, given: set[str], values: dict[str, str]) -> str:
+    """A statement that is more than text and ``{{ name }}``, read by Jinja2: refused unless it only
+    fills in values (with filters) of the template's names."""
     import jinja2
     import jinja2.meta
 
-    from grader.bank.statement import StatementRefused, check_jinja, fill_statement, typst_refusal
+    from grader.bank.statement import StatementRefused, check_jinja, fill_statement
 
     try:
         syntax = check_jinja(template.statement)
@@ -296,18 +361,14 @@ def _check_statement(template: Template, given: set[str]) -> None:
         raise TemplateError(template.where, "statement", "values filled in, not code", str(error)) from None
     unknown = jinja2.meta.find_undeclared_variables(syntax) - given - {"g"}
     if unknown:
+        asked = sorted(unknown & set(template.answers))
         raise TemplateError(template.where, "statement", "only parameters, symbols and g",
-                            f"unknown {', '.join(sorted(unknown))}")
-    # A trial fill (parameters and g as "1", symbols as their names, as a sheet shows them) refuses
-    # what would be too costly for every student alike, and Typst code assembled from pieces.
-    values = {**dict.fromkeys([*template.parameters, "g"], "1"), **{n: n for n in template.symbols}}
+                            f"the answer {', '.join(asked)}, which the student finds" if asked
+                            else f"unknown {', '.join(sorted(unknown))}")
     try:
-        filled = fill_statement(template.statement, values)
+        return fill_statement(template.statement, values)
     except StatementRefused as error:
         raise TemplateError(template.where, "statement", "values filled in, not code", str(error)) from None
-    refusal = typst_refusal(template.statement) or typst_refusal(filled)
-    if refusal is not None:
-        raise TemplateError(template.where, "statement", "text and math only", refusal)
 
 
 def _text(raw: Mapping[str, Any], key: str, where: str) -> str:
@@ -336,6 +397,29 @@ def _unit(text: Any, where: str, key: str) -> Unit:
         return parse_unit("" if text is None else str(text))
     except GraderError as error:
         raise TemplateError(where, key, "a unit like m, m/s, kg, deg, %", str(error)) from None
+
+
+def _topic(declared: Any, scene: Scene, where: str) -> str:
+    if declared is None:
+        return infer_topic(scene)
+    if declared not in TOPICS:
+        raise TemplateError(where, "topic", f"one of {', '.join(TOPICS)} (or no topic: the scene decides)",
+                            shown(declared))
+    return str(declared)
+
+
+def infer_topic(scene: Scene) -> str:
+    """The topic of a scene that does not name one (see :data:`TOPICS`).
+
+    >>> infer_topic(load_bank()["pile-driver"].scene), infer_topic(load_bank()["ball-plate"].scene)
+    ('drops and rebounds', 'oblique impact')
+    """
+    effects = {stage.effect for stage in scene.stages}
+    if "velocity" in effects or any(stage.is_oblique for stage in scene.stages):
+        return "oblique impact"
+    if effects & {"free_fall", "rise"}:
+        return "drops and rebounds"
+    return "direct impact"
 
 
 def _gravity(text: Any, where: str) -> Gravity | None:
@@ -426,9 +510,30 @@ def _constraint(index: int, spec: Any, where: str) -> Constraint:
     if not isinstance(spec, Mapping) or set(spec) != {"require", "message"}:
         raise TemplateError(where, key, "{require: EXPR, message: TEXT}", shown(spec))
     holds = _parse(spec["require"], where, f"{key}.require", compare=True)
-    if not (isinstance(holds, Op) and holds.op in ("lt", "le", "gt", "ge", "and", "or")):
-        raise TemplateError(where, f"{key}.require", "a comparison like 'h_rebound <= h_drop'", shown(spec["require"]))
+    if not _is_condition(holds):
+        raise TemplateError(where, f"{key}.require", "a comparison like 'h_rebound <= h_drop', or comparisons "
+                            "joined by and/or (a comparison is not a number to compute with)", shown(spec["require"]))
     return Constraint(holds, str(spec["require"]), str(spec["message"]))
+
+
+def _is_condition(node: Node) -> bool:
+    """A comparison of two numeric expressions, or conditions joined by and/or.
+
+    >>> _is_condition(parse("h < 1 and (h > 0 or h < -1)", allow_compare=True))
+    True
+    >>> _is_condition(parse("-(h > 1) >= -0.5", allow_compare=True)), _is_condition(parse("h", allow_compare=True))
+    (False, False)
+    """
+    if not isinstance(node, Op):
+        return False
+    if node.op in ("and", "or"):
+        return all(_is_condition(arg) for arg in node.args)
+    return node.op in ("lt", "le", "gt", "ge") and not any(_holds_condition(arg) for arg in node.args)
+
+
+def _holds_condition(node: Node) -> bool:
+    return isinstance(node, Op) and (node.op in ("lt", "le", "gt", "ge", "and", "or") or
+                                     any(_holds_condition(arg) for arg in node.args))
 
 
 def _parse(text: Any, where: str, key: str, compare: bool = False) -> Node:

@@ -14,6 +14,7 @@ keeps full relative accuracy.
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Callable, Mapping
 from fractions import Fraction
@@ -59,7 +60,10 @@ OPERATIONS: dict[str, Callable[..., Any]] = {
     "pow": _power, "sqrt": np.sqrt, "sin": np.sin, "cos": np.cos, "tan": np.tan, "exp": np.exp,
     "log": np.log, "abs": np.abs, "atan2": np.arctan2, "hypot": np.hypot, "sind": sind, "cosd": cosd,
     "Max": np.maximum, "Min": np.minimum, "lt": np.less, "le": np.less_equal, "gt": np.greater, "ge": np.greater_equal,
-    "and": np.logical_and, "or": np.logical_or,
+    # A constraint's ``a and b and c`` is one operation of three arguments: numpy's two-argument ufuncs
+    # would take the third for their output array (and drop that condition).
+    "and": lambda *args: functools.reduce(np.logical_and, args),
+    "or": lambda *args: functools.reduce(np.logical_or, args),
 }
 
 

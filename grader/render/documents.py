@@ -35,10 +35,9 @@ from grader.assign.variants import AnswerPart, Generation, ProblemVariant
 from grader.bank.statement import StatementRefused, fill_statement, typst_refusal
 from grader.bank.template import Template
 from grader.errors import GraderError
-from grader.model.expr import parse
 from grader.render.figures import figure
 from grader.render.typeset import compile_typst, font_paths, one_pdf
-from grader.render.worked import Typ, Worked, WorkedStep, answer_math, math, name, number, string, text, worked
+from grader.render.worked import Typ, Worked, WorkedStep, answer_math, math, name, string, text, worked
 from grader.resources import templates_dir
 from grader.solve.cache import compiled_for
 from grader.solve.compiled import Compiled
@@ -274,9 +273,7 @@ def _given_header(parameter: str, unit: str) -> str:
 def _glance_value(part: AnswerPart) -> Typ:
     if part.value is None:
         return text("undefined")
-    if isinstance(part.value, str):
-        return _math(math(parse(part.value)))
-    return _math(number(part.value))
+    return _math(answer_math(part.value, ""))
 
 
 def _key_step(step: WorkedStep) -> KeyStep:
@@ -433,6 +430,14 @@ def _join_pdfs(parts: Sequence[Path], target: Path) -> None:
         writer.append(str(part))
     with target.open("wb") as stream:
         writer.write(stream)
+
+
+def sources(assignment: Assignment, generation: Generation, bank: Mapping[str, Template],
+            indices: Sequence[int]) -> tuple[str, str]:
+    """The Typst sources of the listed students' sheets (statements, figures) and of their answer key
+    (worked solutions, without the class overview)."""
+    documents = _Documents(assignment, generation, bank)
+    return student_source(documents, indices), key_source(documents, indices, overview=False)
 
 
 def render_page_png(assignment: Assignment, generation: Generation, bank: Mapping[str, Template],

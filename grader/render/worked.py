@@ -35,6 +35,7 @@ from grader.assign.variants import ProblemVariant
 from grader.bank.template import Template
 from grader.model.expr import FUNCTIONS, Node, Num, Op, Sym, format_number, parse
 from grader.model.kernel import evaluate
+from grader.render.readable import Names, counted, readable
 from grader.solve.cache import compiled_for
 from grader.solve.compiled import Compiled, Step
 
@@ -170,20 +171,15 @@ class _Math:
         return [node]
 
     def _product(self, node: Op) -> str:
-        counted: list[tuple[Node, int]] = []
-        for factor in self._factors(node):
-            for index, (seen, count) in enumerate(counted):
-                if seen == factor:
-                    counted[index] = (seen, count + 1)
-                    break
-            else:
-                counted.append((factor, 1))
         pieces: list[tuple[str, bool]] = []
-        for factor, count in counted:
+        for factor, count in counted(self._factors(node)):
             if count > 1:
                 pieces.append((self._power(factor, str(count)), self.convert(factor)[2]))
                 continue
             shown, level, numeric = self.convert(factor)
+            if not pieces and _is_fraction(factor):  # 1/2 m v^2: Typst's fraction takes the 2 alone
+                pieces.append((shown, False))
+                continue
             if level <= 5 or (pieces and shown.startswith("-")):
                 shown = f"({shown})"
             pieces.append((shown, numeric or shown[:1].isdigit()))
@@ -201,7 +197,8 @@ class _Math:
             exponent = node.args[1]
             if isinstance(exponent, Num) and exponent.value == Fraction(1, 2):
                 return f"sqrt({self.convert(node.args[0])[0]})", 9, False
-            return self._power(node.args[0], f"({self.convert(exponent)[0]})"), 7, False
+            power = self.convert(exponent)[0]
+            return self._power(node.args[0], power if re.fullmatch(r"\d+", power) else f"({power})"), 7, False
         left, left_level, _ = self.convert(node.args[0])
         right, right_level, _ = self.convert(node.args[1])
         if node.op == "div":
@@ -212,6 +209,12 @@ class _Math:
             right = f"({right})"
         sign = " + " if node.op == "add" else " - "
         return left + sign + right, level, False
+
+
+def _is_fraction(node: Node) -> bool:
+    """A quotient of two whole numbers: a product's leading coefficient, as :mod:`readable` writes it."""
+    return isinstance(node, Op) and node.op == "div" and all(
+        isinstance(arg, Num) and isinstance(arg.value, Fraction) and arg.value.denominator == 1 for arg in node.args)
 
 
 def math(node: Node, values: Mapping[str, str] | None = None, degrees: Mapping[str, str] | None = None) -> str:
@@ -455,6 +458,7 @@ class _Context:
     quantities: set[str]
     symbol_units: Mapping[str, str]
     undefined: Mapping[str, str]
+    names: Names
 
 
 def worked(template: Template, variant: ProblemVariant, compiled: Compiled | None = None) -> Worked:
@@ -463,29 +467,43 @@ def worked(template: Template, variant: ProblemVariant, compiled: Compiled | Non
     si = si_parameters(template, variant)
     symbols = sorted(template.symbols)
     scaled = scalings(compiled, si, symbols)
-    known: dict[str, Sequence[int | Fraction]] = {n: p.unit.dimension for n, p in template.parameters.items()}
-    known.update({n: s.unit.dimension for n, s in template.symbols.items()})
-    known.update({c: (1, 0, -2, 0) for c in compiled.constants if c == "g"})
+    dimensions = quantity_dimensions(template, compiled)
     shown = {n: _shown_parameter(variant.printed[n], p.unit.to_si) for n, p in template.parameters.items()}
     shown.update({c: number(v, 3) for c, v in compiled.constants.items()})
     context = _Context(
         shown, {n: f"{variant.printed[n]} degree" for n, p in template.parameters.items() if p.unit.text == "deg"},
-        set(known) | {s.unknown for s in compiled.steps},
+        set(dimensions) | {s.unknown for s in compiled.steps},
         {n: _si_unit(s.unit.dimension) or "1" for n, s in template.symbols.items()},
-        _undefined(template, variant))
+        _undefined(template, variant), reader_names(template, compiled, dimensions))
     steps = []
     for step in compiled.steps:
-        # A bare number (a velocity that stays 0) says nothing about its unit.
-        dim = None if isinstance(step.solved, Num) else dimension(step.solved, known)
-        if dim is not None:
-            known[step.unknown] = dim
         scaling = scaled.get(step.unknown)
-        steps.append(_step(step, scaling, dim, context))
+        steps.append(_step(step, scaling, dimensions.get(step.unknown), context))
         if scaling is not None:
             shown[step.unknown] = scaling.math()
     notes = tuple(_symbol_note(s, template.symbols[s].description) for s in symbols)
     values = chain_values(compiled, {**si, **{s: 1.0 for s in symbols}})
     return Worked(tuple(given_lines(template, variant, compiled)), notes, tuple(steps), values)
+
+
+def quantity_dimensions(template: Template, compiled: Compiled) -> dict[str, Dimension]:
+    """The dimension of every parameter, symbol, constant and step quantity whose dimension can be
+    told (a step's from its solved form; a bare number, a velocity that stays 0, says nothing)."""
+    known: dict[str, Dimension] = {n: _dim(p.unit.dimension) for n, p in template.parameters.items()}
+    known.update({n: _dim(s.unit.dimension) for n, s in template.symbols.items()})
+    known.update({c: _dim((1, 0, -2, 0)) for c in compiled.constants if c == "g"})
+    for step in compiled.steps:
+        found = None if isinstance(step.solved, Num) else dimension(step.solved, known)
+        if found is not None:
+            known[step.unknown] = found
+    return known
+
+
+def reader_names(template: Template, compiled: Compiled, dimensions: Mapping[str, Dimension] | None = None) -> Names:
+    """The names of a template for :func:`~grader.render.readable.readable`: their dimensions, and the
+    order the problem introduces them in (parameters, symbols, constants, then the steps')."""
+    order = [*template.parameters, *template.symbols, *compiled.constants, *(s.unknown for s in compiled.steps)]
+    return Names(quantity_dimensions(template, compiled) if dimensions is None else dimensions, order)
 
 
 def _undefined(template: Template, variant: ProblemVariant) -> dict[str, str]:
@@ -504,11 +522,11 @@ def _symbol_note(symbol: str, description: str) -> Typ:
 
 
 def _step(step: Step, scaling: Scaling | None, dim: Dimension | None, context: _Context) -> WorkedStep:
-    lhs, rhs = step.equation
+    lhs, rhs, solved = (readable(side, context.names) for side in (*step.equation, step.solved))
     relation = relation_markup(step.relation, context.quantities)
-    equation = None if (lhs == Sym(step.unknown) and rhs == step.solved) else f"{math(lhs)} = {math(rhs)}"
-    chain = [name(step.unknown), math(step.solved)]
-    substituted = math(step.solved, context.shown, context.degrees)
+    equation = None if (lhs == Sym(step.unknown) and rhs == solved) else f"{math(lhs)} = {math(rhs)}"
+    chain = [name(step.unknown), math(solved)]
+    substituted = math(solved, context.shown, context.degrees)
     if substituted != chain[-1]:
         chain.append(substituted)
     if step.unknown in context.undefined:
@@ -533,11 +551,15 @@ def _step(step: Step, scaling: Scaling | None, dim: Dimension | None, context: _
 
 def answer_math(value: float | str | None, unit: str) -> str:
     """An answer as Typst math: a number to 4 significant figures with its (template) unit, or a
-    symbolic answer as an expression; ``""`` when it is undefined."""
+    symbolic answer as an expression, written for a reader; ``""`` when it is undefined.
+
+    >>> answer_math("v*(1 - 0.1*p)/(p + 1)", "m/s")
+    '(v (1 - 0.1 p))/(1 + p)'
+    """
     if value is None:
         return ""
     if isinstance(value, str):
-        return math(parse(value))
+        return math(readable(parse(value), Names({})))
     if unit == "deg":
         return f"{number(value)} degree"
     return number(value) + _unit_math(unit)

@@ -185,7 +185,7 @@ class _Compiler:
 
     def _step(self, solved: _Solved) -> Step:
         return Step(solved.unknown.name, solved.relation.label,
-                    (to_node(solved.relation.lhs), to_node(solved.relation.rhs)), to_node(solved.display))
+                    (to_node(solved.relation.lhs), to_node(solved.relation.rhs)), to_node(for_reader(solved.display)))
 
     def _answer(self, name: str, expr: Any, chain: list[_Solved], composed: Mapping[Any, Any]) -> CompiledAnswer:
         spec = self.template.answers[name]
@@ -256,6 +256,21 @@ class _Compiler:
         # Against zero, a positive factor changes nothing: 381*v*x/1250 > 0 is x > 0.
         kept = [f for f in sp.Mul.make_args(difference) if not f.is_positive]
         return numeric_order(to_node(type(holds)(sp.Mul(*kept), 0)))
+
+
+def for_reader(expr: Any) -> Any:
+    """A solved form as a reader wants it: with no fraction inside a denominator (the impulse
+    ``(1 + e)(v1 - v2)/(1/m1 + 1/m2)`` is ``m1 m2 (1 + e)(v1 - v2)/(m1 + m2)``). Order and signs are
+    the printer's (:mod:`grader.render.readable`).
+
+    >>> m1, m2, v = sp.symbols("m1 m2 v", positive=True)
+    >>> for_reader(v / (1 / m1 + 1 / m2)), for_reader(v - v / m1)
+    (m1*m2*v/(m1 + m2), v - v/m1)
+    """
+    compound = any(power.exp.is_negative and isinstance(power.base, sp.Add) and any(
+        part.is_Pow and part.exp.is_negative for term in power.base.args for part in sp.Mul.make_args(term))
+        for power in sp.sympify(expr).atoms(sp.Pow))
+    return sp.factor(expr) if compound else expr
 
 
 def _si_factor(unit: Unit) -> Any:

@@ -1,0 +1,128 @@
+"""`grader check-bank`: the shipped bank passes; each way a template can be broken is one clear line."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from grader import bankcheck
+from grader.cli import main
+from grader.model.expr import parse
+from grader.model.kernel import evaluate
+from grader.physics.integrate import Settings
+from grader.physics.run import Options
+from grader.resources import bank_dir
+
+
+def run(capsys: pytest.CaptureFixture[str], *argv: str) -> tuple[int, str, str]:
+    code = main(list(argv))
+    captured = capsys.readouterr()
+    return code, captured.out, captured.err
+
+
+def lines_by_template(out: str) -> dict[str, str]:
+    """The report lines, keyed by template (the summary line left out)."""
+    lines = out.splitlines()
+    return {line.split()[0]: line.split(maxsplit=1)[1] for line in lines[:-1]}
+
+
+def test_the_shipped_bank_passes(capsys: pytest.CaptureFixture[str]) -> None:
+    """One ok line per shipped template, a summary, exit 0."""
+    code, out, _ = run(capsys, "check-bank")
+    reports = lines_by_template(out)
+    assert set(reports) == {path.stem for path in bank_dir().glob("*.yaml")}
+    assert all(line.startswith("ok    200 draws: ") and "sheet and key typeset" in line for line in reports.values())
+    assert out.splitlines()[-1] == f"{len(reports)} templates: all passed" and code == 0
+
+
+def broken(folder: Path, name: str, old: str = "", new: str = "", source: str = "drop-rebound") -> None:
+    """``folder/name.yaml``: a shipped template under the id ``name`` with ``old`` replaced by ``new``."""
+    folder.mkdir(exist_ok=True)
+    text = (bank_dir() / f"{source}.yaml").read_text(encoding="utf-8").replace(f"id: {source}", f"id: {name}")
+    assert old in text
+    (folder / f"{name}.yaml").write_text(text.replace(old, new, 1), encoding="utf-8")
+
+
+BROKEN = {
+    "unknown-name": ("{{ h_rebound }} mm.", "{{ h_rebound }} mm, {{ h_bounce }} mm.",
+                     "FAIL  load: {folder}/unknown-name.yaml: statement: expected only parameters, symbols and g, "
+                     "got unknown h_bounce"),
+    "zero-answer": ("sample: {uniform: [500, 1400]}", "sample: {choice: [0, 600, 900, 1200]}",
+                    "FAIL  degenerate draws: 52 of the 200 answered draws sit at a degenerate point, e.g. answer e = 0 "
+                    "is too close to zero to grade with a relative tolerance at h_drop = 1914 mm, h_rebound = 0 mm; "
+                    "generate draws them again"),
+    "all-refused": ("require: h_rebound <= h_drop", "require: h_rebound >= 2 * h_drop",
+                    "FAIL  draws: none of 200 sampled draws is answered; 200 are refused because constraint "
+                    "h_rebound >= 2 * h_drop fails: the ball cannot bounce higher than it was dropped from"),
+    "bad-typst": ("Find the coefficient of restitution $e$", "Find the coefficient of restitution $e",
+                  "FAIL  typesetting the sheet (statement, figure): Typst could not typeset a document: unclosed "
+                  "delimiter"),
+    "boolean-arithmetic": ("require: h_rebound <= h_drop", "require: -(h_rebound > h_drop) >= 0",
+                           "FAIL  load: {folder}/boolean-arithmetic.yaml: constraints[0].require: expected a "
+                           "comparison like 'h_rebound <= h_drop', or comparisons joined by and/or"),
+}
+
+
+def test_each_broken_template_gets_one_line_saying_why(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """A template that does not load, whose answer vanishes for a quarter of its draws, whose constraint
+    refuses every draw, or whose statement Typst cannot typeset: each is one FAIL line with the reason,
+    the good template beside them still passes, and the exit code is 2."""
+    folder = tmp_path / "mine"
+    for name, (old, new, _) in BROKEN.items():
+        broken(folder, name, old, new)
+    broken(folder, "fine")
+    code, out, _ = run(capsys, "--no-shipped-bank", "check-bank", "--bank", str(folder))
+    reports = lines_by_template(out)
+    for name, (_, _, expected) in BROKEN.items():
+        assert reports[name].startswith(expected.format(folder=folder)), reports[name]
+    assert reports["fine"].startswith("ok ")
+    assert out.splitlines()[-1] == f"{len(BROKEN) + 1} templates: {len(BROKEN)} failed" and code == 2
+
+
+def test_a_template_repeating_an_id_is_reported_and_the_rest_checked(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    broken(tmp_path / "mine", "drop-rebound")
+    code, out, _ = run(capsys, "check-bank", "--bank", str(tmp_path / "mine"), "--json")
+    reports = [json.loads(line) for line in out.splitlines()]
+    failed = [r for r in reports if not r["ok"]]
+    assert code == 2 and len(reports) == len(list(bank_dir().glob("*.yaml"))) + 1 and len(failed) == 1
+    assert failed[0]["file"] == str(tmp_path / "mine" / "drop-rebound.yaml")
+    assert failed[0]["problem"].startswith(f"load: two templates have the id 'drop-rebound': "
+                                           f"{bank_dir() / 'drop-rebound.yaml'} and ")
+
+
+def test_an_exception_while_solving_is_a_failure_not_a_refusal(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Draws are answered or refused with a reason; a solver that raises (a bug) is reported as one."""
+    from grader.bank.template import load_bank
+
+    def raises(*args: object) -> None:
+        raise ZeroDivisionError("float division by zero")
+
+    monkeypatch.setattr("grader.solve.evaluate._check_constraints", raises)
+    report = bankcheck.check_template(load_bank()["drop-rebound"])
+    assert report.problem == ("draws: raised ZeroDivisionError: float division by zero (an exception, not a refusal "
+                              "with a reason: a bug in the template or in grader)")
+
+
+def test_a_simulation_that_disagrees_with_the_closed_form_is_reported(monkeypatch: pytest.MonkeyPatch) -> None:
+    """With the weight acting during a 50 ms contact, the simulated rebound is no longer the textbook's."""
+    from grader.bank.template import load_bank
+
+    monkeypatch.setattr(bankcheck, "SIMULATION", Options(Settings("adaptive", rtol=1e-10), 0.05, True))
+    report = bankcheck.check_template(load_bank()["pile-driver"])
+    assert report.problem is not None and report.problem.startswith("simulation: v_pile = ")
+    assert "in closed form (relative difference" in report.problem and "at most 1e-06 allowed) at m_ram = " \
+        in report.problem
+
+
+@pytest.mark.parametrize(("condition", "values"), [
+    ("h > 0 and h < 5 and h < 2", [True, False, False]),
+    ("h > 0 and h < 5 and 1 < 2", [True, True, False]),
+    ("h < 0 or h > 5 or h < 2", [True, False, True]),
+])
+def test_a_condition_of_three_parts_checks_all_three(condition: str, values: list[bool]) -> None:
+    """numpy's logical_and took the third part for its output array: it was ignored, or raised TypeError."""
+    assert evaluate(parse(condition, allow_compare=True), {"h": np.array([1.0, 3.0, 6.0])}).tolist() == values

@@ -1,0 +1,171 @@
+"""Worked solutions read as a textbook writes them: the seed templates' steps against forms written by
+hand from the textbook's conventions, and the rewriting never changes a value."""
+
+from __future__ import annotations
+
+from fractions import Fraction
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from grader.assign.variants import ProblemVariant
+from grader.bank.template import Template
+from grader.model.expr import Node, Num, Op, Sym, parse, to_text
+from grader.model.kernel import evaluate
+from grader.render.preview import example_printed
+from grader.render.readable import Names, readable
+from grader.render.worked import math, worked
+
+# Each step as the key prints it (Typst math): the relation's equation where it is not already the
+# solved form, then "unknown = solved form". Written by hand: numbers first, then masses, g, lengths,
+# velocities, functions, sums, and (1 + e)-like sums last; one root of a product; the sign in front;
+# 1/2 m v^2; no fraction inside a denominator.
+GOLDEN: dict[str, list[tuple[str | None, str]]] = {
+    "drop-rebound": [
+        (None, 'v_"impact" = sqrt(2 g h_"drop")'),
+        (None, 'T = 1/2 m v_"impact"^2'),
+        ('-v\' = sqrt(2 g h_"rebound")', 'v\' = -sqrt(2 g h_"rebound")'),
+        (None, 'e = -v\'/v_"impact"'),
+        (None, 'E_"lost" = 1/2 m v_"impact"^2 (1 - e^2)'),
+        (None, 'f_"loss" = E_"lost"/T'),
+    ],
+    "pile-driver": [
+        (None, 'v_"ram" = sqrt(2 g h_"drop")'),
+        (None, 'T = 1/2 m_"ram" v_"ram"^2'),
+        ('-v\'_"ram" = sqrt(2 g h_"rebound")', 'v\'_"ram" = -sqrt(2 g h_"rebound")'),
+        ('v\'_"ram" = v_"ram" - J/m_"ram"', 'J = m_"ram" (v_"ram" - v\'_"ram")'),
+        (None, 'v_"pile" = J/m_"pile"'),
+        (None, 'e = (v_"pile" - v\'_"ram")/v_"ram"'),
+        ('E_"lost" = (v_"ram"^2 (1 - e^2))/(2 (1/m_"ram" + 1/m_"pile"))',
+         'E_"lost" = (m_"ram" m_"pile" v_"ram"^2 (1 - e^2))/(2 (m_"ram" + m_"pile"))'),
+        (None, 'f_"loss" = E_"lost"/T'),
+    ],
+    "ball-plate": [
+        (None, "v_t = v cos(theta)"),
+        (None, "v_n = v sin(theta)"),
+        (None, "J = m v_n (1 + e)"),
+        (None, "v'_n = v_n - J/m"),
+        (None, "v'_t = v_t"),
+        (None, 'v_"out" = sqrt(v\'_n^2 + v\'_t^2)'),
+        ('tan(theta_"out") = -v\'_n/v\'_t', 'theta_"out" = op("atan2")(-v\'_n, v\'_t)'),
+    ],
+    "car-collision": [
+        ("J = (v (1 + e))/(1/m + 1/(p m))", "J = (p m v (1 + e))/(1 + p)"),
+        (None, "v'_A = v - J/m"),
+        (None, "v'_B = J/(p m)"),
+    ],
+    "oblique-spheres": [
+        (None, "v_(1, n) = v_1 cos(theta)"),
+        (None, "v_(1, t) = v_1 sin(theta)"),
+        ("J = (v_(1, n) (1 + e))/(1/m_1 + 1/m_2)", "J = (m_1 m_2 v_(1, n) (1 + e))/(m_1 + m_2)"),
+        (None, "v'_(1, n) = v_(1, n) - J/m_1"),
+        (None, "v'_(2, n) = J/m_2"),
+        (None, "v'_(1, t) = v_(1, t)"),
+        (None, "v'_(2, t) = 0"),
+        (None, "T = 1/2 m_1 (v_(1, n)^2 + v_(1, t)^2)"),
+        ('E_"lost" = (v_(1, n)^2 (1 - e^2))/(2 (1/m_1 + 1/m_2))',
+         'E_"lost" = (m_1 m_2 v_(1, n)^2 (1 - e^2))/(2 (m_1 + m_2))'),
+        (None, 'f_"loss" = E_"lost"/T'),
+        (None, 'v_(1, "out") = sqrt(v\'_(1, n)^2 + v\'_(1, t)^2)'),
+        ('tan(theta_(1, "out")) = v\'_(1, n)/v\'_(1, t)', 'theta_(1, "out") = op("atan2")(v\'_(1, n), v\'_(1, t))'),
+        (None, 'v_(2, "out") = sqrt(v\'_(2, n)^2 + v\'_(2, t)^2)'),
+    ],
+}
+
+
+def example_variant(template: Template) -> ProblemVariant:
+    printed = example_printed(template)
+    return ProblemVariant("1", template.id, "golden", {n: float(v) for n, v in printed.items()}, printed, ())
+
+
+@pytest.mark.parametrize("template_id", GOLDEN)
+def test_the_seed_templates_steps_read_as_the_textbook_writes_them(template_id: str,
+                                                                   bank: dict[str, Template]) -> None:
+    steps = worked(bank[template_id], example_variant(bank[template_id])).steps
+    assert [(step.equation, f"{step.chain[0]} = {step.chain[1]}") for step in steps] == GOLDEN[template_id]
+
+
+def test_numbers_are_put_in_the_same_order(bank: dict[str, Template]) -> None:
+    """The substituted line follows the readable form: the pile driver's rebound and energy lost."""
+    solution = worked(bank["pile-driver"], example_variant(bank["pile-driver"]))
+    steps = {step.chain[0]: step.chain for step in solution.steps}
+    assert steps['v\'_"ram"'][2] == "-sqrt(2 dot 9.81 dot 0.10)"
+    assert steps['E_"lost"'][2] == "(800 dot 2400 dot 6.264^2 (1 - 0.6315^2))/(2 (800 + 2400))"
+    assert steps["T"][2] == "1/2 dot 800 dot 6.264^2"
+
+
+NAMES = Names({"m": (0, 1, 0, 0), "M": (0, 1, 0, 0), "g": (1, 0, -2, 0), "h": (1, 0, 0, 0), "v": (1, 0, -1, 0),
+               "u": (1, 0, -1, 0), "e": (0, 0, 0, 0), "J": (1, 1, -1, 0), "theta": (0, 0, 0, 1)},
+              ["m", "M", "h", "u", "v", "e"])
+
+
+@pytest.mark.parametrize(("source", "expected"), [
+    ("-sqrt(2)*sqrt(h)*sqrt(g)", "-sqrt(2*g*h)"),  # one root, the sign in front
+    ("sqrt(h)/sqrt(g)", "sqrt(h)/sqrt(g)"),
+    ("v*m*(e + 1)", "m*v*(1 + e)"),  # masses, velocities, then (1 + e)
+    ("(e + 1)*(u + v)*m", "m*(u + v)*(1 + e)"),  # a sum with a dimension before a pure one
+    ("cos(theta)*v", "v*cos(theta)"),
+    ("M*m", "m*M"),  # the order the problem introduces them in
+    ("-J/m + v", "v - J/m"),  # positive terms first
+    ("J/M + u", "u + J/M"),  # simple terms first
+    ("-(e - 1)*(e + 1)*m*v**2/2", "1/2*m*v**2*(1 - e**2)"),
+    ("v*v/(2*g)", "v**2/(2*g)"),
+    ("(1 - e)*v/(2/m + 2/M)", "v*(1 - e)/(2*(1/m + 1/M))"),  # a common whole number taken out
+    ("-2*u - 4*v", "-2*(u + 2*v)"),
+    ("m*hypot(u, v)*hypot(u, v)/2", "1/2*m*(u**2 + v**2)"),
+    ("v*(1 - 0.1*p)/(p + 1)", "v*(1 - 0.1*p)/(1 + p)"),  # the data's decimals stay decimals
+    ("0.3*m*v", "0.3*m*v"),
+    ("h", "h"),
+])
+def test_readable_rewrites(source: str, expected: str) -> None:
+    assert to_text(readable(parse(source), NAMES)) == expected
+
+
+def test_a_leading_half_is_printed_before_the_factors() -> None:
+    assert math(readable(parse("m*v*v/2"), NAMES)) == "1/2 m v^2"
+    assert math(readable(parse("m*v*v/2"), NAMES), {"m": "2.0", "v": "3.1"}) == "1/2 dot 2.0 dot 3.1^2"
+
+
+LEAVES = st.sampled_from([Sym("m"), Sym("M"), Sym("h"), Sym("v"), Sym("u"), Sym("e"), Sym("g"),
+                          Num(Fraction(1)), Num(Fraction(2)), Num(Fraction(1, 2)), Num(Fraction(-3))])
+
+
+def _trees(children: st.SearchStrategy[Node]) -> st.SearchStrategy[Node]:
+    binary = st.tuples(st.sampled_from(["add", "sub", "mul", "div"]), children, children).map(
+        lambda t: Op(t[0], (t[1], t[2])))
+    unary = st.tuples(st.sampled_from(["neg", "sqrt", "cos"]), children).map(lambda t: Op(t[0], (t[1],)))
+    square = children.map(lambda c: Op("pow", (c, Num(Fraction(2)))))
+    return st.one_of(binary, unary, square, st.tuples(children, children).map(lambda t: Op("hypot", t)))
+
+
+@settings(max_examples=400, deadline=None)
+@given(tree=st.recursive(LEAVES, _trees, max_leaves=10),
+       values=st.lists(st.floats(0.3, 3.0), min_size=7, max_size=7))
+def test_readable_never_changes_a_value(tree: Node, values: list[float]) -> None:
+    """Wherever the expression has a value, the rewritten one has the same (radicands positive: the
+    roots merge as they do for the quantities of a scene, which are positive where they are rooted)."""
+    env = {name: np.float64(value) for name, value in zip("mMhvueg", values, strict=True)}
+    with np.errstate(all="ignore"):
+        before = float(evaluate(tree, env))
+        if not np.isfinite(before) or _roots_of_negatives(tree, env):
+            return
+        after = float(evaluate(readable(tree, NAMES), env))
+    assert after == pytest.approx(before, rel=1e-9, abs=1e-9 * max(1.0, abs(before))), to_text(readable(tree, NAMES))
+
+
+def _roots_of_negatives(node: Node, env: dict[str, np.float64]) -> bool:
+    """Whether a root's factors are not all positive (sqrt(a) sqrt(b) = sqrt(a b) needs a, b >= 0)."""
+    if not isinstance(node, Op):
+        return False
+    if node.op == "sqrt" and _has_negative_factor(node.args[0], env):
+        return True
+    return any(_roots_of_negatives(arg, env) for arg in node.args)
+
+
+def _has_negative_factor(node: Node, env: dict[str, np.float64]) -> bool:
+    if isinstance(node, Op) and node.op in ("mul", "div"):
+        return any(_has_negative_factor(arg, env) for arg in node.args)
+    with np.errstate(all="ignore"):
+        return not float(evaluate(node, env)) >= 0

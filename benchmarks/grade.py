@@ -7,9 +7,10 @@ Run: ``python benchmarks/grade.py [--students N] [--runs R]`` (defaults 100,000 
   ball-plate and oblique-spheres problems, from ``grader generate --no-pdf``) and a long-format
   submissions CSV with one answer per part: most within tolerance, some with units (``165 cm/s``),
   some wrong, some invalid. Timed from process start: ``grader grade`` (parsing, units, tolerance,
-  feedback, four report files) beside a minimal script that reads the same CSV and key with the
-  csv and json modules, converts with ``float`` (no units: a cell that does not parse scores 0) and
-  compares with ``numpy.isclose(rtol=0.01)``, writing one grades CSV. Interleaved, median of R.
+  feedback, four CSV files and ``report.html``, whose figures take about a second at any class size)
+  beside a minimal script that reads the same CSV and key with the csv and json modules, converts
+  with ``float`` (no units: a cell that does not parse scores 0) and compares with
+  ``numpy.isclose(rtol=0.01)``, writing one grades CSV. Interleaved, median of R.
   Targets: ``grader grade`` within 2x the minimal script; peak memory under 2 GiB (the grader process's
   own: the inputs are made in another process, whose peak a later child would report as its own).
 - **Symbolic**: 20,000 answers to the car-collision expressions (5,000 distinct texts), compared by

@@ -148,7 +148,7 @@ def test_reruns_are_byte_identical(tmp_path: Path, capsys: pytest.CaptureFixture
     (tmp_path / "a.csv").write_text(long_csv(key_answers(key_path, ".2g")), encoding="utf-8")
     for out in ("g1", "g2"):
         run(capsys, "grade", "--key", key_path, tmp_path / "a.csv", "--out", tmp_path / out)
-    for name in ("grades.csv", "details.csv", "problems.csv", "canvas.csv"):
+    for name in ("grades.csv", "details.csv", "problems.csv", "canvas.csv", "report.html"):
         assert (tmp_path / "g1" / name).read_bytes() == (tmp_path / "g2" / name).read_bytes(), name
 
 

@@ -12,6 +12,14 @@
 >>> key = load_key(path)
 >>> key.labels, key.students[0].id, key.students[0].parts["1a"].value, key.students[0].parts["1a"].tolerance
 (('1a',), '007', 0.7, {'mode': 'rtol', 'rtol': 0.01, 'atol': 0})
+
+A student's printed parameters (``params``), where the key has them, are kept for the class report:
+
+>>> raw = json.loads(path.read_text())
+>>> raw["students"][0]["problems"][0]["params"] = {"h_drop": 2.5, "h_rebound": 1.2}
+>>> _ = path.write_text(json.dumps(raw))
+>>> load_key(path).students[0].params("1")
+{'h_drop': 2.5, 'h_rebound': 1.2}
 """
 
 from __future__ import annotations
@@ -63,11 +71,20 @@ class KeyStudent:
     email: str
     section: str
     parts: Mapping[str, KeyPart]
+    # The parameters printed on the student's sheet, kept flat (a class of 100,000 has 1.5 million):
+    # ``values[i]`` is parameter ``parameters[i]``, a (problem key, name) pair; the class shares one
+    # ``parameters`` tuple. A key without ``params`` (or a value that is no number) leaves them out.
+    parameters: tuple[tuple[str, str], ...] = ()
+    values: tuple[float, ...] = ()
 
     @property
     def possible(self) -> float:
         """The points this student could earn."""
         return sum(part.points for part in self.parts.values())
+
+    def params(self, problem: str) -> dict[str, float]:
+        """The parameters printed for one problem (its key, ``1``), by name."""
+        return {name: value for (key, name), value in zip(self.parameters, self.values, strict=True) if key == problem}
 
 
 @dataclass(frozen=True)
@@ -256,13 +273,21 @@ def _symbols(problems: Any) -> dict[str, dict[str, tuple[float, float]]]:
 def _student(raw: Mapping[str, Any], symbols: Mapping[str, Mapping[str, tuple[float, float]]],
              shared: dict[Any, Any]) -> KeyStudent:
     parts = {}
+    parameters: list[tuple[str, str]] = []
+    values: list[float] = []
     for problem in raw["problems"]:
         key = _one(shared, str(problem["key"]))
         for name, answer in problem["answers"].items():
             part = _part(key, _one(shared, str(name)), answer, symbols, shared)
             parts[part.label] = part
+        printed = problem.get("params")
+        for name, value in printed.items() if isinstance(printed, dict) else ():
+            if type(value) in (int, float) and math.isfinite(value):  # not bool: True is no parameter value
+                parameters.append((key, str(name)))
+                values.append(_one(shared, float(value)))
     return KeyStudent(str(raw["id"]), str(raw.get("name", "")), str(raw.get("email", "")),
-                      str(raw.get("section", "")), parts)
+                      str(raw.get("section", "")), parts, _one(shared, ("parameters", tuple(parameters)))[1],
+                      tuple(values))
 
 
 def _part(problem: str, name: str, raw: Mapping[str, Any],

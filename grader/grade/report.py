@@ -1,4 +1,5 @@
-"""The files a grading run writes: ``grades.csv``, ``details.csv``, ``problems.csv``, ``canvas.csv``.
+"""The files a grading run writes: ``grades.csv``, ``details.csv``, ``problems.csv``, ``canvas.csv``, and
+the class report ``report.html`` (:mod:`grader.grade.class_report`).
 
 Every text cell is guarded against formula injection (:func:`grader.assign.keyfile.safe_cell`);
 numbers stay numbers and are never NaN or infinite. Rows come in the key's order, so two runs on
@@ -16,16 +17,17 @@ from pathlib import Path
 from grader.assign.keyfile import safe_cell
 from grader.files import write_atomic
 from grader.grade.canvas import CanvasExport
+from grader.grade.class_report import REPORT, class_report
 from grader.grade.grading import Graded, totals
 
 GRADES, DETAILS, PROBLEMS, CANVAS = "grades.csv", "details.csv", "problems.csv", "canvas.csv"
 
 
 def write_reports(graded: Graded, folder: Path, export: CanvasExport | None = None) -> list[Path]:
-    """Write the four files into ``folder`` (``canvas.csv`` after a Canvas ``export`` when one is
+    """Write the five files into ``folder`` (``canvas.csv`` after a Canvas ``export`` when one is
     given); returns their paths."""
     files = {GRADES: grades_csv(graded), DETAILS: details_csv(graded), PROBLEMS: problems_csv(graded, export),
-             CANVAS: canvas_csv(graded, export)}
+             CANVAS: canvas_csv(graded, export), REPORT: class_report(graded)}
     for name, text in files.items():
         write_atomic(folder / name, text)
     return [folder / name for name in files]

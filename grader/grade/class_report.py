@@ -1,0 +1,262 @@
+"""``report.html``: the class report, one self-contained page an instructor opens in a browser.
+
+It shows the score histogram; per part the share of each verdict kind, the most frequent diagnosed
+mistakes and the tolerance used; per problem the score against each printed parameter, so that a
+corner of the parameter space that was unfair stands out (and is listed); and the students with
+answers that could not be read. The figures are inline SVG (:mod:`grader.grade.report_plots`); the
+page loads nothing (no script, no font, no network: its content security policy allows none), and
+every text from the key, the roster or the submissions is escaped. Two runs on the same inputs write
+the same bytes.
+
+>>> from grader.grade.key import Key, KeyPart, KeyProblem, KeyStudent
+>>> part = KeyPart("1", "e", "1a", 0.5, "", 2.0, {"mode": "rtol", "rtol": 0.01, "atol": 0.0}, None, {})
+>>> key = Key("key.json", 2, "HW <1>", True, (KeyProblem("1", "Drop", ("1a",)),),
+...           (KeyStudent("s1", "<script>alert(1)</script>", "", "1", {"1a": part}),))
+>>> row = ("x", "invalid", 0.0, 2.0, "0.5", "", "", None, None, "±1 %", "could not read this answer: x", "a:2")
+>>> page = class_report(Graded(key, {"1a": [row]}, (), (), ()))
+>>> "&lt;script&gt;alert(1)&lt;/script&gt;" in page, "<script" in page, "HW &lt;1&gt;" in page
+(True, False, True)
+"""
+
+from __future__ import annotations
+
+import html
+from collections.abc import Sequence
+
+import numpy as np
+
+from grader.grade.class_summary import (
+    HARD_DROP,
+    INVALID_STUDENTS,
+    ClassSummary,
+    PartSummary,
+    ProblemSummary,
+    summarize,
+)
+from grader.grade.grading import Graded
+
+REPORT = "report.html"
+CELL_CHARS = 60  # of a typed answer shown in the report; details.csv has it whole
+
+_STYLE = """
+:root { --ink: #222; --muted: #5f6b7a; --line: #dde2ea; --soft: #f5f7fa; --accent: #1f4e99; --warn: #c62828; }
+* { box-sizing: border-box; }
+body { margin: 0; color: var(--ink); background: #fff;
+       font: 15px/1.45 system-ui, -apple-system, "Segoe UI", Roboto, "DejaVu Sans", sans-serif; }
+main { max-width: 1040px; margin: 0 auto; padding: 24px 28px 48px; }
+header { border-bottom: 3px solid var(--accent); padding-bottom: 12px; margin-bottom: 8px; }
+h1 { font-size: 26px; margin: 0 0 4px; }
+h2 { font-size: 20px; margin: 30px 0 8px; padding-top: 6px; border-top: 1px solid var(--line); }
+h3 { font-size: 16px; margin: 20px 0 4px; }
+p { margin: 6px 0; }
+.muted, .note { color: var(--muted); }
+.note { font-size: 13px; }
+nav { font-size: 14px; margin: 10px 0 0; }
+nav a { color: var(--accent); text-decoration: none; margin-right: 14px; }
+.stats { display: flex; flex-wrap: wrap; gap: 10px; margin: 14px 0 4px; }
+.stat { background: var(--soft); border: 1px solid var(--line); border-radius: 6px; padding: 6px 12px;
+        min-width: 112px; }
+.stat b { display: block; font-size: 20px; }
+.stat span { color: var(--muted); font-size: 12px; }
+table { border-collapse: collapse; margin: 8px 0; font-size: 13.5px; width: 100%; }
+th, td { text-align: left; padding: 4px 8px; border-bottom: 1px solid var(--line); vertical-align: top; }
+th { background: var(--soft); font-weight: 600; white-space: nowrap; }
+td.n, th.n { text-align: right; font-variant-numeric: tabular-nums; white-space: nowrap; }
+td.n small { color: var(--muted); }
+td code, li code { background: var(--soft); padding: 0 3px; border-radius: 3px; word-break: break-all; }
+.chip { display: inline-block; width: 10px; height: 10px; border-radius: 2px; margin-right: 4px; }
+.hard { color: var(--warn); font-weight: 600; }
+svg { max-width: 100%; height: auto; display: block; }
+ul.corners li { margin: 2px 0; }
+"""
+
+
+def class_report(graded: Graded) -> str:
+    """The page, for a grading run."""
+    summary = summarize(graded)
+    title = f"{summary.key.title}: class report"
+    body = "\n".join([_header(summary), _scores(summary), _parts(summary), _mistakes(summary),
+                      _difficulty(summary), _invalid(summary), _tolerances(summary)])
+    return ("<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
+            "<meta http-equiv=\"Content-Security-Policy\" content=\"default-src 'none'; style-src 'unsafe-inline'\">\n"
+            "<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n"
+            f"<title>{_e(title)}</title>\n<style>{_STYLE}</style>\n</head>\n<body>\n<main>\n{body}\n</main>\n"
+            "</body>\n</html>\n")
+
+
+def _e(text: object) -> str:
+    """Text as HTML shows it, quotes included (it may go into an attribute)."""
+    return html.escape(str(text), quote=True)
+
+
+def _header(summary: ClassSummary) -> str:
+    key, percent = summary.key, summary.percent
+    stats = [("students", f"{len(key.students):,}"), ("submitted", f"{summary.submitted:,}"),
+             ("parts", f"{len(summary.parts)}"), ("points possible", _number(key.possible))]
+    if len(percent):
+        stats += [("mean score", _percent(float(percent.mean()))),
+                  ("median score", _percent(float(np.median(percent))))]
+    notes = list(summary.notes)
+    if summary.rows_not_graded:
+        notes.insert(0, f"{summary.rows_not_graded:,} submitted rows were not graded: see problems.csv")
+    sections = [("scores", "Scores"), ("parts", "Parts"), ("mistakes", "Diagnosed mistakes"),
+                ("difficulty", "Difficulty per variant"), ("invalid", "Unreadable answers"),
+                ("tolerances", "Tolerances")]
+    return (f"<header>\n<h1>{_e(key.title)}</h1>\n<p class=\"muted\">Class report: how the class did, part by "
+            "part and variant by variant</p>\n<div class=\"stats\">"
+            + "".join(f"<div class=\"stat\"><b>{_e(value)}</b><span>{_e(name)}</span></div>" for name, value in stats)
+            + "</div>\n" + "".join(f"<p class=\"note\">{_e(note)}</p>\n" for note in notes)
+            + "<nav>" + "".join(f"<a href=\"#{anchor}\">{name}</a>" for anchor, name in sections)
+            + "</nav>\n</header>")
+
+
+def _scores(summary: ClassSummary) -> str:
+    from grader.grade.report_plots import score_histogram
+
+    percent = summary.percent
+    below = int((percent < 50).sum())
+    return (f"<h2 id=\"scores\">Scores</h2>\n<p>Each student's score as a share of the points they could earn; "
+            f"{below:,} of {len(percent):,} scored under 50 %.</p>\n{score_histogram(summary)}")
+
+
+def _parts(summary: ClassSummary) -> str:
+    from grader.grade.report_plots import color, verdict_bars
+
+    kinds = summary.kinds
+    head = ("<tr><th>part</th><th>answer</th><th class=\"n\">mean score</th>"
+            + "".join(f"<th class=\"n\"><span class=\"chip\" style=\"background:{color(kind, kinds)}\"></span>"
+                      f"{_e(kind)}</th>" for kind in kinds) + "</tr>")
+    rows = []
+    for part in summary.parts:
+        shares = "".join(f"<td class=\"n\">{_share(part.counts[kind], part.students)}</td>" for kind in kinds)
+        rows.append(f"<tr><td>{_e(part.label)}</td><td>{_answer(part)}</td>"
+                    f"<td class=\"n\">{_percent(100 * part.mean_credit)}</td>{shares}</tr>")
+    return (f"<h2 id=\"parts\">Parts</h2>\n<p>What share of the class got each verdict, part by part (every "
+            f"student of the key counts: a part not answered is <i>missing</i>).</p>\n{verdict_bars(summary)}\n"
+            f"<table>\n{head}\n" + "\n".join(rows) + "\n</table>")
+
+
+def _mistakes(summary: ClassSummary) -> str:
+    rows = [f"<tr><td>{_e(part.label)}</td><td><code>{_e(mistake)}</code></td><td class=\"n\">{count:,}</td>"
+            f"<td class=\"n\">{_percent(100 * count / part.students)}</td></tr>"
+            for part in summary.parts for mistake, count in part.mistakes]
+    text = "<h2 id=\"mistakes\">Diagnosed mistakes</h2>\n"
+    if not rows:
+        return text + "<p>No answer was matched to a diagnosed mistake.</p>"
+    more = [part for part in summary.parts if part.diagnosed > sum(count for _, count in part.mistakes)]
+    return (text + "<p>The most frequent typical mistakes that wrong answers matched, part by part, with how many "
+            "students made each.</p>\n<table>\n<tr><th>part</th><th>mistake</th><th class=\"n\">students</th>"
+            "<th class=\"n\">of the class</th></tr>\n" + "\n".join(rows) + "\n</table>"
+            + "".join(f"\n<p class=\"note\">{_e(part.label)}: {part.diagnosed:,} diagnosed in all (see details.csv)</p>"
+                      for part in more))
+
+
+def _difficulty(summary: ClassSummary) -> str:
+    corners = [(problem, parameter, part) for problem in summary.problems
+               for parameter, part in problem.hard_corners()]
+    text = ["<h2 id=\"difficulty\">Difficulty per variant</h2>\n<p>Each problem's score against each parameter "
+            "printed on the students' sheets, over the students who answered at least one of its parts: blue, "
+            "the mean score of the students in each range of the parameter (bars: its standard error); dashed, "
+            "the problem's mean; grey, each student. A range whose mean is at least "
+            f"{100 * HARD_DROP:.0f} points below the problem's, by more than twice its standard error, is red "
+            "and listed here: those variants may have been harder than the others.</p>"]
+    if corners:
+        text.append("<ul class=\"corners\">" + "".join(
+            f"<li><span class=\"hard\">Problem {_e(problem.key)}</span>, <code>{_e(parameter.name)}</code> "
+            f"{_e(_range(part.low, part.high))}: {_students(part.students)} scored {_percent(100 * part.mean)} "
+            f"(the problem: {_percent(100 * problem.mean)})</li>" for problem, parameter, part in corners)
+            + "</ul>")
+    else:
+        text.append("<p>No range of any parameter scored clearly below its problem.</p>")
+    text += [_problem(problem, f"problem-{number}") for number, problem in enumerate(summary.problems, 1)]
+    return "\n".join(text)
+
+
+def _problem(problem: ProblemSummary, name: str) -> str:
+    from grader.grade.report_plots import difficulty
+
+    attempted = int(problem.attempted.sum())
+    head = (f"<h3>Problem {_e(problem.key)}: {_e(problem.title)}</h3>\n<p class=\"muted\">parts "
+            f"{_e(', '.join(problem.labels))}; {_students(attempted)} answered, mean score "
+            f"{_percent(100 * problem.mean)}</p>")
+    varied = [p for p in problem.parameters if len(p.bins) > 1]
+    fixed = [f"{p.name} = {_range(p.bins[0].low, p.bins[0].high)}" for p in problem.parameters if len(p.bins) == 1]
+    notes = []
+    if fixed:
+        notes.append("the same for everyone: " + ", ".join(fixed))
+    if not problem.parameters:
+        notes.append("the key holds no parameters for this problem")
+    elif not varied and attempted:
+        notes.append("no parameter varies among the students who answered")
+    figure = difficulty(problem, name) if varied and attempted else ""
+    return "\n".join([head, figure, *(f"<p class=\"note\">{_e(note)}</p>" for note in notes)])
+
+
+def _invalid(summary: ClassSummary) -> str:
+    count = summary.invalid_students
+    text = [f"<h2 id=\"invalid\">Unreadable answers</h2>\n<p>{_students(count)} "
+            f"{'has answers' if count == 1 else 'have answers'} that could not be read (verdict <i>invalid</i>): "
+            "they score 0 for those parts, and may deserve a look.</p>"]
+    if summary.invalid:
+        rows = [f"<tr><td>{_e(student.id)}</td><td>{_e(student.name)}</td><td>{_e(student.section)}</td>"
+                f"<td>{_e(cell.label)}</td><td><code>{_e(_cut(cell.submitted))}</code></td><td>{_e(cell.reason)}</td>"
+                "</tr>" for student, cells in summary.invalid for cell in cells]
+        text.append("<table>\n<tr><th>student</th><th>name</th><th>section</th><th>part</th><th>typed</th>"
+                    "<th>why it could not be read</th></tr>\n" + "\n".join(rows) + "\n</table>")
+    if summary.invalid_students > len(summary.invalid):
+        text.append(f"<p class=\"note\">The first {INVALID_STUDENTS} are listed; "
+                    f"{_students(summary.invalid_students - len(summary.invalid))} more: "
+                    "details.csv lists every one (verdict invalid).</p>")
+    return "\n".join(text)
+
+
+def _tolerances(summary: ClassSummary) -> str:
+    rows = [f"<tr><td>{_e(part.label)}</td><td>{_answer(part)}</td>"
+            f"<td class=\"n\">{_e(' or '.join(_number(p) for p in part.points))}</td>"
+            f"<td>{_tolerance_words(part.tolerances, part.students)}</td></tr>" for part in summary.parts]
+    return ("<h2 id=\"tolerances\">Tolerances</h2>\n<p>How each part was compared to the key (a symbolic answer: "
+            "by value at random points), and what it was worth.</p>\n<table>\n<tr><th>part</th><th>answer</th>"
+            "<th class=\"n\">points</th><th>tolerance</th></tr>\n" + "\n".join(rows) + "\n</table>")
+
+
+def _tolerance_words(tolerances: Sequence[tuple[str, int]], students: int) -> str:
+    if len(tolerances) == 1:
+        return _e(tolerances[0][0])
+    return "; ".join(f"{_e(words)} <small class=\"muted\">({count:,} of {students:,})</small>"
+                     for words, count in tolerances)
+
+
+def _answer(part: PartSummary) -> str:
+    unit = f" <span class=\"muted\">({_e(part.unit)})</span>" if part.unit else ""
+    return f"<code>{_e(part.name)}</code>{unit}"
+
+
+def _students(count: int) -> str:
+    return f"{count:,} student" if count == 1 else f"{count:,} students"
+
+
+def _share(count: int, total: int) -> str:
+    if not count:
+        return "<small>–</small>"
+    return f"{_percent(100 * count / total)} <small>({count:,})</small>"
+
+
+def _percent(value: float) -> str:
+    """A percentage as the report shows it.
+
+    >>> _percent(93.333), _percent(0.2), _percent(100.0)
+    ('93 %', '0.2 %', '100 %')
+    """
+    return f"{value:.1f} %" if 0 < abs(value) < 1 else f"{value:.0f} %"
+
+
+def _number(value: float) -> str:
+    return f"{value:g}"
+
+
+def _range(low: float, high: float) -> str:
+    return f"{low:.4g}" if low == high else f"{low:.4g} to {high:.4g}"
+
+
+def _cut(text: str) -> str:
+    return text if len(text) <= CELL_CHARS else text[:CELL_CHARS - 1] + "…"

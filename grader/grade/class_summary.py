@@ -1,0 +1,313 @@
+"""What the class report shows, worked out from a grading run with numpy: the class's scores, each
+part's verdicts, tolerances and diagnosed mistakes, each problem's score against its printed
+parameters, and the students with answers that could not be read.
+
+Everything here is an aggregate of the class, or a list cut to a few entries, so that a class of
+100,000 costs a few passes over its verdict rows and a few arrays of floats. Verdict kinds are read
+generically: every kind of :data:`~grader.grade.grading.VERDICTS` is counted, in the order of
+:data:`SHOWN_ORDER` (kinds grading does not have yet are left out), and a row's diagnosis is read by
+:func:`diagnosis`, by field name.
+
+>>> from grader.grade.key import Key, KeyPart, KeyProblem, KeyStudent
+>>> tol = {"mode": "rtol", "rtol": 0.01, "atol": 0.0}
+>>> def student(id, e):
+...     part = KeyPart("1", "e", "1a", 0.5, "", 2.0, tol, None, {})
+...     return KeyStudent(id, f"Student {id}", "", "1", {"1a": part}, (("1", "h"),), (e,))
+>>> key = Key("key.json", 2, "HW", True, (KeyProblem("1", "Drop", ("1a",)),), (student("a", 1.0), student("b", 2.0)))
+>>> row = lambda kind, credit: ("0.5", kind, credit, 2.0, "0.5", "0.5", "", None, None, "±1 %", "", "a.csv:2")
+>>> graded = Graded(key, {"1a": [row("correct", 1.0), row("invalid", 0.0)]}, (), (), ())
+>>> summary = summarize(graded)
+>>> summary.percent.tolist(), summary.parts[0].counts["invalid"], summary.parts[0].tolerances
+([100.0, 0.0], 1, (('±1 %', 2),))
+>>> [(p.name, p.values.tolist()) for p in summary.problems[0].parameters]
+[('h', [1.0, 2.0])]
+>>> [(s.id, [(c.label, c.submitted) for c in cells]) for s, cells in summary.invalid]
+[('b', [('1a', '0.5')])]
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections import Counter
+from collections.abc import Sequence
+from dataclasses import dataclass
+from itertools import chain, repeat
+from operator import attrgetter, eq, is_not, itemgetter
+
+import numpy as np
+import numpy.typing as npt
+
+from grader.grade.grading import VERDICTS, Graded, Row, Verdict
+from grader.grade.key import Key, KeyStudent
+
+Floats = npt.NDArray[np.float64]
+
+SHOWN_ORDER = ("correct", "ecf", "mistake", "incorrect", "invalid", "missing")
+"""The order the report shows verdict kinds in; a kind grading has that is not here comes after them."""
+
+HARD_DROP = 0.10  # a parameter's bin is hard when its mean is this far below the problem's (and clearly so)
+HARD_STUDENTS = 5  # ... and it holds at least this many students
+MAX_BINS = 12  # a parameter with at most this many values gets a bin per value
+TOP_MISTAKES = 5  # diagnosed mistakes listed per part
+INVALID_STUDENTS = 50  # students listed with the answers that could not be read; the rest are counted
+
+_FIELDS = tuple(field.name for field in dataclasses.fields(Verdict))[2:]  # a Row: after student_id and label
+_SUBMITTED, _KIND, _CREDIT, _POINTS, _TOLERANCE, _FEEDBACK = (
+    _FIELDS.index(name) for name in ("submitted", "verdict", "credit", "points", "tolerance", "feedback"))
+_DIAGNOSIS = _FIELDS.index("diagnosis") if "diagnosis" in _FIELDS else None
+
+
+def diagnosis(row: Row) -> str:
+    """The mistake a verdict row was diagnosed with, or ``""`` (none; or grading diagnoses none yet)."""
+    return "" if _DIAGNOSIS is None else str(row[_DIAGNOSIS] or "")
+
+
+def shown_kinds(kinds: Sequence[str] = VERDICTS) -> tuple[str, ...]:
+    """The verdict kinds the report shows, in its order.
+
+    >>> shown_kinds(("missing", "correct", "late", "incorrect"))
+    ('correct', 'incorrect', 'missing', 'late')
+    """
+    return (*(kind for kind in SHOWN_ORDER if kind in kinds), *(kind for kind in kinds if kind not in SHOWN_ORDER))
+
+
+@dataclass(frozen=True)
+class PartSummary:
+    """One part over the class: how many verdicts of each kind, the mean score, and how it was graded."""
+
+    label: str
+    problem: str  # the problem's key
+    name: str  # the answer's name in the template (``v_out``)
+    unit: str
+    points: tuple[float, ...]  # the distinct points it is worth (one, unless the key was edited)
+    counts: dict[str, int]  # by verdict kind, every kind shown (0 too)
+    mean_credit: float  # 0..1 over every student of the key
+    tolerances: tuple[tuple[str, int], ...]  # each tolerance in words, with how many verdicts it decided
+    mistakes: tuple[tuple[str, int], ...]  # the most frequent diagnoses, with their counts
+    diagnosed: int  # verdicts with a diagnosis in all
+
+    @property
+    def students(self) -> int:
+        """How many students the part was graded for."""
+        return sum(self.counts.values())
+
+
+@dataclass(frozen=True)
+class ParameterBin:
+    """The students whose parameter lies in ``[low, high]`` (the least and greatest of their values), and
+    how they did."""
+
+    low: float
+    high: float
+    students: int
+    mean: float  # their mean share of the problem's points, 0..1
+    error: float  # its standard error (0 for fewer than 2 students)
+
+
+@dataclass(frozen=True)
+class Parameter:
+    """A printed parameter of a problem, against the problem's score."""
+
+    name: str
+    values: Floats  # per student of the key (NaN: none in the key)
+    bins: tuple[ParameterBin, ...]  # over the students who attempted the problem
+
+
+@dataclass(frozen=True)
+class ProblemSummary:
+    """One problem: each student's share of its points (0..1), who tried it, and the printed parameters."""
+
+    key: str
+    title: str
+    labels: tuple[str, ...]
+    score: Floats  # per student of the key
+    attempted: npt.NDArray[np.bool_]  # not every part missing
+    parameters: tuple[Parameter, ...]
+
+    @property
+    def mean(self) -> float:
+        """The mean share of the points of the students who attempted the problem (0 when nobody did)."""
+        return float(self.score[self.attempted].mean()) if self.attempted.any() else 0.0
+
+    def hard_corners(self) -> list[tuple[Parameter, ParameterBin]]:
+        """Where a parameter's bin scored clearly below the problem (:func:`is_hard`), lowest first."""
+        mean = self.mean
+        found = [(parameter, part) for parameter in self.parameters for part in parameter.bins if is_hard(part, mean)]
+        return sorted(found, key=lambda item: (item[1].mean, item[0].name, item[1].low))
+
+
+@dataclass(frozen=True)
+class InvalidCell:
+    """An answer that could not be read."""
+
+    label: str
+    submitted: str
+    reason: str
+
+
+@dataclass(frozen=True)
+class ClassSummary:
+    """The whole class: see the module's docstring."""
+
+    key: Key
+    kinds: tuple[str, ...]
+    percent: Floats  # each student's score, as a percentage of what they could earn
+    submitted: int  # students with at least one answer
+    parts: tuple[PartSummary, ...]
+    problems: tuple[ProblemSummary, ...]
+    invalid: tuple[tuple[KeyStudent, tuple[InvalidCell, ...]], ...]  # the first INVALID_STUDENTS
+    invalid_students: int  # in all
+    rows_not_graded: int
+    notes: tuple[str, ...]
+
+
+def summarize(graded: Graded) -> ClassSummary:
+    """The report's aggregates of a grading run."""
+    key = graded.key
+    count = len(key.students)
+    kinds = shown_kinds(tuple(dict.fromkeys((*VERDICTS, *_kinds_found(graded)))))
+    scores: dict[str, Floats] = {}
+    points: dict[str, Floats] = {}
+    missing: dict[str, npt.NDArray[np.bool_]] = {}
+    parts = []
+    invalid: set[int] = set()  # students with an answer that could not be read
+    answered = np.zeros(count, dtype=bool)
+    for problem in key.problems:
+        for label in problem.labels:
+            rows = graded.columns[label]
+            verdicts = list(map(itemgetter(_KIND), rows))
+            worth = np.fromiter(map(itemgetter(_POINTS), rows), np.float64, count)
+            scores[label] = np.fromiter(map(itemgetter(_CREDIT), rows), np.float64, count) * worth
+            points[label] = worth
+            missing[label] = _is(verdicts, "missing")
+            answered |= np.fromiter(map(is_not, map(itemgetter(_SUBMITTED), rows), repeat(None)), bool, count)
+            parts.append(_part(key, problem.key, label, rows, verdicts, scores[label], worth, kinds))
+            if parts[-1].counts.get("invalid"):
+                invalid.update(np.flatnonzero(_is(verdicts, "invalid")).tolist())
+    possible = sum(points.values(), np.zeros(count))
+    earned = sum(scores.values(), np.zeros(count))
+    percent = np.divide(100.0 * earned, possible, out=np.zeros(count), where=possible > 0)
+    return ClassSummary(key, kinds, percent, int(answered.sum()), tuple(parts),
+                        _problems(key, scores, points, missing), _invalid(graded, sorted(invalid)[:INVALID_STUDENTS]),
+                        len(invalid), sum(problem.not_graded for problem in graded.problems), graded.notes)
+
+
+def _is(verdicts: list[str], kind: str) -> npt.NDArray[np.bool_]:
+    """Which verdicts are of ``kind`` (``map`` with C functions: a class of 100,000 in a few ms)."""
+    return np.fromiter(map(eq, verdicts, repeat(kind)), bool, len(verdicts))
+
+
+def _kinds_found(graded: Graded) -> set[str]:
+    """Kinds in the rows that :data:`VERDICTS` does not name (none, unless grading and VERDICTS disagree)."""
+    found: set[str] = set()
+    for rows in graded.columns.values():
+        found.update(map(itemgetter(_KIND), rows))
+    return found - set(VERDICTS)
+
+
+def _part(key: Key, problem: str, label: str, rows: Sequence[Row], verdicts: list[str], scores: Floats,
+          worth: Floats, kinds: tuple[str, ...]) -> PartSummary:
+    found = Counter(verdicts)
+    mistakes = Counter(filter(None, map(diagnosis, rows))) if _DIAGNOSIS is not None else Counter[str]()
+    first = key.students[0].parts[label] if key.students else None
+    credit = float(scores.sum() / worth.sum()) if worth.sum() > 0 else 0.0
+    return PartSummary(label, problem, first.name if first else "", first.unit if first else "",
+                       tuple(sorted(set(worth.tolist()))), {kind: found.get(kind, 0) for kind in kinds}, credit,
+                       _by_count(Counter(map(itemgetter(_TOLERANCE), rows))),
+                       _by_count(mistakes)[:TOP_MISTAKES], sum(mistakes.values()))
+
+
+def _by_count(found: Counter[str]) -> tuple[tuple[str, int], ...]:
+    """Most frequent first; equal counts in the order of the text, so that reruns agree."""
+    return tuple(sorted(found.items(), key=lambda item: (-item[1], item[0])))
+
+
+def _invalid(graded: Graded, students: list[int]) -> tuple[tuple[KeyStudent, tuple[InvalidCell, ...]], ...]:
+    """The students (their indices in the key) with the answers of theirs that could not be read."""
+    found = []
+    for index in students:
+        rows = ((label, graded.columns[label][index]) for label in graded.key.labels)
+        found.append((graded.key.students[index], tuple(
+            InvalidCell(label, "" if row[_SUBMITTED] is None else str(row[_SUBMITTED]),
+                        str(row[_FEEDBACK]).removeprefix("could not read this answer: "))
+            for label, row in rows if row[_KIND] == "invalid")))
+    return tuple(found)
+
+
+def _problems(key: Key, scores: dict[str, Floats], points: dict[str, Floats],
+              missing: dict[str, npt.NDArray[np.bool_]]) -> tuple[ProblemSummary, ...]:
+    count = len(key.students)
+    parameters = _parameters(key.students)
+    found = []
+    for problem in key.problems:
+        earned = sum((scores[label] for label in problem.labels), np.zeros(count))
+        possible = sum((points[label] for label in problem.labels), np.zeros(count))
+        share = np.divide(earned, possible, out=np.zeros(count), where=possible > 0)
+        attempted = np.zeros(count, dtype=bool)
+        for label in problem.labels:
+            attempted |= ~missing[label]
+        mine = tuple(Parameter(name, values, binned(values[attempted], share[attempted]))
+                     for (owner, name), values in parameters if owner == problem.key)
+        found.append(ProblemSummary(problem.key, problem.title, problem.labels, share, attempted, mine))
+    return tuple(found)
+
+
+def _parameters(students: Sequence[KeyStudent]) -> list[tuple[tuple[str, str], Floats]]:
+    """Each (problem key, name) of a parameter any student has, with its value per student (NaN where
+    a student has none). Students share their ``parameters`` tuple: one layout is placed at a time."""
+    layouts: dict[int, tuple[tuple[tuple[str, str], ...], list[int]]] = {}
+    for index, student in enumerate(students):
+        layouts.setdefault(id(student.parameters), (student.parameters, []))[1].append(index)
+    names = list(dict.fromkeys(name for layout, _ in layouts.values() for name in layout))
+    table = np.full((len(students), len(names)), np.nan)
+    for layout, members in layouts.values():
+        if layout:
+            values = chain.from_iterable(map(attrgetter("values"), map(students.__getitem__, members)))
+            table[np.array(members)[:, None], [names.index(name) for name in layout]] = np.fromiter(
+                values, np.float64, len(members) * len(layout)).reshape(len(members), len(layout))
+    return [(name, table[:, column]) for column, name in enumerate(names)]
+
+
+def binned(values: Floats, score: Floats) -> tuple[ParameterBin, ...]:
+    """The scores grouped by parameter value: a bin per value where there are few, else equal widths
+    (3 to 12 of them, more for a bigger class); empty bins and students without the parameter left out.
+
+    >>> [(b.low, b.high, b.students, b.mean) for b in binned(np.array([1.0, 1, 2, 2]), np.array([1.0, 0, 1, 1]))]
+    [(1.0, 1.0, 2, 0.5), (2.0, 2.0, 2, 1.0)]
+    >>> [(b.low, b.high, b.students) for b in binned(np.arange(20.0), np.ones(20))]
+    [(0.0, 6.0, 7), (7.0, 12.0, 6), (13.0, 19.0, 7)]
+    """
+    known = np.isfinite(values)
+    values, score = values[known], score[known]
+    distinct = np.unique(values)
+    if len(distinct) <= MAX_BINS:
+        count = len(distinct)
+        which = np.searchsorted(distinct, values)
+    else:
+        count = int(np.clip(np.sqrt(len(values)) / 2, 3, MAX_BINS))
+        cuts = np.linspace(distinct[0], distinct[-1], count + 1)
+        which = np.clip(np.searchsorted(cuts, values, side="right") - 1, 0, count - 1)
+    students = np.bincount(which, minlength=count)
+    sums = np.bincount(which, weights=score, minlength=count)
+    squares = np.bincount(which, weights=score * score, minlength=count)
+    lows, highs = np.full(count, np.inf), np.full(count, -np.inf)
+    np.minimum.at(lows, which, values)
+    np.maximum.at(highs, which, values)
+    found = []
+    for low, high, size, total, square in zip(lows.tolist(), highs.tolist(), students.tolist(), sums.tolist(),
+                                              squares.tolist(), strict=True):
+        if size:
+            mean = total / size
+            variance = max(square - size * mean * mean, 0.0) / (size - 1) if size > 1 else 0.0
+            found.append(ParameterBin(low, high, size, mean, (variance / size) ** 0.5))
+    return tuple(found)
+
+
+def is_hard(part: ParameterBin, mean: float) -> bool:
+    """Whether a bin scored clearly below the problem's ``mean``: by :data:`HARD_DROP` at least and by
+    more than twice its standard error, with :data:`HARD_STUDENTS` students at least.
+
+    >>> is_hard(ParameterBin(1, 2, 10, 0.5, 0.05), 0.8), is_hard(ParameterBin(1, 2, 10, 0.5, 0.2), 0.8)
+    (True, False)
+    """
+    return part.students >= HARD_STUDENTS and mean - part.mean >= max(HARD_DROP, 2 * part.error)

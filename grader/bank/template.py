@@ -30,6 +30,7 @@ from grader.resources import bank_dir
 RESERVED = {"g", "pi"}
 _BOUND = r"(-?inf|[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)"
 _INTERVAL = re.compile(rf"^\s*([\[(])\s*{_BOUND}\s*,\s*{_BOUND}\s*([\])])\s*$")
+_ID = re.compile(r"[a-z0-9][a-z0-9-]*\Z")
 _TOP_KEYS = {"id", "title", "version", "gravity", "bodies", "stages", "symbols", "parameters",
              "constraints", "answers", "tolerance", "statement", "example"}
 
@@ -161,6 +162,19 @@ def load_bank(directory: Path | None = None) -> dict[str, Template]:
     return templates
 
 
+def load_one(template_id: str, directory: Path | None = None) -> Template | None:
+    """The template ``template_id`` of a bank folder, read from its own file alone (a template's id
+    is its file's name), or None when the folder has no such file: then :func:`load_bank` tells why.
+
+    >>> load_one("drop-rebound").title, load_one("../drop-rebound"), load_one("nothing-like-it")
+    ('Ball dropped onto a rigid floor', None, None)
+    """
+    path = (directory or bank_dir()) / f"{template_id}.yaml"
+    if not _ID.match(template_id) or not path.is_file():
+        return None
+    return load_template(path)
+
+
 def load_template(path: Path) -> Template:
     """Read, parse and validate one template file."""
     where = str(path)
@@ -178,7 +192,7 @@ def parse_template(raw: Mapping[str, Any], where: str, source_hash: str, stem: s
         raise TemplateError(where, ", ".join(sorted(map(str, unknown))),
                             f"only the keys {', '.join(sorted(_TOP_KEYS))}", "unknown key(s)")
     template_id = _text(raw, "id", where)
-    if not re.match(r"^[a-z0-9][a-z0-9-]*$", template_id):
+    if not _ID.match(template_id):
         raise TemplateError(where, "id", "lower-case letters, digits and -", shown(template_id))
     if stem is not None and stem != template_id:
         raise TemplateError(where, "id", f"the file name's stem '{stem}'", shown(template_id))
@@ -283,10 +297,26 @@ def _expect(node: Node, expected: Dimension, known: dict[str, Dimension], where:
 
 
 def _check_statement(template: Template, given: set[str]) -> None:
+    from grader.bank.markup import plain_fill, typst_refusal
+
+    # A trial fill (parameters and g as "1", symbols as their names, as a sheet shows them) refuses
+    # what would be too costly for every student alike, and Typst code assembled from pieces.
+    values = {**dict.fromkeys([*template.parameters, "g"], "1"), **{n: n for n in template.symbols}}
+    filled = plain_fill(template.statement, values)  # text and {{ name }}: no Jinja2 needed
+    if filled is None:
+        filled = _jinja_fill(template, given, values)
+    refusal = typst_refusal(template.statement) or typst_refusal(filled)
+    if refusal is not None:
+        raise TemplateError(template.where, "statement", "text and math only", refusal)
+
+
+def _jinja_fill(template: Template, given: set[str], values: dict[str, str]) -> str:
+    """A statement that is more than text and ``{{ name }}``, read by Jinja2: refused unless it only
+    fills in values (with filters) of the template's names."""
     import jinja2
     import jinja2.meta
 
-    from grader.bank.statement import StatementRefused, check_jinja, fill_statement, typst_refusal
+    from grader.bank.statement import StatementRefused, check_jinja, fill_statement
 
     try:
         syntax = check_jinja(template.statement)
@@ -298,16 +328,10 @@ def _check_statement(template: Template, given: set[str]) -> None:
     if unknown:
         raise TemplateError(template.where, "statement", "only parameters, symbols and g",
                             f"unknown {', '.join(sorted(unknown))}")
-    # A trial fill (parameters and g as "1", symbols as their names, as a sheet shows them) refuses
-    # what would be too costly for every student alike, and Typst code assembled from pieces.
-    values = {**dict.fromkeys([*template.parameters, "g"], "1"), **{n: n for n in template.symbols}}
     try:
-        filled = fill_statement(template.statement, values)
+        return fill_statement(template.statement, values)
     except StatementRefused as error:
         raise TemplateError(template.where, "statement", "values filled in, not code", str(error)) from None
-    refusal = typst_refusal(template.statement) or typst_refusal(filled)
-    if refusal is not None:
-        raise TemplateError(template.where, "statement", "text and math only", refusal)
 
 
 def _text(raw: Mapping[str, Any], key: str, where: str) -> str:

@@ -1,27 +1,36 @@
-"""Benchmark: answers for many parameter sets, compiled kernels against a sympy baseline.
+"""Benchmark: the solver's kernels and commands, each against what a competent user would use instead.
 
-For each template of the shipped bank this draws ``--sets`` parameter sets from the parameters'
-sampling specs and times
+Three parts, each timed with its baseline interleaved in one run, and each printed with the machine's
+load average (``os.getloadavg()``) measured beside it:
 
-* the raw kernels: :func:`grader.model.kernel.evaluate` on every numeric answer tree (best of ``--repeat``);
-* :func:`grader.solve.evaluate.solve_batch`: checks plus one Python result object per row (best of 3);
-* the baseline: each numeric answer tree turned back into sympy and evaluated with
-  ``expr.subs(values).evalf()``, one set at a time, on the first ``--baseline-sets`` sets only
-  (the full run would take minutes); its 10^5-set time is extrapolated from the per-set time.
+1. **Kernels**, per template of the shipped bank, on ``--sets`` parameter sets drawn from the
+   parameters' sampling specs: :class:`grader.model.kernel.Kernel` over the template's numeric answers
+   against ``sympy.lambdify(symbols, answers, "numpy")`` of the same expressions (the target: at least
+   as fast), and with ``cse=True``; both get grader's own ``sind``, ``cosd`` and numpy's ``hypot``
+   (the expressions use them). Best of ``--rounds`` interleaved rounds. Context: the tree walk
+   (:func:`grader.model.kernel.evaluate` on each tree, as the kernels were before), ``solve_columns``
+   (checks and answers) and ``expr.subs(values).evalf()`` one set at a time on ``--baseline-sets``
+   sets, extrapolated. lambdify's and subs' values must agree with the kernel's to 1e-9.
+2. **``grader solve ID --batch FILE.csv --json``** against ``benchmarks/minimal_solve.py`` (numpy.loadtxt,
+   the closed form in numpy, ``json.dumps`` per row) on the same CSV of ``--batch-rows`` rows printed as a
+   sheet prints them: whole processes from start, interleaved, median of ``--runs``; the two outputs must
+   be the same JSON lines (values to 1e-9).
+3. **Start-up**: ``grader --help``, ``grader list`` and a warm ``grader solve pile-driver ...`` against
+   ``python -c "import numpy, yaml"``, interleaved, median of ``--startup-runs``; one cold solve (empty
+   compile cache) for context.
 
-The baseline's values must agree with the kernels' (relative 1e-9) on that subset. It also times
-``python -m grader solve pile-driver ...`` with an empty compile cache (cold) and a filled one (warm).
-
-Run: ``python benchmarks/solve.py [--sets 100000] [--baseline-sets 300]``. Writes
-``benchmarks/results/solve.md``, ``solve.csv``, ``solve_startup.csv`` and, with matplotlib, ``solve.png``.
+Run: ``python benchmarks/solve.py [--sets 100000] [--quick]``. Writes ``benchmarks/results/solve.md``,
+``solve.csv``, ``solve_batch.csv``, ``solve_startup.csv`` and, with matplotlib, ``solve.png``.
 """
 
 from __future__ import annotations
 
 import argparse
 import csv
+import json
 import os
 import platform
+import shutil
 import statistics
 import subprocess
 import sys
@@ -36,82 +45,112 @@ import numpy as np
 import sympy as sp
 
 from grader.bank.template import Parameter, Template, load_bank
-from grader.model.kernel import evaluate
+from grader.model import kernel
+from grader.model.kernel import Kernel, evaluate
 from grader.physics.symbolic import from_node
 from grader.solve.cache import compiled_for
 from grader.solve.compiled import Compiled
-from grader.solve.evaluate import Solution, solve_batch, solve_columns
+from grader.solve.evaluate import solve_columns
 
-RESULTS = Path(__file__).resolve().parent / "results"
+HERE = Path(__file__).resolve().parent
+RESULTS = HERE / "results"
+MINIMAL = HERE / "minimal_solve.py"
 AGREEMENT_RTOL = 1e-9
-TARGET_SPEEDUP = 1_000.0
-TARGET_RATE = 1e6
-TARGET_WARM_S = 1.0
-SOLVE_BATCH_REPEAT = 3
-CLI_COMMAND = ("solve", "pile-driver", "--set", "m_ram=800", "--set", "m_pile=2400",
-               "--set", "h_drop=2", "--set", "h_rebound=0.1")
+TARGET_LAMBDIFY = 1.0  # kernels at least as fast as lambdify
+TARGET_BATCH = 1.5  # solve --batch --json within 1.5x of the minimal script
+TARGET_STARTUP = 2.0  # warm start-up within 2x of python -c "import numpy, yaml"
+SOLVE_ARGS = ("solve", "pile-driver", "--set", "m_ram=800", "--set", "m_pile=2400", "--set", "h_drop=2",
+              "--set", "h_rebound=0.1")
+LAMBDIFY_MODULES = [{"sind": kernel.sind, "cosd": kernel.cosd, "hypot": np.hypot}, "numpy"]
 
 
 @dataclass(frozen=True)
-class Row:
-    """The measurements for one template."""
+class KernelRow:
+    """One template's kernel timings (seconds for all sets) and agreement."""
 
     template: str
     answers: int
+    steps: int
     sets: int
-    refused: int
     kernel_s: float
+    lambdify_s: float
+    lambdify_cse_s: float
+    tree_walk_s: float
     columns_s: float
-    solve_batch_s: float
+    subs_s_per_set: float
     baseline_sets: int
-    sympy_s_per_set: float
     max_rel_diff: float
-    disagreements: int
+    load: float
 
     @property
-    def kernel_rate(self) -> float:
-        """Parameter sets per second through the raw kernels."""
-        return self.sets / self.kernel_s
+    def vs_lambdify(self) -> float:
+        """How many times faster than lambdify (>= 1 is the target)."""
+        return self.lambdify_s / self.kernel_s
 
     @property
-    def columns_rate(self) -> float:
-        """Parameter sets per second through ``solve_columns`` (checks and answers, as arrays)."""
-        return self.sets / self.columns_s
-
-    @property
-    def solve_batch_rate(self) -> float:
-        """Parameter sets per second through ``solve_batch``."""
-        return self.sets / self.solve_batch_s
-
-    @property
-    def sympy_rate(self) -> float:
-        """Parameter sets per second through the sympy baseline."""
-        return 1.0 / self.sympy_s_per_set
+    def vs_subs(self) -> float:
+        """How many times faster than subs().evalf() per set (context)."""
+        return self.subs_s_per_set * self.sets / self.kernel_s
 
 
 @dataclass(frozen=True)
-class Startup:
-    """Wall time of one CLI solve with an empty cache and with a filled one."""
+class BatchRow:
+    """One template's whole-command times: grader solve --batch --json and the minimal script."""
 
-    cold_s: float
-    warm_s: float
-    warm_runs: tuple[float, ...]
+    template: str
+    rows: int
+    grader_s: float
+    minimal_s: float
+    grader_runs: tuple[float, ...]
+    minimal_runs: tuple[float, ...]
+    load: float
+
+    @property
+    def ratio(self) -> float:
+        """grader's time over the minimal script's (<= 1.5 is the target)."""
+        return self.grader_s / self.minimal_s
+
+
+@dataclass(frozen=True)
+class StartupRow:
+    """One command's median wall time from process start, beside the baseline's in the same rounds."""
+
+    command: str
+    seconds: float
+    runs: tuple[float, ...]
+    load: float
 
 
 def parse_args(argv: Sequence[str] | None = None) -> argparse.Namespace:
     """The command-line options."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0] if __doc__ else None)
     parser.add_argument("--sets", type=int, default=100_000, help="parameter sets per template (default 100000)")
-    parser.add_argument("--baseline-sets", type=int, default=300,
-                        help="sets evaluated with the sympy baseline (default 300)")
-    parser.add_argument("--repeat", type=int, default=5, help="kernel timings: best of this many (default 5)")
+    parser.add_argument("--rounds", type=int, default=25, help="kernel timings: best of this many interleaved "
+                                                              "rounds (default 25)")
+    parser.add_argument("--baseline-sets", type=int, default=200,
+                        help="sets evaluated with subs().evalf() (default 200)")
+    parser.add_argument("--batch-rows", type=int, default=100_000, help="rows of the batch CSV (default 100000)")
+    parser.add_argument("--runs", type=int, default=5, help="batch commands: median of this many (default 5)")
+    parser.add_argument("--startup-runs", type=int, default=15, help="start-up: median of this many (default 15)")
+    parser.add_argument("--quick", action="store_true", help="a smoke run: few sets, rows and runs")
     parser.add_argument("--seed", type=int, default=20240601, help="numpy random seed (default 20240601)")
     parser.add_argument("--out", type=Path, default=RESULTS, help=f"output folder (default {RESULTS})")
     arguments = parser.parse_args(argv)
-    if arguments.sets < 1 or not 1 <= arguments.baseline_sets <= arguments.sets or arguments.repeat < 1:
-        parser.error("need --sets >= 1, 1 <= --baseline-sets <= --sets and --repeat >= 1")
+    if arguments.quick:
+        arguments.sets, arguments.rounds, arguments.baseline_sets = 2_000, 3, 5
+        arguments.batch_rows, arguments.runs, arguments.startup_runs = 2_000, 1, 3
+    if min(arguments.sets, arguments.rounds, arguments.baseline_sets, arguments.batch_rows, arguments.runs,
+           arguments.startup_runs) < 1 or arguments.baseline_sets > arguments.sets:
+        parser.error("every count must be >= 1, and --baseline-sets <= --sets")
     return arguments
 
+
+def load() -> float:
+    """The machine's 1-minute load average."""
+    return os.getloadavg()[0]
+
+
+# --- 1. kernels ----------------------------------------------------------------------------------
 
 def sample_column(parameter: Parameter, count: int, rng: np.random.Generator) -> np.ndarray:
     """``count`` draws of one parameter from its sampling spec, kept inside its domain."""
@@ -136,130 +175,194 @@ def draw_table(template: Template, count: int, rng: np.random.Generator) -> dict
     return {name: sample_column(parameter, count, rng) for name, parameter in template.parameters.items()}
 
 
-def best_of(function: Callable[[], Any], repeat: int) -> tuple[float, Any]:
-    """The shortest of ``repeat`` timed calls, and the last call's result."""
-    best, result = float("inf"), None
-    for _ in range(repeat):
-        result = None  # let the previous result go before timing the next call
-        start = time.perf_counter()
-        result = function()
-        best = min(best, time.perf_counter() - start)
-    return best, result
-
-
 def numeric_answers(compiled: Compiled) -> dict[str, Any]:
     """The answers that have a numeric tree (symbolic answers have no kernel)."""
     return {name: answer.numeric for name, answer in compiled.answers.items() if answer.numeric is not None}
 
 
-def run_kernels(trees: Mapping[str, Any], env: Mapping[str, Any], count: int) -> dict[str, np.ndarray]:
-    """Every numeric answer for all sets at once, straight through the kernels."""
-    with np.errstate(all="ignore"):
-        return {name: np.broadcast_to(np.asarray(evaluate(tree, env), dtype=float), (count,))
-                for name, tree in trees.items()}
+def interleaved_best(contenders: Mapping[str, Callable[[], Any]], rounds: int) -> dict[str, float]:
+    """The shortest time of each contender over ``rounds`` rounds, each round timing each once in turn."""
+    best = dict.fromkeys(contenders, float("inf"))
+    for _ in range(rounds):
+        for name, function in contenders.items():
+            start = time.perf_counter()
+            function()
+            best[name] = min(best[name], time.perf_counter() - start)
+    return best
 
 
-def sympy_baseline(compiled: Compiled, trees: Mapping[str, Any], table: Mapping[str, np.ndarray],
-                   example: Mapping[str, float], rows: int) -> tuple[float, dict[str, np.ndarray]]:
+def lambdified(compiled: Compiled, trees: Mapping[str, Any], cse: bool) -> tuple[Callable[..., Any], list[str]]:
+    """``sympy.lambdify`` of the answers (constants such as g substituted), and its arguments' names."""
+    exprs = [from_node(tree, {}) for tree in trees.values()]
+    symbols = sorted({s for expr in exprs for s in expr.free_symbols}, key=lambda s: s.name)
+    constants = {s: compiled.constants[s.name] for s in symbols if s.name in compiled.constants}
+    arguments = [s for s in symbols if s.name not in compiled.constants]
+    function = sp.lambdify(arguments, [expr.subs(constants) for expr in exprs], LAMBDIFY_MODULES, cse=cse)
+    return function, [s.name for s in arguments]
+
+
+def subs_per_set(compiled: Compiled, trees: Mapping[str, Any], table: Mapping[str, np.ndarray],
+                 rows: int) -> tuple[float, dict[str, np.ndarray]]:
     """Seconds per set of ``expr.subs(values).evalf()`` over the first ``rows`` sets, and the values."""
     exprs = {name: from_node(tree, {}) for name, tree in trees.items()}
     symbols = {s.name: s for expr in exprs.values() for s in expr.free_symbols}
 
-    def one_set(params: Mapping[str, float]) -> dict[str, float]:
-        values = {symbols[k]: v for k, v in {**params, **compiled.constants}.items() if k in symbols}
+    def one_set(row: int) -> dict[str, float]:
+        values = {symbols[k]: float(v[row]) for k, v in table.items() if k in symbols}
+        values |= {symbols[k]: v for k, v in compiled.constants.items() if k in symbols}
         return {name: _to_float(expr.subs(values).evalf()) for name, expr in exprs.items()}
 
-    one_set(example)  # warm-up outside the timing: sympy's first calls pay for lazy set-up
+    one_set(0)  # warm-up: sympy's first calls pay for lazy set-up
     start = time.perf_counter()
-    results = [one_set({k: float(column[row]) for k, column in table.items()}) for row in range(rows)]
+    results = [one_set(row) for row in range(rows)]
     elapsed = time.perf_counter() - start
     return elapsed / rows, {name: np.array([r[name] for r in results]) for name in exprs}
 
 
 def _to_float(value: Any) -> float:
-    """A sympy number as a float; NaN when it is not a real number."""
     try:
         return float(value)
     except (TypeError, ValueError):
         return float("nan")
 
 
-def compare(kernel: Mapping[str, np.ndarray], baseline: Mapping[str, np.ndarray],
-            solutions: Sequence[Solution]) -> tuple[float, int]:
-    """Largest relative difference kernel vs sympy, and how many values exceed ``AGREEMENT_RTOL``.
-
-    Rows that ``solve_batch`` refused, and answers it reports as undefined, are not compared.
-    """
-    worst, bad = 0.0, 0
-    for name, reference in baseline.items():
-        rows = len(reference)
-        keep = np.array([s.answers is not None and s.answers[name].value is not None for s in solutions[:rows]])
-        ours, ref = kernel[name][:rows][keep], reference[keep]
+def worst_difference(ours: Mapping[str, Any], theirs: Mapping[str, Any]) -> float:
+    """Largest relative difference over the answers both give (rows where ours is finite)."""
+    worst = 0.0
+    for name, reference in theirs.items():
+        reference = np.asarray(reference, dtype=float)
+        mine = np.ravel(np.asarray(ours[name], dtype=float))
+        mine = np.full(reference.size, mine[0]) if mine.size == 1 else mine[: reference.size]
+        keep = np.isfinite(mine)
         with np.errstate(all="ignore"):
-            rel = np.abs(ours - ref) / np.maximum(np.abs(ref), np.finfo(float).tiny)
-        rel = np.where(np.isnan(rel), np.inf, rel)
-        worst = max(worst, float(rel.max(initial=0.0)))
-        bad += int(np.count_nonzero(rel > AGREEMENT_RTOL))
-    return worst, bad
+            rel = np.abs(mine[keep] - reference[keep]) / np.maximum(np.abs(reference[keep]), 1e-300)
+        worst = max(worst, float(np.nan_to_num(rel, nan=np.inf).max(initial=0.0)))
+    return worst
 
 
-def check_solve_batch(kernel: Mapping[str, np.ndarray], solutions: Sequence[Solution]) -> None:
-    """``solve_batch``'s numbers must be the raw kernels' numbers (same trees, same inputs)."""
-    for name, values in kernel.items():
-        theirs = np.array([np.nan if s.answers is None or not isinstance(s.answers[name].value, float)
-                           else s.answers[name].value for s in solutions])
-        same = np.isnan(theirs) | (theirs == values)
-        if not same.all():
-            raise AssertionError(f"{name}: solve_batch differs from the kernel in {np.count_nonzero(~same)} rows")
-
-
-def bench_template(template: Template, arguments: argparse.Namespace, rng: np.random.Generator) -> Row:
-    """All measurements for one template."""
+def bench_kernels(template: Template, arguments: argparse.Namespace, rng: np.random.Generator) -> KernelRow:
+    """Kernel, lambdify (plain and cse) and tree walk interleaved; solve_columns and subs for context."""
     compiled = compiled_for(template)
     table = draw_table(template, arguments.sets, rng)
-    env = {**table, **compiled.constants}
     trees = numeric_answers(compiled)
-    kernel_s, kernel = best_of(lambda: run_kernels(trees, env, arguments.sets), arguments.repeat)
-    columns_s, _ = best_of(lambda: solve_columns(template, compiled, table), arguments.repeat)
-    batch_s, solutions = best_of(lambda: solve_batch(template, compiled, table), SOLVE_BATCH_REPEAT)
-    check_solve_batch(kernel, solutions)
-    per_set, baseline = sympy_baseline(compiled, trees, table, template.example, arguments.baseline_sets)
-    worst, bad = compare(kernel, baseline, solutions)
-    refused = sum(solution.error is not None for solution in solutions)
-    return Row(template.id, len(trees), arguments.sets, refused, kernel_s, columns_s, batch_s,
-               arguments.baseline_sets, per_set, worst, bad)
+    ours = Kernel(trees, compiled.constants)
+    plain, names = lambdified(compiled, trees, cse=False)
+    shared, _ = lambdified(compiled, trees, cse=True)
+    columns = [table[name] for name in names]
+    inputs = {name: table[name] for name in ours.inputs}
+    env = {**table, **compiled.constants}
+    with np.errstate(all="ignore"):
+        best = interleaved_best({
+            "kernel": lambda: ours(inputs), "lambdify": lambda: plain(*columns),
+            "lambdify_cse": lambda: shared(*columns),
+            "tree_walk": lambda: [evaluate(tree, env) for tree in trees.values()],
+        }, arguments.rounds)
+        results = ours(inputs)
+        worst = max(worst_difference(results, dict(zip(trees, plain(*columns), strict=True))),
+                    worst_difference(results, dict(zip(trees, shared(*columns), strict=True))))
+        columns_s = min(_timed(lambda: solve_columns(template, compiled, table)) for _ in range(5))
+    per_set, subs_values = subs_per_set(compiled, trees, table, arguments.baseline_sets)
+    worst = max(worst, worst_difference(results, subs_values))
+    return KernelRow(template.id, len(trees), len(ours), arguments.sets, best["kernel"], best["lambdify"],
+                     best["lambdify_cse"], best["tree_walk"], columns_s, per_set, arguments.baseline_sets, worst,
+                     load())
 
 
-def run_cli(cache: Path) -> tuple[float, str]:
-    """Wall time and output of ``python -m grader solve pile-driver ...`` with ``cache`` as cache folder."""
-    env = {**os.environ, "GRADER_CACHE_DIR": str(cache)}
+def _timed(function: Callable[[], Any]) -> float:
     start = time.perf_counter()
-    done = subprocess.run([sys.executable, "-m", "grader", *CLI_COMMAND], env=env, capture_output=True,
-                          text=True, check=False)
-    elapsed = time.perf_counter() - start
+    function()
+    return time.perf_counter() - start
+
+
+# --- 2. solve --batch --json against the minimal script ------------------------------------------
+
+def printed(parameter: Parameter, value: float) -> str:
+    """A value as a sheet prints it: to its decimals or significant figures."""
+    if parameter.decimals is not None:
+        return f"{value:.{parameter.decimals}f}"
+    return f"{float(f'{value:.{parameter.sig_figs}g}'):g}"
+
+
+def write_batch(template: Template, rows: int, rng: np.random.Generator, path: Path) -> None:
+    """A comma-separated batch of sampled parameter sets, as printed on sheets."""
+    table = draw_table(template, rows, rng)
+    parameters = list(template.parameters.values())
+    with path.open("w", encoding="utf-8") as handle:
+        handle.write(",".join(template.parameters) + "\n")
+        for row in zip(*table.values(), strict=True):
+            handle.write(",".join(printed(p, v) for p, v in zip(parameters, row, strict=True)) + "\n")
+
+
+def grader_command(*args: str) -> list[str]:
+    """``grader ARGS`` as a user runs it: the installed script beside this Python, else ``-m grader``."""
+    script = Path(sys.executable).parent / "grader"
+    return [str(script), *args] if script.is_file() else [sys.executable, "-m", "grader", *args]
+
+
+def run(command: Sequence[str], out: Path | None = None, env: Mapping[str, str] | None = None) -> float:
+    """Wall time of a whole process from start (its output to ``out`` or discarded)."""
+    with (out.open("wb") if out else open(os.devnull, "wb")) as sink:
+        start = time.perf_counter()
+        done = subprocess.run(command, stdout=sink, stderr=subprocess.PIPE, env=env, check=False)
+        elapsed = time.perf_counter() - start
     if done.returncode != 0:
-        raise RuntimeError(f"grader solve failed ({done.returncode}): {done.stderr.strip()}")
-    return elapsed, done.stdout
+        raise RuntimeError(f"{' '.join(command)} failed ({done.returncode}): {done.stderr.decode()[-500:]}")
+    return elapsed
 
 
-def measure_startup(warm_runs: int = 3) -> Startup:
-    """Cold (empty cache: compiles with sympy) and warm (median of ``warm_runs``) CLI solves."""
-    with tempfile.TemporaryDirectory(prefix="grader-bench-cache-") as folder:
-        cache = Path(folder)
-        cold, expected = run_cli(cache)
-        if not any(cache.glob("pile-driver-*.json")):
-            raise AssertionError("the cold run left no compiled template in the cache folder")
-        files = sorted(cache.iterdir())
-        warm = []
-        for _ in range(warm_runs):
-            elapsed, output = run_cli(cache)
-            if output != expected:
-                raise AssertionError("a warm run printed something else than the cold run")
-            if sorted(cache.iterdir()) != files:
-                raise AssertionError("a warm run compiled again (did a solver source change meanwhile?)")
-            warm.append(elapsed)
-    return Startup(cold, statistics.median(warm), tuple(warm))
+def same_lines(ours: Path, theirs: Path) -> None:
+    """The two outputs are the same JSON lines: keys, units, rows and parameters equal, answers to 1e-9."""
+    with ours.open(encoding="utf-8") as mine, theirs.open(encoding="utf-8") as other:
+        for number, (a, b) in enumerate(zip(mine, other, strict=True), 1):
+            first, second = json.loads(a), json.loads(b)
+            if first.keys() != second.keys() or any(first[k] != second[k] for k in first if k != "answers"):
+                raise AssertionError(f"line {number}: {a.strip()} != {b.strip()}")
+            for name, answer in first["answers"].items():
+                other_answer = second["answers"][name]
+                if answer["unit"] != other_answer["unit"] or not np.isclose(
+                        answer["value"], other_answer["value"], rtol=AGREEMENT_RTOL, atol=1e-12):
+                    raise AssertionError(f"line {number}, {name}: {answer} != {other_answer}")
 
+
+def bench_batch(template: Template, arguments: argparse.Namespace, rng: np.random.Generator,
+                folder: Path) -> BatchRow:
+    """The two commands on the same CSV, interleaved; median of ``--runs`` each."""
+    path = folder / f"{template.id}.csv"
+    write_batch(template, arguments.batch_rows, rng, path)
+    ours = grader_command("solve", template.id, "--batch", str(path), "--json")
+    theirs = [sys.executable, str(MINIMAL), template.id, str(path)]
+    run(ours, folder / "grader.jsonl")
+    run(theirs, folder / "minimal.jsonl")
+    same_lines(folder / "grader.jsonl", folder / "minimal.jsonl")
+    times: dict[str, list[float]] = {"grader": [], "minimal": []}
+    for _ in range(arguments.runs):
+        times["grader"].append(run(ours))
+        times["minimal"].append(run(theirs))
+    return BatchRow(template.id, arguments.batch_rows, statistics.median(times["grader"]),
+                    statistics.median(times["minimal"]), tuple(times["grader"]), tuple(times["minimal"]), load())
+
+
+# --- 3. start-up ---------------------------------------------------------------------------------
+
+STARTUP = {"python -c \"import numpy, yaml\"": [sys.executable, "-c", "import numpy, yaml"],
+           "grader --help": grader_command("--help"), "grader list": grader_command("list"),
+           "grader solve pile-driver ... (warm)": grader_command(*SOLVE_ARGS)}
+
+
+def bench_startup(arguments: argparse.Namespace) -> tuple[list[StartupRow], float]:
+    """Each command's median over interleaved rounds (the compile cache filled first), and one cold solve."""
+    with tempfile.TemporaryDirectory(prefix="grader-bench-cache-") as cache:
+        env = {**os.environ, "GRADER_CACHE_DIR": cache}
+        cold = run(grader_command(*SOLVE_ARGS), env=env)  # an empty cache: compiles with sympy
+        times: dict[str, list[float]] = {name: [] for name in STARTUP}
+        for _ in range(arguments.startup_runs):
+            for name, command in STARTUP.items():
+                times[name].append(run(command, env=env))
+    now = load()
+    return [StartupRow(name, statistics.median(runs), tuple(runs), now) for name, runs in times.items()], cold
+
+
+# --- report --------------------------------------------------------------------------------------
 
 def rate(value: float) -> str:
     """A rate with thousands separators and about three significant figures."""
@@ -271,98 +374,97 @@ def verdict(ok: bool) -> str:
     return "met" if ok else "**NOT met**"
 
 
-def throughput_table(rows: Sequence[Row]) -> str:
-    """The per-template Markdown table."""
-    first = rows[0]
-    lines = [f"| template | answers | kernel sets/s | solve_columns sets/s | solve_batch sets/s | sympy sets/s "
-             f"({first.baseline_sets}-set subset) | sympy, {first.sets:,} sets (extrapolated) | speed-up (kernel / "
-             "sympy) | speed-up (solve_batch / sympy) | refused rows | max rel. diff vs sympy |",
-             "|---|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|"]
+def kernel_table(rows: Sequence[KernelRow]) -> str:
+    """Sets per second through each, and the kernel's speed-ups."""
+    lines = ["| template | answers | kernel steps | kernel sets/s | lambdify sets/s | kernel / lambdify (target >= 1) "
+             "| lambdify cse=True sets/s | kernel / cse | tree walk (before) sets/s | solve_columns sets/s "
+             "| subs().evalf() sets/s | kernel / subs | max rel. diff | load |",
+             "|---|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|"]
     for row in rows:
-        lines.append(f"| {row.template} | {row.answers} | {rate(row.kernel_rate)} | {rate(row.columns_rate)} "
-                     f"| {rate(row.solve_batch_rate)} "
-                     f"| {rate(row.sympy_rate)} | {row.sympy_s_per_set * row.sets:,.0f} s "
-                     f"| {rate(row.kernel_rate / row.sympy_rate)}× | {rate(row.solve_batch_rate / row.sympy_rate)}× "
-                     f"| {row.refused} / {row.sets:,} | {row.max_rel_diff:.1e} |")
+        lines.append(
+            f"| {row.template} | {row.answers} | {row.steps} | {rate(row.sets / row.kernel_s)} "
+            f"| {rate(row.sets / row.lambdify_s)} | {row.vs_lambdify:.2f}x | {rate(row.sets / row.lambdify_cse_s)} "
+            f"| {row.lambdify_cse_s / row.kernel_s:.2f}x | {rate(row.sets / row.tree_walk_s)} "
+            f"| {rate(row.sets / row.columns_s)} | {rate(1 / row.subs_s_per_set)} | {rate(row.vs_subs)}x "
+            f"| {row.max_rel_diff:.1e} | {row.load:.2f} |")
     return "\n".join(lines)
 
 
-def startup_table(startup: Startup) -> str:
-    """The cold / warm Markdown table."""
-    runs = ", ".join(f"{t:.3f}" for t in startup.warm_runs)
-    return "\n".join([
-        "| `python -m grader solve pile-driver ...` | seconds |", "|---|--:|",
-        f"| cold (empty cache: compiles with sympy) | {startup.cold_s:.3f} |",
-        f"| warm (cache filled), median of {len(startup.warm_runs)} ({runs}) | {startup.warm_s:.3f} |",
-    ])
+def batch_table(rows: Sequence[BatchRow]) -> str:
+    """Whole-command times for the batch."""
+    lines = ["| template | rows | `grader solve --batch --json` | minimal numpy script | ratio (target <= 1.5) "
+             "| load |", "|---|--:|--:|--:|--:|--:|"]
+    lines += [f"| {r.template} | {r.rows:,} | {r.grader_s:.3f} s | {r.minimal_s:.3f} s | {r.ratio:.2f}x "
+              f"| {r.load:.2f} |" for r in rows]
+    return "\n".join(lines)
 
 
-def targets(rows: Sequence[Row], startup: Startup) -> str:
-    """One line per target, with the worst template's figure."""
-    speed = min(rows, key=lambda r: r.kernel_rate / r.sympy_rate)
-    slow = min(rows, key=lambda r: r.kernel_rate)
-    agree = all(r.disagreements == 0 for r in rows)
-    worst = max(r.max_rel_diff for r in rows)
-    factor = speed.kernel_rate / speed.sympy_rate
+def startup_table(rows: Sequence[StartupRow], cold: float) -> str:
+    """Start-up medians against the numpy+yaml baseline."""
+    base = rows[0].seconds
+    lines = ["| command (whole process) | median | / baseline (target <= 2) | load |", "|---|--:|--:|--:|"]
+    lines += [f"| `{r.command}` | {r.seconds:.3f} s | {r.seconds / base:.2f}x | {r.load:.2f} |" for r in rows]
+    lines.append(f"| `grader solve pile-driver ...` (cold: empty cache, compiles with sympy) | {cold:.3f} s "
+                 f"| {cold / base:.2f}x | |")
+    return "\n".join(lines)
+
+
+def targets(kernels: Sequence[KernelRow], batches: Sequence[BatchRow], startup: Sequence[StartupRow]) -> str:
+    """One line per target, with the worst figure."""
+    slowest = min(kernels, key=lambda r: r.vs_lambdify)
+    batch = max(batches, key=lambda r: r.ratio)
+    base, worst = startup[0].seconds, max(startup[1:], key=lambda r: r.seconds)
+    agree = max(r.max_rel_diff for r in kernels)
     return "\n".join([
-        f"- kernels >= {TARGET_SPEEDUP:,.0f}× the sympy baseline: {verdict(factor >= TARGET_SPEEDUP)}"
-        f" (lowest: {speed.template}, {rate(factor)}×)",
-        f"- >= 10^6 answer sets/s through the kernels: {verdict(slow.kernel_rate >= TARGET_RATE)}"
-        f" (lowest: {slow.template}, {rate(slow.kernel_rate)} sets/s)",
-        f"- warm CLI solve < {TARGET_WARM_S:g} s: {verdict(startup.warm_s < TARGET_WARM_S)} ({startup.warm_s:.3f} s)",
-        f"- sympy baseline agrees with the kernels to rel. {AGREEMENT_RTOL:g}: {verdict(agree)} (worst {worst:.1e})",
+        f"- kernels >= {TARGET_LAMBDIFY:g}x sympy.lambdify on every template: "
+        f"{verdict(slowest.vs_lambdify >= TARGET_LAMBDIFY)} (lowest: {slowest.template}, {slowest.vs_lambdify:.2f}x)",
+        f"- `solve --batch --json` within {TARGET_BATCH:g}x of the minimal numpy script: "
+        f"{verdict(batch.ratio <= TARGET_BATCH)} (highest: {batch.template}, {batch.ratio:.2f}x)",
+        f"- warm start-up within {TARGET_STARTUP:g}x of `python -c \"import numpy, yaml\"`: "
+        f"{verdict(worst.seconds <= TARGET_STARTUP * base)} (slowest: `{worst.command}`, {worst.seconds / base:.2f}x)",
+        f"- lambdify and subs().evalf() agree with the kernels to rel. {AGREEMENT_RTOL:g}: "
+        f"{verdict(agree <= AGREEMENT_RTOL)} (worst {agree:.1e})",
     ])
 
 
 def environment(arguments: argparse.Namespace) -> str:
-    """What the numbers were measured on."""
+    """What the numbers were measured on, and how."""
     return (f"Python {platform.python_version()}, numpy {np.__version__}, sympy {sp.__version__}, "
-            f"{os.cpu_count()} CPUs ({platform.machine()}), seed {arguments.seed}. Kernel timings: best of "
-            f"{arguments.repeat}; solve_batch: best of {SOLVE_BATCH_REPEAT}; sympy baseline "
-            "(`expr.subs(values).evalf()` per set, every numeric answer): one pass over the first "
-            f"{arguments.baseline_sets} sets, its {arguments.sets:,}-set time extrapolated from the per-set time.")
+            f"{os.cpu_count()} CPUs ({platform.machine()}), seed {arguments.seed}. Kernels: {arguments.sets:,} sets, "
+            f"best of {arguments.rounds} interleaved rounds; subs().evalf() on {arguments.baseline_sets} sets. "
+            f"Batch: {arguments.batch_rows:,} rows, median of {arguments.runs} interleaved runs. Start-up: median of "
+            f"{arguments.startup_runs} interleaved runs. Load: the 1-minute load average after each part.")
 
 
-def report(rows: Sequence[Row], startup: Startup, arguments: argparse.Namespace) -> str:
+def report(kernels: Sequence[KernelRow], batches: Sequence[BatchRow], startup: Sequence[StartupRow], cold: float,
+           arguments: argparse.Namespace, loads: Sequence[float]) -> str:
     """The whole Markdown report."""
     return "\n\n".join([
-        f"# Solve benchmark: {arguments.sets:,} parameter sets per template", environment(arguments),
-        "## Throughput", throughput_table(rows),
-        "A set is all of a template's numeric answers for one parameter set. The kernel column evaluates the "
-        "answer trees only; solve_columns also checks domains, constraints and physics and returns arrays; "
-        "solve_batch adds one Python result per row (car-collision's two symbolic answers "
-        "are written out as text per row, which dominates its time).",
-        "## Startup", startup_table(startup), "## Targets", targets(rows, startup),
+        "# Solve benchmark", environment(arguments),
+        f"Load average (1, 5, 15 min) at the start: {loads[0]:.2f}, {loads[1]:.2f}, {loads[2]:.2f}.",
+        "## Kernels against sympy.lambdify", kernel_table(kernels),
+        "A set is all of a template's numeric answers for one parameter set. lambdify gets the same expressions "
+        "(the constants substituted) and grader's sind and cosd; the tree walk is how the kernels evaluated "
+        "before (each tree on its own, node by node); solve_columns adds the domain, constraint and physics "
+        "checks; subs().evalf() is one set at a time, its figure extrapolated.",
+        "## `grader solve --batch --json` against a minimal numpy script", batch_table(batches),
+        "## Start-up", startup_table(startup, cold), "## Targets", targets(kernels, batches, startup),
     ]) + "\n"
 
 
-def write_csv(rows: Sequence[Row], startup: Startup, folder: Path) -> None:
-    """``solve.csv`` (one line per template) and ``solve_startup.csv``."""
-    with (folder / "solve.csv").open("w", newline="", encoding="utf-8") as handle:
-        writer = csv.writer(handle)
-        fields = list(asdict(rows[0]))
-        writer.writerow([*fields, "kernel_sets_per_s", "solve_columns_sets_per_s", "solve_batch_sets_per_s",
-                         "sympy_sets_per_s",
-                         "speedup_kernel", "speedup_solve_batch"])
-        for row in rows:
-            writer.writerow([*asdict(row).values(), row.kernel_rate, row.columns_rate, row.solve_batch_rate,
-                             row.sympy_rate,
-                             row.kernel_rate / row.sympy_rate, row.solve_batch_rate / row.sympy_rate])
-    with (folder / "solve_startup.csv").open("w", newline="", encoding="utf-8") as handle:
-        writer = csv.writer(handle)
-        writer.writerow(["cold_s", "warm_median_s", "warm_runs_s"])
-        writer.writerow([startup.cold_s, startup.warm_s, " ".join(f"{t:.6f}" for t in startup.warm_runs)])
+def write_csv(kernels: Sequence[KernelRow], batches: Sequence[BatchRow], startup: Sequence[StartupRow],
+              folder: Path) -> None:
+    """``solve.csv`` (kernels), ``solve_batch.csv`` and ``solve_startup.csv``."""
+    for name, rows in (("solve.csv", kernels), ("solve_batch.csv", batches), ("solve_startup.csv", startup)):
+        with (folder / name).open("w", newline="", encoding="utf-8") as handle:
+            writer = csv.writer(handle)
+            writer.writerow(list(asdict(rows[0])))
+            for row in rows:
+                writer.writerow([" ".join(f"{v:.6f}" for v in value) if isinstance(value, tuple) else value
+                                 for value in asdict(row).values()])
 
 
-def short(value: float) -> str:
-    """A compact bar label: 3.2M, 85k, 210."""
-    for limit, suffix in ((1e9, "G"), (1e6, "M"), (1e3, "k")):
-        if value >= limit:
-            return f"{value / limit:.3g}{suffix}"
-    return f"{value:.3g}"
-
-
-def plot(rows: Sequence[Row], path: Path) -> str:
+def plot(rows: Sequence[KernelRow], path: Path) -> str:
     """A log-scale bar chart of sets/s per template; a note when matplotlib is missing."""
     try:
         import matplotlib
@@ -371,22 +473,24 @@ def plot(rows: Sequence[Row], path: Path) -> str:
         import matplotlib.pyplot as plt
     except ImportError:
         return "matplotlib is not installed: skipped the plot (pip install matplotlib)"
-    series = (("kernel", "kernel_rate", "#1f77b4"), ("solve_columns", "columns_rate", "#2ca02c"),
-              ("solve_batch", "solve_batch_rate", "#ff7f0e"),
-              (f"sympy baseline ({rows[0].baseline_sets} sets)", "sympy_rate", "#7f7f7f"))
-    x, width = np.arange(len(rows)), 0.2
-    figure, axes = plt.subplots(figsize=(11, 5.5), dpi=120)
+    series = (("kernel", "kernel_s", "#1f77b4"), ("sympy.lambdify", "lambdify_s", "#d62728"),
+              ("lambdify cse=True", "lambdify_cse_s", "#ff9896"), ("tree walk (before)", "tree_walk_s", "#2ca02c"),
+              ("solve_columns", "columns_s", "#9467bd"))
+    x, width = np.arange(len(rows)), 0.15
+    figure, axes = plt.subplots(figsize=(12, 5.5), dpi=120)
     for index, (label, field, colour) in enumerate(series):
-        values = [getattr(row, field) for row in rows]
-        bars = axes.bar(x + (index - 1.5) * width, values, width, label=label, color=colour)
-        axes.bar_label(bars, labels=[short(v) for v in values], fontsize=8, padding=2)
-    axes.axhline(TARGET_RATE, color="#d62728", linestyle="--", linewidth=1, label="target: $10^6$ sets/s")
+        values = [row.sets / getattr(row, field) for row in rows]
+        bars = axes.bar(x + (index - 2.5) * width, values, width, label=label, color=colour)
+        axes.bar_label(bars, labels=[f"{v / 1e6:.3g}M" for v in values], fontsize=7, padding=2, rotation=90)
+    subs = [1 / row.subs_s_per_set for row in rows]
+    bars = axes.bar(x + 2.5 * width, subs, width, label="subs().evalf()", color="#7f7f7f")
+    axes.bar_label(bars, labels=[rate(v) for v in subs], fontsize=7, padding=2, rotation=90)
     axes.set_yscale("log")
-    axes.set_ylim(top=axes.get_ylim()[1] * 4)
+    axes.set_ylim(top=axes.get_ylim()[1] * 20)
     axes.set_xticks(x, [row.template for row in rows])
     axes.set_ylabel("parameter sets per second (log scale)")
-    axes.set_title(f"Answers for {rows[0].sets:,} parameter sets per template: compiled kernels vs sympy")
-    axes.legend(loc="upper right", fontsize=9, ncols=2)
+    axes.set_title(f"Answers for {rows[0].sets:,} parameter sets per template: kernels against sympy")
+    axes.legend(loc="upper right", fontsize=8, ncols=3)
     axes.grid(axis="y", which="major", alpha=0.3)
     figure.tight_layout()
     figure.savefig(path)
@@ -397,20 +501,31 @@ def plot(rows: Sequence[Row], path: Path) -> str:
 def main(argv: Sequence[str] | None = None) -> int:
     """Run every measurement, print the report and write the result files."""
     arguments = parse_args(argv)
+    loads = os.getloadavg()
+    print(f"load average at the start: {loads[0]:.2f} {loads[1]:.2f} {loads[2]:.2f}", file=sys.stderr, flush=True)
     rng = np.random.default_rng(arguments.seed)
-    rows = []
-    for template in load_bank().values():
-        print(f"benchmarking {template.id} ...", file=sys.stderr, flush=True)
-        rows.append(bench_template(template, arguments, rng))
-    print("timing the CLI, cold and warm ...", file=sys.stderr, flush=True)
-    startup = measure_startup()
-    text = report(rows, startup, arguments)
+    bank = load_bank()
+    kernels = []
+    for template in bank.values():
+        print(f"kernels: {template.id} ...", file=sys.stderr, flush=True)
+        kernels.append(bench_kernels(template, arguments, rng))
+    folder = Path(tempfile.mkdtemp(prefix="grader-bench-batch-"))
+    try:
+        batches = []
+        for template_id in ("drop-rebound", "pile-driver", "ball-plate", "oblique-spheres"):
+            print(f"batch: {template_id} ...", file=sys.stderr, flush=True)
+            batches.append(bench_batch(bank[template_id], arguments, rng, folder))
+    finally:
+        shutil.rmtree(folder)
+    print("start-up ...", file=sys.stderr, flush=True)
+    startup, cold = bench_startup(arguments)
+    text = report(kernels, batches, startup, cold, arguments, loads)
     arguments.out.mkdir(parents=True, exist_ok=True)
     (arguments.out / "solve.md").write_text(text, encoding="utf-8")
-    write_csv(rows, startup, arguments.out)
+    write_csv(kernels, batches, startup, arguments.out)
     print(text)
-    print(plot(rows, arguments.out / "solve.png"), file=sys.stderr)
-    return 1 if any(row.disagreements for row in rows) else 0
+    print(plot(kernels, arguments.out / "solve.png"), file=sys.stderr)
+    return 1 if any(row.max_rel_diff > AGREEMENT_RTOL for row in kernels) else 0
 
 
 if __name__ == "__main__":

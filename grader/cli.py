@@ -7,9 +7,7 @@ Exit codes: 0 ok; 1 runtime error (a bug: it keeps its traceback); 2 usage or in
 from __future__ import annotations
 
 import argparse
-import difflib
 import json
-import math
 import os
 import re
 import shlex
@@ -21,11 +19,14 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from grader import __version__
-from grader.bank.template import TOPICS, Parameter, Template, load_banks
-from grader.errors import GraderError, UsageError, shown
-from grader.files import describe_os_error
-from grader.inputs import read_csv
-from grader.model.units import parse_unit, split_quantity
+from grader.errors import GraderError, UsageError, some
+
+if TYPE_CHECKING:
+    from grader.bank.template import Parameter, Template
+
+# Each command imports what it needs when it runs: `grader --help` and `grader list` do not pay for
+# the solver, and nothing imports sympy, scipy, matplotlib, typst, jinja2 or pint unless its command
+# needs it (a test checks this).
 
 if TYPE_CHECKING:  # imported when used: `grader list` must not pay for numpy
     from grader.grade.run import GradeSummary
@@ -192,6 +193,8 @@ def main(argv: Sequence[str] | None = None) -> int:
             _discard_stdout()
             return _error(f"cannot write to standard output ({error.strerror}); free some space, or send the "
                           "output to a file or program that takes it")
+        from grader.files import describe_os_error
+
         return _error(describe_os_error(error))
     finally:
         if previous is not None:
@@ -233,12 +236,27 @@ def _discard_stdout() -> None:
 
 
 def _bank(arguments: argparse.Namespace) -> dict[str, Template]:
-    folders = [*arguments.banks_global, *arguments.banks]
-    return load_banks(folders, shipped=not (arguments.no_shipped_bank_global or arguments.no_shipped_bank))
+    from grader.bank.template import load_banks
+
+    return load_banks(*_bank_sources(arguments))
+
+
+def _bank_sources(arguments: argparse.Namespace) -> tuple[list[Path], bool]:
+    """The ``--bank`` folders (given before or after the command), and whether the shipped bank is in."""
+    return ([*arguments.banks_global, *arguments.banks],
+            not (arguments.no_shipped_bank_global or arguments.no_shipped_bank))
 
 
 def _template(arguments: argparse.Namespace) -> Template:
-    bank = _bank(arguments)
+    """The template the command names: read from its own file, or else the bank's error."""
+    import difflib
+
+    from grader.bank.template import load_named
+
+    template = load_named(arguments.template, *_bank_sources(arguments))
+    if template is not None:
+        return template
+    bank = _bank(arguments)  # an unusable folder is refused as such; a missing template gets suggestions
     if arguments.template not in bank:
         close = difflib.get_close_matches(arguments.template, list(bank), n=3, cutoff=0.5)
         hint = f"; did you mean {' or '.join(close)}?" if close else f"; the bank has {', '.join(sorted(bank))}"
@@ -268,6 +286,8 @@ def _list(arguments: argparse.Namespace) -> int:
 
 def _by_topic(templates: Iterable[Template]) -> list[Template]:
     """Templates grouped by topic, in the order of :data:`TOPICS`, each group by id."""
+    from grader.bank.template import TOPICS
+
     return sorted(templates, key=lambda t: (TOPICS.index(t.topic), t.id))
 
 
@@ -327,23 +347,28 @@ def _show(arguments: argparse.Namespace) -> int:
 
 
 def _solve(arguments: argparse.Namespace) -> int:
+    from grader.solve.batch import json_lines, read_assignments, read_batch
     from grader.solve.cache import compiled_for
-    from grader.solve.evaluate import solve_batch, solve_one
+    from grader.solve.evaluate import solve_batch, solve_columns, solve_one
 
     template = _template(arguments)
     if arguments.batch is not None:
-        table, raw_rows, errors = _read_batch(arguments.batch, template)
+        batch = read_batch(arguments.batch, template)
         compiled = compiled_for(template)
-        solutions = solve_batch(template, compiled, table)
-        refused = 0
-        for row, solution in enumerate(solutions):
-            error = errors[row] or solution.error
-            refused += error is not None
-            params = raw_rows[row] if errors[row] else solution.params
-            _print_solution(template, params, solution.answers if error is None else None, error, arguments.json,
-                            row + 1)
+        if arguments.json:
+            result = solve_columns(template, compiled, batch.columns)
+            for lines in json_lines(template, compiled, batch, result):
+                sys.stdout.write(lines)
+            refused = any(e is not None or r is not None for e, r in zip(batch.errors, result.refusals, strict=True))
+            return EXIT_REFUSED if refused else EXIT_OK
+        refused = False
+        for row, solution in enumerate(solve_batch(template, compiled, batch.columns)):
+            error = batch.errors[row] or solution.error
+            refused |= error is not None
+            params = batch.cells(row) if batch.errors[row] else solution.params
+            _print_solution(template, params, solution.answers if error is None else None, error, False, row + 1)
         return EXIT_REFUSED if refused else EXIT_OK
-    params = _read_assignments(arguments.assignments, template)
+    params = read_assignments(arguments.assignments, template)
     solution = solve_one(template, compiled_for(template), params)
     _print_solution(template, solution.params, solution.answers, solution.error, arguments.json, None)
     return EXIT_REFUSED if solution.error else EXIT_OK
@@ -352,13 +377,9 @@ def _solve(arguments: argparse.Namespace) -> int:
 def _print_solution(template: Template, params: Any, answers: Any, error: str | None, as_json: bool,
                     row: int | None) -> None:
     if as_json:
-        record: dict[str, Any] = {"template": template.id} if row is None else {"template": template.id, "row": row}
-        record["params"] = dict(params)
-        if error is None:
-            record["answers"] = {name: value.to_json() for name, value in answers.items()}
-        else:
-            record["error"] = error
-        print(json.dumps(record, allow_nan=False))
+        from grader.solve.batch import record
+
+        print(json.dumps(record(template, params, answers, error, row), allow_nan=False))
         return
     heading = f"{template.id}" + (f", row {row}" if row is not None else "") + ": " + ", ".join(
         f"{name} = {_number(value)}{_unit(template.parameters[name])}" for name, value in params.items()
@@ -381,86 +402,6 @@ def _unit(parameter: Parameter) -> str:
     return f" {parameter.unit.text}" if parameter.unit.text else ""
 
 
-def _check_names(given: Sequence[str], template: Template, where: str) -> None:
-    unknown = [n for n in given if n not in template.parameters]
-    missing = [n for n in template.parameters if n not in given]
-    problems = []
-    if unknown:
-        problems.append(f"unknown parameter(s) {_some(unknown)}")
-    if missing:
-        problems.append(f"missing parameter(s) {_some(missing)}")
-    if problems:
-        raise UsageError(f"{where}: {'; '.join(problems)} (template '{template.id}' takes "
-                         f"{', '.join(template.parameters)})")
-
-
-def _some(names: Sequence[str], most: int = 10) -> str:
-    """Names for a message, at most ``most`` of them.
-
-    >>> _some([f"c{i}" for i in range(25)], 3)
-    'c0, c1, c2 and 22 more'
-    """
-    shown_names = ", ".join(shown(n, 40)[1:-1] for n in names[:most])
-    return shown_names + (f" and {len(names) - most:,} more" if len(names) > most else "")
-
-
-def _read_assignments(assignments: Sequence[str], template: Template) -> dict[str, float]:
-    params: dict[str, float] = {}
-    for text in assignments:
-        name, sep, value = text.partition("=")
-        name = name.strip()
-        if not sep or not name:
-            raise UsageError(f"--set {text}: expected NAME=VALUE, like h_drop=2.1")
-        if name in params:
-            raise UsageError(f"--set {text}: {name} is given twice")
-        if name in template.parameters:
-            params[name] = _read_value(value, template.parameters[name], f"--set {name}")
-        else:
-            params[name] = float("nan")
-    _check_names(list(params), template, "--set")
-    return params
-
-
-def _read_value(text: str, parameter: Parameter, where: str) -> float:
-    """A number in the parameter's unit, or with another unit of the same kind (``2.1 m``)."""
-    quantity = split_quantity(text)
-    expected = f"a finite number in {parameter.unit.text}" if parameter.unit.text else "a finite number"
-    if quantity is None:
-        raise GraderError(f"{where}: expected {expected}, got {shown(text.strip(), 40)}")
-    number, unit_text = quantity
-    if not unit_text:
-        return number + 0.0  # -0 is 0
-    try:
-        unit = parse_unit(unit_text)
-    except GraderError as error:
-        raise GraderError(f"{where}: expected {expected}, got {shown(text.strip(), 40)} ({error})") from None
-    if not unit.same_dimension(parameter.unit):
-        raise GraderError(f"{where}: '{unit_text}' cannot be converted to {parameter.unit.text or 'a pure number'}")
-    converted = number * unit.to_si / parameter.unit.to_si
-    if not math.isfinite(converted):
-        raise GraderError(f"{where}: expected {expected}, got {shown(text.strip(), 40)}")
-    return converted + 0.0
-
-
-def _read_batch(path: Path, template: Template) -> tuple[dict[str, Any], list[dict[str, str]], list[str | None]]:
-    table = read_csv(path)
-    _check_names(table.header, template, str(path))
-    if not table.rows:
-        raise UsageError(f"{path}: no data rows; expected the header line, then one row of values per line")
-    columns: dict[str, list[float]] = {name: [] for name in template.parameters}
-    errors: list[str | None] = []
-    for row in table.rows:
-        reason = row.problem
-        for name, parameter in template.parameters.items():
-            try:
-                columns[name].append(_read_value(row.cells[name], parameter, f"line {row.line}, {name}"))
-            except GraderError as problem:
-                columns[name].append(math.nan)
-                reason = reason or str(problem)
-        errors.append(reason)
-    return columns, [row.cells for row in table.rows], errors
-
-
 def _table(header: Sequence[str], rows: Sequence[Sequence[str]]) -> str:
     widths = [max(len(str(r[i])) for r in [header, *rows]) for i in range(len(header))]
     lines = ["  ".join(str(cell).ljust(width) for cell, width in zip(row, widths, strict=True)).rstrip()
@@ -473,11 +414,12 @@ def _simulate(arguments: argparse.Namespace) -> int:
     from grader.physics.integrate import Settings
     from grader.physics.run import Options
     from grader.simulate.walker import simulate
+    from grader.solve.batch import read_assignments
     from grader.solve.cache import compiled_for
     from grader.solve.evaluate import solve_one
 
     template = _template(arguments)
-    params = _read_assignments(arguments.assignments, template)
+    params = read_assignments(arguments.assignments, template)
     if arguments.method == "adaptive" and arguments.steps_per_contact is not None:
         raise UsageError("--steps-per-contact is for the fixed-step methods (euler, rk4); use --rtol with adaptive")
     if arguments.method != "adaptive" and arguments.rtol is not None:
@@ -619,7 +561,7 @@ def _grade(arguments: argparse.Namespace) -> int:
                           arguments.canvas)
     print(_graded_line(summary), file=sys.stderr)
     if summary.ignored_columns:
-        print(f"columns ignored: {_some(list(summary.ignored_columns))}", file=sys.stderr)
+        print(f"columns ignored: {some(list(summary.ignored_columns))}", file=sys.stderr)
     for note in summary.notes:
         print(f"note: {_printable(note)}", file=sys.stderr)
     if arguments.json:
@@ -702,6 +644,8 @@ def _check_arguments(arguments: argparse.Namespace) -> None:
 
 def _expected_quantity(text: str, unit: str | None) -> tuple[float | str, str]:
     """``--expected``: a number (``6.26``, or ``6.26 m/s`` when ``--unit`` is not given) or an expression."""
+    from grader.model.units import parse_unit, split_quantity
+
     quantity = split_quantity(text)
     if quantity is None:
         return text, unit or ""  # an expression

@@ -12,6 +12,7 @@ grader.errors.TemplateError: bank/x.yaml: parameters.e.domain: expected an inter
 from __future__ import annotations
 
 import reprlib
+from collections.abc import Sequence
 from typing import Any
 
 _SHOWN = reprlib.Repr()  # keyword arguments need Python 3.12
@@ -30,6 +31,16 @@ def shown(value: Any, limit: int = 80) -> str:
     """
     text = _SHOWN.repr(value)
     return text if len(text) <= limit else text[:limit - 3] + "..."
+
+
+def some(names: Sequence[str], most: int = 10) -> str:
+    """Names for a message, at most ``most`` of them, each cut to 40 characters.
+
+    >>> some([f"c{i}" for i in range(25)], 3)
+    'c0, c1, c2 and 22 more'
+    """
+    listed = ", ".join(shown(name, 40)[1:-1] for name in names[:most])
+    return listed + (f" and {len(names) - most:,} more" if len(names) > most else "")
 
 
 class GraderError(Exception):

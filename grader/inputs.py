@@ -22,6 +22,7 @@ from __future__ import annotations
 import codecs
 import csv
 import io
+import itertools
 import math
 import re
 from collections import Counter
@@ -304,6 +305,86 @@ def read_csv(path: Path, *, exports: bool = False) -> CsvTable:
     >>> table.header, [(row.line, row.cells) for row in table.rows]
     (('h_drop', 'h_rebound'), [(3, {'h_drop': '2100', 'h_rebound': '1100'}), (5, {'h_drop': '2,0', 'h_rebound': '1'})])
     """
+    head, records = _open_csv(path, exports)
+    header, width = head.header, len(head.header)
+    rows = []
+    for line, cells in records:
+        problem = None
+        longest = max(map(len, cells))
+        if longest > CELL_CHARS:
+            if not exports:
+                _check_cell_lengths(cells, path, line)
+            problem = f"line {line}: a cell of {longest:,} characters; expected at most {CELL_CHARS}"
+        problem = _width_problem(cells, width, line) or problem
+        if len(cells) != width:  # cells beyond the header's are dropped, missing ones are empty
+            cells = (cells + [""] * width)[:width]
+        rows.append(CsvRow(line, dict(zip(header, map(str.strip, cells), strict=True)), problem))
+    return CsvTable(path, header, tuple(rows), head.header_line, head.delimiter, head.encoding)
+
+
+@dataclass(frozen=True)
+class CsvColumns:
+    """A CSV file read column by column (for many rows of few columns): each column's cells (stripped)
+    by header name, each data row's line, and what is wrong with a row as a whole (see ``CsvRow``)."""
+
+    path: Path
+    header: tuple[str, ...]
+    columns: dict[str, list[str]]
+    lines: list[int]
+    problems: list[str | None]
+
+
+def read_csv_columns(path: Path) -> CsvColumns:
+    """A CSV file as :func:`read_csv` reads it (``exports=False``), as columns: no object per row.
+
+    >>> import tempfile, pathlib
+    >>> path = pathlib.Path(tempfile.mkdtemp()) / "c.csv"
+    >>> _ = path.write_text('h_drop,h_rebound\\n2100, 1100\\n\\n2000\\n1,2,3\\n')
+    >>> table = read_csv_columns(path)
+    >>> table.columns, table.lines
+    ({'h_drop': ['2100', '2000', '1'], 'h_rebound': ['1100', '', '2']}, [2, 4, 5])
+    >>> table.problems
+    [None, None, 'line 5: 3 cells, but the header has 2 columns; expected one cell per column']
+    """
+    head, records = _open_csv(path, False)
+    width = len(head.header)
+    lines, grid = [], []
+    try:
+        for line, cells in records:
+            lines.append(line)
+            grid.append(cells)
+    except GraderError:
+        _check_every_cell_length(grid, lines, path)  # a long cell before the line that cannot be read comes first
+        raise
+    _check_every_cell_length(grid, lines, path)
+    problems: list[str | None] = [None] * len(grid)
+    if set(map(len, grid)) != {width}:  # a row with fewer cells than the header, or more
+        for row, cells in enumerate(grid):
+            problems[row] = _width_problem(cells, width, lines[row])
+            grid[row] = cells[:width] + [""] * (width - len(cells))
+    columns = zip(*grid, strict=True) if grid else iter([()] * width)
+    return CsvColumns(path, head.header, {name: list(map(str.strip, column))
+                                          for name, column in zip(head.header, columns, strict=True)},
+                      lines, problems)
+
+
+def _check_every_cell_length(grid: list[list[str]], lines: list[int], path: Path) -> None:
+    """Refuse the first row (in file order) with a cell longer than ``CELL_CHARS``, as read_csv does."""
+    if grid and max(map(len, itertools.chain.from_iterable(grid))) > CELL_CHARS:
+        for line, cells in zip(lines, grid, strict=True):
+            _check_cell_lengths(cells, path, line)
+
+
+@dataclass(frozen=True)
+class _CsvHead:
+    header: tuple[str, ...]
+    header_line: int
+    delimiter: str
+    encoding: str
+
+
+def _open_csv(path: Path, exports: bool) -> tuple[_CsvHead, Iterator[tuple[int, list[str]]]]:
+    """The header of a CSV file, and its non-blank data rows to come: ``(line, cells)``."""
     data = read_bytes(path, CSV_BYTES)
     text, encoding = decode_export(data, path) if exports else (decode_text(data, path), "UTF-8")
     text_starts = len(text) - len(text.lstrip())  # on the first line that is not blank
@@ -320,23 +401,14 @@ def read_csv(path: Path, *, exports: bool = False) -> CsvTable:
         raise GraderError(f"{path}: no header line with text; expected a header line")
     header_line, header_cells = first_record
     _check_cell_lengths(header_cells, path, header_line)
-    header = _header(header_cells, path, header_line)
-    rows = []
-    width = len(header)
-    for line, cells in records:
-        problem = None
-        longest = max(map(len, cells))
-        if longest > CELL_CHARS:
-            if not exports:
-                _check_cell_lengths(cells, path, line)
-            problem = f"line {line}: a cell of {longest:,} characters; expected at most {CELL_CHARS}"
-        if len(cells) > width and any(map(str.strip, cells[width:])):
-            problem = (f"line {line}: {len(cells)} cells, but the header has {width} column"
-                       f"{'s' if width > 1 else ''}; expected one cell per column")
-        if len(cells) != width:  # cells beyond the header's are dropped, missing ones are empty
-            cells = (cells + [""] * width)[:width]
-        rows.append(CsvRow(line, dict(zip(header, map(str.strip, cells), strict=True)), problem))
-    return CsvTable(path, header, tuple(rows), header_line, delimiter, encoding)
+    return _CsvHead(_header(header_cells, path, header_line), header_line, delimiter, encoding), records
+
+
+def _width_problem(cells: list[str], width: int, line: int) -> str | None:
+    if len(cells) > width and any(c.strip() for c in cells[width:]):
+        return (f"line {line}: {len(cells)} cells, but the header has {width} column"
+                f"{'s' if width > 1 else ''}; expected one cell per column")
+    return None
 
 
 def _count_outside_quotes(line: str, delimiter: str) -> int:
@@ -345,6 +417,8 @@ def _count_outside_quotes(line: str, delimiter: str) -> int:
 
 
 def _check_cell_lengths(cells: list[str], path: Path, line: int) -> None:
+    if cells and max(map(len, cells)) <= CELL_CHARS:
+        return
     long = next((c for c in cells if len(c) > CELL_CHARS), None)
     if long is not None:
         raise GraderError(f"{path}: line {line}: a cell of {len(long):,} characters; expected at most {CELL_CHARS}")
@@ -353,20 +427,15 @@ def _check_cell_lengths(cells: list[str], path: Path, line: int) -> None:
 def _records(stream: io.StringIO, path: Path, delimiter: str, offset: int) -> Iterator[tuple[int, list[str]]]:
     reader = csv.reader(stream, delimiter=delimiter, strict=True)  # an unclosed quote is an error, not a cell
     end = 0
-    while True:
-        start = end + 1
-        try:
-            cells = next(reader)
-        except StopIteration:
-            return
-        except csv.Error as error:
-            reason = (f"a cell longer than {CELL_CHARS} characters" if "field limit" in str(error)
-                      else f"{error} (check the quotes)")
-            raise GraderError(f"{path}: line {offset + reader.line_num}: {reason}; expected CSV") from None
-        end = reader.line_num
-        if not any(map(str.strip, cells)):
-            continue
-        yield offset + start, cells
+    try:
+        for cells in reader:
+            start, end = end + 1, reader.line_num
+            if "".join(cells).strip():  # a row with a cell of text
+                yield offset + start, cells
+    except csv.Error as error:
+        reason = (f"a cell longer than {CELL_CHARS} characters" if "field limit" in str(error)
+                  else f"{error} (check the quotes)")
+        raise GraderError(f"{path}: line {offset + reader.line_num}: {reason}; expected CSV") from None
 
 
 def _header(cells: list[str], path: Path, line: int) -> tuple[str, ...]:

@@ -27,6 +27,11 @@ _PLACEHOLDER = re.compile(r"\{\{\s*([A-Za-z_][A-Za-z0-9_]*)\s*\}\}")
 _SPECIAL = {*keyword.kwlist, "true", "false", "none", "self", "loop", "caller", "varargs", "kwargs", "super"}
 
 
+def paragraphs(text: str) -> list[str]:
+    """Text split at blank lines, each paragraph on one line."""
+    return [" ".join(p.split()) for p in re.split(r"\n\s*\n", text) if p.strip()]
+
+
 def plain_fill(source: str, values: Mapping[str, str]) -> str | None:
     """``source`` filled in as :func:`grader.bank.statement.fill_statement` fills it, when it is
     text and ``{{ name }}`` of names in ``values`` only; None for anything else (Jinja2 reads it).

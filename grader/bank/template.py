@@ -30,6 +30,7 @@ from grader.resources import bank_dir
 RESERVED = {"g", "pi"}
 _BOUND = r"(-?inf|[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)"
 _INTERVAL = re.compile(rf"^\s*([\[(])\s*{_BOUND}\s*,\s*{_BOUND}\s*([\])])\s*$")
+_ID = re.compile(r"[a-z0-9][a-z0-9-]*\Z")
 _TOP_KEYS = {"id", "title", "topic", "version", "gravity", "bodies", "stages", "symbols", "parameters",
              "constraints", "answers", "tolerance", "statement", "example"}
 
@@ -209,6 +210,29 @@ def same_id(first: Template, second: Template) -> str:
             "its file name), or leave out its folder (--no-shipped-bank leaves out the shipped bank)")
 
 
+def load_one(template_id: str, directory: Path | None = None) -> Template | None:
+    """The template ``template_id`` of a bank folder, read from its own file alone (a template's id
+    is its file's name), or None when the folder has no such file: then :func:`load_bank` tells why.
+
+    >>> load_one("drop-rebound").title, load_one("../drop-rebound"), load_one("nothing-like-it")
+    ('Ball dropped onto a rigid floor', None, None)
+    """
+    path = (directory or bank_dir()) / f"{template_id}.yaml"
+    if not _ID.match(template_id) or not path.is_file():
+        return None
+    return load_template(path)
+
+
+def load_named(template_id: str, folders: Sequence[Path] = (), shipped: bool = True) -> Template | None:
+    """The template ``template_id`` of the banks :func:`load_banks` reads, from its own file alone, or
+    None when no folder has it (then :func:`load_banks` tells why); in two folders, refused as there."""
+    found = [template for folder in bank_folders(folders, shipped)
+             if (template := load_one(template_id, folder)) is not None]
+    if len(found) > 1:
+        raise GraderError(same_id(found[0], found[1]))
+    return found[0] if found else None
+
+
 def load_template(path: Path) -> Template:
     """Read, parse and validate one template file."""
     where = str(path)
@@ -226,7 +250,7 @@ def parse_template(raw: Mapping[str, Any], where: str, source_hash: str, stem: s
         raise TemplateError(where, ", ".join(sorted(map(str, unknown))),
                             f"only the keys {', '.join(sorted(_TOP_KEYS))}", "unknown key(s)")
     template_id = _text(raw, "id", where)
-    if not re.match(r"^[a-z0-9][a-z0-9-]*$", template_id):
+    if not _ID.match(template_id):
         raise TemplateError(where, "id", "lower-case letters, digits and -", shown(template_id))
     if stem is not None and stem != template_id:
         raise TemplateError(where, "id", f"the file name's stem '{stem}'", shown(template_id))
@@ -343,6 +367,31 @@ def _check_statement(template: Template, given: set[str]) -> None:
     refusal = typst_refusal(template.statement) or typst_refusal(filled)
     if refusal is not None:
         raise TemplateError(template.where, "statement", "text and math only", refusal)
+
+
+def filled_statement(template: Template, printed: Mapping[str, str]) -> str:
+    """The statement with a variant's printed values (symbols stay their names, ``g`` as the scene
+    gives it): text and ``{{ name }}`` filled in without Jinja2, anything else by the bounded sandbox
+    of :mod:`grader.bank.statement`. Typst code in the result is refused."""
+    from grader.bank.markup import plain_fill, typst_refusal
+
+    values = {n: n for n in template.symbols}
+    if template.scene.gravity is not None:
+        values["g"] = template.scene.gravity.text.split()[0]
+    values.update(printed)
+    filled = plain_fill(template.statement, values)
+    if filled is None:
+        from grader.bank.statement import StatementRefused, fill_statement
+
+        try:
+            filled = fill_statement(template.statement, values)
+        except StatementRefused as error:
+            raise GraderError(f"{template.where}: statement: expected values filled in, not code, got {error}") \
+                from None
+    refusal = typst_refusal(filled)
+    if refusal is not None:
+        raise GraderError(f"{template.where}: statement: expected text and math only, got {refusal}")
+    return filled
 
 
 def _jinja_fill(template: Template, given: set[str], values: dict[str, str]) -> str:

@@ -4,49 +4,158 @@ Every operation is vectorised, so one call answers any number of parameter sets.
 sine and cosine reduce the angle in degrees first, so ``cosd(90) == 0`` and ``cosd(89.9999999)``
 keeps full relative accuracy.
 
+:func:`evaluate` walks one tree (a constraint, a student's expression). :class:`Kernel` compiles
+named trees once into one function of numpy calls for the solver's hot path: a subtree that occurs
+more than once is computed once, constants are folded when it is built, the sine and cosine of
+one angle share their reduction, and on long float64 columns each call writes into an array no
+later step reads (``out=``) instead of allocating. None of this changes a number: every step is the
+same numpy operation on the same operands as in :func:`evaluate`.
+
 >>> import numpy as np
 >>> from grader.model.expr import parse
 >>> evaluate(parse("hypot(3*x, 4)"), {"x": np.array([1.0, 0.0])}).tolist()
 [5.0, 4.0]
 >>> float(cosd(np.float64(90.0))), float(sind(np.float64(-180.0)))
 (0.0, 0.0)
+>>> kernel = Kernel({"a": parse("sqrt(x) + sqrt(x)*g"), "b": parse("2*sqrt(x)")}, {"g": 9.0})
+>>> len(kernel), {name: value.tolist() for name, value in kernel({"x": np.array([4.0])}).items()}
+(4, {'a': [20.0], 'b': [4.0]})
 """
 
 from __future__ import annotations
 
-import functools
 import math
 from collections.abc import Callable, Mapping
 from fractions import Fraction
-from typing import Any
+from functools import reduce
+from typing import Any, NamedTuple
 
 import numpy as np
 
 from grader.model.expr import Node, Num, Op, Sym
 
+_NUMERIC: dict[str, Any] = {
+    "add": np.add, "sub": np.subtract, "mul": np.multiply, "div": np.divide, "neg": np.negative,
+    "sqrt": np.sqrt, "sin": np.sin, "cos": np.cos, "tan": np.tan, "exp": np.exp, "log": np.log,
+    "abs": np.absolute, "atan2": np.arctan2, "hypot": np.hypot, "Max": np.maximum, "Min": np.minimum,
+}
+"""Operations that are numpy ufuncs from float64 to float64: they can write into a given array."""
 
-def _quadrant(degrees: Any) -> tuple[Any, Any, Any]:
+
+_TRUTH: dict[str, Any] = {
+    "lt": np.less, "le": np.less_equal, "gt": np.greater, "ge": np.greater_equal,
+    "and": np.logical_and, "or": np.logical_or,
+}
+
+
+class _Quadrant(NamedTuple):
+    """An angle as ``360 j + 90 k + r`` degrees with ``|r| <= 45``, as arrays of at least one dimension."""
+
+    k: Any  # k mod 4, as int8
+    sine: Any  # sin r
+    cosine: Any  # cos r
+    shape: tuple[int, ...]  # the angle's own shape: () for a number
+
+
+def _quadrant(degrees: Any) -> _Quadrant:
+    """Reduce an angle in degrees exactly: ``fmod`` is exact, and ``r`` is the difference of two
+    close numbers. Arrays are written in place where they are this function's own."""
     x = np.asarray(degrees, dtype=float)
+    shape = x.shape
+    x = x.reshape(-1)  # a view: never written
     finite = np.isfinite(x)
-    reduced = np.fmod(np.where(finite, x, 0.0), 360.0)  # exact
-    quarter = np.round(reduced / 90.0)
-    rest = reduced - 90.0 * quarter  # exact: |rest| <= 45 and the operands are close
-    radians = rest * (np.pi / 180.0)
-    # A non-finite angle has no sine: NaN, which the caller refuses (never an index error).
-    return np.mod(quarter, 4).astype(int), np.where(finite, np.sin(radians), np.nan), np.where(
-        finite, np.cos(radians), np.nan)
+    every = bool(finite.all())
+    if not every:  # a non-finite angle has no sine: NaN, which the caller refuses (never an index error)
+        x = np.where(finite, x, 0.0)
+    # fmod(x, 360) is x itself when |x| < 360, as textbook angles are: skip its cost on long arrays.
+    inside = every and x.size >= _SHORT and float(x.min()) > -360.0 and float(x.max()) < 360.0
+    reduced = x if inside else np.fmod(x, 360.0)
+    quarter = np.divide(reduced, 90.0)
+    np.round(quarter, out=quarter)
+    radians = np.multiply(quarter, 90.0)
+    np.subtract(reduced, radians, out=radians)
+    radians *= np.pi / 180.0
+    k = quarter.astype(np.int8)  # |quarter| <= 4; int8 keeps this array small
+    k &= 3  # mod 4, negative quarters included
+    sine = np.sin(radians, out=quarter)
+    cosine = np.cos(radians, out=radians)
+    if not every:
+        sine[~finite] = np.nan
+        cosine[~finite] = np.nan
+    return _Quadrant(k, sine, cosine, shape)
+
+
+def _sine_of(quadrant: _Quadrant, turn: int = 0, out: Any = None) -> Any:
+    """The sine of ``90 turn + 90 k + r`` degrees, ``sin r * a + cos r * b`` with weights for ``k`` of
+    ``(1, 0)``, ``(0, 1)``, ``(-1, 0)``, ``(0, -1)``: one is ±1 and the other 0, so the sum is ±sin r or
+    ±cos r exactly (written into ``out``, a float64 array of the angle's shape, if given). Arithmetic,
+    not numpy.where, whose branches on mixed quadrants cost 5x more."""
+    of_sine, of_cosine = _weights(quadrant.k, turn)
+    value = np.multiply(quadrant.sine, of_sine, out=None if out is None else out.reshape(-1))
+    value += quadrant.cosine * of_cosine
+    value += 0.0  # turns -0.0 into 0.0 (atan2 tells them apart)
+    if out is not None:
+        return out
+    return value.reshape(quadrant.shape) if quadrant.shape else value[0]
+
+
+# Weights of (sin r, cos r) for k = 0..3 (the sine of 90 k + r degrees), and for k + 1 (its cosine).
+_WEIGHTS = ((np.array([1, 0, -1, 0], dtype=np.int8), np.array([0, 1, 0, -1], dtype=np.int8)),
+            (np.array([0, -1, 0, 1], dtype=np.int8), np.array([1, 0, -1, 0], dtype=np.int8)))
+
+
+def _weights(k: Any, turn: int) -> tuple[Any, Any]:
+    """The weights of ``sin r`` and ``cos r`` for ``k + turn`` quarter turns (int8): looked up in a
+    table for a few angles, computed for many (numpy's indexing costs more than five int8 operations)."""
+    if k.size < _SHORT:
+        return _WEIGHTS[turn][0][k], _WEIGHTS[turn][1][k]
+    if turn:
+        k = (k + turn) & 3
+    odd, sign = k & 1, 1 - (k & 2)
+    return (1 - odd) * sign, odd * sign
+
+
+def _cosine_of(quadrant: _Quadrant, out: Any = None) -> Any:
+    return _sine_of(quadrant, 1, out)  # cos x = sin(x + 90)
 
 
 def sind(degrees: Any) -> Any:
     """Sine of an angle in degrees."""
-    q, s, c = _quadrant(degrees)
-    return np.choose(q, [s, c, -s, -c]) + 0.0  # + 0.0 turns -0.0 into 0.0 (atan2 tells them apart)
+    return _sine_of(_quadrant(degrees))
 
 
 def cosd(degrees: Any) -> Any:
     """Cosine of an angle in degrees."""
-    q, s, c = _quadrant(degrees)
-    return np.choose(q, [c, -s, -c, s]) + 0.0
+    return _cosine_of(_quadrant(degrees))
+
+
+def _at_least(limit: Any, x: Any, out: Any = None) -> Any:
+    """``numpy.maximum(limit, x)`` for a number ``limit`` (not NaN) and a float64 array ``x``, three
+    times faster on long arrays (numpy's loop for a number first is slow): ``limit`` where it is
+    larger, else ``x``, which is what numpy.maximum gives where they are equal (its second argument:
+    -0.0 stays) or ``x`` is NaN."""
+    if x.size < _SHORT:
+        return np.maximum(limit, x, out=out)
+    return _limited(np.greater(limit, x), limit, x, out)
+
+
+def _at_most(limit: Any, x: Any, out: Any = None) -> Any:
+    """``numpy.minimum(limit, x)`` for a number ``limit`` (not NaN) and a float64 array ``x``."""
+    if x.size < _SHORT:
+        return np.minimum(limit, x, out=out)
+    return _limited(np.less(limit, x), limit, x, out)
+
+
+_SHORT = 4096  # elements below which allocating is cheap, and numpy's own loops beat planning around them
+
+
+def _limited(wins: Any, limit: Any, x: Any, out: Any) -> Any:
+    if out is None:
+        out = np.array(x, dtype=float)
+    elif out is not x:
+        np.copyto(out, x)
+    np.copyto(out, limit, where=wins)
+    return out
 
 
 def _power(base: Any, exponent: Any) -> Any:
@@ -55,16 +164,11 @@ def _power(base: Any, exponent: Any) -> Any:
     return np.power(base, exponent)
 
 
-OPERATIONS: dict[str, Callable[..., Any]] = {
-    "add": np.add, "sub": np.subtract, "mul": np.multiply, "div": np.divide, "neg": np.negative,
-    "pow": _power, "sqrt": np.sqrt, "sin": np.sin, "cos": np.cos, "tan": np.tan, "exp": np.exp,
-    "log": np.log, "abs": np.abs, "atan2": np.arctan2, "hypot": np.hypot, "sind": sind, "cosd": cosd,
-    "Max": np.maximum, "Min": np.minimum, "lt": np.less, "le": np.less_equal, "gt": np.greater, "ge": np.greater_equal,
-    # A constraint's ``a and b and c`` is one operation of three arguments: numpy's two-argument ufuncs
-    # would take the third for their output array (and drop that condition).
-    "and": lambda *args: functools.reduce(np.logical_and, args),
-    "or": lambda *args: functools.reduce(np.logical_or, args),
-}
+_LIMITS = {np.maximum: _at_least, np.minimum: _at_most}
+_WRITERS = {*_NUMERIC.values(), np.power, *_LIMITS.values(), _sine_of, _cosine_of}  # functions that take out=
+
+OPERATIONS: dict[str, Callable[..., Any]] = {**_NUMERIC, **_TRUTH, "pow": _power, "sind": sind, "cosd": cosd}
+"""Every operation of a tree by name (``and`` and ``or`` take two arguments here; a tree's may take more)."""
 
 
 def _float(value: Fraction | float) -> float:
@@ -88,4 +192,179 @@ def evaluate(node: Node, env: Mapping[str, Any]) -> Any:
             return np.pi
         return env[node.name]
     assert isinstance(node, Op)
-    return OPERATIONS[node.op](*(evaluate(arg, env) for arg in node.args))
+    return _apply(node.op, [evaluate(arg, env) for arg in node.args])
+
+
+def _apply(op: str, args: list[Any]) -> Any:
+    if op in ("and", "or"):  # a constraint may join more than two conditions
+        return reduce(_TRUTH[op], args)
+    return OPERATIONS[op](*args)
+
+
+class _Step(NamedTuple):
+    target: int  # the slot the result goes to
+    function: Callable[..., Any]
+    args: tuple[int, ...]
+    out: int  # a slot whose array nothing reads any more, to write the result into; -1: allocate
+
+
+class Kernel:
+    """Named trees compiled into numpy calls made in a row; ``kernel(inputs)`` evaluates them all.
+
+    Building it walks the trees once: equal subtrees become one step, operations on constants
+    (``constants`` and numbers) are done here, ``sind`` and ``cosd`` of one angle share its
+    reduction. The steps then become the text of one Python function, compiled once, so that a call
+    does no work per tree node beyond the numpy calls themselves (as ``sympy.lambdify`` does). That
+    text is made here from slot numbers alone (``v7 = f2(x0, c3, out=v5)``): no name, number or text
+    of a tree or template enters it, and it runs with no builtins, so it can only call this kernel's
+    own functions on its own values. When every input is a float64 array of one shape, and a long
+    one (``solve_columns`` gives such columns), a step whose function takes ``out=`` writes into the
+    array of a step that nothing reads any more, planned here; otherwise each step allocates its result.
+    Results are those of :func:`evaluate` bit for bit. A result may be an input array itself, or a
+    number when it depends on no input.
+    """
+
+    def __init__(self, trees: Mapping[str, Node], constants: Mapping[str, float] | None = None) -> None:
+        self._known: dict[str, Any] = {"pi": np.pi, **(constants or {})}
+        self._slots: dict[Any, int] = {}  # a node (or a derived key) -> its slot
+        self._values: list[Any] = []  # a slot's value when it is known now, else None
+        self._floats: list[bool] = []  # whether a slot holds float64 when the inputs do
+        self._steps: list[_Step] = []
+        self.inputs: list[str] = []
+        self.roots = {name: self._slot(tree) for name, tree in trees.items()}
+        self._plain = self._function(self._steps)
+        self._in_place = self._function(self._plan_buffers())
+
+    def __len__(self) -> int:
+        """How many numpy calls one evaluation makes (one per distinct subtree that needs the inputs)."""
+        return len(self._steps)
+
+    def __call__(self, inputs: Mapping[str, Any]) -> dict[str, Any]:
+        """Every tree's value, by name; ``inputs`` holds the names the trees use."""
+        arrays = [inputs[name] for name in self.inputs]
+        results = (self._in_place if _uniform(arrays) else self._plain)(*arrays)
+        return dict(zip(self.roots, results, strict=True))
+
+    def _function(self, steps: list[_Step]) -> Callable[..., tuple[Any, ...]]:
+        """One Python function making ``steps``' calls in order and returning the roots' values."""
+        inputs = {self._slots[("input", name)]: f"x{index}" for index, name in enumerate(self.inputs)}
+        namespace: dict[str, Any] = {"__builtins__": {}}
+        functions: dict[Callable[..., Any], str] = {}
+
+        def value(slot: int) -> str:
+            if slot in inputs:
+                return inputs[slot]
+            if self._values[slot] is not None:
+                namespace[f"c{slot}"] = self._values[slot]
+                return f"c{slot}"
+            return f"v{slot}"
+
+        lines = [f"def kernel({', '.join(inputs.values())}):"]
+        for step in steps:
+            called = functions.setdefault(step.function, f"f{len(functions)}")
+            namespace[called] = step.function
+            args = [value(arg) for arg in step.args] + ([f"out={value(step.out)}"] if step.out >= 0 else [])
+            lines.append(f"    v{step.target} = {called}({', '.join(args)})")
+        lines.append(f"    return ({''.join(value(slot) + ', ' for slot in self.roots.values())})")
+        exec(compile("\n".join(lines), "<grader kernel>", "exec"), namespace)  # noqa: S102  (text of slot numbers)
+        function: Callable[..., tuple[Any, ...]] = namespace["kernel"]
+        return function
+
+    def _new(self, key: Any, value: Any = None, floats: bool = True) -> int:
+        self._slots[key] = len(self._values)
+        self._values.append(value)
+        self._floats.append(floats)
+        return self._slots[key]
+
+    def _slot(self, node: Node) -> int:
+        if node in self._slots:
+            return self._slots[node]
+        if isinstance(node, Num):
+            return self._new(node, _float(node.value))
+        if isinstance(node, Sym):
+            if node.name in self._known:
+                return self._new(node, self._known[node.name])
+            if ("input", node.name) not in self._slots:
+                self.inputs.append(node.name)
+                self._new(("input", node.name))
+            self._slots[node] = self._slots[("input", node.name)]
+            return self._slots[node]
+        args = tuple(self._slot(arg) for arg in node.args)
+        if node.op in ("and", "or"):  # two at a time, as evaluate does
+            return reduce(lambda left, right: self._call(_TRUTH[node.op], (left, right), floats=False), args)
+        if node.op in ("sind", "cosd"):
+            quadrant = self._call(_quadrant, args, floats=False)
+            slot = self._call(_sine_of if node.op == "sind" else _cosine_of, (quadrant,), floats=True)
+        elif node.op == "pow":
+            slot = self._power(args)
+        else:
+            slot = self._call(OPERATIONS[node.op], args, floats=None if node.op in _NUMERIC else False)
+        self._slots[node] = slot
+        return slot
+
+    def _power(self, args: tuple[int, ...]) -> int:
+        base, exponent = args
+        if self._values[exponent] is None:  # an exponent that depends on the inputs
+            return self._call(_power, args)
+        if np.ndim(self._values[exponent]) == 0 and float(self._values[exponent]) == 2.0:
+            return self._call(np.multiply, (base, base))  # what _power does
+        return self._call(np.power, args)
+
+    def _call(self, function: Callable[..., Any], args: tuple[int, ...], floats: bool | None = None) -> int:
+        """The slot of ``function(*args)``: a known value when every argument is known, else a step.
+        ``floats``: whether the result is float64 when the inputs are; None: when its arguments are."""
+        key = (function, args)
+        if key in self._slots:
+            return self._slots[key]
+        known = [self._values[a] for a in args]
+        if all(value is not None for value in known):
+            with np.errstate(all="ignore"):  # as evaluate does it under the caller's errstate
+                return self._new(key, function(*known))
+        if floats is None:
+            floats = all(self._floats[a] if self._values[a] is None else _is_float(self._values[a]) for a in args)
+        slot = self._new(key, floats=floats)
+        self._steps.append(_Step(slot, function, args, -1))
+        return slot
+
+    def _plan_buffers(self) -> list[_Step]:
+        """The steps again, each ufunc writing into the array of a step no later step reads."""
+        last_use: dict[int, int] = {}
+        for index, step in enumerate(self._steps):
+            for arg in step.args:
+                last_use[arg] = index
+        for slot in self.roots.values():
+            last_use[slot] = len(self._steps)  # results are returned: never written over
+        computed = {step.target for step in self._steps}
+        free: list[int] = []
+        planned = []
+        for index, step in enumerate(self._steps):
+            for arg in dict.fromkeys(step.args):  # an argument read for the last time may be the output
+                if arg in computed and self._floats[arg] and last_use[arg] == index:
+                    free.append(arg)
+            step = self._faster(step)
+            writes = step.function in _WRITERS and self._floats[step.target] and free
+            planned.append(step._replace(out=free.pop()) if writes else step)
+        return planned
+
+    def _faster(self, step: _Step) -> _Step:
+        """``Max(0, x)`` (an energy lost is never negative) without numpy's slow loop for a number first."""
+        limit = self._values[step.args[0]]
+        if step.function in _LIMITS and _is_float(limit) and limit == limit and self._floats[step.args[1]]:
+            return step._replace(function=_LIMITS[step.function])
+        return step
+
+
+def _is_float(value: Any) -> bool:
+    return isinstance(value, float) or (isinstance(value, np.generic) and value.dtype == np.float64)
+
+
+_FLOAT64 = np.dtype(np.float64)
+
+
+def _uniform(arrays: list[Any]) -> bool:
+    """Whether every input is a float64 array of one shape (and not a short one), so every step's result
+    has that shape too."""
+    if not arrays or type(arrays[0]) is not np.ndarray or arrays[0].size < _SHORT:  # short: allocating is cheap
+        return False
+    shape = arrays[0].shape
+    return all(type(a) is np.ndarray and a.dtype is _FLOAT64 and a.shape == shape for a in arrays)

@@ -61,7 +61,7 @@ _BASE: dict[str, tuple[Fraction, int, tuple[int, int, int, int]]] = {
 }
 _ALIASES = {"°": "deg", "mph": "mi/h", "km/hr": "km/h", "sec": "s", "ft-lb": "ft*lbf", "ft*lb": "ft*lbf"}
 _TOKEN = re.compile(r"\s*([*/])?\s*([A-Za-z%°]+|1)\s*(?:(?:\^|\*\*)\s*(-?\d+))?\s*")
-_NUMBER = re.compile(r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?")
+NUMBER = re.compile(r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?")  # a number as a value is written
 MAX_POWER = 9  # no unit of mechanics needs more; bounds the exact factor's size
 MAX_TEXT = 100  # characters of a number with its unit
 
@@ -127,7 +127,7 @@ def split_quantity(text: str) -> tuple[float, str] | None:
     ((2100.0, 'mm'), None, None)
     """
     text = text.strip()
-    match = _NUMBER.match(text) if len(text) <= MAX_TEXT else None
+    match = NUMBER.match(text) if len(text) <= MAX_TEXT else None
     if match is None:
         return None
     value = float(match.group())

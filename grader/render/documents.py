@@ -32,8 +32,8 @@ import jinja2
 
 from grader.assign.assignment import Assignment
 from grader.assign.variants import AnswerPart, Generation, ProblemVariant
-from grader.bank.statement import StatementRefused, fill_statement, typst_refusal
-from grader.bank.template import Template
+from grader.bank.markup import paragraphs
+from grader.bank.template import Template, filled_statement
 from grader.errors import GraderError
 from grader.render.figures import figure
 from grader.render.typeset import compile_typst, font_paths, one_pdf
@@ -178,11 +178,6 @@ def _unit_text(unit: str) -> str:
     return {"deg": "degrees", "": "(no unit)"}.get(unit, unit.replace("^2", "²").replace("^3", "³").replace("*", "·"))
 
 
-def paragraphs(text_: str) -> list[str]:
-    """Text split at blank lines, each paragraph on one line."""
-    return [" ".join(p.split()) for p in re.split(r"\n\s*\n", text_) if p.strip()]
-
-
 class _Documents:
     """Builds the views of one generation, computing each variant's worked solution once."""
 
@@ -295,19 +290,8 @@ def _key_answer(template: Template, part: AnswerPart) -> KeyAnswer:
 
 def statement(template: Template, variant: ProblemVariant) -> Typ:
     """The template's statement (instructor-written Typst markup, text and math only) with the
-    variant's printed values, filled in by the bounded sandbox of :mod:`grader.bank.statement`."""
-    values: dict[str, Any] = {n: n for n in template.symbols}
-    if template.scene.gravity is not None:
-        values["g"] = template.scene.gravity.text.split()[0]
-    values.update(variant.printed)
-    try:
-        filled = fill_statement(template.statement, values)
-    except StatementRefused as error:
-        raise GraderError(f"{template.where}: statement: expected values filled in, not code, got {error}") from None
-    refusal = typst_refusal(filled)
-    if refusal is not None:
-        raise GraderError(f"{template.where}: statement: expected text and math only, got {refusal}")
-    return Typ(filled)
+    variant's printed values."""
+    return Typ(filled_statement(template, variant.printed))
 
 
 # --- documents ----------------------------------------------------------------------------------

@@ -13,9 +13,9 @@ from __future__ import annotations
 
 import math
 
-from grader.assign.variants import ProblemVariant, printed_text
-from grader.bank.template import Parameter, Template
-from grader.render.documents import paragraphs, statement
+from grader.assign.variants import printed_text
+from grader.bank.markup import paragraphs
+from grader.bank.template import Parameter, Template, filled_statement
 
 
 def example_printed(template: Template) -> dict[str, str]:
@@ -35,6 +35,4 @@ def _middle(parameter: Parameter) -> float:
 def example_statement(template: Template) -> str:
     """The statement filled in with :func:`example_printed`, as a sheet shows it (Typst markup, one
     line per paragraph)."""
-    printed = example_printed(template)
-    variant = ProblemVariant("1", template.id, "example", {n: float(v) for n, v in printed.items()}, printed, ())
-    return "\n\n".join(paragraphs(statement(template, variant)))
+    return "\n\n".join(paragraphs(filled_statement(template, example_printed(template))))

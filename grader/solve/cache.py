@@ -17,7 +17,6 @@ from pathlib import Path
 
 from grader import __version__
 from grader.bank.template import Template
-from grader.files import write_atomic
 from grader.solve.compiled import FORMAT, Compiled
 
 # Every stage folder whose source can change what the solver compiles: editing any file in them
@@ -56,6 +55,7 @@ def compiled_for(template: Template) -> Compiled:
         return Compiled.from_json(json.loads(path.read_text(encoding="utf-8")))
     except (OSError, ValueError, KeyError, TypeError, IndexError):
         pass
+    from grader.files import write_atomic  # only a first run writes
     from grader.solve.solver import compile_template
 
     compiled = compile_template(template)

@@ -7,9 +7,11 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass
+from functools import cached_property
 from typing import Any
 
 from grader.model.expr import Node, from_json, to_json, to_text
+from grader.model.kernel import Kernel
 
 FORMAT = 1
 
@@ -67,6 +69,23 @@ class Compiled:
     steps: tuple[Step, ...]
     checks: tuple[Check, ...]
     answers: Mapping[str, CompiledAnswer]
+
+    @cached_property
+    def kernel(self) -> Kernel:
+        """Every tree the solver evaluates per parameter set, compiled once (the first use builds it):
+        ``("holds", i)`` and ``("subject", i)`` of each check, ``("undefined", name, i)`` of each
+        answer's undefined conditions, and ``("answer", name)`` of each numeric answer."""
+        trees: dict[Any, Node] = {}
+        for index, check in enumerate(self.checks):
+            trees["holds", index] = check.holds
+            if check.subject is not None:
+                trees["subject", index] = check.subject
+        for name, answer in self.answers.items():
+            for index, rule in enumerate(answer.undefined):
+                trees["undefined", name, index] = rule.when
+            if answer.numeric is not None:
+                trees["answer", name] = answer.numeric
+        return Kernel(trees, self.constants)
 
     def to_json(self) -> dict[str, Any]:
         """A JSON-ready dictionary."""

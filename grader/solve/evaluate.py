@@ -81,12 +81,12 @@ def solve_columns(template: Template, compiled: Compiled, table: Mapping[str, An
     columns = {name: np.asarray(table[name], dtype=float) for name in template.parameters}
     count = len(next(iter(columns.values()))) if columns else 0
     refusals: list[str | None] = [None] * count
-    env: dict[str, Any] = {**columns, **compiled.constants}
     with np.errstate(all="ignore"):
         _check_domains(template, columns, refusals)
-        _check_constraints(template, env, refusals)
-        _check_physics(compiled, env, refusals)
-        values, undefined = _numeric_answers(compiled, env, refusals, count)
+        _check_constraints(template, columns, refusals)
+        trees = compiled.kernel(columns)
+        _check_physics(compiled, trees, refusals)
+        values, undefined = _numeric_answers(compiled, trees, refusals, count)
     return Columns(columns, values, undefined, refusals)
 
 
@@ -119,30 +119,30 @@ def _check_constraints(template: Template, env: Mapping[str, Any], refusals: lis
                 f"constraint {constraint.text} fails: {constraint.message}")
 
 
-def _check_physics(compiled: Compiled, env: Mapping[str, Any], refusals: list[str | None]) -> None:
-    for check in compiled.checks:
-        holds = np.asarray(evaluate(check.holds, env), dtype=bool)
+def _check_physics(compiled: Compiled, trees: Mapping[Any, Any], refusals: list[str | None]) -> None:
+    for index, check in enumerate(compiled.checks):
+        holds = np.asarray(trees["holds", index], dtype=bool)
         if check.subject is not None and "{value}" in check.message:
-            subject = np.broadcast_to(evaluate(check.subject, env), holds.shape)
+            subject = np.broadcast_to(trees["subject", index], holds.shape)
             _refuse(refusals, ~np.isfinite(subject), OVERFLOW)
             _refuse(refusals, ~holds, lambda row, s=subject, m=check.message: m.replace("{value}", _show(s[row])))
         else:
             _refuse(refusals, ~holds, check.message)
 
 
-def _numeric_answers(compiled: Compiled, env: Mapping[str, Any], refusals: list[str | None],
+def _numeric_answers(compiled: Compiled, trees: Mapping[Any, Any], refusals: list[str | None],
                      count: int) -> tuple[dict[str, Any], dict[str, list[str | None]]]:
     values: dict[str, Any] = {}
     undefined: dict[str, list[str | None]] = {}
     for name, answer in compiled.answers.items():
         missing: list[str | None] = [None] * count
-        for rule in answer.undefined:
-            for row in np.flatnonzero(np.broadcast_to(evaluate(rule.when, env), (count,))):
+        for index, rule in enumerate(answer.undefined):
+            for row in np.flatnonzero(np.broadcast_to(trees["undefined", name, index], (count,))):
                 missing[row] = missing[row] or rule.reason
         undefined[name] = missing
         if answer.numeric is None:
             continue
-        value = np.broadcast_to(np.asarray(evaluate(answer.numeric, env), dtype=float), (count,))
+        value = np.broadcast_to(np.asarray(trees["answer", name], dtype=float), (count,))
         values[name] = value
         bad = ~np.isfinite(value) & np.array([m is None for m in missing])
         _refuse(refusals, bad, f"answer {name}: {OVERFLOW}")

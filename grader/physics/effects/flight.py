@@ -13,7 +13,6 @@ import numpy as np
 
 from grader.model.units import LENGTH, SPEED
 from grader.physics.effects.base import Condition, Effect, Field, Relation
-from grader.physics.integrate import Mode
 
 if TYPE_CHECKING:
     from grader.model.scene import Stage
@@ -66,6 +65,8 @@ def gravity(g: float) -> Any:
 
 
 def _simulate_fall(stage: Stage, run: Run) -> None:
+    from grader.physics.integrate import Mode  # the simulator's part: loading a template needs none of it
+
     height, g, body = run.value(stage.fields["height"]), run.gravity(), stage.fields["body"]
     run.uses("gravity")
     if height <= 0:
@@ -81,6 +82,8 @@ def _simulate_fall(stage: Stage, run: Run) -> None:
 
 
 def _simulate_rise(stage: Stage, run: Run) -> None:
+    from grader.physics.integrate import Mode  # the simulator's part: loading a template needs none of it
+
     speed, g, body = run.value(stage.fields["speed"]), run.gravity(), stage.fields["body"]
     run.uses("gravity")
     if speed <= 0:

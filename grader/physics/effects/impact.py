@@ -25,8 +25,6 @@ import numpy as np
 from grader.model.expr import Sym
 from grader.model.units import PURE, SPEED, dimension_from
 from grader.physics.effects.base import Condition, Effect, Field, Relation, Stable
-from grader.physics.integrate import Mode
-from grader.physics.run import ContactRecord
 
 if TYPE_CHECKING:
     from grader.model.scene import Stage
@@ -160,6 +158,9 @@ def _simulate_impact(stage: Stage, run: Run) -> None:
 
 def _contact(stage: Stage, run: Run, bodies: tuple[str, str], inverse: tuple[float, float], e: float,
              before: list[float]) -> list[float]:
+    from grader.physics.integrate import Mode  # the simulator's part: loading a template needs none of it
+    from grader.physics.run import ContactRecord
+
     w1, w2 = inverse
     share1, share2 = w1 / (w1 + w2), w2 / (w1 + w2)
     law = ContactLaw.calibrated(e, run.options.contact_duration)

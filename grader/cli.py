@@ -251,7 +251,7 @@ def _show(arguments: argparse.Namespace) -> int:
     scene = template.scene
     lines = [f"{template.id} (version {template.version}): {template.title}", "", "Bodies:"]
     lines += [f"  {b.name}: {'fixed surface' if b.mass is None else 'mass ' + to_text(b.mass)}"
-              for b in scene.bodies.values()]
+              + (f", radius {to_text(b.radius)}" if b.radius is not None else "") for b in scene.bodies.values()]
     lines += ["", "Stages:"]
     lines += [f"  {s.index + 1}. {s.effect}: " + ", ".join(f"{k}={v}" for k, v in s.source.items())
               for s in scene.stages]

@@ -458,12 +458,19 @@ def test_other_templates_pages_render_to_pngs(others: tuple[Assignment, Generati
     (ARTIFACTS / "answer-key-other-templates.png").write_bytes(key)
 
 
-def test_an_asked_height_is_not_drawn_to_scale(assignment: Assignment, bank: dict[str, Template]) -> None:
-    """moving-plate asks how high the ball rises: two variants that differ only in e (so in that
-    height) get the same figure, which would otherwise give the answer away."""
-    def drawn(e: float) -> str:
-        spec = ProblemSpec("1", "moving-plate", {"*": 1.0}, {"h": 1.2, "u": 1.5, "e": e}, {}, {})
-        one = dataclasses.replace(assignment, problems=(spec,))
-        variant = generate(one, (Student("s1", "Sam", "", ""),), bank).students[0].problems[0]
-        return figure(bank["moving-plate"], variant, worked(bank["moving-plate"], variant).values)
-    assert drawn(0.5) == drawn(0.9)
+def _figure_of(assignment: Assignment, bank: dict[str, Template], template_id: str, fixed: dict[str, float]) -> str:
+    spec = ProblemSpec("1", template_id, {"*": 1.0}, fixed, {}, {})
+    one = dataclasses.replace(assignment, problems=(spec,))
+    variant = generate(one, (Student("s1", "Sam", "", ""),), bank).students[0].problems[0]
+    return figure(bank[template_id], variant, worked(bank[template_id], variant).values)
+
+
+@pytest.mark.parametrize("template_id, fixed", [
+    ("moving-plate", {"h": 1.2, "u": 1.5}),  # the height the ball rises
+])
+def test_an_asked_height_or_angle_is_not_drawn_to_scale(assignment: Assignment, bank: dict[str, Template],
+                                                        template_id: str, fixed: dict[str, float]) -> None:
+    """Two variants that differ only in e (so in what is asked) get the same figure, which would otherwise
+    give the answer away."""
+    assert _figure_of(assignment, bank, template_id, {**fixed, "e": 0.5}) == \
+        _figure_of(assignment, bank, template_id, {**fixed, "e": 0.9})

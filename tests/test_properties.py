@@ -239,6 +239,7 @@ def _widened(template: Template, name: str) -> st.SearchStrategy[float]:
     "moving-plate",
     "three-balls",
     "two-rebounds",
+    "incline-bounce",
 ])
 @PROPERTY
 @given(data=st.data())

@@ -467,6 +467,7 @@ def _figure_of(assignment: Assignment, bank: dict[str, Template], template_id: s
 
 @pytest.mark.parametrize("template_id, fixed", [
     ("moving-plate", {"h": 1.2, "u": 1.5}),  # the height the ball rises
+    ("incline-bounce", {"h": 1.2, "beta": 30}),  # the angle of the rebound
 ])
 def test_an_asked_height_or_angle_is_not_drawn_to_scale(assignment: Assignment, bank: dict[str, Template],
                                                         template_id: str, fixed: dict[str, float]) -> None:

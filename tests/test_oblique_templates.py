@@ -20,6 +20,7 @@ from tests import references
 G = mp.mpf(9.81)  # the bank's g, as the float the kernels use
 ISSUE = {  # ids, parameters and answers exactly as issue 13's table names them
     "incline-bounce": (["h", "beta", "e"], ["v_out", "theta_out"]),
+    "billiards": (["v", "r", "b", "e"], ["v_cue", "v_obj", "angle_cue", "loss_pct"]),
 }
 
 
@@ -49,7 +50,26 @@ def ref_incline_bounce(h, beta, e):
     return {"v_out": mp.sqrt(out**2 + down**2), "theta_out": mp.degrees(mp.atan2(out, down))}
 
 
-REFERENCES = {"incline-bounce": ref_incline_bounce}
+def spheres(m1, m2, r1, r2, v1, b, e):
+    """Sphere 1 at v1 along x; sphere 2 at rest, its centre b off that line: velocities after, energies."""
+    m1, m2, r1, r2, v1, b, e = (mp.mpf(x) for x in (m1, m2, r1, r2, v1, b, e))
+    reach = r1 + r2
+    n = (mp.sqrt(reach**2 - b**2) / reach, b / reach)  # the line of centres at contact: sin theta = b/(r1 + r2)
+    u = (v1, mp.mpf(0))
+    impulse = (1 + e) * dot(u, n) / (1 / m1 + 1 / m2)  # from momentum along n and separation = e approach
+    w1 = (u[0] - impulse / m1 * n[0], u[1] - impulse / m1 * n[1])
+    w2 = (impulse / m2 * n[0], impulse / m2 * n[1])
+    before = m1 * dot(u, u) / 2
+    after = m1 * dot(w1, w1) / 2 + m2 * dot(w2, w2) / 2
+    return u, w1, w2, mp.chop(100 * (before - after) / before, 1e-40)  # e = 1: 0, not 60-digit rounding
+
+
+def ref_billiards(v, r, b, e):
+    u, cue, obj, loss = spheres(1, 1, r, r, v, b, e)
+    return {"v_cue": speed(cue), "v_obj": speed(obj), "angle_cue": angle_between(u, cue), "loss_pct": loss}
+
+
+REFERENCES = {"incline-bounce": ref_incline_bounce, "billiards": ref_billiards}
 
 
 def check(bank, compiled, template_id, params):
@@ -66,6 +86,10 @@ def test_ids_parameters_and_answers_are_the_issues(bank):
     # v = sqrt(2(9.81)(1.2)) = 4.852: v_n = v cos 30 = 4.202 reverses to e v_n = 2.521, v_t = v sin 30 = 2.426
     # stays; v' = 3.499 at atan(2.521/2.426) = 46.10 deg from the surface
     ("incline-bounce", {"h": 1.2, "beta": 30, "e": 0.6}, {"v_out": 3.499, "theta_out": 46.1}),
+    # sin theta = 30/57: v_n = 1.701, v_t = 1.053; equal masses: cue keeps v_n (1 - e)/2 = 0.08503 and v_t,
+    # the object ball gets v_n (1 + e)/2 = 1.616; turned by atan2(1.053, 0.08503) - 31.76 deg; lost (1 - e^2) cos^2/2
+    ("billiards", {"v": 2, "r": 28.5, "b": 30, "e": 0.9},
+     {"v_cue": 1.056, "v_obj": 1.616, "angle_cue": 53.62, "loss_pct": 6.868}),
 ])
 def test_known_answers(bank, compiled, template_id, params, answers):
     """The hand-worked values to four figures, and the reference to 1e-9."""
@@ -82,10 +106,26 @@ def test_incline_bounce(bank, compiled, h, beta, e):
     check(bank, compiled, "incline-bounce", {"h": h, "beta": beta, "e": e})
 
 
+@pytest.mark.parametrize("e", [0.0, 1.0, 0.9])
+@pytest.mark.parametrize("offset", [0.0, 1e-9, 0.5, 1 - 1e-9, 1 - 1e-12], ids=["head-on", "b=1e-9", "half",
+                                                                              "near-grazing", "grazing-1e-12"])
+@pytest.mark.parametrize("v, r", [(2.0, 28.5), (1e-150, 28.5), (1e170, 28.5), (2.0, 1e-150), (2.0, 1e170)],
+                         ids=["table", "tiny-v", "large-v", "tiny-r", "large-r"])
+def test_billiards(bank, compiled, v, r, offset, e):
+    """b as a share of 2r; head-on with e = 1 the cue ball stops, and the angle it turns is undefined.
+    Closer to grazing than 1e-12 the answers are ill-conditioned: one ulp of b moves them by more than 1e-9."""
+    check(bank, compiled, "billiards", {"v": v, "r": r, "b": offset * 2 * r, "e": e})
+
+
 # ---- refusals name the reason -----------------------------------------------------------------
 @pytest.mark.parametrize("template_id, params, reason", [
     ("incline-bounce", {"h": 1.2, "beta": 90, "e": 0.5}, "beta = 90 deg is outside its domain (0, 90)"),
     ("incline-bounce", {"h": 1.2, "beta": 0, "e": 0.5}, "beta = 0 deg is outside its domain (0, 90)"),
+    ("billiards", {"v": 2, "r": 28.5, "b": 57, "e": 0.9},
+     "b/(r + r) is 1: the offset b must be below the sum of the radii, or cue passes object without striking it "
+     "(at b = r + r it only grazes it)"),
+    ("billiards", {"v": 2, "r": 28.5, "b": 60, "e": 0.9}, "b/(r + r) is 1.05263"),
+    ("billiards", {"v": 2, "r": 28.5, "b": -1, "e": 0.9}, "b = -1 mm is outside its domain [0, inf)"),
 ])
 def test_unphysical_input_is_refused_with_the_reason(bank, compiled, template_id, params, reason):
     solution = solve_one(bank[template_id], compiled[template_id], params)

@@ -240,6 +240,7 @@ def _widened(template: Template, name: str) -> st.SearchStrategy[float]:
     "three-balls",
     "two-rebounds",
     "incline-bounce",
+    "billiards",
 ])
 @PROPERTY
 @given(data=st.data())

@@ -475,3 +475,18 @@ def test_an_asked_height_or_angle_is_not_drawn_to_scale(assignment: Assignment, 
     give the answer away."""
     assert _figure_of(assignment, bank, template_id, {**fixed, "e": 0.5}) == \
         _figure_of(assignment, bank, template_id, {**fixed, "e": 0.9})
+
+
+@pytest.mark.parametrize("template_id, fixed, sine", [
+    ("billiards", {"v": 2, "r": 28.5, "b": 30, "e": 0.9}, 30 / 57),
+])
+def test_the_line_of_centres_is_drawn_at_the_variants_angle(assignment: Assignment, bank: dict[str, Template],
+                                                            template_id: str, fixed: dict[str, float],
+                                                            sine: float) -> None:
+    """The two circles touch, and the line through their centres makes asin(b/(r1 + r2)) with the path
+    (horizontal), to the figure's 0.01 cm."""
+    drawn = _figure_of(assignment, bank, template_id, fixed)
+    circles = re.findall(r"fig-circle\(\(([-0-9.]+), ([-0-9.]+)\), ([0-9.]+), w: 0.8pt, fill", drawn)
+    (x1, y1, r1), (x2, y2, r2) = [tuple(map(float, found)) for found in circles]
+    assert abs(((x2 - x1) ** 2 + (y2 - y1) ** 2) ** 0.5 - (r1 + r2)) < 0.02
+    assert abs((y1 - y2) / (r1 + r2) - sine) < 0.02  # Typst's y points down

@@ -75,6 +75,7 @@ def test_every_bank_template_is_cross_checked_by_simulation(bank: dict[str, Temp
     ("ball-plate", {"v": 50, "theta": 30, "e": 0.5}, ("contact (Kelvin-Voigt)",)),
     ("drop-rebound", {"h_drop": 2100, "h_rebound": 1100}, ("gravity", "contact (Kelvin-Voigt)")),
     ("incline-bounce", {"h": 1.2, "beta": 30, "e": 0.6}, ("gravity", "contact (Kelvin-Voigt)")),
+    ("billiards", {"v": 2, "r": 28.5, "b": 30, "e": 0.9}, ("uniform motion to contact", "contact (Kelvin-Voigt)")),
 ])
 def test_only_the_effects_a_scene_declares_are_simulated(template_id: str, params: dict[str, float],
                                                          effects: tuple[str, ...],
@@ -424,3 +425,15 @@ def test_the_weight_on_an_incline_acts_the_way_the_ball_fell(bank: dict[str, Tem
     assert v_out is not None and theta_out is not None
     assert 0 < v_out - closed["v_out"].value < 0.01 * closed["v_out"].value  # type: ignore[operator]
     assert 0 < closed["theta_out"].value - theta_out < 0.01 * theta_out  # type: ignore[operator]
+
+
+@pytest.mark.parametrize("template_id, params", [
+    ("billiards", {"v": 2, "r": 28.5, "b": 0, "e": 1}),
+    ("billiards", {"v": 2, "r": 28.5, "b": 57 * (1 - 1e-6), "e": 0.9}),
+], ids=["head-on-e1", "near-grazing"])
+def test_the_line_of_centres_is_found_where_the_simulated_spheres_touch(template_id: str, params: dict[str, float],
+                                                                      bank: dict[str, Template],
+                                                                      compiled: dict[str, Compiled]) -> None:
+    """Sphere 1 moves along its line until the centres are r1 + r2 apart (a located event); the line of
+    centres measured there, then the contact, give the closed form's answers, head-on to near grazing."""
+    assert max(_compare(bank[template_id], compiled[template_id], params, ADAPTIVE).values()) < 1e-8

@@ -2,7 +2,7 @@
 
 >>> bank = load_bank()
 >>> sorted(bank)[:2]
-['ball-plate', 'car-collision']
+['ball-plate', 'billiards']
 >>> bank["drop-rebound"].parameters["h_drop"].unit.text
 'mm'
 """

@@ -21,6 +21,8 @@ G = mp.mpf(9.81)  # the bank's g, as the float the kernels use
 ISSUE = {  # ids, parameters and answers exactly as issue 13's table names them
     "incline-bounce": (["h", "beta", "e"], ["v_out", "theta_out"]),
     "billiards": (["v", "r", "b", "e"], ["v_cue", "v_obj", "angle_cue", "loss_pct"]),
+    "offset-spheres": (["m1", "m2", "r1", "r2", "v1", "b", "e"], ["v1_out", "v2_out", "theta1_out", "theta2_out",
+                                                                  "loss_pct"]),
 }
 
 
@@ -69,7 +71,13 @@ def ref_billiards(v, r, b, e):
     return {"v_cue": speed(cue), "v_obj": speed(obj), "angle_cue": angle_between(u, cue), "loss_pct": loss}
 
 
-REFERENCES = {"incline-bounce": ref_incline_bounce, "billiards": ref_billiards}
+def ref_offset_spheres(m1, m2, r1, r2, v1, b, e):
+    u, w1, w2, loss = spheres(m1, m2, r1, r2, v1, b, e)
+    return {"v1_out": speed(w1), "v2_out": speed(w2), "theta1_out": angle_between(u, w1),
+            "theta2_out": angle_between(u, w2), "loss_pct": loss}
+
+
+REFERENCES = {"incline-bounce": ref_incline_bounce, "billiards": ref_billiards, "offset-spheres": ref_offset_spheres}
 
 
 def check(bank, compiled, template_id, params):
@@ -90,6 +98,11 @@ def test_ids_parameters_and_answers_are_the_issues(bank):
     # the object ball gets v_n (1 + e)/2 = 1.616; turned by atan2(1.053, 0.08503) - 31.76 deg; lost (1 - e^2) cos^2/2
     ("billiards", {"v": 2, "r": 28.5, "b": 30, "e": 0.9},
      {"v_cue": 1.056, "v_obj": 1.616, "angle_cue": 53.62, "loss_pct": 6.868}),
+    # sin theta = 35/70, theta = 30 deg: v_n = 4.330, v_t = 2.5; J = 1.6 (2/3)(4.330) = 4.619; v1n' = 2.021,
+    # v2n' = 4.619; sphere 1 at atan2(2.5, 2.021) = 51.05 deg from n, 21.05 from its path; sphere 2 along n;
+    # lost 1/2 (2/3)(1 - 0.36)(4.330^2) = 4 J of 25 J
+    ("offset-spheres", {"m1": 2, "m2": 1, "r1": 40, "r2": 30, "v1": 5, "b": 35, "e": 0.6},
+     {"v1_out": 3.215, "v2_out": 4.619, "theta1_out": 21.05, "theta2_out": 30, "loss_pct": 16}),
 ])
 def test_known_answers(bank, compiled, template_id, params, answers):
     """The hand-worked values to four figures, and the reference to 1e-9."""
@@ -117,6 +130,25 @@ def test_billiards(bank, compiled, v, r, offset, e):
     check(bank, compiled, "billiards", {"v": v, "r": r, "b": offset * 2 * r, "e": e})
 
 
+@pytest.mark.parametrize("e", [0.0, 1.0, 0.6])
+@pytest.mark.parametrize("m1, m2", [(1e-12, 1.0), (1e-6, 1.0), (2.0, 1.0), (1e6, 1.0), (1e12, 1.0)],
+                         ids=["m1=1e-12", "m1=1e-6", "m1=2", "m1=1e6", "m1=1e12"])
+@pytest.mark.parametrize("b", [0.0, 35.0, 70 * (1 - 1e-9)], ids=["head-on", "30deg", "near-grazing"])
+def test_offset_spheres(bank, compiled, m1, m2, b, e):
+    """A sphere 10^12 times heavier than the one it strikes turns by 10^-12 of the line of centres' angle,
+    and keeps it to 1e-9; one 10^12 times lighter bounces back (theta1_out near 180)."""
+    check(bank, compiled, "offset-spheres", {"m1": m1, "m2": m2, "r1": 40.0, "r2": 30.0, "v1": 5.0, "b": b, "e": e})
+
+
+@pytest.mark.parametrize("r1, r2, v1", [(1e-150, 3e-150, 5.0), (1e170, 3e170, 5.0), (40.0, 30.0, 1e-150),
+                                        (40.0, 30.0, 1e170), (1e-3, 1e3, 5.0)],
+                         ids=["tiny-radii", "large-radii", "tiny-v", "large-v", "radii-1e6-apart"])
+def test_offset_spheres_tiny_and_large_values(bank, compiled, r1, r2, v1):
+    """Lengths enter only as b/(r1 + r2), speeds only as a scale: nothing over- or underflows."""
+    check(bank, compiled, "offset-spheres",
+          {"m1": 2.0, "m2": 3.0, "r1": r1, "r2": r2, "v1": v1, "b": 0.4 * (r1 + r2), "e": 0.7})
+
+
 # ---- refusals name the reason -----------------------------------------------------------------
 @pytest.mark.parametrize("template_id, params, reason", [
     ("incline-bounce", {"h": 1.2, "beta": 90, "e": 0.5}, "beta = 90 deg is outside its domain (0, 90)"),
@@ -126,6 +158,10 @@ def test_billiards(bank, compiled, v, r, offset, e):
      "(at b = r + r it only grazes it)"),
     ("billiards", {"v": 2, "r": 28.5, "b": 60, "e": 0.9}, "b/(r + r) is 1.05263"),
     ("billiards", {"v": 2, "r": 28.5, "b": -1, "e": 0.9}, "b = -1 mm is outside its domain [0, inf)"),
+    ("offset-spheres", {"m1": 2, "m2": 1, "r1": 40, "r2": 30, "v1": 5, "b": 70, "e": 0.6},
+     "b/(r1 + r2) is 1: the offset b must be below the sum of the radii, or sphere1 passes sphere2"),
+    ("offset-spheres", {"m1": 2, "m2": 1, "r1": 40, "r2": 30, "v1": 5, "b": 35, "e": 1.2},
+     "e = 1.2 is outside its domain [0, 1]"),
 ])
 def test_unphysical_input_is_refused_with_the_reason(bank, compiled, template_id, params, reason):
     solution = solve_one(bank[template_id], compiled[template_id], params)

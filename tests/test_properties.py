@@ -241,6 +241,7 @@ def _widened(template: Template, name: str) -> st.SearchStrategy[float]:
     "two-rebounds",
     "incline-bounce",
     "billiards",
+    "offset-spheres",
 ])
 @PROPERTY
 @given(data=st.data())

@@ -479,6 +479,8 @@ def test_an_asked_height_or_angle_is_not_drawn_to_scale(assignment: Assignment, 
 
 @pytest.mark.parametrize("template_id, fixed, sine", [
     ("billiards", {"v": 2, "r": 28.5, "b": 30, "e": 0.9}, 30 / 57),
+    ("offset-spheres", {"m1": 2, "m2": 1, "r1": 40, "r2": 30, "v1": 5, "b": 35, "e": 0.6}, 0.5),
+    ("offset-spheres", {"m1": 2, "m2": 1, "r1": 20, "r2": 50, "v1": 5, "b": 68, "e": 0.6}, 68 / 70),
 ])
 def test_the_line_of_centres_is_drawn_at_the_variants_angle(assignment: Assignment, bank: dict[str, Template],
                                                             template_id: str, fixed: dict[str, float],

@@ -430,7 +430,9 @@ def test_the_weight_on_an_incline_acts_the_way_the_ball_fell(bank: dict[str, Tem
 @pytest.mark.parametrize("template_id, params", [
     ("billiards", {"v": 2, "r": 28.5, "b": 0, "e": 1}),
     ("billiards", {"v": 2, "r": 28.5, "b": 57 * (1 - 1e-6), "e": 0.9}),
-], ids=["head-on-e1", "near-grazing"])
+    ("offset-spheres", {"m1": 1e-6, "m2": 1, "r1": 40, "r2": 30, "v1": 5, "b": 35, "e": 0}),
+    ("offset-spheres", {"m1": 1e6, "m2": 1, "r1": 1e-3, "r2": 1e3, "v1": 5, "b": 600, "e": 0.6}),
+], ids=["head-on-e1", "near-grazing", "light-sphere-1", "heavy-sphere-1"])
 def test_the_line_of_centres_is_found_where_the_simulated_spheres_touch(template_id: str, params: dict[str, float],
                                                                       bank: dict[str, Template],
                                                                       compiled: dict[str, Compiled]) -> None:

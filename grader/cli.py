@@ -329,7 +329,7 @@ def _show(arguments: argparse.Namespace) -> int:
     _print_solution(template, example.params, example.answers, example.error, False, None)
     lines = ["", "Bodies:"]
     lines += [f"  {b.name}: {'fixed surface' if b.mass is None else 'mass ' + to_text(b.mass)}"
-              for b in scene.bodies.values()]
+              + (f", radius {to_text(b.radius)}" if b.radius is not None else "") for b in scene.bodies.values()]
     lines += ["", "Stages:"]
     lines += [f"  {s.index + 1}. {s.effect}: " + ", ".join(f"{k}={v}" for k, v in s.source.items())
               for s in scene.stages]

@@ -239,6 +239,9 @@ def _widened(template: Template, name: str) -> st.SearchStrategy[float]:
     "moving-plate",
     "three-balls",
     "two-rebounds",
+    "incline-bounce",
+    "billiards",
+    "offset-spheres",
 ])
 @PROPERTY
 @given(data=st.data())

@@ -458,12 +458,37 @@ def test_other_templates_pages_render_to_pngs(others: tuple[Assignment, Generati
     (ARTIFACTS / "answer-key-other-templates.png").write_bytes(key)
 
 
-def test_an_asked_height_is_not_drawn_to_scale(assignment: Assignment, bank: dict[str, Template]) -> None:
-    """moving-plate asks how high the ball rises: two variants that differ only in e (so in that
-    height) get the same figure, which would otherwise give the answer away."""
-    def drawn(e: float) -> str:
-        spec = ProblemSpec("1", "moving-plate", {"*": 1.0}, {"h": 1.2, "u": 1.5, "e": e}, {}, {})
-        one = dataclasses.replace(assignment, problems=(spec,))
-        variant = generate(one, (Student("s1", "Sam", "", ""),), bank).students[0].problems[0]
-        return figure(bank["moving-plate"], variant, worked(bank["moving-plate"], variant).values)
-    assert drawn(0.5) == drawn(0.9)
+def _figure_of(assignment: Assignment, bank: dict[str, Template], template_id: str, fixed: dict[str, float]) -> str:
+    spec = ProblemSpec("1", template_id, {"*": 1.0}, fixed, {}, {})
+    one = dataclasses.replace(assignment, problems=(spec,))
+    variant = generate(one, (Student("s1", "Sam", "", ""),), bank).students[0].problems[0]
+    return figure(bank[template_id], variant, worked(bank[template_id], variant).values)
+
+
+@pytest.mark.parametrize("template_id, fixed", [
+    ("moving-plate", {"h": 1.2, "u": 1.5}),  # the height the ball rises
+    ("incline-bounce", {"h": 1.2, "beta": 30}),  # the angle of the rebound
+])
+def test_an_asked_height_or_angle_is_not_drawn_to_scale(assignment: Assignment, bank: dict[str, Template],
+                                                        template_id: str, fixed: dict[str, float]) -> None:
+    """Two variants that differ only in e (so in what is asked) get the same figure, which would otherwise
+    give the answer away."""
+    assert _figure_of(assignment, bank, template_id, {**fixed, "e": 0.5}) == \
+        _figure_of(assignment, bank, template_id, {**fixed, "e": 0.9})
+
+
+@pytest.mark.parametrize("template_id, fixed, sine", [
+    ("billiards", {"v": 2, "r": 28.5, "b": 30, "e": 0.9}, 30 / 57),
+    ("offset-spheres", {"m1": 2, "m2": 1, "r1": 40, "r2": 30, "v1": 5, "b": 35, "e": 0.6}, 0.5),
+    ("offset-spheres", {"m1": 2, "m2": 1, "r1": 20, "r2": 50, "v1": 5, "b": 68, "e": 0.6}, 68 / 70),
+])
+def test_the_line_of_centres_is_drawn_at_the_variants_angle(assignment: Assignment, bank: dict[str, Template],
+                                                            template_id: str, fixed: dict[str, float],
+                                                            sine: float) -> None:
+    """The two circles touch, and the line through their centres makes asin(b/(r1 + r2)) with the path
+    (horizontal), to the figure's 0.01 cm."""
+    drawn = _figure_of(assignment, bank, template_id, fixed)
+    circles = re.findall(r"fig-circle\(\(([-0-9.]+), ([-0-9.]+)\), ([0-9.]+), w: 0.8pt, fill", drawn)
+    (x1, y1, r1), (x2, y2, r2) = [tuple(map(float, found)) for found in circles]
+    assert abs(((x2 - x1) ** 2 + (y2 - y1) ** 2) ** 0.5 - (r1 + r2)) < 0.02
+    assert abs((y1 - y2) / (r1 + r2) - sine) < 0.02  # Typst's y points down

@@ -74,6 +74,8 @@ def test_every_bank_template_is_cross_checked_by_simulation(bank: dict[str, Temp
     ("car-collision", {"p": 0.5, "e": 0.1}, ("contact (Kelvin-Voigt)",)),
     ("ball-plate", {"v": 50, "theta": 30, "e": 0.5}, ("contact (Kelvin-Voigt)",)),
     ("drop-rebound", {"h_drop": 2100, "h_rebound": 1100}, ("gravity", "contact (Kelvin-Voigt)")),
+    ("incline-bounce", {"h": 1.2, "beta": 30, "e": 0.6}, ("gravity", "contact (Kelvin-Voigt)")),
+    ("billiards", {"v": 2, "r": 28.5, "b": 30, "e": 0.9}, ("uniform motion to contact", "contact (Kelvin-Voigt)")),
 ])
 def test_only_the_effects_a_scene_declares_are_simulated(template_id: str, params: dict[str, float],
                                                          effects: tuple[str, ...],
@@ -409,3 +411,31 @@ def test_a_plate_moving_at_constant_velocity_keeps_it_through_the_contact(bank: 
     result = simulate(bank["moving-plate"], {"h": 1.2, "u": 1.5, "e": 0.6}, ADAPTIVE)
     v = math.sqrt(2 * 9.81 * 1.2)
     assert result.answers["v_out"] == pytest.approx(1.5 + 0.6 * (v + 1.5), rel=1e-8)
+
+
+def test_the_weight_on_an_incline_acts_the_way_the_ball_fell(bank: dict[str, Template],
+                                                           compiled: dict[str, Compiled]) -> None:
+    """With the weight during contact asked for, gravity acts straight down, at beta to the incline's normal:
+    it presses the ball into the plane and speeds it down the slope, so it leaves flatter and faster."""
+    params = {"h": 1.2, "beta": 30.0, "e": 0.6}
+    closed = solve_one(bank["incline-bounce"], compiled["incline-bounce"], params).answers
+    assert closed is not None
+    weighted = simulate(bank["incline-bounce"], params, dataclasses.replace(ADAPTIVE, weight_during_contact=True))
+    v_out, theta_out = weighted.answers["v_out"], weighted.answers["theta_out"]
+    assert v_out is not None and theta_out is not None
+    assert 0 < v_out - closed["v_out"].value < 0.01 * closed["v_out"].value  # type: ignore[operator]
+    assert 0 < closed["theta_out"].value - theta_out < 0.01 * theta_out  # type: ignore[operator]
+
+
+@pytest.mark.parametrize("template_id, params", [
+    ("billiards", {"v": 2, "r": 28.5, "b": 0, "e": 1}),
+    ("billiards", {"v": 2, "r": 28.5, "b": 57 * (1 - 1e-6), "e": 0.9}),
+    ("offset-spheres", {"m1": 1e-6, "m2": 1, "r1": 40, "r2": 30, "v1": 5, "b": 35, "e": 0}),
+    ("offset-spheres", {"m1": 1e6, "m2": 1, "r1": 1e-3, "r2": 1e3, "v1": 5, "b": 600, "e": 0.6}),
+], ids=["head-on-e1", "near-grazing", "light-sphere-1", "heavy-sphere-1"])
+def test_the_line_of_centres_is_found_where_the_simulated_spheres_touch(template_id: str, params: dict[str, float],
+                                                                      bank: dict[str, Template],
+                                                                      compiled: dict[str, Compiled]) -> None:
+    """Sphere 1 moves along its line until the centres are r1 + r2 apart (a located event); the line of
+    centres measured there, then the contact, give the closed form's answers, head-on to near grazing."""
+    assert max(_compare(bank[template_id], compiled[template_id], params, ADAPTIVE).values()) < 1e-8

@@ -40,13 +40,14 @@ def _parse_bodies(raw: Any, where: str) -> dict[str, Body]:
         if not IDENTIFIER.match(str(name)):
             raise TemplateError(where, key, "a name of letters, digits and _", shown(name))
         if not isinstance(spec, Mapping) or set(spec) - {"mass", "fixed", "radius"}:
-            raise TemplateError(where, key, "{mass: EXPR} or {fixed: true}", shown(spec))
+            raise TemplateError(where, key, "{mass: EXPR} or {fixed: true}, and optionally radius: EXPR", shown(spec))
+        radius = _expr(spec["radius"], where, f"{key}.radius") if "radius" in spec else None
         if spec.get("fixed") is True:
             if "mass" in spec:
                 raise TemplateError(where, key, "either a mass or fixed: true, not both", shown(spec))
-            bodies[name] = Body(name, None)
+            bodies[name] = Body(name, None, radius)
         elif "mass" in spec:
-            bodies[name] = Body(name, _expr(spec["mass"], where, f"{key}.mass"))
+            bodies[name] = Body(name, _expr(spec["mass"], where, f"{key}.mass"), radius)
         else:
             raise TemplateError(where, key, "a mass or fixed: true", shown(spec))
     return bodies
@@ -85,11 +86,19 @@ def _parse_field(spec: Field, value: Any, where: str, key: str, bodies: Mapping[
         if not isinstance(value, str) or value not in bodies:
             raise TemplateError(where, key, f"one of the bodies ({', '.join(bodies)})", shown(value))
         return value
-    if spec.kind == "bodies":
+    if spec.kind in ("bodies", "spheres"):
         if not (isinstance(value, list) and len(value) == 2 and all(isinstance(v, str) and v in bodies for v in value)
                 and value[0] != value[1]):
             raise TemplateError(where, key, f"two different bodies from ({', '.join(bodies)})", shown(value))
+        flat = [v for v in value if bodies[v].radius is None]
+        if spec.kind == "spheres" and flat:
+            raise TemplateError(where, key, "two spheres: bodies with a radius (bodies.NAME.radius)",
+                                f"{', '.join(flat)} without one")
         return tuple(value)
+    if spec.kind == "vector":
+        if not isinstance(value, Mapping) or set(value) != {"n", "t"}:
+            raise TemplateError(where, key, "{n: EXPR, t: EXPR}", shown(value))
+        return Velocity(_expr(value["n"], where, f"{key}.n"), _expr(value["t"], where, f"{key}.t"))
     if spec.kind == "name":
         if not (isinstance(value, str) and IDENTIFIER.match(value)):
             raise TemplateError(where, key, "a quantity name of letters, digits and _", shown(value))
@@ -142,12 +151,12 @@ def _quantities(effect: Effect, fields: Mapping[str, Any]) -> set[str]:
     used: set[str] = set()
     for spec in effect.fields:
         value = fields.get(spec.name)
-        if value is None or spec.kind in ("body", "bodies", "flag") or spec.kind.startswith("choice:"):
+        if value is None or spec.kind in ("body", "bodies", "spheres", "flag") or spec.kind.startswith("choice:"):
             continue
         if spec.kind == "name":
             used.add(value)
-        elif spec.kind == "velocities":
-            for velocity in value.values():
+        elif spec.kind in ("velocities", "vector"):
+            for velocity in (value.values() if spec.kind == "velocities" else [value]):
                 for part in (velocity.n, velocity.t):
                     used |= names(part) if part is not None else set()
         else:

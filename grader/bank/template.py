@@ -2,7 +2,7 @@
 
 >>> bank = load_bank()
 >>> sorted(bank)[:2]
-['ball-plate', 'car-collision']
+['ball-plate', 'billiards']
 >>> bank["drop-rebound"].parameters["h_drop"].unit.text
 'mm'
 """
@@ -23,7 +23,7 @@ from grader.inputs import YAML_BYTES, parse_yaml, read_bytes
 from grader.model.expr import Node, Op, Sym, names, parse, to_text
 from grader.model.scene import Gravity, Scene
 from grader.model.tolerance import Tolerance, ToleranceError
-from grader.model.units import MASS, Dimension, Unit, dimension_from, dimension_name, dimension_of, parse_unit
+from grader.model.units import LENGTH, MASS, Dimension, Unit, dimension_from, dimension_name, dimension_of, parse_unit
 from grader.physics.effects import CATALOGUE
 from grader.resources import bank_dir
 
@@ -289,10 +289,11 @@ def _check_names(template: Template) -> None:
     given = set(template.parameters) | set(template.symbols)
     quantities = template.scene.names() | given
     for body in template.scene.bodies.values():
-        missing = names(body.mass) - given if body.mass is not None else set()
-        if missing:
-            raise TemplateError(where, f"bodies.{body.name}.mass", "parameters or symbols only",
-                                ", ".join(sorted(missing)))
+        for key, part in (("mass", body.mass), ("radius", body.radius)):
+            missing = names(part) - given if part is not None else set()
+            if missing:
+                raise TemplateError(where, f"bodies.{body.name}.{key}", "parameters or symbols only",
+                                    ", ".join(sorted(missing)))
     for answer in template.answers.values():
         missing = names(answer.value) - quantities
         if missing:
@@ -321,17 +322,20 @@ def _check_dimensions(template: Template) -> None:
     for body in template.scene.bodies.values():
         if body.mass is not None:
             _expect(body.mass, MASS, known, template.where, f"bodies.{body.name}.mass")
+        if body.radius is not None:
+            _expect(body.radius, LENGTH, known, template.where, f"bodies.{body.name}.radius")
     for stage in template.scene.stages:
         for spec in CATALOGUE[stage.effect].fields:
             value = stage.fields.get(spec.name)
             if spec.dimension is None or value is None:
                 continue
             key = f"stages[{stage.index}].{spec.name}"
-            if spec.kind == "velocities":
-                for body, velocity in value.items():
+            if spec.kind in ("velocities", "vector"):
+                vectors = {f"{key}.{b}": v for b, v in value.items()} if spec.kind == "velocities" else {key: value}
+                for place, velocity in vectors.items():
                     for part in (velocity.n, velocity.t):
                         if part is not None:
-                            _expect(part, spec.dimension, known, template.where, f"{key}.{body}")
+                            _expect(part, spec.dimension, known, template.where, place)
             else:
                 _expect(Sym(value) if spec.kind == "name" else value, spec.dimension, known, template.where, key)
     for name, answer in template.answers.items():

@@ -21,10 +21,12 @@ from grader.model.expr import Node, names
 
 @dataclass(frozen=True)
 class Body:
-    """A point body: its mass expression, or ``None`` for a fixed surface (infinite mass)."""
+    """A body: its mass expression, or ``None`` for a fixed surface (infinite mass), and the radius of
+    a sphere where the scene's geometry needs one (``None``: a point body)."""
 
     name: str
     mass: Node | None
+    radius: Node | None = None
 
 
 @dataclass(frozen=True)
@@ -78,7 +80,8 @@ class Scene:
         """Every name the scene's expressions use."""
         used: set[str] = set()
         for body in self.bodies.values():
-            used |= names(body.mass) if body.mass is not None else set()
+            for part in (body.mass, body.radius):
+                used |= names(part) if part is not None else set()
         for stage in self.stages:
             used |= stage.quantities
         return used

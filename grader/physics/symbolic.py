@@ -232,6 +232,13 @@ class Context:
         mass = self.scene.bodies[body].mass
         return sp.Integer(0) if mass is None else 1 / self.sym(mass)
 
+    def radius(self, body: str) -> Any:
+        """A sphere's radius (the parser makes sure a stage that needs one has it)."""
+        radius = self.scene.bodies[body].radius
+        if radius is None:
+            raise TemplateError(self.scene.where, f"bodies.{body}", "a radius (radius: EXPR)", "a point body")
+        return self.sym(radius)
+
     def quantity(self, stage: Stage, key: str) -> sp.Symbol:
         """The symbol a stage names under ``key``, or a default name (``J``, ``T``, ...)."""
         name = stage.fields.get(key)

@@ -52,9 +52,9 @@ class Canvas:
         """An open polyline."""
         self._add("fig-path", points, _stroke(width, dash, False))
 
-    def polygon(self, points: Sequence[Point], gray: bool = False) -> None:
-        """A filled polygon."""
-        self._add("fig-poly", points, "fill: luma(150)" if gray else "")
+    def polygon(self, points: Sequence[Point], gray: bool = False, fill: str | None = None) -> None:
+        """A filled polygon (black, gray, or ``fill``), without outline."""
+        self._add("fig-poly", points, f"fill: {fill}" if fill else "fill: luma(150)" if gray else "")
 
     def circle(self, center: Point, radius: float, dash: str | None = None, fill: bool = True) -> None:
         """A circle (a body)."""
@@ -63,6 +63,10 @@ class Canvas:
     def rect(self, low: Point, high: Point, dash: str | None = None, fill: str = "luma(235)") -> None:
         """A rectangle between two corners (a block, a plate)."""
         self._add("fig-rect", [(low[0], high[1]), (high[0], low[1])], f"{_stroke(0.8, dash, False)}, fill: {fill}")
+        self.occupied.append((low[0], low[1], high[0], high[1]))
+
+    def reserve(self, low: Point, high: Point) -> None:
+        """Keep the box between two corners clear of the labels placed where they :meth:`fits` (a sphere)."""
         self.occupied.append((low[0], low[1], high[0], high[1]))
 
     def _label_box(self, at: Point, anchor: str, lines: Sequence[str]) -> tuple[float, float, float, float]:

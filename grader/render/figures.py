@@ -8,133 +8,69 @@ The kind of figure follows from the scene's structure, never from the template's
   given heights to scale, an asked one drawn but not to scale (it would give the answer away);
 * a body falls onto a fixed surface and rebounds more than once: its path as arcs, each height
   dimensioned, given ones to scale;
+* a body falls onto a fixed surface and strikes it obliquely: an incline at the angle its velocity
+  makes with n, the body at its drop height, the rebound drawn with its angle to the surface (asked,
+  so not to scale);
 * an oblique ``impact`` (a ``velocity`` stage gives the components) with a fixed body: the surface,
   the incoming and rebound velocity arrows at their angles, lengths proportional to the speeds;
-* an oblique impact of two bodies: two touching circles, the line of centres n and the tangent t,
+* an oblique impact of two spheres whose line of centres an ``impact_geometry`` stage gives: the
+  spheres at contact, radii in their ratio, the offset dimensioned, n at its angle to the path;
+* another oblique impact of two bodies: two touching circles, the line of centres n and the tangent t,
   the incoming velocity at its angle to n;
 * direct impacts of bodies in a line (two, or a chain: 1 strikes 2, 2 strikes 3): blocks whose areas
   follow the masses, above each the velocity before it is struck, an arrow the way it moves with
   lengths in the ratio of the speeds, the bodies at rest marked so;
 * anything else: the bodies in a row, labelled.
 
-The drawing primitives are :class:`grader.render.canvas.Canvas`'s.
+The oblique figures are :mod:`grader.render.oblique`'s, the drawing primitives
+:class:`grader.render.canvas.Canvas`'s.
 """
 
 from __future__ import annotations
 
 import math as _m
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
-
-import numpy as np
 
 from grader.assign.variants import ProblemVariant
 from grader.bank.template import Template
-from grader.model.expr import Node, Op, Sym, names
-from grader.model.kernel import evaluate
+from grader.model.expr import Node, Op
 from grader.model.scene import Stage, Velocity
 from grader.render.canvas import Canvas, Point
-from grader.render.worked import Typ, math, name, string
-
-# --- what the scene says ------------------------------------------------------------------------
-
-@dataclass(frozen=True)
-class _Scene:
-    """One variant's scene: values of every quantity (SI, symbols at 1) and how to label them."""
-
-    template: Template
-    variant: ProblemVariant
-    values: Mapping[str, float]
-
-    def value(self, node: Node | None) -> float:
-        if node is None:
-            return 0.0
-        try:
-            with np.errstate(all="ignore"):
-                return float(evaluate(node, self.values))
-        except KeyError:
-            return _m.nan
-
-    def given(self, node: Node) -> list[str]:
-        """``h_drop = 1863 mm`` for a parameter, the name (or expression) otherwise."""
-        if isinstance(node, Sym) and node.name in self.template.parameters:
-            unit = self.template.parameters[node.name].unit.text
-            printed = self.variant.printed[node.name]
-            shown = " degree" if unit == "deg" else f" thin {string(unit)}" if unit else ""
-            return [f"{name(node.name)} = {printed}{shown}"]
-        return [math(node)]
-
-    def is_given(self, node: Node) -> bool:
-        """Whether the statement gives this quantity (only parameters and numbers in it): what is
-        asked is never drawn to scale."""
-        return names(node) <= set(self.template.parameters)
-
-    def mass_value(self, body: str) -> list[str]:
-        """A body's mass as its printed value and unit (``1.5 kg``) when a parameter gives it."""
-        mass = self.template.scene.bodies[body].mass
-        if isinstance(mass, Sym) and mass.name in self.template.parameters:
-            return [self.given(mass)[0].split(" = ", 1)[1]]
-        return self.mass(body)
-
-    def mass(self, body: str) -> list[str]:
-        """A body's mass as given: ``m_1 = 1.5 kg``, or ``p m = 1.67 m``."""
-        mass = self.template.scene.bodies[body].mass
-        if mass is None:
-            return []
-        if isinstance(mass, Sym):
-            return self.given(mass)
-        printed = {n: self.variant.printed[n] for n in names(mass) if n in self.template.parameters}
-        shown = math(mass)
-        substituted = math(mass, printed)
-        return [shown if substituted == shown else f"{shown} = {substituted}"]
-
-
-def _stage(stages: Sequence[Stage], effect: str, before: int | None = None, after: int | None = None,
-           body: str | None = None) -> Stage | None:
-    for stage in stages:
-        if stage.effect != effect or (before is not None and stage.index >= before) or \
-                (after is not None and stage.index <= after):
-            continue
-        if body is None or stage.fields.get("body") == body:
-            return stage
-    return None
-
-
-def _velocity_stage(stages: Sequence[Stage], velocity: Velocity | None) -> Stage | None:
-    """The ``velocity`` stage that gives (or takes) the components of ``velocity``."""
-    if velocity is None:
-        return None
-    wanted = set().union(*(names(part) for part in (velocity.n, velocity.t) if part is not None))
-    for stage in stages:
-        if stage.effect == "velocity" and (names(stage.fields["n"]) | names(stage.fields["t"])) & wanted:
-            return stage
-    return None
+from grader.render.oblique import incline, offset_spheres, spheres, surface
+from grader.render.scene_view import SceneView, find_stage
+from grader.render.worked import Typ, string
 
 
 def figure(template: Template, variant: ProblemVariant, values: Mapping[str, float]) -> Typ:
     """The figure of one variant's scene, as a Typst expression (code mode)."""
-    scene = _Scene(template, variant, values)
+    scene = SceneView(template, variant, values)
     stages = template.scene.stages
-    impact = _stage(stages, "impact")
+    impact = find_stage(stages, "impact")
     canvas = Canvas()
     if impact is None:
-        fall = _stage(stages, "free_fall")
+        fall = find_stage(stages, "free_fall")
         if fall is None or not _drop(canvas, scene, fall, None, None):
             canvas = Canvas()
             _row(canvas, scene)
         return canvas.typst()
     first, second = impact.fields["bodies"]
-    fall = _stage(stages, "free_fall", before=impact.index, body=first)
+    fall = find_stage(stages, "free_fall", before=impact.index, body=first)
     rises = [s for s in stages if s.effect == "rise" and s.index > impact.index and s.fields["body"] == first]
     drawn = False
-    if fall is not None and len(rises) > 1 and template.scene.bodies[second].mass is None:
+    fixed = template.scene.bodies[second].mass is None
+    geometry = find_stage(stages, "impact_geometry", before=impact.index)
+    if fall is not None and len(rises) > 1 and fixed:
         drawn = _bounces(canvas, scene, fall, rises, second)
+    elif fall is not None and impact.is_oblique and fixed:
+        drawn = incline(canvas, scene, impact)
     elif fall is not None:
         drawn = _drop(canvas, scene, fall, impact, rises[0] if rises else None)
-    elif impact.is_oblique and template.scene.bodies[second].mass is None:
-        drawn = _surface(canvas, scene, impact)
+    elif impact.is_oblique and fixed:
+        drawn = surface(canvas, scene, impact)
+    elif impact.is_oblique and geometry is not None:
+        drawn = offset_spheres(canvas, scene, geometry, impact)
     elif impact.is_oblique:
-        drawn = _spheres(canvas, scene, impact)
+        drawn = spheres(canvas, scene, impact)
     else:
         drawn = _direct(canvas, scene, [s for s in stages if s.effect == "impact" and not s.is_oblique])
     if not drawn:
@@ -145,7 +81,7 @@ def figure(template: Template, variant: ProblemVariant, values: Mapping[str, flo
 
 # --- the figures --------------------------------------------------------------------------------
 
-def _drop(canvas: Canvas, scene: _Scene, fall: Stage, impact: Stage | None, rise: Stage | None) -> bool:
+def _drop(canvas: Canvas, scene: SceneView, fall: Stage, impact: Stage | None, rise: Stage | None) -> bool:
     """A body at its drop height above a floor or a pile (or the ground, without an impact), and
     dashed at its rebound height."""
     first = fall.fields["body"]
@@ -198,7 +134,7 @@ def _drop(canvas: Canvas, scene: _Scene, fall: Stage, impact: Stage | None, rise
     return True
 
 
-def _vertical_velocity(canvas: Canvas, scene: _Scene, at: Point, upward: float, given: Node) -> None:
+def _vertical_velocity(canvas: Canvas, scene: SceneView, at: Point, upward: float, given: Node) -> None:
     """An arrow through ``at`` the way a surface moves (up or down), labelled with what gives its velocity."""
     if not _m.isfinite(upward) or upward == 0:
         canvas.label(at, "w", [*scene.given(_parameter_of(given)), "(at rest)"])
@@ -214,7 +150,7 @@ def _parameter_of(node: Node) -> Node:
     return node.args[0] if isinstance(node, Op) and node.op == "neg" else node
 
 
-def _bounces(canvas: Canvas, scene: _Scene, fall: Stage, rises: Sequence[Stage], surface: str) -> bool:
+def _bounces(canvas: Canvas, scene: SceneView, fall: Stage, rises: Sequence[Stage], surface: str) -> bool:
     """A body dropped onto a fixed surface and rebounding again and again: its path as arcs, the
     given heights to scale, an asked one drawn (not to scale) and labelled with its name only."""
     first = fall.fields["body"]
@@ -251,155 +187,6 @@ def _bounces(canvas: Canvas, scene: _Scene, fall: Stage, rises: Sequence[Stage],
     return True
 
 
-def _axes(canvas: Canvas, origin: Point, n: Point, t: Point) -> None:
-    """A small n-t axis glyph."""
-    for direction, label in ((n, "n"), (t, "t")):
-        tip = (origin[0] + 0.6 * direction[0], origin[1] + 0.6 * direction[1])
-        canvas.arrow(origin, tip, width=0.5, head=0.13)
-        canvas.label((tip[0] + 0.15 * direction[0], tip[1] + 0.15 * direction[1]), "c", [label])
-
-
-def _screen(velocity: Velocity, scene: _Scene, n: Point, t: Point) -> Point:
-    vn, vt = scene.value(velocity.n), scene.value(velocity.t)
-    return vn * n[0] + vt * t[0], vn * n[1] + vt * t[1]
-
-
-def _nearest_axis(ray: Point, axes: Sequence[Point]) -> Point:
-    """Of the axes (either sign), the one closest in direction to ``ray``."""
-    return max(((s * a[0], s * a[1]) for a in axes for s in (1, -1)), key=lambda a: a[0] * ray[0] + a[1] * ray[1])
-
-
-def _axis(stage: Stage, n: Point, t: Point) -> Point:
-    """The axis a velocity stage measures its angle from."""
-    return t if stage.fields.get("from", "t") == "t" else n
-
-
-def _angle_mark(canvas: Canvas, center: Point, ray: Point, axes: Sequence[Point], radius: float,
-                lines: Sequence[str]) -> None:
-    """The arc between ``ray`` and the nearest of ``axes``, labelled outside it."""
-    axis = _nearest_axis(ray, axes)
-    reference = _m.atan2(axis[1], axis[0])
-    end = reference + _wrap(_m.atan2(ray[1], ray[0]) - reference)
-    if abs(end - reference) < 1e-3:
-        return
-    canvas.arc(center, radius, reference, end)
-    span = end - reference
-    places = [((reference + end) / 2, radius + 0.12)]
-    if abs(span) < 0.45:  # a narrow angle: farther out inside it, else just beyond the ray, or the axis
-        inside = 0.3 / _m.sin(abs(span) / 2)
-        places = [((reference + end) / 2, inside)] if inside < radius + 1.2 else []
-        places += [(end + _m.copysign(0.3, span), radius + 0.12), (reference - _m.copysign(0.3, span), radius + 0.12)]
-    for middle, distance in places:
-        at = (center[0] + distance * _m.cos(middle), center[1] + distance * _m.sin(middle))
-        if canvas.fits(at, _anchor(middle), lines) or (middle, distance) == places[-1]:
-            canvas.label(at, _anchor(middle), lines)
-            return
-
-
-def _speed_mark(canvas: Canvas, tail: Point, tip: Point, away: Point, lines: Sequence[str],
-                along: float = 0.5) -> None:
-    """An arrow's label beside it (``along``: where, from the tail), on the side of ``away``."""
-    dx, dy = tip[0] - tail[0], tip[1] - tail[1]
-    length = _m.hypot(dx, dy) or 1.0
-    side = (-dy / length, dx / length)
-    if side[0] * away[0] + side[1] * away[1] < 0:
-        side = (-side[0], -side[1])
-    at = (tail[0] + along * dx + 0.12 * side[0], tail[1] + along * dy + 0.12 * side[1])
-    canvas.label(at, _anchor(_m.atan2(side[1], side[0])), lines)
-
-
-def _wrap(angle: float) -> float:
-    return (angle + _m.pi) % (2 * _m.pi) - _m.pi
-
-
-def _anchor(direction: float) -> str:
-    """The label anchor that keeps a label placed in ``direction`` from a point off that point."""
-    c, s = _m.cos(direction), _m.sin(direction)
-    return ("s" if s > 0.3 else "n" if s < -0.3 else "") + ("w" if c > 0.3 else "e" if c < -0.3 else "") or "c"
-
-
-def _speed_label(scene: _Scene, stage: Stage | None, fallback: str) -> list[str]:
-    return scene.given(stage.fields["speed"]) if stage is not None else [fallback]
-
-
-def _angle_label(scene: _Scene, stage: Stage | None) -> list[str]:
-    return scene.given(stage.fields["angle"]) if stage is not None else []
-
-
-def _surface(canvas: Canvas, scene: _Scene, impact: Stage) -> bool:
-    """A body striking a fixed surface obliquely: incoming and rebound velocities to scale."""
-    first = impact.fields["bodies"][0]
-    before = impact.fields["before"].get(first)
-    after = impact.fields.get("after", {}).get(first)
-    n, t = (0.0, -1.0), (1.0, 0.0)
-    incoming = _screen(before, scene, n, t)
-    outgoing = _screen(after, scene, n, t) if after is not None else (0.0, 0.0)
-    speeds = [_m.hypot(*incoming), _m.hypot(*outgoing)]
-    if not all(_m.isfinite(s) for s in speeds) or speeds[0] <= 0:
-        return False
-    scale = 2.3 / max(speeds)
-    radius = 0.28
-    center = (0.0, radius)
-    canvas.rect((-3.0, -0.3), (3.0, 0.0), fill="luma(215)")
-    canvas.label((2.9, -0.35), "ne", [str(string(impact.fields["bodies"][1]))])
-    canvas.line((-2.9, radius), (2.9, radius), width=0.4, dash="dashed", gray=True)
-    canvas.circle(center, radius)
-    stages = scene.template.scene.stages
-    arrows = [(incoming, -1, _velocity_stage(stages, before), "v")]
-    if speeds[1] > 0:
-        arrows.append((outgoing, 1, _velocity_stage(stages, after), "v'"))
-    for vector, sign, stage, fallback in arrows:
-        length = _m.hypot(*vector)
-        ray = (sign * vector[0] / length, sign * vector[1] / length)  # from the body toward the arrow
-        near = (center[0] + ray[0] * (radius + 0.05), center[1] + ray[1] * (radius + 0.05))
-        far = (near[0] + ray[0] * length * scale, near[1] + ray[1] * length * scale)
-        if sign < 0:
-            canvas.arrow(far, near)
-        else:
-            canvas.arrow(near, far)
-        # The speed at the arrow's far end, clear of the angle marks near the body.
-        end = (far[0] + 0.1 * ray[0], far[1] + 0.1 * ray[1])
-        canvas.label(end, _anchor(_m.atan2(ray[1], ray[0])), _speed_label(scene, stage, fallback))
-        if stage is not None:
-            _angle_mark(canvas, center, ray, [_axis(stage, n, t)], 0.95, _angle_label(scene, stage))
-    _axes(canvas, (3.4, 1.6), n, t)
-    return True
-
-
-def _spheres(canvas: Canvas, scene: _Scene, impact: Stage) -> bool:
-    """Two touching spheres, the line of centres n and the tangent t, the incoming velocity."""
-    first, second = impact.fields["bodies"]
-    radius = 0.85
-    n, t = (1.0, 0.0), (0.0, 1.0)
-    centers = {first: (0.0, 0.0), second: (2 * radius, 0.0)}
-    canvas.line((-radius - 1.2, 0.0), (4 * radius + 0.3, 0.0), width=0.4, dash="dashed", gray=True)
-    canvas.arrow((3 * radius, 0.0), (4 * radius + 0.6, 0.0), width=0.5, head=0.15)
-    canvas.label((4 * radius + 0.7, 0.0), "w", ["n"])
-    canvas.line((radius, -radius - 0.4), (radius, radius + 0.3), width=0.4, dash="dashed", gray=True)
-    canvas.arrow((radius, radius + 0.3), (radius, radius + 0.9), width=0.5, head=0.15)
-    canvas.label((radius, radius + 1.0), "s", ["t"])
-    for body, center in centers.items():
-        canvas.circle(center, radius)
-        canvas.label(center, "c", [str(string(body)), *scene.mass_value(body)])
-    stages = scene.template.scene.stages
-    for body, velocity in impact.fields["before"].items():
-        vector = _screen(velocity, scene, n, t)
-        speed = _m.hypot(*vector)
-        if not _m.isfinite(speed) or speed <= 0:
-            continue
-        ux, uy = vector[0] / speed, vector[1] / speed
-        center = centers[body]
-        tip = (center[0] - ux * (radius + 0.08), center[1] - uy * (radius + 0.08))
-        tail = (tip[0] - ux * 2.0, tip[1] - uy * 2.0)
-        canvas.arrow(tail, tip)
-        stage = _velocity_stage(stages, velocity)
-        axis = _nearest_axis((-ux, -uy), [_axis(stage, n, t) if stage is not None else n])
-        _speed_mark(canvas, tail, tip, (-ux - axis[0], -uy - axis[1]), _speed_label(scene, stage, "v"), 0.2)
-        if stage is not None:
-            _angle_mark(canvas, center, (-ux, -uy), [_axis(stage, n, t)], radius + 0.45, _angle_label(scene, stage))
-    return True
-
-
 def _line_of_bodies(impacts: Sequence[Stage]) -> list[str]:
     """The bodies of direct impacts in the order they are struck: ``[1, 2]`` then ``[2, 3]`` is 1, 2, 3."""
     order: list[str] = []
@@ -408,7 +195,7 @@ def _line_of_bodies(impacts: Sequence[Stage]) -> list[str]:
     return order
 
 
-def _direct(canvas: Canvas, scene: _Scene, impacts: Sequence[Stage]) -> bool:
+def _direct(canvas: Canvas, scene: SceneView, impacts: Sequence[Stage]) -> bool:
     """Bodies on a line in the order they are struck, blocks whose areas follow the masses (a fixed
     one a wall); above each its velocity before it is first struck, an arrow the way it moves with
     lengths in the ratio of the speeds, or ``v = 0``."""
@@ -444,7 +231,7 @@ def _direct(canvas: Canvas, scene: _Scene, impacts: Sequence[Stage]) -> bool:
     return True
 
 
-def _horizontal_velocity(canvas: Canvas, scene: _Scene, at: Point, velocity: Velocity | None,
+def _horizontal_velocity(canvas: Canvas, scene: SceneView, at: Point, velocity: Velocity | None,
                          fastest: float) -> None:
     """Above a body: an arrow centred on ``at`` the way it moves, 1.6 cm for the fastest body of the
     figure (at least 0.5 cm), labelled with its velocity as given; ``v = 0`` for a body at rest."""
@@ -458,7 +245,7 @@ def _horizontal_velocity(canvas: Canvas, scene: _Scene, at: Point, velocity: Vel
     canvas.label((at[0], at[1] + 0.2), "s", scene.given(given))
 
 
-def _row(canvas: Canvas, scene: _Scene) -> None:
+def _row(canvas: Canvas, scene: SceneView) -> None:
     """Bodies side by side, named, with their masses: the figure of a scene of no known kind."""
     x = 0.0
     for body in scene.template.scene.bodies:

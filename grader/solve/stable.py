@@ -33,7 +33,7 @@ def stabilize(expr: Any, degree_angles: Iterable[Any] = ()) -> Any:
     result = expr
     for _ in range(4):
         previous = result
-        result = absorb_reciprocals(positive_factors_out_of_max(root_differences(result)))
+        result = absorb_reciprocals(positive_factors_out_of_max(root_differences(cancel_fraction_sums(result))))
         result = drop_common_factors(sp.factor_terms(result))
         if result == previous:
             break
@@ -73,6 +73,26 @@ def root_differences(expr: Any) -> Any:
     """``k sqrt(x) - k sqrt(y)`` becomes ``k (x - y)/(sqrt(x) + sqrt(y))``: the radicands'
     difference is formed first (exact when they are close), so no rounded roots cancel."""
     return expr.replace(lambda e: isinstance(e, sp.Add), _pair_roots)
+
+
+def _cancelled(add: sp.Add) -> Any:
+    if not any(isinstance(sp.fraction(term)[1], sp.Add) for term in add.args) or not add.is_rational_function():
+        return add
+    combined = sp.factor(sp.together(add))
+    return combined if not isinstance(sp.fraction(combined)[0], sp.Add) else add
+
+
+def cancel_fraction_sums(expr: Any) -> Any:
+    """A sum of fractions that cancels to a product, ``1 - 1/(1 + x) + e/(1/x + 1)``, is written as that
+    product, ``x*(e + 1)/(x + 1)``: the sum cancels in float64 where ``x`` is tiny (a sphere 10**12 times
+    heavier than the one it strikes turns by ``x`` times its angle), the product keeps full accuracy.
+    A sum whose numerator stays a sum (a true difference, ``e*x - 1``) is left as it is.
+
+    >>> x, e = sp.symbols("x e", positive=True)
+    >>> cancel_fraction_sums(1 - 1/(1 + x) + e/(1/x + 1))
+    x*(e + 1)/(x + 1)
+    """
+    return expr.replace(lambda e: isinstance(e, sp.Add), _cancelled)
 
 
 def _pull_out(node: Any) -> Any:

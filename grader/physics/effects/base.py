@@ -26,9 +26,10 @@ if TYPE_CHECKING:
 class Field:
     """One key of a stage: its kind says how the YAML value is read.
 
-    kinds: ``body`` (a body's name), ``bodies`` (two names), ``expr`` (an expression),
-    ``name`` (a new quantity's name), ``velocities`` (per body: an expression, or ``{n:, t:}``),
-    ``choice:a|b`` (one of the listed words), ``flag`` (true or false).
+    kinds: ``body`` (a body's name), ``bodies`` (two names), ``spheres`` (two names of bodies with a
+    radius), ``expr`` (an expression), ``name`` (a new quantity's name), ``velocities`` (per body: an
+    expression, or ``{n:, t:}``), ``vector`` (one ``{n:, t:}``), ``choice:a|b`` (one of the listed
+    words), ``flag`` (true or false).
     """
 
     name: str

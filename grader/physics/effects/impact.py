@@ -165,14 +165,15 @@ def _contact(stage: Stage, run: Run, bodies: tuple[str, str], inverse: tuple[flo
     share1, share2 = w1 / (w1 + w2), w2 / (w1 + w2)
     law = ContactLaw.calibrated(e, run.options.contact_duration)
     run.uses("contact (Kelvin-Voigt)")
-    weight = _weight(stage, run)
+    weight_n, weight_t = _weight(stage, run, before)
 
     def free(_: float, y: Any) -> Any:
         return np.concatenate([y[4:], np.zeros(4)])
 
     def pressed(_: float, y: Any) -> Any:
         f = law.specific_force(y[0] - y[2], y[4] - y[6])
-        return np.concatenate([y[4:], [weight - share1 * f, 0.0, (weight if w2 else 0.0) + share2 * f, 0.0]])
+        second = (weight_n, weight_t) if w2 else (0.0, 0.0)
+        return np.concatenate([y[4:], [weight_n - share1 * f, weight_t, second[0] + share2 * f, second[1]]])
 
     approach = before[0] - before[2]
     duration = run.options.contact_duration
@@ -202,17 +203,21 @@ def _contact(stage: Stage, run: Run, bodies: tuple[str, str], inverse: tuple[flo
     return after
 
 
-def _weight(stage: Stage, run: Run) -> float:
-    """Gravity along n during contact: only if asked for, and only where the first body fell onto
-    the second (n is then downward)."""
+def _weight(stage: Stage, run: Run, before: list[float]) -> tuple[float, float]:
+    """Gravity along n and t during contact: only if asked for, and only where the first body fell
+    onto the second. It fell from rest, so gravity points the way it moves at the impact: straight
+    along n onto a floor or a pile, at an angle to n onto an incline."""
     if not (run.options.weight_during_contact or stage.fields.get("weight_during_contact", False)):
-        return 0.0
+        return 0.0, 0.0
     fell = any(s.effect == "free_fall" and s.fields["body"] == stage.fields["bodies"][0]
                for s in run.scene.stages[:stage.index])
     if not fell:
-        return 0.0
+        return 0.0, 0.0
     run.uses("weight during contact")
-    return run.gravity()
+    speed = math.hypot(before[0], before[1])
+    if speed == 0:  # it fell through no height: n is downward, as the scene's axes say
+        return run.gravity(), 0.0
+    return run.gravity() * before[0] / speed, run.gravity() * before[1] / speed
 
 
 def _inverse_mass(run: Run, body: str) -> float:

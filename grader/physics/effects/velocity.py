@@ -1,7 +1,9 @@
-"""A velocity as speed and angle, or as components along the n (impact) and t (tangent) axes.
+"""A velocity as speed and angle, or as components along the n (impact) and t (tangent) axes; and
+the angle between two velocities.
 
 The angle is measured from the axis named in ``from`` toward the other one. Speeds come from
-``hypot`` and angles from ``atan2``; the angle of a zero velocity is undefined, not zero.
+``hypot`` and angles from ``atan2``; the angle of a zero velocity is undefined, not zero. The angle
+between two velocities is ``atan2(|a x b|, a . b)``, 0 to 180 degrees.
 """
 
 from __future__ import annotations
@@ -81,4 +83,58 @@ VELOCITY = Effect(
     ),
     _components,
     _simulate_components,
+)
+
+
+def _shown(stage: Stage) -> list[str]:
+    return [f"({to_text(v.n)}, {to_text(v.t)})" for v in (stage.fields["first"], stage.fields["second"])]
+
+
+def _no_angle(stage: Stage) -> str:
+    first, second = _shown(stage)
+    return f"the velocity {first} or {second} is zero, so there is no angle between them"
+
+
+def _between(stage: Stage, ctx: Context) -> list[Relation]:
+    import sympy as sp
+
+    from grader.physics.symbolic import hypot
+
+    first, second = stage.fields["first"], stage.fields["second"]
+    an, at, bn, bt = (ctx.sym(part) for part in (first.n, first.t, second.n, second.t))
+    angle = ctx.sym(stage.fields["angle"])
+    if not isinstance(angle, sp.Symbol):
+        return []
+    shown = _shown(stage)
+    # atan2 of the cross and dot products: accurate at 0 and 180 degrees, where acos of the cosine is not.
+    return [Relation(
+        f"angle between the velocities {shown[0]} and {shown[1]} (n and t components), 0 to 180 degrees",
+        sp.cos(angle), (an * bn + at * bt) / (hypot(an, at) * hypot(bn, bt)),
+        solutions={angle: sp.atan2(sp.Abs(an * bt - at * bn), an * bn + at * bt)}, general=False,
+        undefined={angle: (sp.Le(sp.Min(hypot(an, at), hypot(bn, bt)), 0),
+                           _no_angle(stage))})]
+
+
+def _simulate_between(stage: Stage, run: Run) -> None:
+    a, b = ((run.value(v.n), run.value(v.t)) for v in (stage.fields["first"], stage.fields["second"]))
+    sizes = math.hypot(*a), math.hypot(*b)
+    if all(size > 0 and run.resolves(size) for size in sizes):
+        # Directions first: the products of two speeds of 1e170 m/s would overflow.
+        (an, at), (bn, bt) = ((v[0] / s, v[1] / s) for v, s in zip((a, b), sizes, strict=True))
+        run.output(stage.fields["angle"], math.atan2(abs(an * bt - at * bn), an * bn + at * bt))
+        return
+    run.undefined[to_text(stage.fields["angle"])] = _no_angle(stage)
+    run.output(stage.fields["angle"], math.nan)
+
+
+ANGLE_BETWEEN = Effect(
+    "angle_between",
+    "the angle between two velocities given by their n and t components, 0 to 180 degrees",
+    (
+        Field("first", "vector", doc="{n: .., t: ..}: the velocity the angle is measured from", dimension=SPEED),
+        Field("second", "vector", doc="{n: .., t: ..}: the other velocity", dimension=SPEED),
+        Field("angle", "expr", doc="the angle between them, 0 to 180 degrees", dimension=ANGLE),
+    ),
+    _between,
+    _simulate_between,
 )

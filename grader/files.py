@@ -105,6 +105,16 @@ def describe_os_error(error: OSError, outcome: str = "") -> str:
     return "; ".join(part for part in parts if part)
 
 
+def shown_path(path: Path | str) -> str:
+    r"""``path`` as text UTF-8 can write (in a report's cells): the bytes of a file name that are not
+    UTF-8 (Python holds them as lone surrogates) shown as ``\xNN``.
+
+    >>> shown_path(os.fsdecode(b"answers-\xff.csv"))
+    'answers-\\xff.csv'
+    """
+    return os.fsencode(path).decode("utf-8", "backslashreplace")
+
+
 MANIFEST = ".grader-manifest.json"
 """The file in every output folder that lists what the run wrote, each file with its SHA-256."""
 

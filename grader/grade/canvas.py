@@ -47,6 +47,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from grader.errors import GraderError, shown
+from grader.files import shown_path
 from grader.grade.columns import EMAIL, normalized
 from grader.grade.key import Key
 from grader.grade.submissions import TEST_STUDENTS, Roster, RowProblem, StudentRef
@@ -109,7 +110,7 @@ def read_export(path: Path, key: Key) -> CanvasExport:
         if not _is_student(row, name):
             continue
         if row.problem is not None:
-            problems.append(RowProblem(str(path), row.line, _canvas_id(who), "",
+            problems.append(RowProblem(shown_path(path), row.line, _canvas_id(who), "",
                                        f"{row.problem.split(': ', 1)[-1]}: left out of canvas.csv", caveat=True))
             continue
         current = row.cells[assignment] if assignment else ""
@@ -118,14 +119,14 @@ def read_export(path: Path, key: Key) -> CanvasExport:
         if key_id is not None:
             taken.setdefault(key_id, row.line)
         if reason or caveat:
-            problems.append(RowProblem(str(path), row.line, key_id or _canvas_id(who), "", reason or caveat,
+            problems.append(RowProblem(shown_path(path), row.line, key_id or _canvas_id(who), "", reason or caveat,
                                        caveat=True))
         rows.append(CanvasRow(row.line, tuple(who.values()), None if reason else key_id,
                               _kept(current) if reason else None))
     if not taken:
         raise _unrelated(path, key, len(rows))
     missing = [s.id for s in key.students if s.id not in taken]
-    problems += [RowProblem(str(path), 0, student_id, "", "in the key but not in the Canvas export: no score "
+    problems += [RowProblem(shown_path(path), 0, student_id, "", "in the key but not in the Canvas export: no score "
                             "can be imported for them (dropped the course, or enrolled under another id?)",
                             caveat=True) for student_id in missing]
     notes = [*_assignment_notes(table, assignment, key), *_points_notes(table, assignment, key),

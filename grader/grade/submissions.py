@@ -40,6 +40,7 @@ from pathlib import Path
 from typing import Literal
 
 from grader.errors import shown
+from grader.files import shown_path
 from grader.grade.columns import Layout, find_layout
 from grader.inputs import CsvRow, CsvTable, read_csv
 
@@ -138,7 +139,7 @@ def read_submissions(paths: Sequence[Path], students: Sequence[StudentRef], labe
     problems: list[RowProblem] = []
     ignored: dict[str, None] = {}
     notes: list[str] = []
-    shown_as = list(names) or [str(path) for path in paths]
+    shown_as = [shown_path(name) for name in names or paths]
     for index, (path, name) in enumerate(zip(paths, shown_as, strict=True)):
         table = read_csv(path, exports=True)
         layout = find_layout(table, labels, fmt, roster.known)

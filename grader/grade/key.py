@@ -24,9 +24,13 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, TypeVar
 
+from grader.assign.assignment import MAX_POINTS
 from grader.errors import GraderError, shown
-from grader.inputs import decode_text, read_bytes
+from grader.grade.notation import ReadError, check_powers
+from grader.inputs import CELL_CHARS, decode_text, read_bytes
 from grader.model.expr import names, parse
+from grader.model.tolerance import Tolerance
+from grader.model.units import parse_unit
 
 KEY_BYTES = 1 << 30  # 1 GiB: a key holds every student's numbers; 2,000 students take about 2 MB
 SYMBOL_RANGE = (1.0, 10.0)  # version 1 keys give no ranges: a symbolic answer's names are drawn here
@@ -119,9 +123,16 @@ def load_key(path: Path) -> Key:
                           "wrote it? update grader)")
     try:
         return _key(raw, where, version)
-    except (KeyError, TypeError, ValueError, AttributeError) as error:
+    except _EntryError as error:
+        raise GraderError(f"{where}: {error}; correct it, or regenerate the key with grader generate") from None
+    except (KeyError, TypeError, ValueError, AttributeError, OverflowError) as error:
         raise GraderError(f"{where}: a grader key with a missing or malformed entry ({type(error).__name__}: "
                           f"{shown(str(error))}); regenerate it with grader generate") from None
+
+
+class _EntryError(ValueError):
+    """An entry of the key that is present but unusable (a tolerance, unit, expression, points or text no
+    grader key holds); the message says which and why."""
 
 
 def _no_constant(name: str) -> float:
@@ -230,7 +241,8 @@ def _reader(header: Mapping[str, Any]) -> Callable[[Any], Any]:
 # --- the key's objects ----------------------------------------------------------------------------
 
 def _key(raw: Mapping[str, Any], where: str, version: int) -> Key:
-    problems = tuple(KeyProblem(str(p["key"]), str(p.get("title", "")), tuple(str(a["label"]) for a in p["answers"]))
+    problems = tuple(KeyProblem(str(p["key"]), _text(p.get("title", ""), "a problem's title"),
+                                tuple(_text(a["label"], "a problem's label") for a in p["answers"]))
                      for p in raw["problems"])
     symbols = _symbols(raw["problems"])
     shared: dict[Any, Any] = {}
@@ -243,26 +255,54 @@ def _key(raw: Mapping[str, Any], where: str, version: int) -> Key:
         if set(student.parts) != labels:
             raise ValueError(f"student {student.id} has parts {sorted(student.parts)}, the problems {sorted(labels)}")
     grading = raw["assignment"].get("grading", {})
-    return Key(where, version, str(raw["assignment"]["title"]), bool(grading.get("numeric_expressions", True)),
+    numeric_expressions = grading.get("numeric_expressions", True)
+    if not isinstance(numeric_expressions, bool):
+        raise _EntryError(f"assignment.grading.numeric_expressions: expected true or false, got "
+                          f"{shown(numeric_expressions)}")
+    return Key(where, version, _text(raw["assignment"]["title"], "assignment.title"), numeric_expressions,
                problems, students)
 
 
 def _symbols(problems: Any) -> dict[str, dict[str, tuple[float, float]]]:
     """Per label, where each name of a symbolic answer is drawn (empty for numeric answers)."""
-    return {str(a["label"]): {str(n): (float(r[0]), float(r[1])) for n, r in a.get("symbols", {}).items()}
+    return {str(a["label"]): {str(n): _range(a["label"], n, r) for n, r in a.get("symbols", {}).items()}
             for p in problems for a in p["answers"]}
+
+
+def _range(label: str, name: str, bounds: Any) -> tuple[float, float]:
+    """A symbol's range: two finite numbers, low below high, whose span is finite too (random points are
+    drawn across it)."""
+    low, high = float(bounds[0]), float(bounds[1])
+    if len(bounds) != 2 or not (low < high and math.isfinite(high - low)):
+        raise _EntryError(f"answer {label}: symbols.{name}: expected [LOW, HIGH] with LOW < HIGH, finite, got "
+                          f"{shown(bounds)}")
+    return low, high
+
+
+def _text(value: Any, what: str) -> str:
+    """A text entry (an id, name, label, unit, title): text of at most CELL_CHARS characters, as in a roster."""
+    if not isinstance(value, str) or len(value) > CELL_CHARS:
+        raise _EntryError(f"{what}: expected text of at most {CELL_CHARS} characters, got {shown(value)}")
+    return value
 
 
 def _student(raw: Mapping[str, Any], symbols: Mapping[str, Mapping[str, tuple[float, float]]],
              shared: dict[Any, Any]) -> KeyStudent:
+    student_id = _text(raw["id"], "a student's id")
+    if not student_id.strip():
+        raise _EntryError(f"a student's id: expected an id, got {shown(student_id)}")
     parts = {}
     for problem in raw["problems"]:
         key = _one(shared, str(problem["key"]))
         for name, answer in problem["answers"].items():
-            part = _part(key, _one(shared, str(name)), answer, symbols, shared)
+            try:
+                part = _part(key, _one(shared, str(name)), answer, symbols, shared)
+            except _EntryError as error:
+                raise _EntryError(f"student {student_id}: {error}") from None
             parts[part.label] = part
-    return KeyStudent(str(raw["id"]), str(raw.get("name", "")), str(raw.get("email", "")),
-                      str(raw.get("section", "")), parts)
+    name, email, section = (_text(raw.get(field, ""), f"student {student_id}: {field}")
+                            for field in ("name", "email", "section"))
+    return KeyStudent(student_id, name, email, section, parts)
 
 
 def _part(problem: str, name: str, raw: Mapping[str, Any],
@@ -274,14 +314,55 @@ def _part(problem: str, name: str, raw: Mapping[str, Any],
         value = float(value) if isinstance(value, (int, float)) else value
     if isinstance(value, float) and not math.isfinite(value):
         raise ValueError(f"answer {name}: a value that is not finite")
-    label, unit, points = _one(shared, str(raw["label"])), _one(shared, str(raw.get("unit", ""))), _one(
-        shared, float(raw["points"]))
+    label = _one(shared, _text(raw["label"], f"answer {name}: label"))
+    unit, points = _unit(raw.get("unit", ""), name, shared), _one(shared, _points(raw["points"], name))
     domains = symbols.get(label, {})  # the label's own: one mapping for the whole class
-    if isinstance(value, str) and not domains:
-        domains = shared.get(("symbols", value)) or shared.setdefault(
-            ("symbols", value), dict.fromkeys(sorted(names(parse(value))), SYMBOL_RANGE))
-    return KeyPart(problem, name, label, value, unit, points, _tolerance(raw["tolerance"], shared),
-                   raw.get("undefined"), domains)
+    if isinstance(value, str):
+        used = shared.get(("names", value))
+        if used is None:
+            used = shared[("names", value)] = _names(value, name)
+        if not domains:
+            domains = shared.get(("symbols", value)) or shared.setdefault(
+                ("symbols", value), dict.fromkeys(sorted(used), SYMBOL_RANGE))
+        elif not used <= domains.keys():
+            raise _EntryError(f"answer {name}: the expression {shown(value)} uses "
+                              f"{', '.join(sorted(used - domains.keys()))}, not among its symbols "
+                              f"({', '.join(domains)})")
+    undefined = raw.get("undefined")
+    if not (undefined is None or isinstance(undefined, str)):
+        raise _EntryError(f"answer {name}: undefined: expected the reason as text, got {shown(undefined)}")
+    return KeyPart(problem, name, label, value, unit, points, _tolerance(raw["tolerance"], name, shared),
+                   undefined, domains)
+
+
+def _names(expression: str, name: str) -> frozenset[str]:
+    """The names a symbolic answer of the key uses; an expression the allow-list parser refuses, or with a
+    power too large to evaluate (``v**9**9``), is refused."""
+    try:
+        tree = parse(expression)
+        check_powers(tree)
+    except (GraderError, ReadError) as error:
+        raise _EntryError(f"answer {name}: {error}") from None
+    return frozenset(names(tree))
+
+
+def _unit(text: Any, name: str, shared: dict[Any, Any]) -> str:
+    """An answer's unit, checked once per distinct text: one a key can hold (``m/s``, ``deg``, ``%``)."""
+    unit = shared.get(("unit", text)) if isinstance(text, str) else None
+    if unit is None:
+        try:
+            parse_unit(_text(text, f"answer {name}: unit"))
+        except GraderError as error:
+            raise _EntryError(f"answer {name}: unit: {error}") from None
+        unit = shared[("unit", text)] = text
+    return unit  # type: ignore[no-any-return]
+
+
+def _points(value: Any, name: str) -> float:
+    """An answer's points: a number from 0 to MAX_POINTS, as an assignment gives them."""
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not 0 <= value <= MAX_POINTS:
+        raise _EntryError(f"answer {name}: points: expected a number from 0 to {MAX_POINTS:,}, got {shown(value)}")
+    return float(value)
 
 
 def _one(shared: dict[Any, Any], value: _T) -> _T:
@@ -289,13 +370,20 @@ def _one(shared: dict[Any, Any], value: _T) -> _T:
     return shared.setdefault(value, value)  # type: ignore[no-any-return]
 
 
-def _tolerance(raw: Mapping[str, Any], shared: dict[Any, Any]) -> Mapping[str, Any]:
-    """The part's tolerance (version 1 has no mode: ``{"rtol", "atol"}``), one mapping for equal ones."""
+def _tolerance(raw: Mapping[str, Any], name: str, shared: dict[Any, Any]) -> Mapping[str, Any]:
+    """The part's tolerance (version 1 has no mode: ``{"rtol", "atol"}``), one mapping for equal ones,
+    each checked once (a tolerance grading would refuse is refused here, naming the answer)."""
     try:
         key = ("tolerance", tuple(raw.items()), tuple(map(type, raw.values())))  # True is not 1 here
         found = shared.get(key)
     except TypeError:  # a value that cannot be hashed: Tolerance.from_json says what is wrong with it
-        return {"mode": "rtol", **raw}
+        key, found = None, None
     if found is None:
-        found = shared[key] = {"mode": "rtol", **raw}
+        found = {"mode": "rtol", **raw}
+        try:
+            Tolerance.from_json(found)
+        except GraderError as error:
+            raise _EntryError(f"answer {name}: {error}") from None
+        if key is not None:
+            shared[key] = found
     return found

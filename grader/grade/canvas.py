@@ -224,8 +224,18 @@ def _canvas_id(who: Mapping[str, str]) -> str:
 
 def _kept(text: str) -> float | str | None:
     """An export's score as ``canvas.csv`` writes it back: a number stays a number (so ``-1.5`` is not
-    guarded as if it were a formula), other text stays text, empty is None."""
-    return None if not text else float(text) if _SCORE.fullmatch(text) else text
+    guarded as if it were a formula), other text stays text (a number of 400 digits too: as a float
+    it would be infinite), empty is None."""
+    score = _score(text)
+    return text or None if score is None else score
+
+
+def _score(text: str) -> float | None:
+    """A score as Canvas exports it, as a finite number; None for any other text."""
+    if not _SCORE.fullmatch(text):
+        return None
+    score = float(text)
+    return score if math.isfinite(score) else None
 
 
 def _assignment_notes(table: CsvTable, column: str | None, key: Key) -> list[str]:
@@ -245,9 +255,9 @@ def _points_notes(table: CsvTable, column: str | None, key: Key) -> list[str]:
     Canvas' points)."""
     first = table.header[0]
     row = next((row for row in table.rows if "points possible" in row.cells[first].lower()), None)
-    text = row.cells[column].replace(",", ".") if row and column else ""
-    if not _SCORE.fullmatch(text) or math.isclose(float(text), key.possible):
+    points = _score(row.cells[column].replace(",", ".")) if row and column else None
+    if points is None or math.isclose(points, key.possible):
         return []
-    return [f"{table.path}: Canvas gives {shown(column)} {float(text):g} points possible, the key's students can "
+    return [f"{table.path}: Canvas gives {shown(column)} {points:g} points possible, the key's students can "
             f"earn {key.possible:g}: change the assignment's points in Canvas, or the scores read as a fraction of "
-            f"{float(text):g}"]
+            f"{points:g}"]

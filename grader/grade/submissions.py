@@ -205,7 +205,7 @@ def _read_row(file: str, index: int, row: CsvRow, table: CsvTable, layout: Layou
     who = row.cells[layout.student]
     label = ""
     if not layout.wide:
-        label = _find_label(row.cells[layout.label or ""], labels) or row.cells[layout.label or ""]
+        label = find_label(row.cells[layout.label or ""], labels) or row.cells[layout.label or ""]
     if row.problem is not None:
         problems.append(RowProblem(file, row.line, who, label, row.problem.split(": ", 1)[-1]))
         return
@@ -234,7 +234,7 @@ def _read_row(file: str, index: int, row: CsvRow, table: CsvTable, layout: Layou
     rows.append(_Row(file, index, row.line, student_id, answers, stamp, table.delimiter, layout.wide))
 
 
-def _find_label(text: str, labels: Sequence[str]) -> str | None:
+def find_label(text: str, labels: Sequence[str]) -> str | None:
     """The label ``text`` names: exactly, else ignoring case and spaces around it."""
     if text in labels:
         return text

@@ -125,7 +125,7 @@ def load_key(path: Path) -> Key:
         return _key(raw, where, version)
     except _EntryError as error:
         raise GraderError(f"{where}: {error}; correct it, or regenerate the key with grader generate") from None
-    except (KeyError, TypeError, ValueError, AttributeError, OverflowError) as error:
+    except (KeyError, IndexError, TypeError, ValueError, AttributeError, OverflowError) as error:
         raise GraderError(f"{where}: a grader key with a missing or malformed entry ({type(error).__name__}: "
                           f"{shown(str(error))}); regenerate it with grader generate") from None
 
@@ -272,18 +272,24 @@ def _symbols(problems: Any) -> dict[str, dict[str, tuple[float, float]]]:
 def _range(label: str, name: str, bounds: Any) -> tuple[float, float]:
     """A symbol's range: two finite numbers, low below high, whose span is finite too (random points are
     drawn across it)."""
-    low, high = float(bounds[0]), float(bounds[1])
-    if len(bounds) != 2 or not (low < high and math.isfinite(high - low)):
+    low, high = (float(bounds[0]), float(bounds[1])) if isinstance(bounds, list) and len(bounds) == 2 else (0.0, 0.0)
+    if not (low < high and math.isfinite(high - low)):
         raise _EntryError(f"answer {label}: symbols.{name}: expected [LOW, HIGH] with LOW < HIGH, finite, got "
                           f"{shown(bounds)}")
     return low, high
 
 
 def _text(value: Any, what: str) -> str:
-    """A text entry (an id, name, label, unit, title): text of at most CELL_CHARS characters, as in a roster."""
+    """A text entry (an id, name, label, unit, title): text of at most CELL_CHARS characters, as in a
+    roster, that UTF-8 can write (JSON's ``\\ud800`` is a lone surrogate: the reports could not hold it)."""
     if not isinstance(value, str) or len(value) > CELL_CHARS:
         raise _EntryError(f"{what}: expected text of at most {CELL_CHARS} characters, got {shown(value)}")
+    if not value.isascii() and _SURROGATE.search(value):
+        raise _EntryError(f"{what}: expected text, got {shown(value)}, which holds a lone surrogate (no character)")
     return value
+
+
+_SURROGATE = re.compile("[\ud800-\udfff]")
 
 
 def _student(raw: Mapping[str, Any], symbols: Mapping[str, Mapping[str, tuple[float, float]]],

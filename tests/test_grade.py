@@ -229,6 +229,7 @@ HOSTILE_KEYS = [  # (what is changed in the key, what the refusal says): each wa
     (lambda d: d["problems"][1]["answers"][0].update(symbols={"p": [0.1, 10], "v": [-1.7e308, 1.7e308]}),
      "answer 2a: symbols.v: expected [LOW, HIGH] with LOW < HIGH, finite"),
     (lambda d: d["students"][0].update(id=None), "a student's id: expected text"),
+    (lambda d: d["students"][1].update(id=d["students"][0]["id"]), "the student id '2026100' appears twice"),
     (lambda d: d["students"][0].update(name="x" * 10**6), "name: expected text of at most 1000 characters"),
     (lambda d: d["assignment"].update(grading={"numeric_expressions": "no"}),
      "numeric_expressions: expected true or false, got 'no'"),
@@ -242,7 +243,7 @@ HOSTILE_KEYS = [  # (what is changed in the key, what the refusal says): each wa
 
 @pytest.mark.parametrize(("change", "message"), HOSTILE_KEYS, ids=[
     "points-1e308", "points-negative", "value-10**400", "digits-99", "unit-kg^99", "expression-import",
-    "expression-power", "expression-unknown-name", "range-overflows", "id-null", "name-1e6-chars",
+    "expression-power", "expression-unknown-name", "range-overflows", "id-null", "id-twice", "name-1e6-chars",
     "numeric-expressions-text", "undefined-not-text", "range-empty", "section-lone-surrogate"])
 def test_a_hand_edited_key_that_cannot_be_graded_is_refused_naming_the_entry(
         tmp_path: Path, capsys: pytest.CaptureFixture[str], key_path: Path, change: Any, message: str) -> None:

@@ -19,6 +19,7 @@ from __future__ import annotations
 import json
 import math
 import re
+from collections import Counter
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
@@ -249,7 +250,8 @@ def _key(raw: Mapping[str, Any], where: str, version: int) -> Key:
     students = tuple(s if isinstance(s, KeyStudent) else _student(s, symbols, shared) for s in raw["students"])
     ids = [s.id for s in students]
     if len(set(ids)) != len(ids):
-        raise ValueError("a student id appears twice")
+        twice = next(student_id for student_id, n in Counter(ids).items() if n > 1)
+        raise _EntryError(f"the student id {shown(twice)} appears twice; expected each student once")
     labels = {label for problem in problems for label in problem.labels}
     for student in students:
         if set(student.parts) != labels:

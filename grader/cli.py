@@ -680,6 +680,8 @@ def _batch_lines(path: Path) -> list[str]:
 
     limit = 1 << 30
     if str(path) == "-":
+        if sys.stdin is None:  # started with standard input closed (`grader check --batch - <&-`)
+            raise UsageError("--batch -: standard input is closed; send the lines to it, or give --batch FILE.jsonl")
         data = sys.stdin.buffer.read(limit + 1)
         if len(data) > limit:
             raise UsageError(f"standard input: more than {limit:,} bytes; split the batch")

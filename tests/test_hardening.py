@@ -530,6 +530,13 @@ def test_a_closed_standard_output_is_one_line(capsys: pytest.CaptureFixture[str]
     assert "standard output is closed" in capsys.readouterr().err
 
 
+def test_a_batch_from_a_closed_standard_input_is_one_line(capsys: pytest.CaptureFixture[str],
+                                                          monkeypatch: pytest.MonkeyPatch) -> None:
+    """`grader check --batch - <&-` was an AttributeError's traceback."""
+    monkeypatch.setattr("sys.stdin", None)
+    assert "--batch -: standard input is closed" in refused(capsys, "check", "--batch", "-")
+
+
 def test_control_characters_from_input_are_escaped_in_messages(capsys: pytest.CaptureFixture[str]) -> None:
     err = refused(capsys, "solve", "ball-plate", "--set", "v=5 \x1b[31mred", "--set", "theta=30", "--set", "e=0.5")
     assert "\x1b" not in err and "\\x1b[31mred" in err

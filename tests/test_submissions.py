@@ -289,6 +289,14 @@ def test_a_header_of_100000_unknown_columns_is_refused_in_a_short_message(tmp_pa
     assert len(str(refused.value)) < 800
 
 
+@pytest.mark.parametrize("twice", ["a.csv", "./a.csv"])
+def test_a_file_given_twice_is_refused(tmp_path: Path, twice: str) -> None:
+    """Each of its rows was listed as "superseded by" itself (the file and line it is on)."""
+    path = write(tmp_path, "a.csv", "id,1a\n456,1\n")
+    with pytest.raises(GraderError, match="expected each submissions file once"):
+        read_submissions([path, tmp_path / twice], STUDENTS, LABELS)
+
+
 def test_two_columns_for_one_label_are_refused(tmp_path: Path) -> None:
     path = write(tmp_path, "two.csv", "id,1a. speed,1a (m/s)\n456,1,2\n")
     with pytest.raises(GraderError, match="both answer 1a; expected one column per label"):

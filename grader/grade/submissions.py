@@ -31,6 +31,7 @@ competing row has a timestamp, the latest wins (ties: the later row); when any o
 
 from __future__ import annotations
 
+import os
 import re
 from collections import defaultdict
 from collections.abc import Iterable, Sequence
@@ -39,7 +40,7 @@ from datetime import UTC, datetime, timedelta, timezone
 from pathlib import Path
 from typing import Literal
 
-from grader.errors import shown
+from grader.errors import GraderError, shown
 from grader.files import shown_path
 from grader.grade.columns import Layout, find_layout
 from grader.inputs import CsvRow, CsvTable, read_csv
@@ -134,6 +135,7 @@ def read_submissions(paths: Sequence[Path], students: Sequence[StudentRef], labe
     Raises :class:`GraderError` for a file that cannot be used as a whole (unreadable, neither UTF-8
     nor UTF-16 nor clean Windows-1252, no recognisable header); a bad row is a :class:`RowProblem`.
     """
+    _refuse_repeated(paths)
     roster = Roster(students)
     rows: list[_Row] = []
     problems: list[RowProblem] = []
@@ -161,6 +163,17 @@ def read_submissions(paths: Sequence[Path], students: Sequence[StudentRef], labe
     return Submissions(tuple(sorted(answers, key=lambda a: (order[a.file], a.line, position[a.label]))),
                        tuple(sorted(problems, key=lambda p: (order[p.file], p.line, p.caveat, p.label))),
                        tuple(ignored), tuple(notes))
+
+
+def _refuse_repeated(paths: Sequence[Path]) -> None:
+    """One file given twice (``answers.csv`` beside ``*.csv``) would have each row "superseded" by itself."""
+    seen: dict[str, Path] = {}
+    for path in paths:
+        real = os.path.realpath(path)
+        if real in seen:
+            same = "given twice" if str(seen[real]) == str(path) else f"the same file as {seen[real]}"
+            raise GraderError(f"{path}: {same}; expected each submissions file once")
+        seen[real] = path
 
 
 class Roster:

@@ -322,8 +322,7 @@ def read_csv(path: Path, *, exports: bool = False) -> CsvTable:
 
     ``exports=True`` reads files as LMSs and spreadsheets export them, where one bad row must not
     cost the others: the encodings of :func:`decode_export`, and a data row with a cell longer than
-    ``CELL_CHARS`` carries its ``problem`` instead of refusing the file (cells beyond the ``csv``
-    module's own limit of 131,072 characters still refuse it).
+    ``CELL_CHARS`` carries its ``problem`` instead of refusing the file (a 10 MB cell too).
 
     >>> import tempfile, pathlib
     >>> path = pathlib.Path(tempfile.mkdtemp()) / "b.csv"
@@ -396,6 +395,11 @@ def _check_cell_lengths(cells: list[str], path: Path, line: int) -> None:
 
 
 def _records(stream: io.StringIO, path: Path, delimiter: str, offset: int) -> Iterator[tuple[int, list[str]]]:
+    """The non-blank records of the text and the line each starts on; an error names the line of the
+    record it is in (where a quote left open begins, not the end of the file it ran to)."""
+    # The csv module's own limit (131,072 characters a cell) would refuse a whole export for one pasted
+    # essay; cells are measured by the caller instead, so the limit is the largest file's.
+    csv.field_size_limit(max(csv.field_size_limit(), CSV_BYTES))
     reader = csv.reader(stream, delimiter=delimiter, strict=True)  # an unclosed quote is an error, not a cell
     end = 0
     while True:
@@ -405,9 +409,7 @@ def _records(stream: io.StringIO, path: Path, delimiter: str, offset: int) -> It
         except StopIteration:
             return
         except csv.Error as error:
-            reason = (f"a cell longer than {CELL_CHARS} characters" if "field limit" in str(error)
-                      else f"{error} (check the quotes)")
-            raise GraderError(f"{path}: line {offset + reader.line_num}: {reason}; expected CSV") from None
+            raise GraderError(f"{path}: line {offset + start}: {error} (check the quotes); expected CSV") from None
         end = reader.line_num
         if not any(map(str.strip, cells)):
             continue

@@ -271,6 +271,22 @@ def test_a_row_with_too_many_cells_or_a_huge_cell_is_a_row_problem_not_a_refused
         (2, "3 cells, but the hea"), (3, "a cell of 1,001 char")]
 
 
+def test_a_cell_beyond_the_csv_modules_limit_is_a_row_problem_too(tmp_path: Path) -> None:
+    """A 10 MB cell (an essay pasted in a form) refused the whole file, saying "a cell longer than 1000
+    characters" although cells of 1,001 to 131,072 characters were row problems."""
+    path = write(tmp_path, "r.csv", f'id,1a\n789,"{"9" * (10 << 20)}"\n00123,5\n')
+    result = read(path)
+    assert summary(result) == ([(3, "00123", "1a", "5")], [(2, "", "a cell of 10,485,760 characters; expected at "
+                                                               "most 1000")])
+
+
+def test_a_quote_left_open_is_refused_at_the_line_it_opens(tmp_path: Path) -> None:
+    """It was reported at the last line of the file, which the open quote ran to."""
+    path = write(tmp_path, "q.csv", 'id,1a\n456,"1\n' + "789,2\n" * 50)
+    with pytest.raises(GraderError, match=r"q\.csv: line 2: unexpected end of data"):
+        read(path)
+
+
 @pytest.mark.parametrize(("header", "fmt"), [("name,section\n", "auto"), ("id,label,answer\n", "wide"),
                                              ("id,1a\n", "long"), ("1a,1b\n", "auto")])
 def test_a_file_without_a_recognisable_header_is_refused_saying_what_was_expected(tmp_path: Path, header: str,

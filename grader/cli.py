@@ -697,7 +697,7 @@ def _print_check(result: dict[str, Any]) -> None:
     rows = [("verdict", f"{result['verdict']} (credit {result['credit']:g})"), ("read as", amount(result["parsed"])),
             ("expected", "undefined" if result["expected"] is None else amount(result["expected"])),
             ("error", "" if result["abs_error"] is None else
-             f"{amount(result['abs_error'])} ({100 * result['rel_error']:.2g} %)"),
+             f"{amount(result['abs_error'])} ({min(100 * result['rel_error'], sys.float_info.max):.2g} %)"),
             ("tolerance", result["tolerance"]), ("feedback", result["feedback"])]
     for name, text in rows:
         if text:

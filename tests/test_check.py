@@ -195,6 +195,12 @@ def test_a_difference_beyond_float64_is_said_in_words_never_inf(capsys: pytest.C
     assert checked(capsys, *argv)["feedback"] == feedback
 
 
+def test_the_printed_error_of_a_difference_beyond_float64_is_no_inf(capsys: pytest.CaptureFixture[str]) -> None:
+    """The relative error as a percentage overflowed: "error  1.79769e+308 (inf %)"."""
+    code, out, _ = run(capsys, "1e308", "--expected=-1e308")
+    assert code == 0 and "error      1.79769e+308 (1.8e+308 %)" in out and "inf" not in out
+
+
 def test_an_expected_minus_zero_is_zero(capsys: pytest.CaptureFixture[str]) -> None:
     assert str(checked(capsys, "0", "--expected", "-0")["expected"]) == "0.0"
 

@@ -248,6 +248,9 @@ def _key(raw: Mapping[str, Any], where: str, version: int) -> Key:
     symbols = _symbols(raw["problems"])
     shared: dict[Any, Any] = {}
     students = tuple(s if isinstance(s, KeyStudent) else _student(s, symbols, shared) for s in raw["students"])
+    if not students or not problems:
+        raise _EntryError(f"expected at least one {'student' if not students else 'problem'}, got none (grader "
+                          "generate writes a key for a roster of students and an assignment of problems)")
     ids = [s.id for s in students]
     if len(set(ids)) != len(ids):
         twice = next(student_id for student_id, n in Counter(ids).items() if n > 1)

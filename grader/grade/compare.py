@@ -270,7 +270,7 @@ def _shown(value: float, *, full: bool = False, digits: int = 6) -> str:
     """A number as a student reads it: ``6.26``, ``1.5e-7``; ``full`` keeps every digit (their own answer)."""
     value = float(value) + 0.0  # never -0
     if not math.isfinite(value):  # a distance between ±1e308 overflows: said in words, never "inf"
-        return "not a number" if math.isnan(value) else "more than 1.8e308" if value > 0 else "less than -1.8e308"
+        return "more than 1.8e308" if value == math.inf else repr(value)
     text = repr(value) if full else f"{value:.{digits}g}"
     if "e" not in text:
         if not full and digits < 6:

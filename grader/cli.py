@@ -593,7 +593,7 @@ def _check(arguments: argparse.Namespace) -> int:
         failed = 0
         for result in check.batch(_batch_lines(arguments.batch), key):
             failed += "error" in result
-            print(json.dumps(result, ensure_ascii=False, allow_nan=False))
+            print(_json_line(result))
         return EXIT_REFUSED if failed else EXIT_OK
     if key is not None:
         against = check.from_key(key, arguments.student, arguments.label)
@@ -610,10 +610,25 @@ def _check(arguments: argparse.Namespace) -> int:
                                     domains=dict(check.domain(text) for text in arguments.domains))
     result = check.check(arguments.answer, against)
     if arguments.json:
-        print(json.dumps(result, ensure_ascii=False, allow_nan=False))
+        print(_json_line(result))
     else:
         _print_check(result)
     return EXIT_OK
+
+
+def _json_line(result: dict[str, Any]) -> str:
+    r"""A result as one line of strict JSON, UTF-8 as it is (``±1 %``), except lone surrogates (input
+    echoed in an error: a JSON ``\ud800``, a file name that is not UTF-8), which no UTF-8 output can
+    write: they keep their ``\u`` escape.
+
+    >>> _json_line({"error": "unit: cannot read unit '\ud800'", "tolerance": "±1 %"})
+    '{"error": "unit: cannot read unit \'\\ud800\'", "tolerance": "±1 %"}'
+    """
+    text = json.dumps(result, ensure_ascii=False, allow_nan=False)
+    return _SURROGATE.sub(lambda m: f"\\u{ord(m.group()):04x}", text)
+
+
+_SURROGATE = re.compile("[\ud800-\udfff]")
 
 
 def _check_arguments(arguments: argparse.Namespace) -> None:
@@ -666,6 +681,8 @@ def _batch_lines(path: Path) -> list[str]:
 
     limit = 1 << 30
     if str(path) == "-":
+        if sys.stdin is None:  # started with standard input closed (`grader check --batch - <&-`)
+            raise UsageError("--batch -: standard input is closed; send the lines to it, or give --batch FILE.jsonl")
         data = sys.stdin.buffer.read(limit + 1)
         if len(data) > limit:
             raise UsageError(f"standard input: more than {limit:,} bytes; split the batch")
@@ -681,7 +698,7 @@ def _print_check(result: dict[str, Any]) -> None:
     rows = [("verdict", f"{result['verdict']} (credit {result['credit']:g})"), ("read as", amount(result["parsed"])),
             ("expected", "undefined" if result["expected"] is None else amount(result["expected"])),
             ("error", "" if result["abs_error"] is None else
-             f"{amount(result['abs_error'])} ({100 * result['rel_error']:.2g} %)"),
+             f"{amount(result['abs_error'])} ({min(100 * result['rel_error'], sys.float_info.max):.2g} %)"),
             ("tolerance", result["tolerance"]), ("feedback", result["feedback"])]
     for name, text in rows:
         if text:

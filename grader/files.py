@@ -32,6 +32,7 @@ import hashlib
 import json
 import os
 import shutil
+import signal
 import tempfile
 from collections.abc import Iterable, Iterator, Sequence
 from contextlib import contextmanager, suppress
@@ -105,6 +106,16 @@ def describe_os_error(error: OSError, outcome: str = "") -> str:
     return "; ".join(part for part in parts if part)
 
 
+def shown_path(path: Path | str) -> str:
+    r"""``path`` as text UTF-8 can write (in a report's cells): the bytes of a file name that are not
+    UTF-8 (Python holds them as lone surrogates) shown as ``\xNN``.
+
+    >>> shown_path(os.fsdecode(b"answers-\xff.csv"))
+    'answers-\\xff.csv'
+    """
+    return os.fsencode(path).decode("utf-8", "backslashreplace")
+
+
 MANIFEST = ".grader-manifest.json"
 """The file in every output folder that lists what the run wrote, each file with its SHA-256."""
 
@@ -140,12 +151,27 @@ def output_folder(out: Path, *, command: str, inputs: Sequence[Path] = (), force
             raise GraderError(describe_os_error(_outside(error, staging, out),
                                                 f"nothing was written to {out}")) from None
         write_manifest(staging, command)
-        _move_into_place(out, target, work, before)
-        finished = True
+        with _signals_held():  # the previous output aside and the new one in: both renames, or neither
+            _move_into_place(out, target, work, before)
+            finished = True
     finally:
         _remove_work(out, work, finished)
         if not finished:
             _remove_empty(created)
+
+
+@contextmanager
+def _signals_held() -> Iterator[None]:
+    """SIGINT and SIGTERM wait (they are delivered at the end) where an interruption would leave no
+    output in place; without ``pthread_sigmask`` (Windows) nothing is held."""
+    if not hasattr(signal, "pthread_sigmask"):
+        yield
+        return
+    previous = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT, signal.SIGTERM})
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, previous)
 
 
 def write_manifest(folder: Path, command: str) -> None:

@@ -24,7 +24,9 @@ import csv
 import io
 import itertools
 import math
+import os
 import re
+import stat
 from collections import Counter
 from collections.abc import Hashable, Iterator
 from dataclasses import dataclass
@@ -43,13 +45,16 @@ YAML_DEPTH = 64
 
 
 def read_bytes(path: Path, limit: int) -> bytes:
-    """A file's bytes, refused beyond ``limit`` (read no further: ``/dev/zero`` is a file too)."""
+    """A file's bytes, refused beyond ``limit`` (read no further: ``/dev/zero`` is a file too; a
+    regular file's size is known, so a 2 GB file is refused before any of it is read)."""
     try:
         with open(path, "rb") as stream:
-            data = stream.read(limit + 1)
+            status = os.fstat(stream.fileno())
+            too_large = stat.S_ISREG(status.st_mode) and status.st_size > limit
+            data = b"" if too_large else stream.read(limit + 1)
     except OSError as error:
         raise GraderError(f"{path}: cannot read ({error.strerror or error})") from None
-    if len(data) > limit:
+    if too_large or len(data) > limit:
         raise GraderError(f"{path}: larger than {limit >> 20 or 1} MiB; expected a text file of ordinary size")
     return data
 
@@ -88,6 +93,10 @@ def decode_export(data: bytes, path: Path) -> tuple[str, str]:
     ...
     grader.errors.GraderError: a.csv: byte offset 3 (line 2): expected UTF-8 or UTF-16 text, got the byte 0x89 ...
     """
+    unmarked = _utf16_without_bom(data)
+    if unmarked:
+        raise GraderError(f"{path}: {unmarked} text without a byte-order mark; expected UTF-8, or UTF-16 that starts "
+                          'with its byte-order mark (save the file as "CSV UTF-8")')
     if data.startswith((codecs.BOM_UTF16_LE, codecs.BOM_UTF16_BE)):
         try:
             text, encoding = data.decode("utf-16"), "UTF-16"
@@ -109,6 +118,25 @@ def decode_export(data: bytes, path: Path) -> tuple[str, str]:
             text, encoding = legacy, "Windows-1252"
     _refuse_nul(text, path)
     return text, encoding
+
+
+def _utf16_without_bom(data: bytes) -> str | None:
+    """``"UTF-16LE"`` or ``"UTF-16BE"`` when ``data`` looks like UTF-16 saved without its byte-order mark
+    (read as UTF-8 it would fail far into the file, or look binary): among its first characters, NUL
+    bytes on one side of at least half of them (the high byte of ASCII text) and never on the other.
+
+    >>> _utf16_without_bom("id,1a".encode("utf-16-le")), _utf16_without_bom("id,1a".encode("utf-16"))
+    ('UTF-16LE', None)
+    """
+    if data.startswith((codecs.BOM_UTF16_LE, codecs.BOM_UTF16_BE)) or b"\0" not in data[:1024]:
+        return None
+    sample = data[:min(len(data), 1024) // 2 * 2]
+    pairs, even, odd = len(sample) // 2, sample[0::2].count(0), sample[1::2].count(0)
+    if odd * 2 >= pairs and not even:
+        return "UTF-16LE"
+    if even * 2 >= pairs and not odd:
+        return "UTF-16BE"
+    return None
 
 
 _UTF8_SEQUENCE = re.compile(rb"[\xc2-\xdf][\x80-\xbf]|[\xe0-\xef][\x80-\xbf]{2}|[\xf0-\xf4][\x80-\xbf]{3}")
@@ -295,8 +323,7 @@ def read_csv(path: Path, *, exports: bool = False) -> CsvTable:
 
     ``exports=True`` reads files as LMSs and spreadsheets export them, where one bad row must not
     cost the others: the encodings of :func:`decode_export`, and a data row with a cell longer than
-    ``CELL_CHARS`` carries its ``problem`` instead of refusing the file (cells beyond the ``csv``
-    module's own limit of 131,072 characters still refuse it).
+    ``CELL_CHARS`` carries its ``problem`` instead of refusing the file (a 10 MB cell too).
 
     >>> import tempfile, pathlib
     >>> path = pathlib.Path(tempfile.mkdtemp()) / "b.csv"
@@ -387,6 +414,7 @@ def _open_csv(path: Path, exports: bool) -> tuple[_CsvHead, Iterator[tuple[int, 
     """The header of a CSV file, and its non-blank data rows to come: ``(line, cells)``."""
     data = read_bytes(path, CSV_BYTES)
     text, encoding = decode_export(data, path) if exports else (decode_text(data, path), "UTF-8")
+    text = _unified(text)
     text_starts = len(text) - len(text.lstrip())  # on the first line that is not blank
     if text_starts == len(text):
         raise GraderError(f"{path}: empty file; expected a header line")
@@ -411,6 +439,22 @@ def _width_problem(cells: list[str], width: int, line: int) -> str | None:
     return None
 
 
+def _unified(text: str) -> str:
+    r"""Text as the ``csv`` module reads it: a lone CR (Excel for Mac's "CSV (Macintosh)", or a file with
+    mixed line ends) is a line end, and a byte-order mark after the start (two exports pasted together)
+    is dropped rather than stuck to the cell it precedes.
+
+    >>> _unified("id,1a\r456,1\r\n\ufeff789,2\n")
+    'id,1a\n456,1\r\n789,2\n'
+    """
+    if "\ufeff" in text:
+        text = text.replace("\ufeff", "")
+    return _LONE_CR.sub("\n", text) if "\r" in text else text
+
+
+_LONE_CR = re.compile(r"\r(?!\n)")
+
+
 def _count_outside_quotes(line: str, delimiter: str) -> int:
     """How often ``delimiter`` separates cells of ``line`` (a quoted ``"1a, speed"`` is one cell)."""
     return sum(part.count(delimiter) for part in line.split('"')[::2])
@@ -425,6 +469,11 @@ def _check_cell_lengths(cells: list[str], path: Path, line: int) -> None:
 
 
 def _records(stream: io.StringIO, path: Path, delimiter: str, offset: int) -> Iterator[tuple[int, list[str]]]:
+    """The non-blank records of the text and the line each starts on; an error names the line of the
+    record it is in (where a quote left open begins, not the end of the file it ran to)."""
+    # The csv module's own limit (131,072 characters a cell) would refuse a whole export for one pasted
+    # essay; cells are measured by the caller instead, so the limit is the largest file's.
+    csv.field_size_limit(max(csv.field_size_limit(), CSV_BYTES))
     reader = csv.reader(stream, delimiter=delimiter, strict=True)  # an unclosed quote is an error, not a cell
     end = 0
     try:
@@ -432,10 +481,8 @@ def _records(stream: io.StringIO, path: Path, delimiter: str, offset: int) -> It
             start, end = end + 1, reader.line_num
             if "".join(cells).strip():  # a row with a cell of text
                 yield offset + start, cells
-    except csv.Error as error:
-        reason = (f"a cell longer than {CELL_CHARS} characters" if "field limit" in str(error)
-                  else f"{error} (check the quotes)")
-        raise GraderError(f"{path}: line {offset + reader.line_num}: {reason}; expected CSV") from None
+    except csv.Error as error:  # the record that fails starts after the last one read
+        raise GraderError(f"{path}: line {offset + end + 1}: {error} (check the quotes); expected CSV") from None
 
 
 def _header(cells: list[str], path: Path, line: int) -> tuple[str, ...]:

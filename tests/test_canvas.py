@@ -158,6 +158,20 @@ def test_an_excused_student_and_a_second_row_of_one_student_keep_the_exports_cel
                                       "score kept")]
 
 
+def test_scores_of_400_digits_are_kept_as_text_never_infinite(folder: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """A kept score read as a float was infinite: writing canvas.csv stopped with a traceback; the points
+    possible were noted as "inf"."""
+    huge = "9" * 400
+    EXPORT.write_text("Student,ID,SIS User ID,SIS Login ID,Section,Homework 3 (12345)\n"
+                      f"    Points Possible,,,,,{huge}\n"
+                      '"Doe, Jane",4321,00123,jdoe,Section 1,\n'
+                      f'"Stranger, Sam",4330,99999,sstranger,Section 2,{huge}\n', encoding="utf-8")
+    code, out, err = grade(capsys, "g", "--json")
+    assert code == 0, err
+    assert cells(folder / "g" / "canvas.csv")[-1][-1] == huge
+    assert not any("inf" in note for note in json.loads(out)["notes"])
+
+
 def test_a_row_with_more_cells_than_the_header_is_left_out_and_said_so(folder: Path,
                                                                       capsys: pytest.CaptureFixture[str]) -> None:
     EXPORT.write_text("Student;ID;SIS User ID;SIS Login ID;Section;Homework 3 (12345)\n"

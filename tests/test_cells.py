@@ -122,6 +122,12 @@ def test_units_of_another_dimension_are_wrong_units(text: str, unit: str, reason
     assert read_number(text, unit) == CellWrongUnit(reason)
 
 
+def test_an_assignment_hint_names_the_answer_not_an_empty_name() -> None:
+    """grader check's part has no name, only its label: the hint said "(or write  = ...)"."""
+    assert read_number("e = 0.5", "", names=("", "answer")) == CellInvalid(
+        "starts with 'e ='; give only the value (or write answer = ...)")
+
+
 def test_arithmetic_can_be_refused() -> None:
     cell = read_number("2.55 + 1.401", "", numeric_expressions=False)
     assert isinstance(cell, CellInvalid) and "without arithmetic" in cell.reason

@@ -160,6 +160,58 @@ def test_a_batch_gives_one_line_per_line_in_order(tmp_path: Path, capsys: pytest
     assert run(capsys, "--batch", good)[0] == 0
 
 
+def test_batch_lines_beyond_float64_are_error_lines_and_every_line_is_strict_json(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """Each of these stopped the whole batch with a traceback (OverflowError, numpy's "high - low range
+    exceeds valid bounds", a UnicodeEncodeError printing an error that echoed a lone surrogate)."""
+    lines = [
+        '{"submitted": "6.3", "expected": 1' + "0" * 400 + "}",
+        '{"submitted": "v", "expected": "v", "domains": {"v": [1, 1' + "0" * 400 + "]}}",
+        '{"submitted": "v", "expected": "v", "domains": {"v": [-1.7e308, 1.7e308]}}',
+        '{"submitted": "6", "expected": 6, "unit": "\\ud800"}',
+        '{"submitted": "6.3", "expected": 6.26}',
+    ]
+    batch = tmp_path / "answers.jsonl"
+    batch.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    code, out, _ = run(capsys, "--batch", batch)
+    out.encode("utf-8")  # strict: no lone surrogate
+    results = [json.loads(line) for line in out.splitlines()]
+    assert code == 3 and len(results) == len(lines)
+    assert [r.get("line") for r in results] == [1, 2, 3, 4, None]
+    assert "expected: expected a finite number" in results[0]["error"]
+    assert all("LOW < HIGH" in r["error"] for r in results[1:3])
+    assert results[3]["error"] == "unit: cannot read unit '\ud800' (write units like m, m/s, m/s^2, kg, deg, %)"
+
+
+@pytest.mark.parametrize(("argv", "feedback"), [
+    (["1e308", "--expected=-1e308"], "1e308 is more than 1.8e308 % above -1e308; only ±1 % is accepted"),
+    (["1e308", "--expected=1"], "1e308 is more than 1.8e308 % above 1; only ±1 % is accepted"),
+    (["1e308", "--expected=-1e308", "--sigfigs", "3"],
+     "1e308 does not match -1e308 to 3 significant figures (it is more than 1.8e308 above)"),
+])
+def test_a_difference_beyond_float64_is_said_in_words_never_inf(capsys: pytest.CaptureFixture[str],
+                                                                argv: list[str], feedback: str) -> None:
+    """The feedback said "1e308 is inf % above 1" (details.csv too)."""
+    assert checked(capsys, *argv)["feedback"] == feedback
+
+
+def test_the_printed_error_of_a_difference_beyond_float64_is_no_inf(capsys: pytest.CaptureFixture[str]) -> None:
+    """The relative error as a percentage overflowed: "error  1.79769e+308 (inf %)"."""
+    code, out, _ = run(capsys, "1e308", "--expected=-1e308")
+    assert code == 0 and "error      1.79769e+308 (1.8e+308 %)" in out and "inf" not in out
+
+
+def test_an_expected_minus_zero_is_zero(capsys: pytest.CaptureFixture[str]) -> None:
+    assert str(checked(capsys, "0", "--expected", "-0")["expected"]) == "0.0"
+
+
+def test_student_and_label_are_read_as_grade_reads_their_cells(capsys: pytest.CaptureFixture[str],
+                                                                key_path: Path) -> None:
+    """Spaces around an id, a label in other case: grade matches them; check said "no part ' 1A '"."""
+    result = checked(capsys, "--key", key_path, "--student", " 00123 ", "--label", " 1A ", "6.26")
+    assert (result["verdict"], result["expected"]) == ("correct", 6.26)
+
+
 @pytest.mark.parametrize(("argv", "message"), [
     (["6.3"], "expected --expected VALUE"),
     (["--expected", "6.26"], "expected the answer to check"),
@@ -176,6 +228,10 @@ def test_a_batch_gives_one_line_per_line_in_order(tmp_path: Path, capsys: pytest
     (["6.3", "--key", "KEY", "--student", "123", "--label", "1a"], "did you mean 00123?"),
     (["6.3", "--key", "KEY", "--student", "00123", "--label", "9z"], "the parts are 1a, 1b, 1c"),
     (["6.3", "--batch", "x.jsonl"], "give it alone"),
+    (["6.3", "--expected", "nan"], "expected 'nan': nan is not a finite number"),  # was an expression in "nan"
+    (["6.3", "--expected", "inf", "--unit", "m"], "expected 'inf': inf is not a finite number"),
+    (["6.3", "--expected", "v", "--symbols", ""], "symbols: expected names like p, v, got ['']"),  # "use ,  and"
+    (["6.3", "--expected", "v", "--symbols", "p,,v"], "symbols: expected names like p, v"),
 ])
 def test_requests_that_cannot_be_carried_out_exit_2(capsys: pytest.CaptureFixture[str], key_path: Path,
                                                     argv: list[str], message: str) -> None:

@@ -6,6 +6,7 @@ import errno
 import hashlib
 import json
 import os
+import signal
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -45,6 +46,31 @@ def test_force_replaces_an_output_that_matches_its_manifest(tmp_path: Path) -> N
     out = _written(tmp_path / "out")
     with output_folder(out, command="test", force=True) as staging:
         write_atomic(staging / "grades.csv", "id,score\n")
+    assert sorted(p.name for p in out.iterdir()) == [MANIFEST, "grades.csv"]
+    assert [p.name for p in tmp_path.iterdir()] == ["out"]
+
+
+@pytest.mark.skipif(not hasattr(signal, "pthread_sigmask"), reason="needs pthread_sigmask")
+def test_ctrl_c_between_the_two_renames_of_force_leaves_one_whole_output(tmp_path: Path,
+                                                                          monkeypatch: pytest.MonkeyPatch) -> None:
+    """--force moves the previous output aside, then the new one in. A Ctrl-C between the two left no
+    output at --out (the previous one stranded in the work folder, which then blocked every later run);
+    now the signal waits for the second rename, and the run ends with the new output in place."""
+    import grader.files
+
+    out = _written(tmp_path / "out")
+    renames, rename = [], os.rename
+
+    def rename_then_interrupt(source: str, destination: str) -> None:
+        rename(source, destination)
+        renames.append(destination)
+        if len(renames) == 1:  # the previous output just went aside
+            signal.raise_signal(signal.SIGINT)
+
+    monkeypatch.setattr(grader.files.os, "rename", rename_then_interrupt)
+    with pytest.raises(KeyboardInterrupt), output_folder(out, command="test", force=True) as staging:
+        write_atomic(staging / "grades.csv", "id,score\n")
+    assert len(renames) == 2
     assert sorted(p.name for p in out.iterdir()) == [MANIFEST, "grades.csv"]
     assert [p.name for p in tmp_path.iterdir()] == ["out"]
 

@@ -211,6 +211,53 @@ def test_a_key_whose_student_lacks_a_part_is_refused(tmp_path: Path, capsys: pyt
     assert code == 2 and "a missing or malformed entry" in err and not (tmp_path / "g").exists()
 
 
+def _first_answer(document: dict[str, Any], problem: int = 0) -> dict[str, Any]:
+    return next(iter(document["students"][0]["problems"][problem]["answers"].values()))  # type: ignore[no-any-return]
+
+
+HOSTILE_KEYS = [  # (what is changed in the key, what the refusal says): each was a traceback, a refusal naming
+    # no file mid-run, or was taken as it came (points of -5, an id null read as the student "None")
+    (lambda d: _first_answer(d).update(points=1e308), "answer e: points: expected a number from 0 to 1,000,000"),
+    (lambda d: _first_answer(d).update(points=-5), "answer e: points: expected a number from 0 to 1,000,000"),
+    (lambda d: _first_answer(d).update(value=10 ** 400), "OverflowError"),
+    (lambda d: _first_answer(d).update(tolerance={"mode": "sigfigs", "digits": 99}),
+     "answer e: tolerance.digits: expected a whole number from 1 to 17, got 99"),
+    (lambda d: _first_answer(d).update(unit="kg^99"), "answer e: unit: the power 99"),
+    (lambda d: _first_answer(d, 1).update(value="__import__('os').system('id')"), "is not an allowed function"),
+    (lambda d: _first_answer(d, 1).update(value="v**9**9**9"), "the power 9**9 is larger than 64"),
+    (lambda d: _first_answer(d, 1).update(value="w*v"), "uses w, not among its symbols (p, v)"),
+    (lambda d: d["problems"][1]["answers"][0].update(symbols={"p": [0.1, 10], "v": [-1.7e308, 1.7e308]}),
+     "answer 2a: symbols.v: expected [LOW, HIGH] with LOW < HIGH, finite"),
+    (lambda d: d["students"][0].update(id=None), "a student's id: expected text"),
+    (lambda d: d["students"][1].update(id=d["students"][0]["id"]), "the student id '2026100' appears twice"),
+    (lambda d: d["students"][0].update(name="x" * 10**6), "name: expected text of at most 1000 characters"),
+    (lambda d: d["assignment"].update(grading={"numeric_expressions": "no"}),
+     "numeric_expressions: expected true or false, got 'no'"),
+    (lambda d: _first_answer(d).update(value=None, undefined={"a": 1}), "undefined: expected the reason as text"),
+    (lambda d: d["problems"][1]["answers"][0].update(symbols={"p": [], "v": [1, 10]}),
+     "answer 2a: symbols.p: expected [LOW, HIGH]"),  # an IndexError's traceback
+    (lambda d: d.update(students=[]), "expected at least one student, got none"),  # 0 students, all rows refused
+    (lambda d: d["students"][0].update(section="\ud800"), "section: expected text, got '\\ud800', which holds a "
+                                                           "lone surrogate"),  # UnicodeEncodeError writing grades.csv
+]
+
+
+@pytest.mark.parametrize(("change", "message"), HOSTILE_KEYS, ids=[
+    "points-1e308", "points-negative", "value-10**400", "digits-99", "unit-kg^99", "expression-import",
+    "expression-power", "expression-unknown-name", "range-overflows", "id-null", "id-twice", "name-1e6-chars",
+    "numeric-expressions-text", "undefined-not-text", "range-empty", "no-students", "section-lone-surrogate"])
+def test_a_hand_edited_key_that_cannot_be_graded_is_refused_naming_the_entry(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str], key_path: Path, change: Any, message: str) -> None:
+    document = key_document(key_path)
+    change(document)
+    (tmp_path / "key.json").write_text(json.dumps(document), encoding="utf-8")
+    (tmp_path / "a.csv").write_text(long_csv(key_answers(key_path)), encoding="utf-8")
+    code, out, err = run(capsys, "grade", "--key", tmp_path / "key.json", tmp_path / "a.csv", "--out", tmp_path / "g")
+    assert (code, out) == (2, "") and err.count("\n") == 1, err
+    assert f"{tmp_path / 'key.json'}: " in err and message in err
+    assert not (tmp_path / "g").exists()
+
+
 def test_the_assignments_tolerance_mode_and_grading_section_reach_the_verdicts(
         tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     """`tolerance: {e: {decimals: 2}}` and `grading: {numeric_expressions: false}` go through the key to grading."""

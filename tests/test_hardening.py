@@ -7,6 +7,7 @@ from __future__ import annotations
 import json
 import tempfile
 import time
+import tracemalloc
 from pathlib import Path
 from typing import Any
 
@@ -228,6 +229,22 @@ def test_dev_zero_as_a_csv_is_refused_by_size_not_memory(tmp_path: Path, capsys:
         a = write(tmp_path / "a.yaml", ONE_PROBLEM)
         err = refused(capsys, "generate", a, "--roster", "/dev/zero", "--out", tmp_path / "o", "--no-pdf", within=3)
     assert "/dev/zero: larger than 64 MiB" in err
+
+
+def test_a_sparse_2_gb_key_is_refused_by_its_size_before_reading_it(tmp_path: Path,
+                                                                    capsys: pytest.CaptureFixture[str]) -> None:
+    """A regular file's size is known: it took 3 s and 1 GiB of memory to read the first GiB of it first."""
+    key = tmp_path / "key.json"
+    with open(key, "wb") as stream:
+        stream.truncate(2 << 30)  # sparse: no disk space used
+    answers = write(tmp_path / "a.csv", "student_id,label,answer\n")
+    tracemalloc.start()
+    try:
+        err = refused(capsys, "grade", "--key", key, answers, "--out", tmp_path / "g", within=2)
+        assert tracemalloc.get_traced_memory()[1] < 50 << 20
+    finally:
+        tracemalloc.stop()
+    assert "key.json: larger than 1024 MiB" in err
 
 
 @pytest.mark.parametrize(("row", "message"), [
@@ -512,6 +529,13 @@ def test_a_closed_standard_output_is_one_line(capsys: pytest.CaptureFixture[str]
     monkeypatch.setattr("sys.stdout", None)
     assert main(["list"]) == 2
     assert "standard output is closed" in capsys.readouterr().err
+
+
+def test_a_batch_from_a_closed_standard_input_is_one_line(capsys: pytest.CaptureFixture[str],
+                                                          monkeypatch: pytest.MonkeyPatch) -> None:
+    """`grader check --batch - <&-` was an AttributeError's traceback."""
+    monkeypatch.setattr("sys.stdin", None)
+    assert "--batch -: standard input is closed" in refused(capsys, "check", "--batch", "-")
 
 
 def test_control_characters_from_input_are_escaped_in_messages(capsys: pytest.CaptureFixture[str]) -> None:

@@ -3,6 +3,7 @@ row accounted for (an answer used, or a problem saying why not; caveats may acco
 
 from __future__ import annotations
 
+import os
 import tempfile
 from collections import Counter
 from datetime import UTC, datetime, timedelta, timezone
@@ -198,6 +199,36 @@ def test_a_clean_cp1252_file_is_read_and_noted(tmp_path: Path) -> None:
     assert len(result.notes) == 1 and "Windows-1252" in result.notes[0]
 
 
+def test_lone_cr_line_ends_are_line_ends_not_a_refused_file(tmp_path: Path) -> None:
+    """Excel for Mac's "CSV (Macintosh)" ends lines with CR alone; a file edited on two systems mixes
+    them. Both were refused with the csv module's "new-line character seen in unquoted field"."""
+    path = write(tmp_path, "mac.csv", "id,1a\r00123,6.26\r456,1\r\n789,2\n")
+    assert summary(read(path))[0] == [(2, "00123", "1a", "6.26"), (3, "456", "1a", "1"), (4, "789", "1a", "2")]
+
+
+def test_a_byte_order_mark_inside_a_file_does_not_stick_to_an_id(tmp_path: Path) -> None:
+    """Two exports pasted together: the second one's BOM made its first id unknown ('\\ufeff456')."""
+    path = write(tmp_path, "pasted.csv", "\ufeffid,1a\n00123,6.26\n\ufeff456,1\n")
+    assert summary(read(path)) == ([(2, "00123", "1a", "6.26"), (3, "456", "1a", "1")], [])
+
+
+@pytest.mark.parametrize("encoding", ["utf-16-le", "utf-16-be"])
+def test_utf16_without_a_byte_order_mark_is_refused_as_such(tmp_path: Path, encoding: str) -> None:
+    """It was refused for "the byte 0xb0" at the first °, far into the file, or as binary data."""
+    path = write(tmp_path, "u.csv", "id,1a\n456,30°\n".encode(encoding))
+    with pytest.raises(GraderError, match=f"{encoding.upper().replace('-LE', 'LE').replace('-BE', 'BE')} text "
+                                          "without a byte-order mark; expected UTF-8, or UTF-16"):
+        read_submissions([path], STUDENTS, LABELS)
+
+
+def test_a_file_name_that_is_not_utf8_is_written_escaped(tmp_path: Path) -> None:
+    """details.csv and problems.csv name the file; a name with the byte 0xff stopped the run with a
+    UnicodeEncodeError when they were written."""
+    path = write(tmp_path, os.fsdecode(b"answers-\xff.csv"), "id,1a\n999,1\n")
+    assert [p.file for p in read_submissions([path], STUDENTS, LABELS).problems] == [
+        str(tmp_path / "answers-\\xff.csv")]
+
+
 @pytest.mark.parametrize(("content", "offset"), [
     (b"id,1a\n456,1\n\x89PNG\r\n\x1a\n\x00\x00", 12),  # binary: control bytes, not clean cp1252
     ("id,1a\n456,é\n".encode() + b"\xe9", 13),  # UTF-8 with one stray byte: a mix, not cp1252
@@ -240,6 +271,22 @@ def test_a_row_with_too_many_cells_or_a_huge_cell_is_a_row_problem_not_a_refused
         (2, "3 cells, but the hea"), (3, "a cell of 1,001 char")]
 
 
+def test_a_cell_beyond_the_csv_modules_limit_is_a_row_problem_too(tmp_path: Path) -> None:
+    """A 10 MB cell (an essay pasted in a form) refused the whole file, saying "a cell longer than 1000
+    characters" although cells of 1,001 to 131,072 characters were row problems."""
+    path = write(tmp_path, "r.csv", f'id,1a\n789,"{"9" * (10 << 20)}"\n00123,5\n')
+    result = read(path)
+    assert summary(result) == ([(3, "00123", "1a", "5")], [(2, "", "a cell of 10,485,760 characters; expected at "
+                                                               "most 1000")])
+
+
+def test_a_quote_left_open_is_refused_at_the_line_it_opens(tmp_path: Path) -> None:
+    """It was reported at the last line of the file, which the open quote ran to."""
+    path = write(tmp_path, "q.csv", 'id,1a\n456,"1\n' + "789,2\n" * 50)
+    with pytest.raises(GraderError, match=r"q\.csv: line 2: unexpected end of data"):
+        read(path)
+
+
 @pytest.mark.parametrize(("header", "fmt"), [("name,section\n", "auto"), ("id,label,answer\n", "wide"),
                                              ("id,1a\n", "long"), ("1a,1b\n", "auto")])
 def test_a_file_without_a_recognisable_header_is_refused_saying_what_was_expected(tmp_path: Path, header: str,
@@ -248,6 +295,22 @@ def test_a_file_without_a_recognisable_header_is_refused_saying_what_was_expecte
     with pytest.raises(GraderError, match=r"line 1: no recognisable header; expected a long file .*student_id, "
                                           r"label, answer.* or a wide file"):
         read(path, fmt=fmt)
+
+
+def test_a_header_of_100000_unknown_columns_is_refused_in_a_short_message(tmp_path: Path) -> None:
+    """The message listed every column: 789 kB on one line."""
+    path = write(tmp_path, "h.csv", "id," + ",".join(f"c{i}" for i in range(100_000)) + "\n1,2\n")
+    with pytest.raises(GraderError, match="no recognisable header") as refused:
+        read(path)
+    assert len(str(refused.value)) < 800
+
+
+@pytest.mark.parametrize("twice", ["a.csv", "./a.csv"])
+def test_a_file_given_twice_is_refused(tmp_path: Path, twice: str) -> None:
+    """Each of its rows was listed as "superseded by" itself (the file and line it is on)."""
+    path = write(tmp_path, "a.csv", "id,1a\n456,1\n")
+    with pytest.raises(GraderError, match="expected each submissions file once"):
+        read_submissions([path, tmp_path / twice], STUDENTS, LABELS)
 
 
 def test_two_columns_for_one_label_are_refused(tmp_path: Path) -> None:

@@ -47,6 +47,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from grader.errors import GraderError, shown
+from grader.files import shown_path
 from grader.grade.columns import EMAIL, normalized
 from grader.grade.key import Key
 from grader.grade.submissions import TEST_STUDENTS, Roster, RowProblem, StudentRef
@@ -109,7 +110,7 @@ def read_export(path: Path, key: Key) -> CanvasExport:
         if not _is_student(row, name):
             continue
         if row.problem is not None:
-            problems.append(RowProblem(str(path), row.line, _canvas_id(who), "",
+            problems.append(RowProblem(shown_path(path), row.line, _canvas_id(who), "",
                                        f"{row.problem.split(': ', 1)[-1]}: left out of canvas.csv", caveat=True))
             continue
         current = row.cells[assignment] if assignment else ""
@@ -118,14 +119,14 @@ def read_export(path: Path, key: Key) -> CanvasExport:
         if key_id is not None:
             taken.setdefault(key_id, row.line)
         if reason or caveat:
-            problems.append(RowProblem(str(path), row.line, key_id or _canvas_id(who), "", reason or caveat,
+            problems.append(RowProblem(shown_path(path), row.line, key_id or _canvas_id(who), "", reason or caveat,
                                        caveat=True))
         rows.append(CanvasRow(row.line, tuple(who.values()), None if reason else key_id,
                               _kept(current) if reason else None))
     if not taken:
         raise _unrelated(path, key, len(rows))
     missing = [s.id for s in key.students if s.id not in taken]
-    problems += [RowProblem(str(path), 0, student_id, "", "in the key but not in the Canvas export: no score "
+    problems += [RowProblem(shown_path(path), 0, student_id, "", "in the key but not in the Canvas export: no score "
                             "can be imported for them (dropped the course, or enrolled under another id?)",
                             caveat=True) for student_id in missing]
     notes = [*_assignment_notes(table, assignment, key), *_points_notes(table, assignment, key),
@@ -223,8 +224,18 @@ def _canvas_id(who: Mapping[str, str]) -> str:
 
 def _kept(text: str) -> float | str | None:
     """An export's score as ``canvas.csv`` writes it back: a number stays a number (so ``-1.5`` is not
-    guarded as if it were a formula), other text stays text, empty is None."""
-    return None if not text else float(text) if _SCORE.fullmatch(text) else text
+    guarded as if it were a formula), other text stays text (a number of 400 digits too: as a float
+    it would be infinite), empty is None."""
+    score = _score(text)
+    return text or None if score is None else score
+
+
+def _score(text: str) -> float | None:
+    """A score as Canvas exports it, as a finite number; None for any other text."""
+    if not _SCORE.fullmatch(text):
+        return None
+    score = float(text)
+    return score if math.isfinite(score) else None
 
 
 def _assignment_notes(table: CsvTable, column: str | None, key: Key) -> list[str]:
@@ -244,9 +255,9 @@ def _points_notes(table: CsvTable, column: str | None, key: Key) -> list[str]:
     Canvas' points)."""
     first = table.header[0]
     row = next((row for row in table.rows if "points possible" in row.cells[first].lower()), None)
-    text = row.cells[column].replace(",", ".") if row and column else ""
-    if not _SCORE.fullmatch(text) or math.isclose(float(text), key.possible):
+    points = _score(row.cells[column].replace(",", ".")) if row and column else None
+    if points is None or math.isclose(points, key.possible):
         return []
-    return [f"{table.path}: Canvas gives {shown(column)} {float(text):g} points possible, the key's students can "
+    return [f"{table.path}: Canvas gives {shown(column)} {points:g} points possible, the key's students can "
             f"earn {key.possible:g}: change the assignment's points in Canvas, or the scores read as a fraction of "
-            f"{float(text):g}"]
+            f"{points:g}"]

@@ -192,7 +192,8 @@ def _refuse_formula(text: str, names: Sequence[str]) -> None:
         raise ReadError(f"starts with '{text[0]}' like a spreadsheet formula; type the value itself")
     assignment = _ASSIGNMENT.match(text)
     if assignment:
-        hint = f" (or write {names[0]} = ...)" if names else ""
+        shown_name = next(filter(None, names), "")  # grader check's part has no name, only its label
+        hint = f" (or write {shown_name} = ...)" if shown_name else ""
         raise ReadError(f"starts with '{assignment['word']} ='; give only the value{hint}")
 
 

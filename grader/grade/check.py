@@ -27,7 +27,7 @@ from grader.grade.cells import MAX_CELL
 from grader.grade.grading import Verdict, grade_part
 from grader.grade.key import SYMBOL_RANGE, Key, KeyPart
 from grader.grade.notation import ReadError, tree_of, value_of
-from grader.grade.submissions import Answer
+from grader.grade.submissions import Answer, find_label
 from grader.model.expr import CONSTANTS, FUNCTIONS, names, to_text
 from grader.model.tolerance import Tolerance
 from grader.model.units import parse_unit
@@ -53,16 +53,18 @@ class Expectation:
 
 def from_key(key: Key, student: str, label: str) -> Expectation:
     """The part ``label`` of the key's student ``student`` (an id, or an email as in the roster)."""
+    student = student.strip()
     found = [s for s in key.students if s.id == student] or \
-            [s for s in key.students if s.email and s.email.lower() == student.strip().lower()]
+            [s for s in key.students if s.email and s.email.lower() == student.lower()]
     if not found:
         unpadded = [s.id for s in key.students if s.id.lstrip("0") == student.lstrip("0")]
         hint = f"; did you mean {unpadded[0]}?" if len(unpadded) == 1 else ""
         raise UsageError(f"{key.where}: no student {shown(student)} (by id or email){hint}")
     parts = found[0].parts
-    if label not in parts:
+    named = find_label(label, key.labels)  # as grade reads a label cell: " 1A " is 1a
+    if named is None:
         raise UsageError(f"{key.where}: no part {shown(label)}; the parts are {', '.join(key.labels)}")
-    return Expectation(parts[label], key)
+    return Expectation(parts[named], key)
 
 
 def expectation(expected: float | str | None, *, unit: str = "", tolerance: Mapping[str, Any] | None = None,
@@ -89,13 +91,13 @@ def _expected(expected: float | str | None, symbols: Sequence[str] | None,
               domains: Mapping[str, tuple[float, float]]) -> tuple[float | str | None,
                                                                    dict[str, tuple[float, float]]]:
     if expected is None or (isinstance(expected, float | int) and not isinstance(expected, bool)):
-        if expected is not None and not math.isfinite(expected):
-            raise UsageError(f"expected: expected a finite number, got {expected!r}")
         if symbols or domains:
             raise UsageError("symbols and domains are for an expected expression, not a number")
-        return None if expected is None else float(expected), {}
+        return None if expected is None else _finite("expected", expected), {}
     if not isinstance(expected, str):
         raise UsageError(f"expected: expected a number, an expression or null, got {shown(expected)}")
+    if symbols is not None and not all(isinstance(name, str) and name.isidentifier() for name in symbols):
+        raise UsageError(f"symbols: expected names like p, v, got {shown(list(symbols))}")
     try:
         tree = tree_of(expected, tuple(symbols) if symbols is not None else _names_in(expected))
     except (ReadError, GraderError) as error:
@@ -105,7 +107,7 @@ def _expected(expected: float | str | None, symbols: Sequence[str] | None,
         if domains:
             raise UsageError("domains are for an expected expression, not a number")
         try:
-            return value_of(tree), {}
+            return value_of(tree) + 0.0, {}  # never -0
         except ReadError as error:
             raise UsageError(f"expected {shown(expected)}: {error}") from None
     listed = list(symbols) if symbols is not None else used
@@ -117,8 +119,13 @@ def _expected(expected: float | str | None, symbols: Sequence[str] | None,
 
 
 def _names_in(text: str) -> tuple[str, ...]:
-    """The names an expected expression uses, as its symbols when none are given (``2v`` uses v)."""
-    return tuple(sorted(set(re.findall(r"[A-Za-z_]\w*", text[:MAX_CELL])) - set(FUNCTIONS) - set(CONSTANTS)))
+    """The names an expected expression uses, as its symbols when none are given (``2v`` uses v); ``inf``
+    and ``nan`` are no names but numbers, refused as not finite."""
+    words = set(re.findall(r"[A-Za-z_]\w*", text[:MAX_CELL])) - set(FUNCTIONS) - set(CONSTANTS)
+    return tuple(sorted(word for word in words if word.lower() not in _NOT_FINITE))
+
+
+_NOT_FINITE = ("inf", "infinity", "nan")
 
 
 def domain(text: str) -> tuple[str, tuple[float, float]]:
@@ -136,13 +143,31 @@ def domain(text: str) -> tuple[str, tuple[float, float]]:
 
 
 def _range(name: str, bounds: Any) -> tuple[float, float]:
+    """Where a symbol is drawn: LOW < HIGH, both finite and their span too (points are drawn across it)."""
     if not name.isidentifier():
         raise UsageError(f"domain: expected a name like p, got {shown(name)}")
-    if (not isinstance(bounds, list) or len(bounds) != 2
-            or not all(isinstance(b, float | int) and not isinstance(b, bool) and math.isfinite(b) for b in bounds)
-            or not bounds[0] < bounds[1]):
-        raise UsageError(f"domain of {name}: expected two finite numbers LOW < HIGH, got {shown(bounds)}")
-    return float(bounds[0]), float(bounds[1])
+    problem = UsageError(f"domain of {name}: expected two finite numbers LOW < HIGH, got {shown(bounds)}")
+    if not (isinstance(bounds, list) and len(bounds) == 2
+            and all(isinstance(b, float | int) and not isinstance(b, bool) for b in bounds)):
+        raise problem
+    try:
+        low, high = _finite("", bounds[0]), _finite("", bounds[1])
+    except UsageError:
+        raise problem from None
+    if not (low < high and math.isfinite(high - low)):
+        raise problem
+    return low, high
+
+
+def _finite(field: str, number: float) -> float:
+    """A number of a request as a float, finite (an integer of 400 digits is not), never -0."""
+    try:
+        value = float(number) + 0.0
+    except OverflowError:
+        value = math.inf
+    if not math.isfinite(value):
+        raise UsageError(f"{field}: expected a finite number, got {shown(number)}")
+    return value
 
 
 def check(submitted: str, against: Expectation) -> dict[str, Any]:

@@ -15,7 +15,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Literal
 
-from grader.errors import GraderError
+from grader.errors import GraderError, shown
 from grader.inputs import CsvTable
 
 STUDENT = ("student id", "id", "sid", "sis user id", "username")  # "student_id" reads as "student id"
@@ -71,7 +71,8 @@ def find_layout(table: CsvTable, labels: Sequence[str], fmt: Literal["auto", "lo
     student_columns = named["student"] or named["email"]
     if not student_columns or (not wide and not is_long) or (wide and not wide_columns):
         raise GraderError(f"{table.path}: line {table.header_line}: no recognisable header; expected "
-                          f"{_EXPECTED.format(labels=', '.join(labels[:4]))}; got {', '.join(table.header)}")
+                          f"{_EXPECTED.format(labels=', '.join(labels[:4]))}; got the columns "
+                          f"{shown(list(table.header), 160)}")
     by_email = not named["student"]
     student = student_columns[0] if len(student_columns) == 1 else max(student_columns, key=lambda column: (
         sum(known(row.cells[column], by_email) for row in table.rows), -student_columns.index(column)))

@@ -269,8 +269,8 @@ def _clause(tolerance: Tolerance, unit: str, correct: bool) -> str:
 def _shown(value: float, *, full: bool = False, digits: int = 6) -> str:
     """A number as a student reads it: ``6.26``, ``1.5e-7``; ``full`` keeps every digit (their own answer)."""
     value = float(value) + 0.0  # never -0
-    if not math.isfinite(value):
-        return repr(value)
+    if not math.isfinite(value):  # a distance between ±1e308 overflows: said in words, never "inf"
+        return "more than 1.8e308" if value == math.inf else repr(value)
     text = repr(value) if full else f"{value:.{digits}g}"
     if "e" not in text:
         if not full and digits < 6:
@@ -284,6 +284,8 @@ def _shown(value: float, *, full: bool = False, digits: int = 6) -> str:
 
 def _percent(ratio: float) -> str:
     percent = ratio * 100
+    if not math.isfinite(percent):
+        return _shown(percent)
     if 10 <= percent < 1e6:
         return f"{percent:.0f}"
     text = f"{percent:.2g}"

@@ -27,14 +27,19 @@ from __future__ import annotations
 import json
 import math
 import re
+from collections import Counter
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, TypeVar
 
+from grader.assign.assignment import MAX_POINTS
 from grader.errors import GraderError, shown
-from grader.inputs import decode_text, read_bytes
+from grader.grade.notation import ReadError, check_powers
+from grader.inputs import CELL_CHARS, decode_text, read_bytes
 from grader.model.expr import names, parse
+from grader.model.tolerance import Tolerance
+from grader.model.units import parse_unit
 
 KEY_BYTES = 1 << 30  # 1 GiB: a key holds every student's numbers; 2,000 students take about 2 MB
 SYMBOL_RANGE = (1.0, 10.0)  # version 1 keys give no ranges: a symbolic answer's names are drawn here
@@ -136,9 +141,16 @@ def load_key(path: Path) -> Key:
                           "wrote it? update grader)")
     try:
         return _key(raw, where, version)
-    except (KeyError, TypeError, ValueError, AttributeError) as error:
+    except _EntryError as error:
+        raise GraderError(f"{where}: {error}; correct it, or regenerate the key with grader generate") from None
+    except (KeyError, IndexError, TypeError, ValueError, AttributeError, OverflowError) as error:
         raise GraderError(f"{where}: a grader key with a missing or malformed entry ({type(error).__name__}: "
                           f"{shown(str(error))}); regenerate it with grader generate") from None
+
+
+class _EntryError(ValueError):
+    """An entry of the key that is present but unusable (a tolerance, unit, expression, points or text no
+    grader key holds); the message says which and why."""
 
 
 def _no_constant(name: str) -> float:
@@ -247,46 +259,85 @@ def _reader(header: Mapping[str, Any]) -> Callable[[Any], Any]:
 # --- the key's objects ----------------------------------------------------------------------------
 
 def _key(raw: Mapping[str, Any], where: str, version: int) -> Key:
-    problems = tuple(KeyProblem(str(p["key"]), str(p.get("title", "")), tuple(str(a["label"]) for a in p["answers"]))
+    problems = tuple(KeyProblem(str(p["key"]), _text(p.get("title", ""), "a problem's title"),
+                                tuple(_text(a["label"], "a problem's label") for a in p["answers"]))
                      for p in raw["problems"])
     symbols = _symbols(raw["problems"])
     shared: dict[Any, Any] = {}
     students = tuple(s if isinstance(s, KeyStudent) else _student(s, symbols, shared) for s in raw["students"])
+    if not students or not problems:
+        raise _EntryError(f"expected at least one {'student' if not students else 'problem'}, got none (grader "
+                          "generate writes a key for a roster of students and an assignment of problems)")
     ids = [s.id for s in students]
     if len(set(ids)) != len(ids):
-        raise ValueError("a student id appears twice")
+        twice = next(student_id for student_id, n in Counter(ids).items() if n > 1)
+        raise _EntryError(f"the student id {shown(twice)} appears twice; expected each student once")
     labels = {label for problem in problems for label in problem.labels}
     for student in students:
         if set(student.parts) != labels:
             raise ValueError(f"student {student.id} has parts {sorted(student.parts)}, the problems {sorted(labels)}")
     grading = raw["assignment"].get("grading", {})
-    return Key(where, version, str(raw["assignment"]["title"]), bool(grading.get("numeric_expressions", True)),
+    numeric_expressions = grading.get("numeric_expressions", True)
+    if not isinstance(numeric_expressions, bool):
+        raise _EntryError(f"assignment.grading.numeric_expressions: expected true or false, got "
+                          f"{shown(numeric_expressions)}")
+    return Key(where, version, _text(raw["assignment"]["title"], "assignment.title"), numeric_expressions,
                problems, students)
 
 
 def _symbols(problems: Any) -> dict[str, dict[str, tuple[float, float]]]:
     """Per label, where each name of a symbolic answer is drawn (empty for numeric answers)."""
-    return {str(a["label"]): {str(n): (float(r[0]), float(r[1])) for n, r in a.get("symbols", {}).items()}
+    return {str(a["label"]): {str(n): _range(a["label"], n, r) for n, r in a.get("symbols", {}).items()}
             for p in problems for a in p["answers"]}
+
+
+def _range(label: str, name: str, bounds: Any) -> tuple[float, float]:
+    """A symbol's range: two finite numbers, low below high, whose span is finite too (random points are
+    drawn across it)."""
+    low, high = (float(bounds[0]), float(bounds[1])) if isinstance(bounds, list) and len(bounds) == 2 else (0.0, 0.0)
+    if not (low < high and math.isfinite(high - low)):
+        raise _EntryError(f"answer {label}: symbols.{name}: expected [LOW, HIGH] with LOW < HIGH, finite, got "
+                          f"{shown(bounds)}")
+    return low, high
+
+
+def _text(value: Any, what: str) -> str:
+    """A text entry (an id, name, label, unit, title): text of at most CELL_CHARS characters, as in a
+    roster, that UTF-8 can write (JSON's ``\\ud800`` is a lone surrogate: the reports could not hold it)."""
+    if not isinstance(value, str) or len(value) > CELL_CHARS:
+        raise _EntryError(f"{what}: expected text of at most {CELL_CHARS} characters, got {shown(value)}")
+    if not value.isascii() and _SURROGATE.search(value):
+        raise _EntryError(f"{what}: expected text, got {shown(value)}, which holds a lone surrogate (no character)")
+    return value
+
+
+_SURROGATE = re.compile("[\ud800-\udfff]")
 
 
 def _student(raw: Mapping[str, Any], symbols: Mapping[str, Mapping[str, tuple[float, float]]],
              shared: dict[Any, Any]) -> KeyStudent:
+    student_id = _text(raw["id"], "a student's id")
+    if not student_id.strip():
+        raise _EntryError(f"a student's id: expected an id, got {shown(student_id)}")
     parts = {}
     parameters: list[tuple[str, str]] = []
     values: list[float] = []
     for problem in raw["problems"]:
         key = _one(shared, str(problem["key"]))
         for name, answer in problem["answers"].items():
-            part = _part(key, _one(shared, str(name)), answer, symbols, shared)
+            try:
+                part = _part(key, _one(shared, str(name)), answer, symbols, shared)
+            except _EntryError as error:
+                raise _EntryError(f"student {student_id}: {error}") from None
             parts[part.label] = part
         printed = problem.get("params")
         for name, value in printed.items() if isinstance(printed, dict) else ():
-            if type(value) in (int, float) and math.isfinite(value):  # not bool: True is no parameter value
+            if type(value) in (int, float) and abs(value) < 1.7e308:  # not bool, NaN or beyond float64
                 parameters.append((key, str(name)))
                 values.append(_one(shared, float(value)))
-    return KeyStudent(str(raw["id"]), str(raw.get("name", "")), str(raw.get("email", "")),
-                      str(raw.get("section", "")), parts, _one(shared, ("parameters", tuple(parameters)))[1],
+    name, email, section = (_text(raw.get(field, ""), f"student {student_id}: {field}")
+                            for field in ("name", "email", "section"))
+    return KeyStudent(student_id, name, email, section, parts, _one(shared, ("parameters", tuple(parameters)))[1],
                       tuple(values))
 
 
@@ -299,14 +350,55 @@ def _part(problem: str, name: str, raw: Mapping[str, Any],
         value = float(value) if isinstance(value, (int, float)) else value
     if isinstance(value, float) and not math.isfinite(value):
         raise ValueError(f"answer {name}: a value that is not finite")
-    label, unit, points = _one(shared, str(raw["label"])), _one(shared, str(raw.get("unit", ""))), _one(
-        shared, float(raw["points"]))
+    label = _one(shared, _text(raw["label"], f"answer {name}: label"))
+    unit, points = _unit(raw.get("unit", ""), name, shared), _one(shared, _points(raw["points"], name))
     domains = symbols.get(label, {})  # the label's own: one mapping for the whole class
-    if isinstance(value, str) and not domains:
-        domains = shared.get(("symbols", value)) or shared.setdefault(
-            ("symbols", value), dict.fromkeys(sorted(names(parse(value))), SYMBOL_RANGE))
-    return KeyPart(problem, name, label, value, unit, points, _tolerance(raw["tolerance"], shared),
-                   raw.get("undefined"), domains)
+    if isinstance(value, str):
+        used = shared.get(("names", value))
+        if used is None:
+            used = shared[("names", value)] = _names(value, name)
+        if not domains:
+            domains = shared.get(("symbols", value)) or shared.setdefault(
+                ("symbols", value), dict.fromkeys(sorted(used), SYMBOL_RANGE))
+        elif not used <= domains.keys():
+            raise _EntryError(f"answer {name}: the expression {shown(value)} uses "
+                              f"{', '.join(sorted(used - domains.keys()))}, not among its symbols "
+                              f"({', '.join(domains)})")
+    undefined = raw.get("undefined")
+    if not (undefined is None or isinstance(undefined, str)):
+        raise _EntryError(f"answer {name}: undefined: expected the reason as text, got {shown(undefined)}")
+    return KeyPart(problem, name, label, value, unit, points, _tolerance(raw["tolerance"], name, shared),
+                   undefined, domains)
+
+
+def _names(expression: str, name: str) -> frozenset[str]:
+    """The names a symbolic answer of the key uses; an expression the allow-list parser refuses, or with a
+    power too large to evaluate (``v**9**9``), is refused."""
+    try:
+        tree = parse(expression)
+        check_powers(tree)
+    except (GraderError, ReadError) as error:
+        raise _EntryError(f"answer {name}: {error}") from None
+    return frozenset(names(tree))
+
+
+def _unit(text: Any, name: str, shared: dict[Any, Any]) -> str:
+    """An answer's unit, checked once per distinct text: one a key can hold (``m/s``, ``deg``, ``%``)."""
+    unit = shared.get(("unit", text)) if isinstance(text, str) else None
+    if unit is None:
+        try:
+            parse_unit(_text(text, f"answer {name}: unit"))
+        except GraderError as error:
+            raise _EntryError(f"answer {name}: unit: {error}") from None
+        unit = shared[("unit", text)] = text
+    return unit  # type: ignore[no-any-return]
+
+
+def _points(value: Any, name: str) -> float:
+    """An answer's points: a number from 0 to MAX_POINTS, as an assignment gives them."""
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not 0 <= value <= MAX_POINTS:
+        raise _EntryError(f"answer {name}: points: expected a number from 0 to {MAX_POINTS:,}, got {shown(value)}")
+    return float(value)
 
 
 def _one(shared: dict[Any, Any], value: _T) -> _T:
@@ -314,13 +406,20 @@ def _one(shared: dict[Any, Any], value: _T) -> _T:
     return shared.setdefault(value, value)  # type: ignore[no-any-return]
 
 
-def _tolerance(raw: Mapping[str, Any], shared: dict[Any, Any]) -> Mapping[str, Any]:
-    """The part's tolerance (version 1 has no mode: ``{"rtol", "atol"}``), one mapping for equal ones."""
+def _tolerance(raw: Mapping[str, Any], name: str, shared: dict[Any, Any]) -> Mapping[str, Any]:
+    """The part's tolerance (version 1 has no mode: ``{"rtol", "atol"}``), one mapping for equal ones,
+    each checked once (a tolerance grading would refuse is refused here, naming the answer)."""
     try:
         key = ("tolerance", tuple(raw.items()), tuple(map(type, raw.values())))  # True is not 1 here
         found = shared.get(key)
     except TypeError:  # a value that cannot be hashed: Tolerance.from_json says what is wrong with it
-        return {"mode": "rtol", **raw}
+        key, found = None, None
     if found is None:
-        found = shared[key] = {"mode": "rtol", **raw}
+        found = {"mode": "rtol", **raw}
+        try:
+            Tolerance.from_json(found)
+        except GraderError as error:
+            raise _EntryError(f"answer {name}: {error}") from None
+        if key is not None:
+            shared[key] = found
     return found

@@ -31,6 +31,7 @@ competing row has a timestamp, the latest wins (ties: the later row); when any o
 
 from __future__ import annotations
 
+import os
 import re
 from collections import defaultdict
 from collections.abc import Iterable, Sequence
@@ -39,7 +40,8 @@ from datetime import UTC, datetime, timedelta, timezone
 from pathlib import Path
 from typing import Literal
 
-from grader.errors import shown
+from grader.errors import GraderError, shown
+from grader.files import shown_path
 from grader.grade.columns import Layout, find_layout
 from grader.inputs import CsvRow, CsvTable, read_csv
 
@@ -133,12 +135,13 @@ def read_submissions(paths: Sequence[Path], students: Sequence[StudentRef], labe
     Raises :class:`GraderError` for a file that cannot be used as a whole (unreadable, neither UTF-8
     nor UTF-16 nor clean Windows-1252, no recognisable header); a bad row is a :class:`RowProblem`.
     """
+    _refuse_repeated(paths)
     roster = Roster(students)
     rows: list[_Row] = []
     problems: list[RowProblem] = []
     ignored: dict[str, None] = {}
     notes: list[str] = []
-    shown_as = list(names) or [str(path) for path in paths]
+    shown_as = [shown_path(name) for name in names or paths]
     for index, (path, name) in enumerate(zip(paths, shown_as, strict=True)):
         table = read_csv(path, exports=True)
         layout = find_layout(table, labels, fmt, roster.known)
@@ -160,6 +163,17 @@ def read_submissions(paths: Sequence[Path], students: Sequence[StudentRef], labe
     return Submissions(tuple(sorted(answers, key=lambda a: (order[a.file], a.line, position[a.label]))),
                        tuple(sorted(problems, key=lambda p: (order[p.file], p.line, p.caveat, p.label))),
                        tuple(ignored), tuple(notes))
+
+
+def _refuse_repeated(paths: Sequence[Path]) -> None:
+    """One file given twice (``answers.csv`` beside ``*.csv``) would have each row "superseded" by itself."""
+    seen: dict[str, Path] = {}
+    for path in paths:
+        real = os.path.realpath(path)
+        if real in seen:
+            same = "given twice" if str(seen[real]) == str(path) else f"the same file as {seen[real]}"
+            raise GraderError(f"{path}: {same}; expected each submissions file once")
+        seen[real] = path
 
 
 class Roster:
@@ -204,7 +218,7 @@ def _read_row(file: str, index: int, row: CsvRow, table: CsvTable, layout: Layou
     who = row.cells[layout.student]
     label = ""
     if not layout.wide:
-        label = _find_label(row.cells[layout.label or ""], labels) or row.cells[layout.label or ""]
+        label = find_label(row.cells[layout.label or ""], labels) or row.cells[layout.label or ""]
     if row.problem is not None:
         problems.append(RowProblem(file, row.line, who, label, row.problem.split(": ", 1)[-1]))
         return
@@ -233,7 +247,7 @@ def _read_row(file: str, index: int, row: CsvRow, table: CsvTable, layout: Layou
     rows.append(_Row(file, index, row.line, student_id, answers, stamp, table.delimiter, layout.wide))
 
 
-def _find_label(text: str, labels: Sequence[str]) -> str | None:
+def find_label(text: str, labels: Sequence[str]) -> str | None:
     """The label ``text`` names: exactly, else ignoring case and spaces around it."""
     if text in labels:
         return text

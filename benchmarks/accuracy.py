@@ -395,8 +395,8 @@ def onset_note(sweep: Sequence[Point]) -> str:
 
 
 def report(points: Sequence[Point], rows: Sequence[Stiffness], inverse_rows: Sequence[Inverse],
-           args: argparse.Namespace, names: Sequence[str]) -> str:
-    """The whole Markdown report."""
+           args: argparse.Namespace, names: Sequence[str], loads: Sequence[float] = ()) -> str:
+    """The whole Markdown report; ``loads``: the machine's 1-minute load average at the start and the end."""
     sweep = [p for p in points if p.method in COLOURS]
     gap = max(abs(p.closed_max - p.error_max) for p in sweep)
     stiff, power = stiffness_table(rows)
@@ -405,7 +405,8 @@ def report(points: Sequence[Point], rows: Sequence[Stiffness], inverse_rows: Seq
         f"Python {platform.python_version()}, numpy {np.__version__}, mpmath {mp.__version__}, {os.cpu_count()} "
         f"CPUs ({platform.machine()}). Contact duration {DEFAULT_CONTACT_DURATION:g} s. Time: median wall time of "
         f"`simulate` over {args.shifts} onset shifts × {args.repeat} runs. Error: largest relative error over the "
-        "scene's numeric answers.",
+        "scene's numeric answers." + (f" Load average (1 min): {loads[0]:.2f} at the start, {loads[-1]:.2f} at "
+                                      f"the end, on {os.cpu_count()} CPUs." if loads else ""),
         "## Target: adaptive within 1e-8 of the closed form in ≤ 5 ms per scene", targets_table(points, names),
         "## Work-precision: error vs the adaptive rtol 1e-13 reference (mean over onset shifts) / median ms",
         sweep_table(sweep, names),
@@ -516,6 +517,7 @@ def plot(points: Sequence[Point], rows: Sequence[Stiffness], names: Sequence[str
 def main(argv: Sequence[str] | None = None) -> int:
     """Run every measurement, print the report and write the result files; 1 if a target is missed."""
     args = parse_args(argv)
+    load_at_start = os.getloadavg()[0]
     started, forward, points = time.perf_counter(), scenes(), []
     names = [s.name for s in forward]
     for scene in forward:
@@ -525,7 +527,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         points += corners(scene, args.repeat)
     print("stiffness sweep and inverse templates ...", file=sys.stderr, flush=True)
     rows, inverse_rows = stiffness(forward[-1], args.durations), inverse(3 * args.repeat)
-    text = report(points, rows, inverse_rows, args, names)
+    text = report(points, rows, inverse_rows, args, names, (load_at_start, os.getloadavg()[0]))
     args.out.mkdir(parents=True, exist_ok=True)
     (args.out / "accuracy.md").write_text(text, encoding="utf-8")
     write_csv(points, rows, inverse_rows, args.out / "accuracy.csv")

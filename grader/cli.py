@@ -559,7 +559,7 @@ def _grade(arguments: argparse.Namespace) -> int:
     from grader.grade.run import run as run_grading
 
     summary = run_grading(arguments.key, arguments.submissions, arguments.out, arguments.format, arguments.force,
-                          arguments.canvas)
+                          arguments.canvas, arguments.bank)
     print(_graded_line(summary), file=sys.stderr)
     if summary.ignored_columns:
         print(f"columns ignored: {_some(list(summary.ignored_columns))}", file=sys.stderr)
@@ -586,18 +586,20 @@ def _rows(n: int) -> str:
 
 def _check(arguments: argparse.Namespace) -> int:
     from grader.grade import check
+    from grader.grade.diagnosis import physics_for
     from grader.grade.key import load_key
 
     _check_arguments(arguments)
     key = load_key(arguments.key) if arguments.key is not None else None
+    physics = physics_for(key, arguments.bank) if key is not None else None
     if arguments.batch is not None:
         failed = 0
-        for result in check.batch(_batch_lines(arguments.batch), key):
+        for result in check.batch(_batch_lines(arguments.batch), key, physics):
             failed += "error" in result
             print(json.dumps(result, ensure_ascii=False, allow_nan=False))
         return EXIT_REFUSED if failed else EXIT_OK
     if key is not None:
-        against = check.from_key(key, arguments.student, arguments.label)
+        against = check.from_key(key, arguments.student, arguments.label, physics)
     else:
         tolerance = {name: getattr(arguments, name) for name in ("rtol", "atol")
                      if getattr(arguments, name) is not None}
@@ -681,7 +683,7 @@ def _print_check(result: dict[str, Any]) -> None:
             ("expected", "undefined" if result["expected"] is None else amount(result["expected"])),
             ("error", "" if result["abs_error"] is None else
              f"{amount(result['abs_error'])} ({100 * result['rel_error']:.2g} %)"),
-            ("tolerance", result["tolerance"]), ("feedback", result["feedback"])]
+            ("tolerance", result["tolerance"]), ("feedback", result["feedback"]), ("diagnosis", result["diagnosis"])]
     for name, text in rows:
         if text:
             print(f"{name:<10} {_printable(text)}")

@@ -14,6 +14,7 @@ import pytest
 
 from grader.cli import main
 from grader.errors import GraderError
+from grader.grade.diagnosis import physics_for
 from grader.grade.grading import grade, grade_part
 from grader.grade.key import load_key
 from grader.grade.submissions import StudentRef, read_submissions
@@ -245,15 +246,16 @@ def test_one_answer_graded_alone_is_graded_as_in_its_class(tmp_path: Path, key_p
     key = load_key(key_path)
     submissions = read_submissions([tmp_path / "a.csv"], [StudentRef(s.id, s.email) for s in key.students],
                                    key.labels)
-    graded = grade(key, submissions)
+    physics = physics_for(key)
+    graded = grade(key, submissions, physics)
     answers = {(a.student_id, a.label): a for a in submissions.answers}
     parts = {(s.id, label): part for s in key.students for label, part in s.parts.items()}
     verdicts = graded.verdicts
-    assert len(verdicts) == len(parts) and {v.verdict for v in verdicts} == {"correct", "incorrect", "invalid",
-                                                                             "missing"}
-    for verdict in verdicts:
+    assert len(verdicts) == len(parts) and {v.verdict for v in verdicts} == {"correct", "mistake", "incorrect",
+                                                                             "invalid", "missing"}
+    for verdict in verdicts:  # "-{}" is a velocity with its sign turned, an energy lost as T' - T
         where = (verdict.student_id, verdict.label)
-        assert grade_part(parts[where], verdict.student_id, answers.get(where), key) == verdict
+        assert grade_part(parts[where], verdict.student_id, answers.get(where), key, physics) == verdict
 
 
 def test_a_key_laid_out_otherwise_reads_the_same(tmp_path: Path, key_path: Path) -> None:

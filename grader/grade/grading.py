@@ -1,18 +1,22 @@
 """Grading: every part of every student in the key against what they submitted, one verdict each.
 
 A verdict records what was typed, what it was read as (in the expected unit), what was expected,
-the errors, the tolerance that decided it in words, the credit and a sentence that explains it.
-Grading is columnar: a part's answers are graded for the whole class at once, each distinct text
-read once and the numbers compared in one vectorised call per tolerance and unit; the verdicts are
-kept as rows of plain values (a class of 100,000 has a million) and become :class:`Verdict` objects
-only when asked for. :func:`grade_part` grades one answer the same way.
+the errors, the tolerance that decided it in words, the credit, a sentence that explains it and, for
+``ecf`` and ``mistake``, the diagnosis (:mod:`grader.grade.diagnosis`). Grading is columnar: a part's
+answers are graded for the whole class at once, each distinct text read once and the numbers compared
+in one vectorised call per tolerance and unit, the wrong ones then reconsidered by the physics in one
+pass; the verdicts are kept as rows of plain values (a class of 100,000 has a million) and become
+:class:`Verdict` objects only when asked for. :func:`grade_part` grades one answer the same way.
 """
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from functools import lru_cache
+
+import numpy as np
 
 from grader.grade.cells import (
     CellBlank,
@@ -24,13 +28,16 @@ from grader.grade.cells import (
     read_number,
     undefined_word,
 )
-from grader.grade.compare import equivalent, errors, feedbacks, is_correct
+from grader.grade.compare import equivalent, errors, feedbacks, is_correct, number_text
+from grader.grade.diagnosis import Earlier, Physics, ProblemPhysics, physics_for, reconsider
 from grader.grade.key import Key, KeyPart
 from grader.grade.submissions import Answer, RowProblem, Submissions
 from grader.model.expr import Node, parse
 from grader.model.tolerance import Tolerance
 
-VERDICTS = ("correct", "incorrect", "invalid", "missing")
+VERDICTS = ("correct", "ecf", "mistake", "incorrect", "invalid", "missing")
+"""The kinds of verdict: right; right for the student's own earlier answer (error carried forward); a
+diagnosed mistake; wrong; unreadable; not given."""
 
 
 @dataclass(frozen=True)
@@ -50,6 +57,7 @@ class Verdict:
     rel_error: float | None
     tolerance: str
     feedback: str
+    diagnosis: str = ""  # ecf: "ecf:" and the part carried forward (ecf:3a); mistake: its id (impact.e_squared)
     source: str = ""  # "file:line" of the row the answer came from
 
     @property
@@ -58,8 +66,9 @@ class Verdict:
         return self.credit * self.points
 
 
-Row = tuple[str | None, str, float, float, str, str, str, float | None, float | None, str, str, str]
-"""A verdict's fields after ``student_id`` and ``label``, in :class:`Verdict`'s order."""
+Row = tuple[str | None, str, float, float, str, str, str, float | None, float | None, str, str, str, str]
+"""A verdict's fields after ``student_id`` and ``label``, in :class:`Verdict`'s order: submitted, verdict,
+credit, points, expected, parsed, unit, abs_error, rel_error, tolerance, feedback, diagnosis, source."""
 
 
 @dataclass(frozen=True)
@@ -81,31 +90,68 @@ class Graded:
                      for index, student in enumerate(self.key.students) for label in labels)
 
 
-def grade(key: Key, submissions: Submissions) -> Graded:
-    """Grade every student of the key; a part nobody answered is ``missing``."""
+def grade(key: Key, submissions: Submissions, physics: Physics | None = None) -> Graded:
+    """Grade every student of the key; a part nobody answered is ``missing``. ``physics`` carries errors
+    forward and diagnoses mistakes (by default from the shipped bank, :func:`physics_for`)."""
+    physics = physics_for(key) if physics is None else physics
     by_label: dict[str, dict[str, Answer]] = {label: {} for label in key.labels}
     for answer in submissions.answers:
         by_label[answer.label][answer.student_id] = answer
     columns = {}
-    for label in key.labels:
-        answers = by_label.pop(label)
-        columns[label] = _grade_column([(student.parts[label], answers.get(student.id)) for student in key.students],
-                                       key)
-    return Graded(key, columns, submissions.problems, submissions.ignored_columns, submissions.notes)
+    everyone = np.arange(len(key.students))
+    for problem in key.problems:
+        earlier: list[Earlier] = []
+        for label in problem.labels:
+            answers = by_label.pop(label)
+            cells = [(student.parts[label], answers.get(student.id)) for student in key.students]
+            columns[label] = _grade_label(cells, key, everyone, physics.problems.get(problem.key), earlier)
+    return Graded(key, columns, submissions.problems, submissions.ignored_columns,
+                  (*submissions.notes, *physics.notes))
 
 
-def grade_part(part: KeyPart, student_id: str, answer: Answer | None, key: Key) -> Verdict:
-    """One part: the key's expectation against the answer (None: nothing submitted)."""
-    return Verdict(student_id, part.label, *_grade_column([(part, answer)], key)[0])
+def grade_part(part: KeyPart, student_id: str, answer: Answer | None, key: Key,
+               physics: Physics | None = None) -> Verdict:
+    """One part: the key's expectation against the answer (None: nothing submitted). With ``physics``, a
+    wrong number may be a diagnosed mistake (an earlier answer to carry forward is not known here)."""
+    student = next((index for index, s in enumerate(key.students) if s.id == student_id), None)
+    found = None if physics is None or student is None else physics.problems.get(part.problem)
+    return Verdict(student_id, part.label, *_grade_label([(part, answer)], key, np.array([student or 0]), found, [])[0])
+
+
+def _grade_label(cells: Sequence[tuple[KeyPart, Answer | None]], key: Key, students: np.ndarray,
+                 physics: ProblemPhysics | None, earlier: list[Earlier]) -> list[Row]:
+    """The rows of one part (``students``: each cell's student, by index in the key), the wrong numbers
+    reconsidered by the problem's ``physics``, which then adds the part to ``earlier``."""
+    rows, numbers = _grade_column(cells, key)
+    if physics is None or not cells:
+        return rows
+    part = cells[0][0]
+    right = np.array([p.value if isinstance(p.value, float) else np.nan for p, _ in cells])
+    wrong: dict[int, list[int]] = {}  # by id of the tolerance (the key shares equal ones)
+    for index, row in enumerate(rows):
+        if row[1] == "incorrect" and not math.isnan(numbers[index]):
+            wrong.setdefault(id(cells[index][0].tolerance), []).append(index)
+    for members in wrong.values():
+        found = reconsider(physics, key, part.name, part.label, part.unit,
+                           Tolerance.from_json(cells[members[0]][0].tolerance), students[members], numbers[members],
+                           right[members], [rows[index][10] for index in members], earlier)
+        for position, finding in found.items():
+            index = members[position]
+            rows[index] = (*rows[index][:1], finding.kind, finding.credit, *rows[index][3:10], finding.feedback,
+                           finding.diagnosis, rows[index][12])
+    earlier.append(Earlier(part.label, part.name, part.unit, numbers, right))
+    return rows
 
 
 Outcome = tuple[str, float, str, str]
 """A verdict decided without comparing numbers: its kind, credit, sentence and what was read."""
 
 
-def _grade_column(cells: Sequence[tuple[KeyPart, Answer | None]], key: Key) -> list[Row]:
-    """A row for each (part, answer): outcomes decided cell by cell, numbers compared by group."""
+def _grade_column(cells: Sequence[tuple[KeyPart, Answer | None]], key: Key) -> tuple[list[Row], np.ndarray]:
+    """A row for each (part, answer): outcomes decided cell by cell, numbers compared by group; and the
+    number each cell was read as (NaN: none)."""
     rows: list[Row | None] = [None] * len(cells)
+    numbers = np.full(len(cells), np.nan)
     tolerances: dict[int, tuple[Tolerance, str]] = {}  # by id of the key's mapping (the key shares equal ones)
     groups: dict[tuple[int, str], tuple[list[int], list[float], list[float]]] = {}
     for index, (part, answer) in enumerate(cells):
@@ -121,13 +167,14 @@ def _grade_column(cells: Sequence[tuple[KeyPart, Answer | None]], key: Key) -> l
             members, submitted, expected = group
             members.append(index)
             submitted.append(outcome.value)
+            numbers[index] = outcome.value
             expected.append(float(part.value))  # type: ignore[arg-type]  # a number: not symbolic, not None
         else:
             rows[index] = _row(part, answer, _expected(part), "equal expressions" if part.symbolic else known[1],
                                *outcome)
     for (tolerance_id, unit), group in groups.items():
         _compare(cells, group, *tolerances[tolerance_id], unit, rows)
-    return rows  # type: ignore[return-value]  # every index is filled above, or by _compare
+    return rows, numbers  # type: ignore[return-value]  # every index is filled above, or by _compare
 
 
 def _compare(cells: Sequence[tuple[KeyPart, Answer | None]], group: tuple[list[int], list[float], list[float]],
@@ -143,9 +190,9 @@ def _compare(cells: Sequence[tuple[KeyPart, Answer | None]], group: tuple[list[i
     for index, value, key_value, ok, sentence, error, ratio in zip(
             members, submitted, expected, right.tolist(), said, absolute.tolist(), relative.tolist(), strict=True):
         part, answer = cells[index]
-        parsed = shown.get(value) or shown.setdefault(value, _show(value))
-        rows[index] = _row(part, answer, _show(key_value), words, "correct" if ok else "incorrect", 1.0 if ok else 0.0,
-                           sentence, parsed, error, ratio)
+        parsed = shown.get(value) or shown.setdefault(value, number_text(value))
+        rows[index] = _row(part, answer, number_text(key_value), words, "correct" if ok else "incorrect",
+                           1.0 if ok else 0.0, sentence, parsed, error, ratio)
 
 
 def _outcome(part: KeyPart, answer: Answer | None, key: Key) -> Outcome | CellNumber:
@@ -173,8 +220,8 @@ def _row(part: KeyPart, answer: Answer | None, expected: str, words: str, kind: 
          parsed: str = "", absolute: float | None = None, relative: float | None = None) -> Row:
     """The verdict's fields; ``expected``: what the key holds, in words; ``words``: the tolerance that decided it."""
     if answer is None:
-        return None, kind, credit, part.points, expected, parsed, part.unit, absolute, relative, words, said, ""
-    return (answer.text, kind, credit, part.points, expected, parsed, part.unit, absolute, relative, words, said,
+        return None, kind, credit, part.points, expected, parsed, part.unit, absolute, relative, words, said, "", ""
+    return (answer.text, kind, credit, part.points, expected, parsed, part.unit, absolute, relative, words, said, "",
             f"{answer.file}:{answer.line}")
 
 
@@ -214,12 +261,7 @@ def _key_tree(text: str) -> Node:
 def _expected(part: KeyPart) -> str:
     if part.value is None:
         return f"undefined ({part.undefined})"
-    return part.value if isinstance(part.value, str) else _show(part.value)
-
-
-def _show(value: float) -> str:
-    """A number as a person reads it: 6 significant figures, never ``-0``."""
-    return f"{value + 0.0:.6g}"
+    return part.value if isinstance(part.value, str) else number_text(part.value)
 
 
 def totals(graded: Graded) -> Mapping[str, Mapping[str, float]]:

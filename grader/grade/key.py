@@ -20,7 +20,7 @@ import json
 import math
 import re
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, TypeVar
 
@@ -56,13 +56,14 @@ class KeyPart:
 
 @dataclass(frozen=True)
 class KeyStudent:
-    """A student of the key, and their answer parts by label."""
+    """A student of the key, their answer parts by label, and their parameters as printed, by problem key."""
 
     id: str
     name: str
     email: str
     section: str
     parts: Mapping[str, KeyPart]
+    params: Mapping[str, Mapping[str, float]] = field(default_factory=dict)
 
     @property
     def possible(self) -> float:
@@ -72,11 +73,12 @@ class KeyStudent:
 
 @dataclass(frozen=True)
 class KeyProblem:
-    """A problem: its key (``1``), title, and its parts' labels in order."""
+    """A problem: its key (``1``), title, its parts' labels in order, and its template's id."""
 
     key: str
     title: str
     labels: tuple[str, ...]
+    template: str = ""
 
 
 @dataclass(frozen=True)
@@ -89,6 +91,9 @@ class Key:
     numeric_expressions: bool
     problems: tuple[KeyProblem, ...]
     students: tuple[KeyStudent, ...]
+    templates: Mapping[str, str] = field(default_factory=dict)  # id -> SHA-256 of the file the key was made from
+    ecf_credit: float = 1.0  # of a part right for the student's own earlier answer (0: no error carried forward)
+    mistake_credit: float = 0.0  # of a part that matches a diagnosed mistake
 
     @property
     def labels(self) -> tuple[str, ...]:
@@ -230,8 +235,8 @@ def _reader(header: Mapping[str, Any]) -> Callable[[Any], Any]:
 # --- the key's objects ----------------------------------------------------------------------------
 
 def _key(raw: Mapping[str, Any], where: str, version: int) -> Key:
-    problems = tuple(KeyProblem(str(p["key"]), str(p.get("title", "")), tuple(str(a["label"]) for a in p["answers"]))
-                     for p in raw["problems"])
+    problems = tuple(KeyProblem(str(p["key"]), str(p.get("title", "")), tuple(str(a["label"]) for a in p["answers"]),
+                                str(p.get("template", ""))) for p in raw["problems"])
     symbols = _symbols(raw["problems"])
     shared: dict[Any, Any] = {}
     students = tuple(s if isinstance(s, KeyStudent) else _student(s, symbols, shared) for s in raw["students"])
@@ -243,8 +248,17 @@ def _key(raw: Mapping[str, Any], where: str, version: int) -> Key:
         if set(student.parts) != labels:
             raise ValueError(f"student {student.id} has parts {sorted(student.parts)}, the problems {sorted(labels)}")
     grading = raw["assignment"].get("grading", {})
+    templates = {str(name): str(entry.get("sha256", "")) for name, entry in raw.get("templates", {}).items()}
     return Key(where, version, str(raw["assignment"]["title"]), bool(grading.get("numeric_expressions", True)),
-               problems, students)
+               problems, students, templates, _credit(grading, "ecf_credit", 1.0),
+               _credit(grading, "mistake_credit", 0.0))
+
+
+def _credit(grading: Mapping[str, Any], name: str, default: float) -> float:
+    value = grading.get(name, default)
+    if isinstance(value, bool) or not isinstance(value, int | float) or not 0 <= value <= 1:
+        raise ValueError(f"assignment.grading.{name} is {value!r}, not a credit from 0 to 1")
+    return float(value)
 
 
 def _symbols(problems: Any) -> dict[str, dict[str, tuple[float, float]]]:
@@ -255,14 +269,18 @@ def _symbols(problems: Any) -> dict[str, dict[str, tuple[float, float]]]:
 
 def _student(raw: Mapping[str, Any], symbols: Mapping[str, Mapping[str, tuple[float, float]]],
              shared: dict[Any, Any]) -> KeyStudent:
-    parts = {}
+    parts, params = {}, {}
     for problem in raw["problems"]:
         key = _one(shared, str(problem["key"]))
         for name, answer in problem["answers"].items():
             part = _part(key, _one(shared, str(name)), answer, symbols, shared)
             parts[part.label] = part
+        given = problem.get("params", {})
+        if not isinstance(given, dict):
+            raise ValueError(f"problem {key}: params that are not an object")
+        params[key] = given  # the decoded object itself: checked where it is used (a number or not)
     return KeyStudent(str(raw["id"]), str(raw.get("name", "")), str(raw.get("email", "")),
-                      str(raw.get("section", "")), parts)
+                      str(raw.get("section", "")), parts, params)
 
 
 def _part(problem: str, name: str, raw: Mapping[str, Any],

@@ -57,7 +57,7 @@ def _power(base: Any, exponent: Any) -> Any:
 OPERATIONS: dict[str, Callable[..., Any]] = {
     "add": np.add, "sub": np.subtract, "mul": np.multiply, "div": np.divide, "neg": np.negative,
     "pow": _power, "sqrt": np.sqrt, "sin": np.sin, "cos": np.cos, "tan": np.tan, "exp": np.exp,
-    "log": np.log, "abs": np.abs, "atan2": np.arctan2, "hypot": np.hypot, "sind": sind, "cosd": cosd,
+    "log": np.log, "abs": np.abs, "sign": np.sign, "atan2": np.arctan2, "hypot": np.hypot, "sind": sind, "cosd": cosd,
     "Max": np.maximum, "Min": np.minimum, "lt": np.less, "le": np.less_equal, "gt": np.greater, "ge": np.greater_equal,
     "and": np.logical_and, "or": np.logical_or,
 }

@@ -4,11 +4,11 @@
 ['free_fall', 'impact', 'rise', 'velocity']
 """
 
-from grader.physics.effects.base import Condition, Effect, Field, Relation, Stable
+from grader.physics.effects.base import Condition, Effect, Field, Mistake, Relation, Stable
 from grader.physics.effects.flight import FREE_FALL, RISE
 from grader.physics.effects.impact import IMPACT
 from grader.physics.effects.velocity import VELOCITY
 
 CATALOGUE: dict[str, Effect] = {effect.name: effect for effect in (FREE_FALL, RISE, IMPACT, VELOCITY)}
 
-__all__ = ["CATALOGUE", "Condition", "Effect", "Field", "Relation", "Stable"]
+__all__ = ["CATALOGUE", "Condition", "Effect", "Field", "Mistake", "Relation", "Stable"]

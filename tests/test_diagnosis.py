@@ -295,3 +295,6 @@ def test_grader_check_json_shows_the_diagnosis(capsys: pytest.CaptureFixture[str
                  f"{math.radians(angle['value']):.3g}", "--json"]) == 0
     result = json.loads(capsys.readouterr().out)
     assert (result["verdict"], result["diagnosis"]) == ("mistake", "angle.radians")
+    assert main(["check", "--key", str(sample_key), "--student", student["id"], "--label", angle["label"],
+                 f"{math.radians(angle['value']):.3g}"]) == 0
+    assert "\ndiagnosis  angle.radians\n" in capsys.readouterr().out

@@ -11,7 +11,6 @@ pass; the verdicts are kept as rows of plain values (a class of 100,000 has a mi
 
 from __future__ import annotations
 
-import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from functools import lru_cache
@@ -122,24 +121,23 @@ def _grade_label(cells: Sequence[tuple[KeyPart, Answer | None]], key: Key, stude
                  physics: ProblemPhysics | None, earlier: list[Earlier]) -> list[Row]:
     """The rows of one part (``students``: each cell's student, by index in the key), the wrong numbers
     reconsidered by the problem's ``physics``, which then adds the part to ``earlier``."""
-    rows, numbers = _grade_column(cells, key)
+    column = _grade_column(cells, key)
+    rows = column.rows
     if physics is None or not cells:
         return rows
     part = cells[0][0]
-    right = np.array([p.value if isinstance(p.value, float) else np.nan for p, _ in cells])
-    wrong: dict[int, list[int]] = {}  # by id of the tolerance (the key shares equal ones)
-    for index, row in enumerate(rows):
-        if row[1] == "incorrect" and not math.isnan(numbers[index]):
-            wrong.setdefault(id(cells[index][0].tolerance), []).append(index)
-    for members in wrong.values():
-        found = reconsider(physics, key, part.name, part.label, part.unit,
-                           Tolerance.from_json(cells[members[0]][0].tolerance), students[members], numbers[members],
-                           right[members], [rows[index][10] for index in members], earlier)
+    for tolerance, wrong in column.wrong:
+        if not wrong:
+            continue
+        members = np.array(wrong)
+        found = reconsider(physics, key, part.name, part.label, part.unit, tolerance, students[members],
+                           column.numbers[members], column.right[members], [rows[index][10] for index in wrong],
+                           earlier)
         for position, finding in found.items():
-            index = members[position]
+            index = wrong[position]
             rows[index] = (*rows[index][:1], finding.kind, finding.credit, *rows[index][3:10], finding.feedback,
                            finding.diagnosis, rows[index][12])
-    earlier.append(Earlier(part.label, part.name, part.unit, numbers, right))
+    earlier.append(Earlier(part.label, part.name, part.unit, column.numbers, column.right))
     return rows
 
 
@@ -147,11 +145,20 @@ Outcome = tuple[str, float, str, str]
 """A verdict decided without comparing numbers: its kind, credit, sentence and what was read."""
 
 
-def _grade_column(cells: Sequence[tuple[KeyPart, Answer | None]], key: Key) -> tuple[list[Row], np.ndarray]:
-    """A row for each (part, answer): outcomes decided cell by cell, numbers compared by group; and the
-    number each cell was read as (NaN: none)."""
+@dataclass(frozen=True)
+class _Column:
+    """A part graded for a class: a row per cell; the number each cell was read as and the key's number
+    (NaN where either is not a number); and the cells whose number is wrong, grouped by tolerance."""
+
+    rows: list[Row]
+    numbers: np.ndarray
+    right: np.ndarray
+    wrong: list[tuple[Tolerance, list[int]]]
+
+
+def _grade_column(cells: Sequence[tuple[KeyPart, Answer | None]], key: Key) -> _Column:
+    """A row for each (part, answer): outcomes decided cell by cell, numbers compared by group."""
     rows: list[Row | None] = [None] * len(cells)
-    numbers = np.full(len(cells), np.nan)
     tolerances: dict[int, tuple[Tolerance, str]] = {}  # by id of the key's mapping (the key shares equal ones)
     groups: dict[tuple[int, str], tuple[list[int], list[float], list[float]]] = {}
     for index, (part, answer) in enumerate(cells):
@@ -167,32 +174,39 @@ def _grade_column(cells: Sequence[tuple[KeyPart, Answer | None]], key: Key) -> t
             members, submitted, expected = group
             members.append(index)
             submitted.append(outcome.value)
-            numbers[index] = outcome.value
             expected.append(float(part.value))  # type: ignore[arg-type]  # a number: not symbolic, not None
         else:
             rows[index] = _row(part, answer, _expected(part), "equal expressions" if part.symbolic else known[1],
                                *outcome)
+    numbers, right = np.full(len(cells), np.nan), np.full(len(cells), np.nan)
+    wrong = []
     for (tolerance_id, unit), group in groups.items():
-        _compare(cells, group, *tolerances[tolerance_id], unit, rows)
-    return rows, numbers  # type: ignore[return-value]  # every index is filled above, or by _compare
+        members, submitted, expected = group
+        numbers[members], right[members] = submitted, expected
+        wrong.append((tolerances[tolerance_id][0], _compare(cells, group, *tolerances[tolerance_id], unit, rows)))
+    return _Column(rows, numbers, right, wrong)  # type: ignore[arg-type]  # every row is filled, here or by _compare
 
 
 def _compare(cells: Sequence[tuple[KeyPart, Answer | None]], group: tuple[list[int], list[float], list[float]],
-             tolerance: Tolerance, words: str, unit: str, rows: list[Row | None]) -> None:
+             tolerance: Tolerance, words: str, unit: str, rows: list[Row | None]) -> list[int]:
     """The rows of a group of cells (their indices, the numbers read, the key's) of one tolerance and
-    unit: verdicts, errors and sentences, each in one pass over the group."""
+    unit: verdicts, errors and sentences, each in one pass over the group; returns the cells found wrong."""
     members, submitted, expected = group
     angle = unit if unit in ("deg", "rad") else None
     right = is_correct(submitted, expected, tolerance, angle_unit=angle)
     absolute, relative = errors(submitted, expected, angle_unit=angle)
     said = feedbacks(submitted, expected, unit, tolerance, right, angle_unit=angle)
     shown: dict[float, str] = {}  # the numbers a class typed: a few thousand
+    wrong = []
     for index, value, key_value, ok, sentence, error, ratio in zip(
             members, submitted, expected, right.tolist(), said, absolute.tolist(), relative.tolist(), strict=True):
         part, answer = cells[index]
         parsed = shown.get(value) or shown.setdefault(value, number_text(value))
         rows[index] = _row(part, answer, number_text(key_value), words, "correct" if ok else "incorrect",
                            1.0 if ok else 0.0, sentence, parsed, error, ratio)
+        if not ok:
+            wrong.append(index)
+    return wrong
 
 
 def _outcome(part: KeyPart, answer: Answer | None, key: Key) -> Outcome | CellNumber:

@@ -298,3 +298,13 @@ def test_grader_check_json_shows_the_diagnosis(capsys: pytest.CaptureFixture[str
     assert main(["check", "--key", str(sample_key), "--student", student["id"], "--label", angle["label"],
                  f"{math.radians(angle['value']):.3g}"]) == 0
     assert "\ndiagnosis  angle.radians\n" in capsys.readouterr().out
+
+
+def test_the_cached_alternatives_are_the_compiled_ones(bank: dict[str, Template]) -> None:
+    """Compiled again, a template's alternatives are the same, and read back from JSON equal."""
+    from grader.solve.derived import compile_alternatives
+
+    fresh = compile_alternatives(bank["drop-rebound"])
+    assert fresh == alternatives_for(bank["drop-rebound"])
+    assert Alternatives.from_json(json.loads(json.dumps(fresh.to_json()))) == fresh
+    assert {a.kind for a in fresh.items} == {"ecf", "mistake"}

@@ -5,9 +5,15 @@ id)`` (:func:`grader.assign.variants.variant_generator`; no problem key has a sp
 always gives the same file. Most answers are right and rounded to three significant figures, as the
 sheet asks; the others come in the forms real submissions hold: the unit written, another unit of the
 same kind (``283 cm/s``), a decimal comma, ``×10^`` notation, unrounded, wrong (off by 6 to 30 %, a
-percentage typed as a fraction, an angle in radians, a speed with no ``/s``), or blank. Symbolic answers are typed with
-implicit products (``v(1-0.07p)/(p+1)``), as in the key, or with a sign wrong. One student submits
-nothing, one writes ``about 48``, and one resubmits a corrected answer after the deadline.
+percentage typed as a fraction, an angle in radians, a speed with no ``/s``), or blank. Symbolic answers
+are typed with implicit products (``v(1-0.07p)/(p+1)``), as in the key, or with a sign wrong. One student
+submits nothing, one writes ``about 48``, and one resubmits a corrected answer after the deadline.
+
+A second generator per student (``"sample physics"``) turns a few right answers into what the grader's
+physics recognises (:mod:`grader.solve.alternatives`): a diagnosed mistake (``e²`` for ``e``, the masses
+swapped, ...), or, after an earlier wrong answer of the problem, the answer that follows from it (error
+carried forward). An answer off by 6 to 30 % is moved off any value the grader would diagnose, so each
+answer deserves exactly one verdict.
 
 >>> student_style("v*(1 - 0.07*p)/(p + 1)"), sign_error("1.07*v/(p + 1)")
 ('v(1-0.07p)/(p+1)', '1.07v/(p-1)')

@@ -15,15 +15,13 @@ import os
 from collections.abc import Callable
 from functools import lru_cache
 from pathlib import Path
-from typing import Any, TypeVar
+from typing import Any, Protocol, TypeVar
 
 from grader import __version__
 from grader.bank.template import Template
 from grader.files import write_atomic
 from grader.solve.alternatives import Alternatives
 from grader.solve.compiled import FORMAT, Compiled
-
-_T = TypeVar("_T")
 
 # Every stage folder whose source can change what the solver compiles: editing any file in them
 # recompiles (a test checks that everything the solver imports is inside).
@@ -74,7 +72,15 @@ def alternatives_for(template: Template) -> Alternatives:
     return _cached(template, "-alternatives", Alternatives.from_json, compile_now)
 
 
+class _Stored(Protocol):
+    def to_json(self) -> dict[str, Any]: ...
+
+
+_T = TypeVar("_T", bound=_Stored)
+
+
 def _cached(template: Template, kind: str, read: Callable[[Any], _T], compile_now: Callable[[], _T]) -> _T:
+    """What ``compile_now`` makes for a template, kept as ``<id>-<hash><kind>.json`` (``read`` reads it back)."""
     key = hashlib.sha256(f"{template.source_hash}/{_fingerprint()}".encode()).hexdigest()[:20]
     path = cache_dir() / f"{template.id}-{key}{kind}.json"
     try:
@@ -83,5 +89,5 @@ def _cached(template: Template, kind: str, read: Callable[[Any], _T], compile_no
         pass
     made = compile_now()
     with contextlib.suppress(OSError):  # a read-only home folder only costs time
-        write_atomic(path, json.dumps(made.to_json()))  # type: ignore[attr-defined]
+        write_atomic(path, json.dumps(made.to_json()))
     return made

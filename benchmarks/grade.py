@@ -183,11 +183,13 @@ def numeric(students: int, runs: int) -> dict[str, object]:
 
 
 def _verdicts(details: Path) -> dict[str, int]:
-    """How many verdicts of each kind a run gave."""
-    counts: dict[str, int] = {}
+    """How many verdicts of each kind a run gave, in the grader's order of kinds."""
+    from grader.grade.grading import VERDICTS
+
+    counts = dict.fromkeys(VERDICTS, 0)
     with open(details, encoding="utf-8", newline="") as stream:
         for row in csv.DictReader(stream):
-            counts[row["verdict"]] = counts.get(row["verdict"], 0) + 1
+            counts[row["verdict"]] += 1
     return counts
 
 

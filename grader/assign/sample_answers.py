@@ -34,7 +34,7 @@ import numpy as np
 from grader.assign.assignment import Assignment
 from grader.assign.variants import AnswerPart, Generation, printed_text, variant_generator
 from grader.bank.template import Template
-from grader.solve.alternatives import values
+from grader.solve.alternatives import carries_forward, values
 from grader.solve.cache import alternatives_for
 
 HEADER = ("student_id", "label", "answer", "timestamp")
@@ -251,8 +251,8 @@ def _clear_of(typed: _Typed, right: float, near: Sequence[float]) -> _Typed:
 
 
 def _plausible(number: float, right: float) -> bool:
-    """The grader's rule for an earlier answer that carries forward: its sign, within a factor of 3."""
-    return number * right > 0 and abs(right) / 3 <= abs(number) <= 3 * abs(right)
+    """The grader's rule for an earlier answer that carries forward (its sign, within a factor of 3)."""
+    return bool(carries_forward(number, right))
 
 
 def _close(value: float, other: float, share: float = 0.03) -> bool:

@@ -30,11 +30,8 @@ from grader.grade.compare import is_correct, number_text
 from grader.grade.key import Key, KeyProblem
 from grader.model.tolerance import Tolerance, with_unit
 from grader.resources import bank_dir
-from grader.solve.alternatives import Alternative, Alternatives, values
+from grader.solve.alternatives import Alternative, Alternatives, carries_forward, values
 from grader.solve.cache import alternatives_for
-
-PLAUSIBLE = 3.0
-"""How far from the right value an earlier answer may be and still carry forward (a factor, either way)."""
 
 
 @dataclass(frozen=True)
@@ -155,9 +152,7 @@ def reconsider(problem: ProblemPhysics, key: Key, name: str, label: str, unit: s
     for source in reversed(earlier) if key.ecf_credit > 0 else ():
         chains = [a for a in alternatives if a.kind == "ecf" and a.id == source.name]
         given, was = source.given[students], source.right[students]
-        with np.errstate(all="ignore"):
-            plausible = (np.sign(given) == np.sign(was)) & (was != 0) & (np.abs(given) <= PLAUSIBLE * np.abs(was)) \
-                & (PLAUSIBLE * np.abs(given) >= np.abs(was))
+        plausible = carries_forward(given, was)
         for chain in chains:
             rows = np.flatnonzero(open_ & plausible)
             if not rows.size:

@@ -28,12 +28,31 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from grader.model.expr import Node, from_json, to_json
 from grader.model.kernel import evaluate
 
 GIVEN = "_given"
 """The name of the earlier answer in an ECF tree, in that answer's unit (no parameter can be named so)."""
+
+
+PLAUSIBLE = 3.0
+"""How far from the right value an earlier answer may be and still carry forward (a factor, either way)."""
+
+
+def carries_forward(given: ArrayLike, right: ArrayLike) -> np.ndarray:
+    """Whether an earlier answer is plausible enough to carry forward, element-wise: a number of the right
+    value's sign within a factor of :data:`PLAUSIBLE` of it (a nonsense answer must not make later parts
+    trivial).
+
+    >>> carries_forward([2.71, -2.71, 100.0, 0.8, float("nan")], 2.55).tolist()
+    [True, False, False, False, False]
+    """
+    with np.errstate(all="ignore"):
+        mine, theirs = np.abs(np.asarray(given, dtype=float)), np.abs(np.asarray(right, dtype=float))
+        same_sign = np.sign(given) == np.sign(right)
+        return np.asarray(same_sign & (theirs > 0) & (mine <= PLAUSIBLE * theirs) & (PLAUSIBLE * mine >= theirs))
 
 
 @dataclass(frozen=True)

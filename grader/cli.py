@@ -14,7 +14,7 @@ import shlex
 import signal
 import sys
 import threading
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -93,6 +93,7 @@ def build_parser() -> argparse.ArgumentParser:
     grading.add_argument("--key", type=Path, required=True, metavar="DIR/key.json",
                          help="the key grader generate wrote")
     grading.add_argument("--out", type=Path, required=True, metavar="DIR", help="output folder (new or empty)")
+    _bank_options(grading)  # the templates the key was made from: errors carried forward, diagnosed mistakes
     grading.add_argument("--format", choices=("auto", "long", "wide"), default="auto",
                          help="long: a row per answer (student, label, answer); wide: a row per submission, a "
                               "column per label; auto (default): told apart from the header")
@@ -122,6 +123,7 @@ def build_parser() -> argparse.ArgumentParser:
                                                                    "--expected uses)")
     checking.add_argument("--domain", action="append", default=[], metavar="NAME=LOW:HIGH", dest="domains",
                           help="where a symbol is sampled (repeatable; default 1:10)")
+    _bank_options(checking)
     checking.add_argument("--json", action="store_true", help="print the result as one JSON object")
     checking.add_argument("--batch", type=Path, metavar="FILE.jsonl",
                           help="one JSON object a line: submitted, expected, unit, tolerance, symbols, domains "
@@ -239,6 +241,13 @@ def _bank(arguments: argparse.Namespace) -> dict[str, Template]:
     from grader.bank.template import load_banks
 
     return load_banks(*_bank_sources(arguments))
+
+
+def _lazy_bank(arguments: argparse.Namespace) -> Mapping[str, Template]:
+    """The banks as a mapping that reads a template when it is asked for (grading needs the few a key names)."""
+    from grader.bank.template import Banks
+
+    return Banks(*_bank_sources(arguments))
 
 
 def _bank_sources(arguments: argparse.Namespace) -> tuple[list[Path], bool]:
@@ -558,7 +567,7 @@ def _grade(arguments: argparse.Namespace) -> int:
     from grader.grade.run import run as run_grading
 
     summary = run_grading(arguments.key, arguments.submissions, arguments.out, arguments.format, arguments.force,
-                          arguments.canvas)
+                          arguments.canvas, _lazy_bank(arguments))
     print(_graded_line(summary), file=sys.stderr)
     if summary.ignored_columns:
         print(f"columns ignored: {some(list(summary.ignored_columns))}", file=sys.stderr)
@@ -585,18 +594,20 @@ def _rows(n: int) -> str:
 
 def _check(arguments: argparse.Namespace) -> int:
     from grader.grade import check
+    from grader.grade.diagnosis import physics_for
     from grader.grade.key import load_key
 
     _check_arguments(arguments)
     key = load_key(arguments.key) if arguments.key is not None else None
+    physics = physics_for(key, _lazy_bank(arguments)) if key is not None else None
     if arguments.batch is not None:
         failed = 0
-        for result in check.batch(_batch_lines(arguments.batch), key):
+        for result in check.batch(_batch_lines(arguments.batch), key, physics):
             failed += "error" in result
             print(_json_line(result))
         return EXIT_REFUSED if failed else EXIT_OK
     if key is not None:
-        against = check.from_key(key, arguments.student, arguments.label)
+        against = check.from_key(key, arguments.student, arguments.label, physics)
     else:
         tolerance = {name: getattr(arguments, name) for name in ("rtol", "atol")
                      if getattr(arguments, name) is not None}
@@ -699,7 +710,7 @@ def _print_check(result: dict[str, Any]) -> None:
             ("expected", "undefined" if result["expected"] is None else amount(result["expected"])),
             ("error", "" if result["abs_error"] is None else
              f"{amount(result['abs_error'])} ({min(100 * result['rel_error'], sys.float_info.max):.2g} %)"),
-            ("tolerance", result["tolerance"]), ("feedback", result["feedback"])]
+            ("tolerance", result["tolerance"]), ("feedback", result["feedback"]), ("diagnosis", result["diagnosis"])]
     for name, text in rows:
         if text:
             print(f"{name:<10} {_printable(text)}")

@@ -47,9 +47,9 @@ def demo(out: Path, bank: Mapping[str, Template], jobs: int = 1, force: bool = F
         for source in (job.assignment, job.roster):
             shutil.copyfile(source, staging / source.name)
         write_outputs(job, assignment, generation, bank, staging)
-        write_atomic(staging / SUBMISSIONS, submissions_csv(sample_answers(assignment, generation)))
+        write_atomic(staging / SUBMISSIONS, submissions_csv(sample_answers(assignment, generation, bank)))
         graded = grade_into(staging / GRADES, staging / KEY, [staging / SUBMISSIONS], out / GRADES,
-                            [str(out / SUBMISSIONS)])
+                            [str(out / SUBMISSIONS)], bank)
         files = sum(path.is_file() for path in staging.rglob("*"))
     generated = Summary(out, len(roster), len(assignment.problems), generation.collisions, files,
                         time.perf_counter() - started)

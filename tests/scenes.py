@@ -43,3 +43,26 @@ answers:
   J_plus_h2: {value: J + h2, unit: m}
 statement: Dropped from {{ h_drop }} m with e = {{ e }}.
 """
+
+RAM_AND_PILE = """
+id: ram-and-pile
+title: A ram dropped onto a pile, heights in HEIGHT
+version: 1
+gravity: GRAVITY
+bodies: {ram: {mass: m_ram}, pile: {mass: m_pile}}
+parameters:
+  m_ram: {unit: kg, domain: "(0, inf)", sample: {uniform: [600, 1000]}, sig_figs: 3}
+  m_pile: {unit: kg, domain: "(0, inf)", sample: {uniform: [2400, 3000]}, sig_figs: 3}
+  h_drop: {unit: HEIGHT, domain: "(0, inf)", sample: {uniform: [1.5, 3]}, sig_figs: 3}
+  h_rebound: {unit: HEIGHT, domain: "[0, inf)", sample: {uniform: [0.05, 0.2]}, sig_figs: 3}
+stages:
+  - {effect: free_fall, body: ram, height: h_drop, speed: v_ram}
+  - {effect: impact, bodies: [ram, pile], restitution: e, before: {ram: v_ram}, after: {ram: v_back, pile: v_pile}}
+  - {effect: rise, body: ram, speed: -v_back, height: h_rebound}
+answers:
+  v_pile: {value: v_pile, unit: SPEED}
+  e: {value: e, unit: ""}
+statement: The ram falls {{ h_drop }} HEIGHT and rebounds {{ h_rebound }} HEIGHT.
+"""
+"""Sample Problem 3/28's pile driver with other units: replace HEIGHT, GRAVITY and SPEED (``mm``,
+``9.81 m/s^2``, ``m/s``; or ``ft``, ``32.2 ft/s^2``, ``ft/s``)."""

@@ -31,7 +31,7 @@ def make_class(verdicts: dict[str, Sequence[str]], params: Sequence[dict[str, fl
                names: Sequence[str] | None = None, typed: str = "1.5", title: str = "HW 7",
                problem_title: str = "Drop", diagnoses: dict[str, Sequence[str]] | None = None) -> Graded:
     """One problem (key ``1``) whose parts are ``verdicts``' labels, a student per verdict; each student's
-    printed parameters ``params``; with ``diagnoses``, rows carry a diagnosis field after the source."""
+    printed parameters ``params``; ``diagnoses``: each row's diagnosis (default none)."""
     labels = tuple(verdicts)
     count = len(next(iter(verdicts.values())))
     students = []
@@ -47,11 +47,9 @@ def make_class(verdicts: dict[str, Sequence[str]], params: Sequence[dict[str, fl
         rows = []
         for index, kind in enumerate(kinds):
             submitted = None if kind == "missing" else typed
-            row: tuple[object, ...] = (submitted, kind, CREDIT.get(kind, 0.0), 2.0, "1.5", "", "m/s", None, None,
-                                       "±1 %", FEEDBACK.get(kind, kind), "a.csv:2")
-            if diagnoses is not None:
-                row = (*row, diagnoses[label][index])
-            rows.append(row)
+            diagnosis = diagnoses[label][index] if diagnoses is not None else ""
+            rows.append((submitted, kind, CREDIT.get(kind, 0.0), 2.0, "1.5", "", "m/s", None, None, "±1 %",
+                         FEEDBACK.get(kind, kind), diagnosis, "a.csv:2"))
         columns[label] = rows
     return Graded(key, columns, (), (), ())  # type: ignore[arg-type]  # rows of tests' own making
 
@@ -84,15 +82,15 @@ def test_every_verdict_kind_is_counted_even_when_nobody_got_it() -> None:
     graded = make_class({"1a": ["correct", "correct", "incorrect", "missing"],
                          "1b": ["correct", "invalid", "missing", "missing"]})
     summary = summarize(graded)
-    assert summary.kinds == ("correct", "incorrect", "invalid", "missing")
+    assert summary.kinds == ("correct", "ecf", "mistake", "incorrect", "invalid", "missing")
     assert [part.counts for part in summary.parts] == [
-        {"correct": 2, "incorrect": 1, "invalid": 0, "missing": 1},
-        {"correct": 1, "incorrect": 0, "invalid": 1, "missing": 2}]
+        {"correct": 2, "ecf": 0, "mistake": 0, "incorrect": 1, "invalid": 0, "missing": 1},
+        {"correct": 1, "ecf": 0, "mistake": 0, "incorrect": 0, "invalid": 1, "missing": 2}]
     assert summary.percent.tolist() == [100.0, 50.0, 0.0, 0.0]
     assert summary.submitted == 3
     assert [part.mean_credit for part in summary.parts] == [0.5, 0.25]
     headers = re.findall(r"</span>(\w+)</th>", class_report(graded))
-    assert headers == ["correct", "incorrect", "invalid", "missing"]
+    assert headers == ["correct", "ecf", "mistake", "incorrect", "invalid", "missing"]
 
 
 def test_ecf_and_mistake_take_their_places_once_grading_has_them(monkeypatch: pytest.MonkeyPatch) -> None:
@@ -113,16 +111,15 @@ def test_a_kind_verdicts_does_not_name_is_still_counted_after_the_others() -> No
     assert summary.kinds[-1] == "late" and summary.parts[0].counts["late"] == 1
 
 
-def test_no_diagnosis_field_yet_means_no_diagnosis() -> None:
-    graded = make_class({"1a": ["incorrect", "incorrect"]})
+def test_no_diagnosis_means_no_mistakes_listed() -> None:
+    graded = make_class({"1a": ["incorrect", "ecf"]}, diagnoses={"1a": ["", "ecf:1a"]})
     assert class_summary.diagnosis(graded.columns["1a"][0]) == ""
     assert summarize(graded).parts[0].mistakes == ()
     assert "No answer was matched to a diagnosed mistake." in class_report(graded)
 
 
 def test_diagnosed_mistakes_are_listed_most_frequent_first(monkeypatch: pytest.MonkeyPatch) -> None:
-    """With a ``diagnosis`` field (the row's 13th value here), each part lists its top mistakes and counts."""
-    monkeypatch.setattr(class_summary, "_DIAGNOSIS", 12)
+    """Each part lists its top diagnosed mistakes and counts."""
     found = ["e_squared"] * 4 + ["one_over_e"] * 2 + ["sign", "a", "b", "c"]
     graded = make_class({"1a": ["mistake"] * len(found) + ["correct"]}, diagnoses={"1a": [*found, ""]})
     part = summarize(graded).parts[0]

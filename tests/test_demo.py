@@ -36,7 +36,7 @@ REGRADE = "grader grade --key grader-demo/key.json grader-demo/submissions.csv -
 def answers(bank: dict[str, Template]) -> list[SampleAnswer]:
     """The sample assignment's simulated answers, made in process."""
     assignment = load_assignment(sample_dir() / "assignment.yaml")
-    return sample_answers(assignment, generate(assignment, load_roster(sample_dir() / "roster.csv"), bank))
+    return sample_answers(assignment, generate(assignment, load_roster(sample_dir() / "roster.csv"), bank), bank)
 
 
 def rows(path: Path) -> list[dict[str, str]]:
@@ -57,8 +57,8 @@ def test_the_demo_exits_0_and_says_how_the_class_graded_and_how_to_grade_again(d
     lines = demo_run.stdout.splitlines()
     assert lines[0].startswith("30 students x 5 problems -> grader-demo (43 files, ")
     assert lines[1] == ("submissions.csv (simulated answers) graded: 30 students (29 submitted), 450 parts graded "
-                        "(370 correct, 46 incorrect, 1 invalid, 33 missing); 1 row set aside (superseded or not a "
-                        "student), 0 rows not graded (see problems.csv) -> grader-demo/grades")
+                        "(344 correct, 9 ecf, 28 mistake, 35 incorrect, 1 invalid, 33 missing); 1 row set aside "
+                        "(superseded or not a student), 0 rows not graded (see problems.csv) -> grader-demo/grades")
     assert lines[-2:] == ["Grade the submissions again, or your own file, with", f"  {REGRADE}"]
     assert sorted(p.name for p in (demo_run.out / "grades").iterdir()) == [
         MANIFEST, "canvas.csv", "details.csv", "grades.csv", "problems.csv", "report.html"]
@@ -88,6 +88,8 @@ FORMS = {
     "sign error": r"[^* ]*v[^* ]*",
     "words": r"about \d+(\.\d+)?",
     "late resubmission": r"-?\d+(\.\d+)?",
+    "diagnosed mistake": r"-?\d+(\.\d+)?",
+    "error carried forward": r"-?\d+(\.\d+)?",
 }
 
 
@@ -96,14 +98,14 @@ def test_every_form_is_in_the_file_and_typed_as_students_type_it(answers: list[S
     typed = [a.text for a in answers if a.form == form]
     assert typed, f"no answer of the form {form}"
     assert all(re.fullmatch(FORMS[form], text) for text in typed), typed
-    if form in ("3 s.f.", "late resubmission"):
+    if form in ("3 s.f.", "late resubmission", "diagnosed mistake", "error carried forward"):
         assert all(three_figures(text) for text in typed)
 
 
 def test_the_forms_tested_are_all_the_forms() -> None:
     drawn = {form for form, _ in (*NUMERIC, *SYMBOLIC)} - {"wrong"}
     assert drawn | {"off by 6-30 %", "percentage as a fraction", "radians for degrees", "no /s", "words",
-                    "late resubmission"} == set(FORMS)
+                    "late resubmission", "diagnosed mistake", "error carried forward"} == set(FORMS)
 
 
 def test_one_student_submits_nothing_and_one_resubmits_late(answers: list[SampleAnswer]) -> None:
@@ -118,16 +120,30 @@ def test_one_student_submits_nothing_and_one_resubmits_late(answers: list[Sample
 
 
 def test_every_answer_gets_the_verdict_it_deserves(demo_run: DemoRun, answers: list[SampleAnswer]) -> None:
-    """Right in any form: correct; a mistake: incorrect; blank: missing; words: invalid; not submitted: missing.
-    The later of two answers is the one graded."""
+    """Right in any form: correct; right for an earlier wrong answer: ecf; a diagnosed mistake: mistake, with
+    its id; another mistake: incorrect; blank: missing; words: invalid; not submitted: missing. The later of
+    two answers is the one graded."""
     final = {(a.student_id, a.label): a for a in answers}
     details = rows(demo_run.out / "grades" / "details.csv")
     assert len(details) == 30 * 15
     for row in details:
         answer = final.get((row["student_id"], row["label"]))
-        expected = "missing" if answer is None else answer.deserves
-        assert row["verdict"] == expected, (answer, row)
+        expected = ("missing", "") if answer is None else (answer.deserves, answer.diagnosis)
+        assert (row["verdict"], row["diagnosis"]) == expected, (answer, row)
         assert original_cell(row["submitted"]) == ("" if answer is None else answer.text)  # "-5.59" is guarded
+
+
+def test_the_class_shows_errors_carried_forward_and_each_kind_of_diagnosed_mistake(demo_run: DemoRun) -> None:
+    """The report has something to show: errors carried forward from several parts, and mistakes of the
+    impact, its energy, flight and angles (the sample's problems ask no flight answer a mistake can change
+    except through the pile driver's)."""
+    details = rows(demo_run.out / "grades" / "details.csv")
+    carried = {row["diagnosis"] for row in details if row["verdict"] == "ecf"}
+    mistakes = {row["diagnosis"] for row in details if row["verdict"] == "mistake"}
+    assert len(carried) >= 3 and all(re.fullmatch(r"ecf:\d[a-d]", item) for item in carried)
+    assert {item.split(".")[0] for item in mistakes} == {"impact", "energy", "flight", "angle"}
+    assert all(row["credit"] == "0" for row in details if row["verdict"] == "mistake")
+    assert all(row["credit"] == "1" for row in details if row["verdict"] == "ecf")
 
 
 def test_the_absent_student_scores_0_and_the_superseded_row_is_the_only_problem(
@@ -194,7 +210,7 @@ def test_a_failure_while_grading_leaves_nothing_behind(tmp_path: Path, monkeypat
     assert list(tmp_path.iterdir()) == []
 
 
-@pytest.mark.parametrize("header", ["student_id,label,submitted,verdict,expected,feedback",
+@pytest.mark.parametrize("header", ["student_id,label,submitted,verdict,expected,feedback,diagnosis",
                                     "file,line,student_id,label,reason"])
 def test_the_readme_excerpts_are_rows_of_the_demo_output(demo_run: DemoRun, header: str) -> None:
     """Each excerpt row is a real row of details.csv (or problems.csv), in the excerpt's columns."""
@@ -207,7 +223,7 @@ def test_the_readme_excerpts_are_rows_of_the_demo_output(demo_run: DemoRun, head
     assert len(excerpt) > 1 and set(excerpt[1:]) <= set(stream.getvalue().splitlines())
 
 
-@pytest.mark.parametrize("typed", ["2.75 m/s", "7.60°", "283 cm/s", "17.0 mph", "14.4 km/h", "2,95", "5.72×10^1",
+@pytest.mark.parametrize("typed", ["2.75 m/s", "7.60°", "283 cm/s", "17.0 mph", "7.18 km/h", "2,95", "5.72×10^1",
                                    "2.06 m", "about 48", "v(1-0.07p)/(p+1)"])
 def test_the_readme_examples_of_forms_are_in_the_demo_file(answers: list[SampleAnswer], typed: str) -> None:
     assert f"`{typed}`" in README or f'`"{typed}"`' in README

@@ -14,6 +14,7 @@ import pytest
 
 from grader.cli import main
 from grader.errors import GraderError
+from grader.grade.diagnosis import physics_for
 from grader.grade.grading import grade, grade_part
 from grader.grade.key import load_key
 from grader.grade.submissions import StudentRef, read_submissions
@@ -260,8 +261,10 @@ def test_a_hand_edited_key_that_cannot_be_graded_is_refused_naming_the_entry(
 
 def test_the_assignments_tolerance_mode_and_grading_section_reach_the_verdicts(
         tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    """`tolerance: {e: {decimals: 2}}` and `grading: {numeric_expressions: false}` go through the key to grading."""
-    (tmp_path / "a.yaml").write_text("title: HW\ncourse: C\nseed: s\ngrading: {numeric_expressions: false}\n"
+    """`tolerance: {e: {decimals: 2}}` and `grading: {numeric_expressions: false, ecf_credit: 0.5,
+    mistake_credit: 0.25}` go through the key to grading."""
+    (tmp_path / "a.yaml").write_text("title: HW\ncourse: C\nseed: s\ngrading: {numeric_expressions: false, "
+                                     "ecf_credit: 0.5, mistake_credit: 0.25}\n"
                                      "problems:\n  - template: drop-rebound\n    tolerance: {e: {decimals: 2}}\n",
                                      encoding="utf-8")
     assert main(["generate", str(tmp_path / "a.yaml"), "--roster", str(sample_dir() / "roster.csv"), "--out",
@@ -271,7 +274,11 @@ def test_the_assignments_tolerance_mode_and_grading_section_reach_the_verdicts(
     e = student["problems"][0]["answers"]["e"]
     assert e["tolerance"] == {"mode": "decimals", "digits": 2}
     loss = student["problems"][0]["answers"]["loss_pct"]["value"]
-    rows = [(student["id"], "1a", f"{e['value']:.2f}"), (student["id"], "1b", f"sqrt({loss ** 2})")]
+    other = key_document(key)["students"][1]
+    params = other["problems"][0]["params"]
+    ratio = params["h_rebound"] / params["h_drop"]  # e = h'/h: v = 2gh for sqrt(2gh); 1b carried forward from it
+    rows = [(student["id"], "1a", f"{e['value']:.2f}"), (student["id"], "1b", f"sqrt({loss ** 2})"),
+            (other["id"], "1a", f"{ratio:.2f}"), (other["id"], "1b", f"{100 * (1 - ratio**2):.3g}")]
     (tmp_path / "s.csv").write_text(long_csv(rows), encoding="utf-8")
     capsys.readouterr()
     run(capsys, "grade", "--key", key, tmp_path / "s.csv", "--out", tmp_path / "g")
@@ -279,6 +286,21 @@ def test_the_assignments_tolerance_mode_and_grading_section_reach_the_verdicts(
                if row["student_id"] == student["id"]}
     assert details["1a"]["verdict"] == "correct" and details["1a"]["tolerance"] == "2 decimal places"
     assert details["1b"]["verdict"] == "invalid"  # arithmetic is refused when numeric_expressions is false
+    theirs = {row["label"]: row for row in read(tmp_path / "g" / "details.csv") if row["student_id"] == other["id"]}
+    assert [(theirs[label]["verdict"], theirs[label]["credit"]) for label in ("1a", "1b")] == [
+        ("mistake", "0.25"), ("ecf", "0.5")]
+    assert load_key(key).ecf_credit == 0.5 and load_key(key).mistake_credit == 0.25
+
+
+@pytest.mark.parametrize("grading", ["{ecf_credit: 2}", "{mistake_credit: -0.1}", "{ecf_credit: yes}",
+                                     "{partial: 1}"])
+def test_a_credit_that_is_no_fraction_of_the_points_is_refused(tmp_path: Path, capsys: pytest.CaptureFixture[str],
+                                                               grading: str) -> None:
+    (tmp_path / "a.yaml").write_text(f"title: HW\ncourse: C\nseed: s\ngrading: {grading}\n"
+                                     "problems:\n  - template: drop-rebound\n", encoding="utf-8")
+    code, _, err = run(capsys, "generate", tmp_path / "a.yaml", "--roster", sample_dir() / "roster.csv", "--out",
+                       tmp_path / "hw", "--no-pdf")
+    assert code == 2 and "grading" in err and not (tmp_path / "hw").exists()
 
 
 def test_one_answer_graded_alone_is_graded_as_in_its_class(tmp_path: Path, key_path: Path) -> None:
@@ -292,15 +314,16 @@ def test_one_answer_graded_alone_is_graded_as_in_its_class(tmp_path: Path, key_p
     key = load_key(key_path)
     submissions = read_submissions([tmp_path / "a.csv"], [StudentRef(s.id, s.email) for s in key.students],
                                    key.labels)
-    graded = grade(key, submissions)
+    physics = physics_for(key)
+    graded = grade(key, submissions, physics)
     answers = {(a.student_id, a.label): a for a in submissions.answers}
     parts = {(s.id, label): part for s in key.students for label, part in s.parts.items()}
     verdicts = graded.verdicts
-    assert len(verdicts) == len(parts) and {v.verdict for v in verdicts} == {"correct", "incorrect", "invalid",
-                                                                             "missing"}
-    for verdict in verdicts:
+    assert len(verdicts) == len(parts) and {v.verdict for v in verdicts} == {"correct", "mistake", "incorrect",
+                                                                             "invalid", "missing"}
+    for verdict in verdicts:  # "-{}" is a velocity with its sign turned, an energy lost as T' - T
         where = (verdict.student_id, verdict.label)
-        assert grade_part(parts[where], verdict.student_id, answers.get(where), key) == verdict
+        assert grade_part(parts[where], verdict.student_id, answers.get(where), key, physics) == verdict
 
 
 def test_a_key_laid_out_otherwise_reads_the_same(tmp_path: Path, key_path: Path) -> None:

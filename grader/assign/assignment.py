@@ -42,9 +42,13 @@ class ProblemSpec:
 
 @dataclass(frozen=True)
 class Grading:
-    """How answers are read: ``numeric_expressions``, whether ``sqrt(2*9.81*2)`` counts as a number."""
+    """How answers are read and credited: ``numeric_expressions``, whether ``sqrt(2*9.81*2)`` counts as a
+    number; ``ecf_credit``, the credit of a part right for the student's own earlier answer (error carried
+    forward; 0 turns it off); ``mistake_credit``, that of a part matching a diagnosed mistake."""
 
     numeric_expressions: bool = True
+    ecf_credit: float = 1.0
+    mistake_credit: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -100,12 +104,20 @@ def load_assignment(path: Path) -> Assignment:
 def _grading(raw: Any, where: str) -> Grading:
     if raw is None:
         return Grading()
-    if not isinstance(raw, Mapping) or set(raw) - {"numeric_expressions"}:
-        raise TemplateError(where, "grading", "{numeric_expressions: true or false}", shown(raw))
+    if not isinstance(raw, Mapping) or set(raw) - {"numeric_expressions", "ecf_credit", "mistake_credit"}:
+        raise TemplateError(where, "grading", "{numeric_expressions: true or false, ecf_credit: 0 to 1, "
+                            "mistake_credit: 0 to 1}", shown(raw))
     value = raw.get("numeric_expressions", True)
     if not isinstance(value, bool):
         raise TemplateError(where, "grading.numeric_expressions", "true or false", shown(value))
-    return Grading(numeric_expressions=value)
+    credits = {}
+    for name, default in (("ecf_credit", Grading.ecf_credit), ("mistake_credit", Grading.mistake_credit)):
+        credit = raw.get(name, default)
+        if not (_number(credit) and 0 <= credit <= 1):
+            raise TemplateError(where, f"grading.{name}", "a credit from 0 to 1 (a fraction of the part's points)",
+                                shown(credit))
+        credits[name] = float(credit)
+    return Grading(numeric_expressions=value, **credits)
 
 
 def _text(raw: Mapping[str, Any], key: str, where: str, required: bool = True) -> str:

@@ -4,11 +4,12 @@ Re-grading reads the key; it never regenerates variants. Nothing in the key depe
 of the run, so generating twice gives byte-identical files.
 
 Schema ``grader-key`` version 2 (version 1, still read by grading, lacks ``grading``, ``symbols``,
-and the tolerance's ``mode``: its tolerances are ``{"rtol", "atol"}``)::
+and the tolerance's ``mode``: its tolerances are ``{"rtol", "atol"}``; a version 2 key from before
+``ecf_credit`` and ``mistake_credit`` is graded with their defaults, 1 and 0)::
 
     {"schema": "grader-key", "version": 2, "generator": "grader X.Y.Z",
      "assignment": {"title", "course", "seed", "due", "instructions", "source_sha256",
-                    "grading": {"numeric_expressions": true}},
+                    "grading": {"numeric_expressions": true, "ecf_credit": 1.0, "mistake_credit": 0.0}},
      "templates": {ID: {"version", "sha256"}},
      "problems": [{"key", "template", "title",
                    "answers": [{"name", "label", "unit", "points",
@@ -74,7 +75,9 @@ def key_document(assignment: Assignment, generation: Generation, bank: Mapping[s
         "assignment": {"title": assignment.title, "course": assignment.course, "seed": assignment.seed,
                        "due": assignment.due, "instructions": assignment.instructions,
                        "source_sha256": hashlib.sha256(Path(assignment.where).read_bytes()).hexdigest(),
-                       "grading": {"numeric_expressions": assignment.grading.numeric_expressions}},
+                       "grading": {"numeric_expressions": assignment.grading.numeric_expressions,
+                                   "ecf_credit": assignment.grading.ecf_credit,
+                                   "mistake_credit": assignment.grading.mistake_credit}},
         "templates": {t.id: {"version": t.version, "sha256": t.source_hash} for t in used.values()},
         "problems": [{"key": v.key, "template": v.template, "title": used[v.template].title,
                       "answers": [_part(a, used[v.template], spec) for a in v.answers]}

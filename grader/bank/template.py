@@ -12,7 +12,7 @@ from __future__ import annotations
 import hashlib
 import math
 import re
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -231,6 +231,27 @@ def load_named(template_id: str, folders: Sequence[Path] = (), shipped: bool = T
     if len(found) > 1:
         raise GraderError(same_id(found[0], found[1]))
     return found[0] if found else None
+
+
+class Banks(Mapping[str, "Template"]):
+    """The banks :func:`load_banks` reads, as a mapping that reads a template from its own file when it is
+    asked for (:func:`load_named`): grading needs the few templates a key names, not the whole bank."""
+
+    def __init__(self, folders: Sequence[Path] = (), shipped: bool = True) -> None:
+        self.folders, self.shipped = list(folders), shipped
+
+    def __getitem__(self, template_id: str) -> Template:
+        template = load_named(template_id, self.folders, self.shipped)
+        if template is None:
+            raise KeyError(template_id)
+        return template
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(sorted({path.stem for folder in bank_folders(self.folders, self.shipped)
+                            for path in template_files(folder)}))
+
+    def __len__(self) -> int:
+        return sum(1 for _ in self)
 
 
 def load_template(path: Path) -> Template:

@@ -24,6 +24,7 @@ from typing import Any
 
 from grader.errors import GraderError, UsageError, shown
 from grader.grade.cells import MAX_CELL
+from grader.grade.diagnosis import Physics
 from grader.grade.grading import Verdict, grade_part
 from grader.grade.key import SYMBOL_RANGE, Key, KeyPart
 from grader.grade.notation import ReadError, tree_of, value_of
@@ -36,7 +37,8 @@ _GIVEN = Key(where="the command line", version=2, title="grader check", numeric_
              problems=(), students=())
 """The context of an answer checked against a given value: arithmetic allowed, as by default."""
 
-FIELDS = ("verdict", "credit", "parsed", "expected", "unit", "abs_error", "rel_error", "tolerance", "feedback")
+FIELDS = ("verdict", "credit", "parsed", "expected", "unit", "abs_error", "rel_error", "tolerance", "feedback",
+          "diagnosis")
 """The fields of a result, in order (``--json`` and ``--batch``)."""
 
 _BATCH_FIELDS = {"submitted", "expected", "unit", "tolerance", "symbols", "domains", "student", "label"}
@@ -45,14 +47,18 @@ _BATCH_FIELDS = {"submitted", "expected", "unit", "tolerance", "symbols", "domai
 @dataclass(frozen=True)
 class Expectation:
     """What an answer is checked against: a part, and the key it belongs to (for the assignment's
-    grading settings and the seed of symbolic comparisons)."""
+    grading settings and the seed of symbolic comparisons); for a part of a key, the student's id and
+    what diagnoses mistakes (:func:`grader.grade.diagnosis.physics_for`)."""
 
     part: KeyPart
     key: Key
+    student: str = ""
+    physics: Physics | None = None
 
 
-def from_key(key: Key, student: str, label: str) -> Expectation:
-    """The part ``label`` of the key's student ``student`` (an id, or an email as in the roster)."""
+def from_key(key: Key, student: str, label: str, physics: Physics | None = None) -> Expectation:
+    """The part ``label`` of the key's student ``student`` (an id, or an email as in the roster); with
+    ``physics``, a wrong number is diagnosed as ``grader grade`` diagnoses it."""
     student = student.strip()
     found = [s for s in key.students if s.id == student] or \
             [s for s in key.students if s.email and s.email.lower() == student.lower()]
@@ -64,7 +70,7 @@ def from_key(key: Key, student: str, label: str) -> Expectation:
     named = find_label(label, key.labels)  # as grade reads a label cell: " 1A " is 1a
     if named is None:
         raise UsageError(f"{key.where}: no part {shown(label)}; the parts are {', '.join(key.labels)}")
-    return Expectation(parts[named], key)
+    return Expectation(parts[named], key, found[0].id, physics)
 
 
 def expectation(expected: float | str | None, *, unit: str = "", tolerance: Mapping[str, Any] | None = None,
@@ -173,7 +179,7 @@ def _finite(field: str, number: float) -> float:
 def check(submitted: str, against: Expectation) -> dict[str, Any]:
     """Grade one answer; the result has the fields of :data:`FIELDS`."""
     answer = Answer("the command line", 0, "", against.part.label, submitted, ",", None)
-    return result(grade_part(against.part, "", answer, against.key), against.part)
+    return result(grade_part(against.part, against.student, answer, against.key, against.physics), against.part)
 
 
 def result(verdict: Verdict, part: KeyPart) -> dict[str, Any]:
@@ -183,22 +189,22 @@ def result(verdict: Verdict, part: KeyPart) -> dict[str, Any]:
         parsed = float(parsed)
     return {"verdict": verdict.verdict, "credit": verdict.credit, "parsed": parsed, "expected": part.value,
             "unit": part.unit, "abs_error": verdict.abs_error, "rel_error": verdict.rel_error,
-            "tolerance": verdict.tolerance, "feedback": verdict.feedback}
+            "tolerance": verdict.tolerance, "feedback": verdict.feedback, "diagnosis": verdict.diagnosis}
 
 
-def batch(lines: Sequence[str], key: Key | None) -> Iterator[dict[str, Any]]:
+def batch(lines: Sequence[str], key: Key | None, physics: Physics | None = None) -> Iterator[dict[str, Any]]:
     """One result per line that is not blank, in order; a line that cannot be checked gives
-    ``{"line": n, "error": reason}`` and the others go on."""
+    ``{"line": n, "error": reason}`` and the others go on. ``physics`` diagnoses the key's parts."""
     for number, line in enumerate(lines, start=1):
         if not line.strip():
             continue
         try:
-            yield _line(line, key)
+            yield _line(line, key, physics)
         except (GraderError, ValueError, RecursionError) as error:
             yield {"line": number, "error": str(error)}
 
 
-def _line(line: str, key: Key | None) -> dict[str, Any]:
+def _line(line: str, key: Key | None, physics: Physics | None) -> dict[str, Any]:
     try:
         item = json.loads(line, parse_constant=_refuse_constant)
     except ValueError as error:
@@ -216,7 +222,7 @@ def _line(line: str, key: Key | None) -> dict[str, Any]:
     if "student" in item or "label" in item:
         if key is None:
             raise UsageError("student and label need --key")
-        return check(submitted, from_key(key, _text(item, "student"), _text(item, "label")))
+        return check(submitted, from_key(key, _text(item, "student"), _text(item, "label"), physics))
     if "expected" not in item:
         raise UsageError("expected: missing (a number, an expression or null)" +
                          ("; or give student and label" if key is not None else ""))

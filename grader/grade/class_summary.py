@@ -58,7 +58,7 @@ _DIAGNOSIS = _FIELDS.index("diagnosis") if "diagnosis" in _FIELDS else None
 
 
 def diagnosis(row: Row) -> str:
-    """The mistake a verdict row was diagnosed with, or ``""`` (none; or grading diagnoses none yet)."""
+    """A verdict row's diagnosis (a ``mistake``'s id, ``ecf:3a`` for an error carried forward), or ``""``."""
     return "" if _DIAGNOSIS is None else str(row[_DIAGNOSIS] or "")
 
 
@@ -208,7 +208,7 @@ def _kinds_found(graded: Graded) -> set[str]:
 def _part(key: Key, problem: str, label: str, rows: Sequence[Row], verdicts: list[str], scores: Floats,
           worth: Floats, kinds: tuple[str, ...]) -> PartSummary:
     found = Counter(verdicts)
-    mistakes = Counter(filter(None, map(diagnosis, rows))) if _DIAGNOSIS is not None else Counter[str]()
+    mistakes = Counter(diagnosis(row) for row in rows if row[_KIND] == "mistake")  # ecf rows name their part
     first = key.students[0].parts[label] if key.students else None
     credit = float(scores.sum() / worth.sum()) if worth.sum() > 0 else 0.0
     return PartSummary(label, problem, first.name if first else "", first.unit if first else "",

@@ -282,6 +282,15 @@ def _shown(value: float, *, full: bool = False, digits: int = 6) -> str:
     return f"{mantissa}e{int(power)}" if power else mantissa
 
 
+def number_text(value: float) -> str:
+    """A number as a person reads it in a report: 6 significant figures, never ``-0``.
+
+    >>> number_text(2.83138271), number_text(-0.0), number_text(1.5e-7)
+    ('2.83138', '0', '1.5e-07')
+    """
+    return f"{float(value) + 0.0:.6g}"
+
+
 def _percent(ratio: float) -> str:
     percent = ratio * 100
     if not math.isfinite(percent):

@@ -1,11 +1,12 @@
 """Grading: every part of every student in the key against what they submitted, one verdict each.
 
 A verdict records what was typed, what it was read as (in the expected unit), what was expected,
-the errors, the tolerance that decided it in words, the credit and a sentence that explains it.
-Grading is columnar: a part's answers are graded for the whole class at once, each distinct text
-read once and the numbers compared in one vectorised call per tolerance and unit; the verdicts are
-kept as rows of plain values (a class of 100,000 has a million) and become :class:`Verdict` objects
-only when asked for. :func:`grade_part` grades one answer the same way.
+the errors, the tolerance that decided it in words, the credit, a sentence that explains it and, for
+``ecf`` and ``mistake``, the diagnosis (:mod:`grader.grade.diagnosis`). Grading is columnar: a part's
+answers are graded for the whole class at once, each distinct text read once and the numbers compared
+in one vectorised call per tolerance and unit, the wrong ones then reconsidered by the physics in one
+pass; the verdicts are kept as rows of plain values (a class of 100,000 has a million) and become
+:class:`Verdict` objects only when asked for. :func:`grade_part` grades one answer the same way.
 """
 
 from __future__ import annotations
@@ -13,6 +14,8 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from functools import lru_cache
+
+import numpy as np
 
 from grader.grade.cells import (
     CellBlank,
@@ -24,14 +27,17 @@ from grader.grade.cells import (
     read_number,
     undefined_word,
 )
-from grader.grade.compare import equivalent, errors, feedbacks, is_correct
+from grader.grade.compare import equivalent, errors, feedbacks, is_correct, number_text
+from grader.grade.diagnosis import Earlier, Physics, ProblemPhysics, physics_for, reconsider
 from grader.grade.key import Key, KeyPart
 from grader.grade.notation import cut
 from grader.grade.submissions import Answer, RowProblem, Submissions
 from grader.model.expr import Node, parse
 from grader.model.tolerance import Tolerance
 
-VERDICTS = ("correct", "incorrect", "invalid", "missing")
+VERDICTS = ("correct", "ecf", "mistake", "incorrect", "invalid", "missing")
+"""The kinds of verdict: right; right for the student's own earlier answer (error carried forward); a
+diagnosed mistake; wrong; unreadable; not given."""
 
 
 @dataclass(frozen=True)
@@ -51,6 +57,7 @@ class Verdict:
     rel_error: float | None
     tolerance: str
     feedback: str
+    diagnosis: str = ""  # ecf: "ecf:" and the part carried forward (ecf:3a); mistake: its id (impact.e_squared)
     source: str = ""  # "file:line" of the row the answer came from
 
     @property
@@ -59,8 +66,9 @@ class Verdict:
         return self.credit * self.points
 
 
-Row = tuple[str | None, str, float, float, str, str, str, float | None, float | None, str, str, str]
-"""A verdict's fields after ``student_id`` and ``label``, in :class:`Verdict`'s order."""
+Row = tuple[str | None, str, float, float, str, str, str, float | None, float | None, str, str, str, str]
+"""A verdict's fields after ``student_id`` and ``label``, in :class:`Verdict`'s order: submitted, verdict,
+credit, points, expected, parsed, unit, abs_error, rel_error, tolerance, feedback, diagnosis, source."""
 
 
 @dataclass(frozen=True)
@@ -82,29 +90,74 @@ class Graded:
                      for index, student in enumerate(self.key.students) for label in labels)
 
 
-def grade(key: Key, submissions: Submissions) -> Graded:
-    """Grade every student of the key; a part nobody answered is ``missing``."""
+def grade(key: Key, submissions: Submissions, physics: Physics | None = None) -> Graded:
+    """Grade every student of the key; a part nobody answered is ``missing``. ``physics`` carries errors
+    forward and diagnoses mistakes (by default from the shipped bank, :func:`physics_for`)."""
+    physics = physics_for(key) if physics is None else physics
     by_label: dict[str, dict[str, Answer]] = {label: {} for label in key.labels}
     for answer in submissions.answers:
         by_label[answer.label][answer.student_id] = answer
     columns = {}
-    for label in key.labels:
-        answers = by_label.pop(label)
-        columns[label] = _grade_column([(student.parts[label], answers.get(student.id)) for student in key.students],
-                                       key)
-    return Graded(key, columns, submissions.problems, submissions.ignored_columns, submissions.notes)
+    everyone = np.arange(len(key.students))
+    for problem in key.problems:
+        earlier: list[Earlier] = []
+        for label in problem.labels:
+            answers = by_label.pop(label)
+            cells = [(student.parts[label], answers.get(student.id)) for student in key.students]
+            columns[label] = _grade_label(cells, key, everyone, physics.problems.get(problem.key), earlier)
+    return Graded(key, columns, submissions.problems, submissions.ignored_columns,
+                  (*submissions.notes, *physics.notes))
 
 
-def grade_part(part: KeyPart, student_id: str, answer: Answer | None, key: Key) -> Verdict:
-    """One part: the key's expectation against the answer (None: nothing submitted)."""
-    return Verdict(student_id, part.label, *_grade_column([(part, answer)], key)[0])
+def grade_part(part: KeyPart, student_id: str, answer: Answer | None, key: Key,
+               physics: Physics | None = None) -> Verdict:
+    """One part: the key's expectation against the answer (None: nothing submitted). With ``physics``, a
+    wrong number may be a diagnosed mistake (an earlier answer to carry forward is not known here)."""
+    student = next((index for index, s in enumerate(key.students) if s.id == student_id), None)
+    found = None if physics is None or student is None else physics.problems.get(part.problem)
+    return Verdict(student_id, part.label, *_grade_label([(part, answer)], key, np.array([student or 0]), found, [])[0])
+
+
+def _grade_label(cells: Sequence[tuple[KeyPart, Answer | None]], key: Key, students: np.ndarray,
+                 physics: ProblemPhysics | None, earlier: list[Earlier]) -> list[Row]:
+    """The rows of one part (``students``: each cell's student, by index in the key), the wrong numbers
+    reconsidered by the problem's ``physics``, which then adds the part to ``earlier``."""
+    column = _grade_column(cells, key)
+    rows = column.rows
+    if physics is None or not cells:
+        return rows
+    part = cells[0][0]
+    for tolerance, wrong in column.wrong:
+        if not wrong:
+            continue
+        members = np.array(wrong)
+        found = reconsider(physics, key, part.name, part.label, part.unit, tolerance, students[members],
+                           column.numbers[members], column.right[members], [rows[index][10] for index in wrong],
+                           earlier)
+        for position, finding in found.items():
+            index = wrong[position]
+            rows[index] = (*rows[index][:1], finding.kind, finding.credit, *rows[index][3:10], finding.feedback,
+                           finding.diagnosis, rows[index][12])
+    earlier.append(Earlier(part.label, part.name, part.unit, column.numbers, column.right))
+    return rows
 
 
 Outcome = tuple[str, float, str, str]
 """A verdict decided without comparing numbers: its kind, credit, sentence and what was read."""
 
 
-def _grade_column(cells: Sequence[tuple[KeyPart, Answer | None]], key: Key) -> list[Row]:
+@dataclass(frozen=True)
+class _Column:
+    """A part graded for a class: a row per cell; the number each cell was read as and the key's number
+    (NaN where either is not a number); and the cells whose number is wrong, grouped by tolerance."""
+
+    rows: list[Row]
+    numbers: np.ndarray
+    right: np.ndarray
+    wrong: list[tuple[Tolerance, list[int]]]
+
+
+def _grade_column(cells: Sequence[tuple[KeyPart, Answer | None]], key: Key) -> _Column:
     """A row for each (part, answer): outcomes decided cell by cell, numbers compared by group."""
     rows: list[Row | None] = [None] * len(cells)
     tolerances: dict[int, tuple[Tolerance, str]] = {}  # by id of the key's mapping (the key shares equal ones)
@@ -127,9 +180,13 @@ def _grade_column(cells: Sequence[tuple[KeyPart, Answer | None]], key: Key) -> l
         else:
             rows[index] = _row(part, answer, _expected(part), "equal expressions" if part.symbolic else known[1],
                                *outcome)
+    numbers, right = np.full(len(cells), np.nan), np.full(len(cells), np.nan)
+    wrong = []
     for (tolerance_id, unit), group in groups.items():
-        _compare(cells, group, *tolerances[tolerance_id], unit, rows)
-    return rows  # type: ignore[return-value]  # every index is filled above, or by _compare
+        members, submitted, expected, _ = group
+        numbers[members], right[members] = submitted, expected
+        wrong.append((tolerances[tolerance_id][0], _compare(cells, group, *tolerances[tolerance_id], unit, rows)))
+    return _Column(rows, numbers, right, wrong)  # type: ignore[arg-type]  # every row is filled, here or by _compare
 
 
 def _converted(cell: CellNumber, part: KeyPart, answer: Answer | None) -> str | None:
@@ -141,21 +198,26 @@ def _converted(cell: CellNumber, part: KeyPart, answer: Answer | None) -> str | 
 
 def _compare(cells: Sequence[tuple[KeyPart, Answer | None]],
              group: tuple[list[int], list[float], list[float], list[str | None]],
-             tolerance: Tolerance, words: str, unit: str, rows: list[Row | None]) -> None:
+             tolerance: Tolerance, words: str, unit: str, rows: list[Row | None]) -> list[int]:
     """The rows of a group of cells (their indices, the numbers read, the key's, what was typed in another
-    unit) of one tolerance and unit: verdicts, errors and sentences, each in one pass over the group."""
+    unit) of one tolerance and unit: verdicts, errors and sentences, each in one pass over the group;
+    returns the cells found wrong."""
     members, submitted, expected, typed = group
     angle = unit if unit in ("deg", "rad") else None
     right = is_correct(submitted, expected, tolerance, angle_unit=angle)
     absolute, relative = errors(submitted, expected, angle_unit=angle)
     said = feedbacks(submitted, expected, unit, tolerance, right, angle_unit=angle, typed=typed)
     shown: dict[float, str] = {}  # the numbers a class typed: a few thousand
+    wrong = []
     for index, value, key_value, ok, sentence, error, ratio in zip(
             members, submitted, expected, right.tolist(), said, absolute.tolist(), relative.tolist(), strict=True):
         part, answer = cells[index]
-        parsed = shown.get(value) or shown.setdefault(value, _show(value))
-        rows[index] = _row(part, answer, _show(key_value), words, "correct" if ok else "incorrect", 1.0 if ok else 0.0,
-                           sentence, parsed, error, ratio)
+        parsed = shown.get(value) or shown.setdefault(value, number_text(value))
+        rows[index] = _row(part, answer, number_text(key_value), words, "correct" if ok else "incorrect",
+                           1.0 if ok else 0.0, sentence, parsed, error, ratio)
+        if not ok:
+            wrong.append(index)
+    return wrong
 
 
 def _outcome(part: KeyPart, answer: Answer | None, key: Key) -> Outcome | CellNumber:
@@ -183,8 +245,8 @@ def _row(part: KeyPart, answer: Answer | None, expected: str, words: str, kind: 
          parsed: str = "", absolute: float | None = None, relative: float | None = None) -> Row:
     """The verdict's fields; ``expected``: what the key holds, in words; ``words``: the tolerance that decided it."""
     if answer is None:
-        return None, kind, credit, part.points, expected, parsed, part.unit, absolute, relative, words, said, ""
-    return (answer.text, kind, credit, part.points, expected, parsed, part.unit, absolute, relative, words, said,
+        return None, kind, credit, part.points, expected, parsed, part.unit, absolute, relative, words, said, "", ""
+    return (answer.text, kind, credit, part.points, expected, parsed, part.unit, absolute, relative, words, said, "",
             f"{answer.file}:{answer.line}")
 
 
@@ -224,12 +286,7 @@ def _key_tree(text: str) -> Node:
 def _expected(part: KeyPart) -> str:
     if part.value is None:
         return f"undefined ({part.undefined})"
-    return part.value if isinstance(part.value, str) else _show(part.value)
-
-
-def _show(value: float) -> str:
-    """A number as a person reads it: 6 significant figures, never ``-0``."""
-    return f"{value + 0.0:.6g}"
+    return part.value if isinstance(part.value, str) else number_text(part.value)
 
 
 def totals(graded: Graded) -> Mapping[str, Mapping[str, float]]:

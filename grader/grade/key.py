@@ -29,7 +29,7 @@ import math
 import re
 from collections import Counter
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, TypeVar
 
@@ -69,7 +69,7 @@ class KeyPart:
 
 @dataclass(frozen=True)
 class KeyStudent:
-    """A student of the key, and their answer parts by label."""
+    """A student of the key, their answer parts by label, and their parameters as printed, by problem key."""
 
     id: str
     name: str
@@ -94,11 +94,12 @@ class KeyStudent:
 
 @dataclass(frozen=True)
 class KeyProblem:
-    """A problem: its key (``1``), title, and its parts' labels in order."""
+    """A problem: its key (``1``), title, its parts' labels in order, and its template's id."""
 
     key: str
     title: str
     labels: tuple[str, ...]
+    template: str = ""
 
 
 @dataclass(frozen=True)
@@ -111,6 +112,9 @@ class Key:
     numeric_expressions: bool
     problems: tuple[KeyProblem, ...]
     students: tuple[KeyStudent, ...]
+    templates: Mapping[str, str] = field(default_factory=dict)  # id -> SHA-256 of the file the key was made from
+    ecf_credit: float = 1.0  # of a part right for the student's own earlier answer (0: no error carried forward)
+    mistake_credit: float = 0.0  # of a part that matches a diagnosed mistake
 
     @property
     def labels(self) -> tuple[str, ...]:
@@ -260,7 +264,8 @@ def _reader(header: Mapping[str, Any]) -> Callable[[Any], Any]:
 
 def _key(raw: Mapping[str, Any], where: str, version: int) -> Key:
     problems = tuple(KeyProblem(str(p["key"]), _text(p.get("title", ""), "a problem's title"),
-                                tuple(_text(a["label"], "a problem's label") for a in p["answers"]))
+                                tuple(_text(a["label"], "a problem's label") for a in p["answers"]),
+                                _text(p.get("template", ""), "a problem's template"))
                      for p in raw["problems"])
     symbols = _symbols(raw["problems"])
     shared: dict[Any, Any] = {}
@@ -281,8 +286,17 @@ def _key(raw: Mapping[str, Any], where: str, version: int) -> Key:
     if not isinstance(numeric_expressions, bool):
         raise _EntryError(f"assignment.grading.numeric_expressions: expected true or false, got "
                           f"{shown(numeric_expressions)}")
+    templates = {str(name): str(entry.get("sha256", "")) for name, entry in raw.get("templates", {}).items()}
     return Key(where, version, _text(raw["assignment"]["title"], "assignment.title"), numeric_expressions,
-               problems, students)
+               problems, students, templates, _credit(grading, "ecf_credit", 1.0),
+               _credit(grading, "mistake_credit", 0.0))
+
+
+def _credit(grading: Mapping[str, Any], name: str, default: float) -> float:
+    value = grading.get(name, default)
+    if isinstance(value, bool) or not isinstance(value, int | float) or not 0 <= value <= 1:
+        raise _EntryError(f"assignment.grading.{name}: expected a credit from 0 to 1, got {shown(value)}")
+    return float(value)
 
 
 def _symbols(problems: Any) -> dict[str, dict[str, tuple[float, float]]]:
@@ -335,8 +349,8 @@ def _student(raw: Mapping[str, Any], symbols: Mapping[str, Mapping[str, tuple[fl
             if type(value) in (int, float) and abs(value) < 1.7e308:  # not bool, NaN or beyond float64
                 parameters.append((key, str(name)))
                 values.append(_one(shared, float(value)))
-    name, email, section = (_text(raw.get(field, ""), f"student {student_id}: {field}")
-                            for field in ("name", "email", "section"))
+    name, email, section = (_text(raw.get(entry, ""), f"student {student_id}: {entry}")
+                            for entry in ("name", "email", "section"))
     return KeyStudent(student_id, name, email, section, parts, _one(shared, ("parameters", tuple(parameters)))[1],
                       tuple(values))
 

@@ -46,7 +46,7 @@ def grades_csv(graded: Graded) -> str:
 
 
 DETAILS_HEADER = ("student_id", "label", "submitted", "verdict", "credit", "points", "score", "expected", "parsed",
-                  "unit", "abs_error", "rel_error", "tolerance", "feedback", "source")
+                  "unit", "abs_error", "rel_error", "tolerance", "feedback", "diagnosis", "source")
 
 
 def details_csv(graded: Graded, students_per_piece: int = 2000) -> Iterator[str]:
@@ -65,12 +65,12 @@ def details_csv(graded: Graded, students_per_piece: int = 2000) -> Iterator[str]
         who = safe_cell(student.id)
         for label, rows in columns:
             (submitted, verdict, credit, points, expected, parsed, unit, abs_error, rel_error, tolerance, feedback,
-             source) = rows[index]
+             diagnosis, source) = rows[index]
             writer.writerow((who, label, "" if submitted is None else safe_cell(submitted), words[verdict],
                              numbers[credit], numbers[points], numbers[credit * points], safe_cell(expected),
                              safe_cell(parsed), words[unit], "" if abs_error is None else _number(abs_error),
                              "" if rel_error is None else _number(rel_error), words[tolerance], safe_cell(feedback),
-                             safe_cell(source)))
+                             words[diagnosis], safe_cell(source)))
         if index % students_per_piece == students_per_piece - 1:
             yield stream.getvalue()
             stream.seek(0)

@@ -15,8 +15,10 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Literal
 
+from grader.bank.template import Template
 from grader.files import output_folder, write_manifest
 from grader.grade.canvas import CanvasExport, read_export
+from grader.grade.diagnosis import physics_for
 from grader.grade.grading import Graded, counts, grade
 from grader.grade.key import Key, load_key
 from grader.grade.report import write_reports
@@ -49,9 +51,12 @@ class GradeSummary:
 
 
 def run(key_path: Path, paths: Sequence[Path], out: Path, fmt: Literal["auto", "long", "wide"] = "auto",
-        force: bool = False, canvas: Path | None = None) -> GradeSummary:
+        force: bool = False, canvas: Path | None = None,
+        bank: Path | Mapping[str, Template] | None = None) -> GradeSummary:
     """Grade the submission files against the key into ``out``; ``canvas``: a Canvas gradebook export
-    whose students, names and ids ``canvas.csv`` then carries.
+    whose students, names and ids ``canvas.csv`` then carries; ``bank``: the templates the key was made
+    from (a folder, or a mapping of templates; by default the shipped bank), for error carried forward
+    and diagnosed mistakes.
 
     ``rows_not_graded`` counts submission rows only: the export's mismatches are caveats (see
     :mod:`grader.grade.canvas`).
@@ -60,29 +65,31 @@ def run(key_path: Path, paths: Sequence[Path], out: Path, fmt: Literal["auto", "
     with _collector_paused():
         key = load_key(key_path)
         export = read_export(canvas, key) if canvas is not None else None
-        graded = _graded(key, paths, fmt, ())
+        graded = _graded(key, paths, fmt, (), bank)
         inputs = (key_path, *paths, *([canvas] if canvas is not None else []))
         with output_folder(out, command=COMMAND, inputs=inputs, force=force) as staging:
             write_reports(graded, staging, export)
     return _summary(graded, out, started, export)
 
 
-def grade_into(folder: Path, key_path: Path, paths: Sequence[Path], out: Path, names: Sequence[str]) -> GradeSummary:
+def grade_into(folder: Path, key_path: Path, paths: Sequence[Path], out: Path, names: Sequence[str],
+               bank: Path | Mapping[str, Template] | None = None) -> GradeSummary:
     """Grade into ``folder``, a part of an output folder still being written (the demo's ``grades/``), as
     ``grader grade --out out`` would, with the files named as in ``names`` (where they will be) and the
     manifest ``grader grade`` writes, so that ``grader grade --out out --force`` may replace it later."""
     started = time.perf_counter()
     with _collector_paused():
-        graded = _graded(load_key(key_path), paths, "auto", names)
+        graded = _graded(load_key(key_path), paths, "auto", names, bank)
         write_reports(graded, folder)
         write_manifest(folder, COMMAND)
     return _summary(graded, out, started, None)
 
 
-def _graded(key: Key, paths: Sequence[Path], fmt: Literal["auto", "long", "wide"], names: Sequence[str]) -> Graded:
+def _graded(key: Key, paths: Sequence[Path], fmt: Literal["auto", "long", "wide"], names: Sequence[str],
+            bank: Path | Mapping[str, Template] | None) -> Graded:
     submissions = read_submissions(paths, [StudentRef(s.id, s.email) for s in key.students], key.labels, fmt,
                                    names)
-    return grade(key, submissions)
+    return grade(key, submissions, physics_for(key, bank))
 
 
 def _summary(graded: Graded, out: Path, started: float, export: CanvasExport | None) -> GradeSummary:

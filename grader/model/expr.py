@@ -33,7 +33,7 @@ MAX_EXPONENT = 64
 
 FUNCTIONS = {
     "sqrt": 1, "sin": 1, "cos": 1, "tan": 1, "sind": 1, "cosd": 1,
-    "exp": 1, "log": 1, "abs": 1, "atan2": 2, "hypot": 2, "Max": 2, "Min": 2,
+    "exp": 1, "log": 1, "abs": 1, "sign": 1, "atan2": 2, "hypot": 2, "Max": 2, "Min": 2,
 }
 """Functions an expression may call, with their number of arguments."""
 

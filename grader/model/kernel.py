@@ -37,7 +37,7 @@ from grader.model.expr import Node, Num, Op, Sym
 _NUMERIC: dict[str, Any] = {
     "add": np.add, "sub": np.subtract, "mul": np.multiply, "div": np.divide, "neg": np.negative,
     "sqrt": np.sqrt, "sin": np.sin, "cos": np.cos, "tan": np.tan, "exp": np.exp, "log": np.log,
-    "abs": np.absolute, "atan2": np.arctan2, "hypot": np.hypot, "Max": np.maximum, "Min": np.minimum,
+    "abs": np.absolute, "sign": np.sign, "atan2": np.arctan2, "hypot": np.hypot, "Max": np.maximum, "Min": np.minimum,
 }
 """Operations that are numpy ufuncs from float64 to float64: they can write into a given array."""
 

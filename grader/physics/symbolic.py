@@ -22,6 +22,7 @@ import sympy as sp
 from grader.errors import TemplateError
 from grader.model.expr import FUNCTIONS, Node, Num, Op, Sym, parse  # noqa: F401  (parse: doctest)
 from grader.model.scene import Scene, Stage
+from grader.model.units import Unit
 
 INNER = "(compiled expression)"  # the ``where`` of an error raised without the template's file
 
@@ -94,6 +95,7 @@ class cosd(sp.Function):  # type: ignore[misc]  # noqa: N801
 _SYMPY_FUNCTIONS: dict[str, Any] = {
     "sqrt": sp.sqrt, "sin": sp.sin, "cos": sp.cos, "tan": sp.tan, "exp": sp.exp, "log": sp.log,
     "abs": sp.Abs, "atan2": sp.atan2, "hypot": hypot, "sind": sind, "cosd": cosd, "Max": sp.Max, "Min": sp.Min,
+    "sign": sp.sign,
 }
 _BINARY = {"add": lambda a, b: a + b, "sub": lambda a, b: a - b, "mul": lambda a, b: a * b,
            "div": lambda a, b: a / b, "pow": lambda a, b: a**b,
@@ -209,6 +211,7 @@ class Context:
     scene: Scene
     symbols: dict[str, sp.Symbol] = field(default_factory=dict)
     defaults: dict[str, int] = field(default_factory=dict)  # default name -> the stage that owns it
+    units: dict[str, Unit] = field(default_factory=dict)  # a parameter's unit, by name (a height in mm)
 
     def sym(self, node: Node) -> Any:
         """A stage field as a sympy expression over the scene's symbols."""
@@ -265,13 +268,3 @@ class Context:
         if when == "before":
             return sp.Integer(0)
         return self.symbol(self.unused_name(f"v_{body}_{axis}_after", stage))
-
-    def kinetic_energy(self, stage: Stage, when: str) -> Any:
-        """Sum of ``(v_n^2 + v_t^2) / (2 w)`` over the stage's movable bodies."""
-        total = sp.Integer(0)
-        for body in stage.fields["bodies"]:
-            w = self.inverse_mass(body)
-            if w != 0:
-                n, t = self.velocity(stage, body, when, "n"), self.velocity(stage, body, when, "t")
-                total += hypot(n, t) ** 2 / (2 * w)  # no square of a component under- or overflows
-        return total

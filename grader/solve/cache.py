@@ -1,4 +1,4 @@
-"""Compiled templates kept on disk, so only the first run of a template pays for sympy.
+"""Compiled templates and their alternatives kept on disk, so only the first run of a template pays for sympy.
 
 The key is the template file's hash, the package version and a fingerprint of the solver's
 source: editing either recompiles. The folder is ``$GRADER_CACHE_DIR``, else
@@ -12,11 +12,14 @@ import contextlib
 import hashlib
 import json
 import os
+from collections.abc import Callable
 from functools import lru_cache
 from pathlib import Path
+from typing import Any, Protocol, TypeVar
 
 from grader import __version__
 from grader.bank.template import Template
+from grader.solve.alternatives import Alternatives
 from grader.solve.compiled import FORMAT, Compiled
 
 # Every stage folder whose source can change what the solver compiles: editing any file in them
@@ -49,16 +52,43 @@ def _fingerprint() -> str:
 
 def compiled_for(template: Template) -> Compiled:
     """The compiled form of a template: from the cache, or compiled now and cached."""
+    def compile_now() -> Compiled:
+        from grader.solve.solver import compile_template
+
+        return compile_template(template)
+
+    return _cached(template, "", Compiled.from_json, compile_now)
+
+
+def alternatives_for(template: Template) -> Alternatives:
+    """A template's alternatives (error carried forward, diagnosed mistakes): from the cache, or
+    compiled now and cached beside its compiled form."""
+    def compile_now() -> Alternatives:
+        from grader.solve.derived import compile_alternatives
+
+        return compile_alternatives(template)
+
+    return _cached(template, "-alternatives", Alternatives.from_json, compile_now)
+
+
+class _Stored(Protocol):
+    def to_json(self) -> dict[str, Any]: ...
+
+
+_T = TypeVar("_T", bound=_Stored)
+
+
+def _cached(template: Template, kind: str, read: Callable[[Any], _T], compile_now: Callable[[], _T]) -> _T:
+    """What ``compile_now`` makes for a template, kept as ``<id>-<hash><kind>.json`` (``read`` reads it back)."""
     key = hashlib.sha256(f"{template.source_hash}/{_fingerprint()}".encode()).hexdigest()[:20]
-    path = cache_dir() / f"{template.id}-{key}.json"
+    path = cache_dir() / f"{template.id}-{key}{kind}.json"
     try:
-        return Compiled.from_json(json.loads(path.read_text(encoding="utf-8")))
+        return read(json.loads(path.read_text(encoding="utf-8")))
     except (OSError, ValueError, KeyError, TypeError, IndexError):
         pass
+    made = compile_now()
     from grader.files import write_atomic  # only a first run writes
-    from grader.solve.solver import compile_template
 
-    compiled = compile_template(template)
     with contextlib.suppress(OSError):  # a read-only home folder only costs time
-        write_atomic(path, json.dumps(compiled.to_json()))
-    return compiled
+        write_atomic(path, json.dumps(made.to_json()))
+    return made

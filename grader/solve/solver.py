@@ -38,39 +38,57 @@ class _Solved:
     relation: Relation
     display: Any
     numeric: Any
+    branch: bool = False  # the magnitude only: the sign is the one the unknown has in the scene's own solution
 
 
-def derive(relations: list[Relation], knowns: Iterable[Any], given: Iterable[Any]) -> list[_Solved]:
+def derive(relations: list[Relation], knowns: Iterable[Any], given: Iterable[Any],
+           branches: bool = False) -> list[_Solved]:
     """Solve relations one unknown at a time, earliest relation first, as far as they go.
 
     ``given`` are the knowns that are inputs (not derived): a stable form that asks for its
-    symbols to be given is used only then.
+    symbols to be given is used only then. With ``branches``, a relation may also give an unknown
+    known only up to sign (a step marked ``branch``), where no other relation gives it.
     """
     known, given_set = set(knowns), set(given)
     used: set[int] = set()
     chain: list[_Solved] = []
-    progress = True
-    while progress:
-        progress = False
-        for index, relation in enumerate(relations):
-            if index in used:
-                continue
-            unknowns = relation.symbols() - known
-            if not unknowns:
-                used.add(index)
-                continue
-            if len(unknowns) != 1:
-                continue
-            unknown = unknowns.pop()
-            display = _solve(relation, unknown)
-            if display is None:
-                continue
-            chain.append(_Solved(unknown, relation, display, _stable(relation, unknown, display, known, given_set)))
-            known.add(unknown)
+    while True:
+        step = _next_step(relations, known, given_set, used) or (
+            _next_branch(relations, known, used) if branches else None)
+        if step is None:
+            return chain
+        chain.append(step)
+        known.add(step.unknown)
+
+
+def _next_step(relations: list[Relation], known: set[Any], given: set[Any], used: set[int]) -> _Solved | None:
+    """The earliest relation that gives its one unknown (marked used), or None."""
+    for index, relation in enumerate(relations):
+        if index in used:
+            continue
+        unknowns = relation.symbols() - known
+        if not unknowns:
             used.add(index)
-            progress = True
-            break
-    return chain
+            continue
+        if len(unknowns) != 1:
+            continue
+        unknown = unknowns.pop()
+        display = _solve(relation, unknown)
+        if display is None:
+            continue
+        used.add(index)
+        return _Solved(unknown, relation, display, _stable(relation, unknown, display, known, given))
+    return None
+
+
+def _next_branch(relations: list[Relation], known: set[Any], used: set[int]) -> _Solved | None:
+    """The earliest relation that gives its one unknown up to sign (marked used), or None."""
+    for index, relation in enumerate(relations):
+        unknowns = relation.symbols() - known
+        if index not in used and len(unknowns) == 1 and (unknown := unknowns.pop()) in relation.branches:
+            used.add(index)
+            return _Solved(unknown, relation, relation.branches[unknown], relation.branches[unknown], branch=True)
+    return None
 
 
 def _solve(relation: Relation, unknown: Any) -> Any:
@@ -109,7 +127,7 @@ class _Compiler:
 
     def __init__(self, template: Template) -> None:
         self.template = template
-        self.ctx = Context(template.scene)
+        self.ctx = Context(template.scene, units={name: p.unit for name, p in template.parameters.items()})
         for name, parameter in template.parameters.items():
             low = parameter.domain.low
             positive = low > 0 or (low == 0 and parameter.domain.low_open)
@@ -200,9 +218,9 @@ class _Compiler:
                                   undefined)
         return CompiledAnswer(name, spec.unit.text, self._tree(in_units, name), None, undefined)
 
-    def _tree(self, expr: Any, name: str) -> Any:
-        """A numeric expression over parameters only, stabilised, as a tree."""
-        allowed = {self.ctx.symbols[p] for p in self.template.parameters} | {self.ctx.symbols.get("g")}
+    def _tree(self, expr: Any, name: str, extra: Iterable[Any] = ()) -> Any:
+        """A numeric expression over parameters (and ``extra``) only, stabilised, as a tree."""
+        allowed = {self.ctx.symbols[p] for p in self.template.parameters} | {self.ctx.symbols.get("g"), *extra}
         stable = stabilize(expr, self.degree_angles)
         if stable.free_symbols - allowed:
             stable = stabilize(sp.cancel(stable), self.degree_angles)

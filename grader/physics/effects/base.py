@@ -1,9 +1,12 @@
-"""What every effect provides: field schema, relations with solved and stable forms, conditions.
+"""What every effect provides: field schema, relations with solved and stable forms, conditions,
+and the mistakes students make with it.
 
 An effect turns one stage of a scene into :class:`Relation` objects. A relation is one
 equation as a student would write it (for the worked solution), the forms solved for each
 unknown it can give, and, per unknown, numerically stable forms the compiled kernel prefers.
-Sympy is imported lazily: loading and validating a template never needs it.
+A :class:`Mistake` is the same stage as a student who makes that mistake writes it, so the
+solver re-derives what such a student answers. Sympy is imported lazily: loading and validating
+a template never needs it.
 """
 
 from __future__ import annotations
@@ -72,6 +75,10 @@ class Relation:
     general: bool = True
     requires: tuple[Condition, ...] = ()
     undefined: Mapping[Any, tuple[Any, str]] = field(default_factory=dict)
+    branches: Mapping[Any, Any] = field(default_factory=dict)
+    """Solutions known only up to sign (a component from a speed and the other component): per
+    unknown, its magnitude. Only chains that carry a student's answer forward use them, with the
+    sign the quantity has in the scene's own solution."""
 
     def symbols(self) -> set[sp.Symbol]:
         """Every quantity the equation involves."""
@@ -81,12 +88,31 @@ class Relation:
 
 
 @dataclass(frozen=True)
+class Mistake:
+    """A typical mistake with an effect, as the solver re-derives it.
+
+    Either the stage's relations as a student who makes it writes them (``relations``: all of the
+    stage's relations, one or more of them changed), or, for an answer printed in ``unit``, the right
+    value read in another unit: the student gives ``scale`` times it (radians for degrees: pi/180).
+    ``says`` completes "your answer matches ...".
+    """
+
+    id: str
+    says: str
+    relations: tuple[Relation, ...] = ()
+    unit: str | None = None
+    scale: Any = None
+
+
+@dataclass(frozen=True)
 class Effect:
     """An entry of the catalogue: its name, what it means, its fields, its relations (the
-    closed form) and how to simulate it (its force law in the time domain; None: it has none)."""
+    closed form), how to simulate it (its force law in the time domain; None: it has none) and
+    the mistakes students make with it, first the most telling (None: none declared)."""
 
     name: str
     summary: str
     fields: tuple[Field, ...]
     relations: Callable[[Stage, Context], list[Relation]]
     simulate: Callable[[Stage, Run], None] | None = None
+    mistakes: Callable[[Stage, Context], list[Mistake]] | None = None

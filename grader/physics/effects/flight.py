@@ -2,6 +2,9 @@
 
 Force law: gravity, ``a = -g`` upward. The simulation starts the body at the height (fall) or at
 the bottom with the speed (rise) and ends at the located event: reaching the bottom, or the apex.
+
+Mistakes: ``v = sqrt(g h)`` or ``v = 2 g h``; the other system's ``g`` (32.2 in a problem in metres,
+9.81 in one in feet); a height printed in mm used as metres.
 """
 
 from __future__ import annotations
@@ -11,8 +14,9 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from grader.model.expr import Sym
 from grader.model.units import LENGTH, SPEED
-from grader.physics.effects.base import Condition, Effect, Field, Relation
+from grader.physics.effects.base import Condition, Effect, Field, Mistake, Relation
 
 if TYPE_CHECKING:
     from grader.model.scene import Stage
@@ -26,20 +30,27 @@ _FIELDS = (
 )
 
 
-def _energy(stage: Stage, ctx: Context, verb: str) -> list[Relation]:
+def _energy(stage: Stage, ctx: Context, verb: str, law: str = "sqrt(2gh)", g: Any = None,
+            height_scale: Any = 1) -> list[Relation]:
+    """The stage's relation: ``v = sqrt(2 g h)``, or as a student who makes a mistake writes it
+    (``law`` ``sqrt(gh)`` or ``2gh``; another value of ``g``; the height scaled: mm read as m)."""
     import sympy as sp
 
     height, speed = ctx.sym(stage.fields["height"]), ctx.sym(stage.fields["speed"])
-    g = ctx.gravity_symbol(stage)
+    g = ctx.gravity_symbol(stage) if g is None else g
     body = stage.fields["body"]
+    used = height * height_scale
+    bottom_speed = {"sqrt(2gh)": sp.Pow(2 * g * used, sp.Rational(1, 2), evaluate=False),
+                    "sqrt(gh)": sp.Pow(g * used, sp.Rational(1, 2), evaluate=False), "2gh": 2 * g * used}[law]
     solutions = {}
     if isinstance(height, sp.Symbol):
-        solutions[height] = speed**2 / (2 * g)
+        solutions[height] = {"sqrt(2gh)": speed**2 / (2 * g), "sqrt(gh)": speed**2 / g,
+                             "2gh": speed / (2 * g)}[law] / height_scale
     if isinstance(speed, sp.Symbol):
-        solutions[speed] = sp.Pow(2 * g * height, sp.Rational(1, 2), evaluate=False)
+        solutions[speed] = bottom_speed
     return [Relation(
         label=f"conservation of energy, {body} {verb} through {stage.text('height')}",
-        lhs=speed, rhs=sp.Pow(2 * g * height, sp.Rational(1, 2), evaluate=False),
+        lhs=speed, rhs=bottom_speed,
         solutions=solutions,
         requires=(
             Condition(sp.Ge(height, 0), f"the {verb} height {stage.text('height')} must not be negative"),
@@ -55,6 +66,37 @@ def _free_fall(stage: Stage, ctx: Context) -> list[Relation]:
 
 def _rise(stage: Stage, ctx: Context) -> list[Relation]:
     return _energy(stage, ctx, "rises")
+
+
+def _mistakes(stage: Stage, ctx: Context, verb: str) -> list[Mistake]:
+    """A fall and a rise share their mistakes (one id each), so a student makes them in every flight stage."""
+    import sympy as sp
+
+    gravity = ctx.scene.gravity
+    customary = gravity is not None and "ft" in gravity.text  # the problem's g is given in ft/s^2
+    mistakes = [
+        Mistake("flight.sqrt_gh", "v = √(gh) instead of v = √(2gh)", tuple(_energy(stage, ctx, verb, "sqrt(gh)"))),
+        Mistake("flight.two_gh", "v = 2gh instead of v = √(2gh)", tuple(_energy(stage, ctx, verb, "2gh"))),
+        # The other system's number for g, in this problem's units.
+        Mistake("flight.g_metric", "g = 9.81 (the value in m/s²) in a problem in feet",
+                tuple(_energy(stage, ctx, verb, g=sp.Rational(981, 100) * sp.Rational(381, 1250)))) if customary else
+        Mistake("flight.g_customary", "g = 32.2 (the value in ft/s²) in a problem in metres",
+                tuple(_energy(stage, ctx, verb, g=sp.Rational(161, 5)))),
+    ]
+    height = stage.fields["height"]
+    unit = ctx.units.get(height.name) if isinstance(height, Sym) else None
+    if unit is not None and unit.text == "mm":
+        mistakes.append(Mistake("flight.mm_as_m", "the height in mm used as metres",
+                                tuple(_energy(stage, ctx, verb, height_scale=1000))))
+    return mistakes
+
+
+def _fall_mistakes(stage: Stage, ctx: Context) -> list[Mistake]:
+    return _mistakes(stage, ctx, "falls")
+
+
+def _rise_mistakes(stage: Stage, ctx: Context) -> list[Mistake]:
+    return _mistakes(stage, ctx, "rises")
 
 
 def gravity(g: float) -> Any:
@@ -103,6 +145,6 @@ def _simulate_rise(stage: Stage, run: Run) -> None:
 
 
 FREE_FALL = Effect("free_fall", "a body falls from rest through a height: v = sqrt(2 g h)", _FIELDS, _free_fall,
-                   _simulate_fall)
+                   _simulate_fall, _fall_mistakes)
 RISE = Effect("rise", "a body moving up at a speed rises to a height where it stops: h = v^2/(2 g)", _FIELDS, _rise,
-              _simulate_rise)
+              _simulate_rise, _rise_mistakes)

@@ -12,19 +12,24 @@ accuracy when ``e`` is small or the masses are very unequal; energy lost as
 
 Force law (simulation): a Kelvin-Voigt contact calibrated to ``e`` (:class:`ContactLaw`), plus the
 weight during contact only where asked for.
+
+Mistakes: the first body's velocity after with its sign turned; ``e**2`` or ``1/e`` for ``e``; the full
+speed for the normal component (oblique); the masses swapped, or a fixed surface taken as a body of
+the other's mass; and with the energy: the energy kept reported as lost, a fraction for a
+percentage, the loss as ``T' - T``.
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from grader.model.expr import Sym
 from grader.model.units import PURE, SPEED, dimension_from
-from grader.physics.effects.base import Condition, Effect, Field, Relation, Stable
+from grader.physics.effects.base import Condition, Effect, Field, Mistake, Relation, Stable
 
 if TYPE_CHECKING:
     from grader.model.scene import Stage
@@ -32,74 +37,160 @@ if TYPE_CHECKING:
     from grader.physics.symbolic import Context
 
 
-def _impact(stage: Stage, ctx: Context) -> list[Relation]:
-    import sympy as sp
+@dataclass(frozen=True)
+class _Impact:
+    """One impact's quantities as its relations use them. A mistake is the same impact with a field
+    changed: ``e`` used as ``e**2``, the masses swapped, a velocity with its sign turned."""
 
-    first, second = stage.fields["bodies"]
-    w1, w2 = ctx.inverse_mass(first), ctx.inverse_mass(second)
-    e = ctx.sym(stage.fields["restitution"])
-    impulse = ctx.quantity(stage, "impulse")
-    u1, u2 = ctx.velocity(stage, first, "before", "n"), ctx.velocity(stage, second, "before", "n")
-    a1, a2 = ctx.velocity(stage, first, "after", "n"), ctx.velocity(stage, second, "after", "n")
-    approach, separation = u1 - u2, a2 - a1
-    centre = (w2 * u1 + w1 * u2) / (w1 + w2)
-    e_text = stage.text("restitution")
+    stage: Stage
+    bodies: tuple[str, str]
+    inverse: tuple[Any, Any]  # w = 1/m of each body (0: fixed)
+    e: Any  # the restitution as the template gives it (a parameter, a derived quantity or a number)
+    before: tuple[tuple[Any, Any], tuple[Any, Any]]  # (n, t) of each body
+    after: tuple[tuple[Any, Any], tuple[Any, Any]]
+    tangents: tuple[int, ...]  # the bodies whose t-velocity the impact leaves unchanged (movable, oblique)
+    law: str = "e"  # how the equations use e: "e", "e**2" or "1/e"
+    loss: str = "lost"  # the energy lost as "lost", the energy "kept" instead, or T' - T ("negated")
 
-    relations = [
-        Relation(f"impulse along n in the impact of {first} and {second}, with restitution {e_text}",
-                 impulse, (1 + e) * approach / (w1 + w2), solutions={impulse: (1 + e) * approach / (w1 + w2)},
-                 general=False),
-        Relation(f"impulse-momentum for {first} along n", a1, u1 - impulse * w1,
-                 solutions={a1: u1 - impulse * w1, impulse: (u1 - a1) / w1},
-                 stable={a1: (Stable(centre - e * w1 * approach / (w1 + w2)),)}),
-    ]
-    if w2 != 0:
+    @classmethod
+    def of(cls, stage: Stage, ctx: Context) -> _Impact:
+        """The impact a stage describes."""
+        first, second = stage.fields["bodies"]
+
+        def velocities(when: str) -> tuple[tuple[Any, Any], tuple[Any, Any]]:
+            return ((ctx.velocity(stage, first, when, "n"), ctx.velocity(stage, first, when, "t")),
+                    (ctx.velocity(stage, second, when, "n"), ctx.velocity(stage, second, when, "t")))
+
+        inverse = (ctx.inverse_mass(first), ctx.inverse_mass(second))
+        return cls(stage, (first, second), inverse, ctx.sym(stage.fields["restitution"]), velocities("before"),
+                   velocities("after"), tuple(i for i, w in enumerate(inverse) if w != 0 and stage.is_oblique))
+
+    def relations(self, ctx: Context) -> list[Relation]:
+        """The impact's equations, as a student would write them."""
+        import sympy as sp
+
+        (first, second), (w1, w2), e = self.bodies, self.inverse, self.e
+        used = {"e": e, "e**2": e**2, "1/e": 1 / e}[self.law]
+        impulse = ctx.quantity(self.stage, "impulse")
+        (u1, u2), (a1, a2) = (self.before[0][0], self.before[1][0]), (self.after[0][0], self.after[1][0])
+        approach, separation = u1 - u2, a2 - a1
+        ratio = separation / approach
+        centre = (w2 * u1 + w1 * u2) / (w1 + w2)
+        e_text = self.stage.text("restitution")
+
+        relations = [
+            Relation(f"impulse along n in the impact of {first} and {second}, with restitution {e_text}",
+                     impulse, (1 + used) * approach / (w1 + w2), solutions={impulse: (1 + used) * approach / (w1 + w2)},
+                     general=False),
+            Relation(f"impulse-momentum for {first} along n", a1, u1 - impulse * w1,
+                     solutions={a1: u1 - impulse * w1, impulse: (u1 - a1) / w1},
+                     stable={a1: (Stable(centre - used * w1 * approach / (w1 + w2)),)}),
+        ]
+        if w2 != 0:
+            relations.append(Relation(
+                f"impulse-momentum for {second} along n", a2, u2 + impulse * w2,
+                solutions={a2: u2 + impulse * w2, impulse: (a2 - u2) / w2},
+                stable={a2: (Stable(centre + used * w2 * approach / (w1 + w2)),)}))
         relations.append(Relation(
-            f"impulse-momentum for {second} along n", a2, u2 + impulse * w2,
-            solutions={a2: u2 + impulse * w2, impulse: (a2 - u2) / w2},
-            stable={a2: (Stable(centre + e * w2 * approach / (w1 + w2)),)}))
-    relations.append(Relation(
-        "coefficient of restitution: separation over approach along n", e, separation / approach,
-        solutions={e: separation / approach, a1: a2 - e * approach, a2: a1 + e * approach},
-        requires=(
-            Condition(sp.Gt(approach, 0), f"{first} and {second} are not approaching along the line of "
-                      "impact (relative normal velocity <= 0), so they do not collide"),
-            Condition(sp.Ge(e, 0), "the coefficient of restitution is {value}; it cannot be negative "
-                      "(the bodies would pass through each other)", subject=e),
-            # Slack of 1e-12: a derived e one rounding above 1 (an exactly elastic rebound, its
-            # height rounded) is 1, not a refusal; a real excess is far larger.
-            Condition(sp.Le(e, 1 + sp.Rational(1, 10**12)), "the coefficient of restitution is {value}; above 1 "
-                      "the impact would create energy", subject=e),
-        )))
-    for body in (first, second):
-        if ctx.inverse_mass(body) != 0 and stage.is_oblique:
-            before, after = ctx.velocity(stage, body, "before", "t"), ctx.velocity(stage, body, "after", "t")
-            relations.append(Relation(f"smooth surfaces: no impulse along t, so {body}'s t-velocity is "
+            "coefficient of restitution: separation over approach along n", used, ratio,
+            solutions={e: {"e": ratio, "e**2": sp.sqrt(ratio), "1/e": 1 / ratio}[self.law],
+                       a1: a2 - used * approach, a2: a1 + used * approach},
+            requires=(
+                Condition(sp.Gt(approach, 0), f"{first} and {second} are not approaching along the line of "
+                          "impact (relative normal velocity <= 0), so they do not collide"),
+                Condition(sp.Ge(e, 0), "the coefficient of restitution is {value}; it cannot be negative "
+                          "(the bodies would pass through each other)", subject=e),
+                # Slack of 1e-12: a derived e one rounding above 1 (an exactly elastic rebound, its
+                # height rounded) is 1, not a refusal; a real excess is far larger.
+                Condition(sp.Le(e, 1 + sp.Rational(1, 10**12)), "the coefficient of restitution is {value}; above 1 "
+                          "the impact would create energy", subject=e),
+            )))
+        for index in self.tangents:
+            (_, before), (_, after) = self.before[index], self.after[index]
+            relations.append(Relation(f"smooth surfaces: no impulse along t, so {self.bodies[index]}'s t-velocity is "
                                       "unchanged", after, before, solutions={after: before}))
-    return relations + _energy(stage, ctx, e, approach, separation, w1, w2)
+        return relations + self._energy(ctx, used, approach, separation)
+
+    def _kinetic(self, when: str) -> Any:
+        """Sum of ``(v_n^2 + v_t^2) / (2 w)`` over the movable bodies."""
+        import sympy as sp
+
+        from grader.physics.symbolic import hypot
+
+        velocities = self.before if when == "before" else self.after
+        total = sp.Integer(0)
+        for w, (n, t) in zip(self.inverse, velocities, strict=True):
+            if w != 0:
+                total += hypot(n, t) ** 2 / (2 * w)  # no square of a component under- or overflows
+        return total
+
+    def _energy(self, ctx: Context, used: Any, approach: Any, separation: Any) -> list[Relation]:
+        import sympy as sp
+
+        stage, (w1, w2) = self.stage, self.inverse
+        before, after = ctx.quantity(stage, "energy_before"), ctx.quantity(stage, "energy_after")
+        lost, fraction = ctx.quantity(stage, "energy_lost"), ctx.quantity(stage, "loss_fraction")
+        totals = {when: self._kinetic(when) for when in ("before", "after")}
+        lost_form = (1 - used) * (1 + used) * approach**2 / (2 * (w1 + w2))
+        # With e derived, (v_rel - v_sep) is a difference of measured quantities; once e <= 1 is
+        # checked the true loss is >= 0, so a negative result is rounding of an exact 0.
+        derived_form = sp.Max(0, (approach - separation) * (approach + separation) / (2 * (w1 + w2)))
+        sign = -1 if self.loss == "negated" else 1
+        if self.loss == "kept":
+            loss = Relation("energy lost in the impact", lost, totals["after"], solutions={lost: totals["after"]},
+                            general=False)
+        else:
+            loss = Relation("energy lost in the impact", lost, sign * lost_form, solutions={lost: sign * lost_form},
+                            general=False, stable={lost: (Stable(sign * lost_form, given=(self.e,)),
+                                                          Stable(sign * derived_form))})
+        return [
+            Relation("kinetic energy just before the impact", before, totals["before"],
+                     solutions={before: totals["before"]}, general=False),
+            Relation("kinetic energy just after the impact", after, totals["after"],
+                     solutions={after: totals["after"]}, general=False),
+            loss,
+            Relation("fraction of the kinetic energy lost", fraction, lost / before,
+                     solutions={fraction: lost / before}, general=False),
+        ]
 
 
-def _energy(stage: Stage, ctx: Context, e: Any, approach: Any, separation: Any, w1: Any, w2: Any) -> list[Relation]:
+def _impact(stage: Stage, ctx: Context) -> list[Relation]:
+    return _Impact.of(stage, ctx).relations(ctx)
+
+
+def _mistakes(stage: Stage, ctx: Context) -> list[Mistake]:
+    """The mistakes of an impact, then of its energy; each only where the scene lets it differ."""
     import sympy as sp
 
-    before, after = ctx.quantity(stage, "energy_before"), ctx.quantity(stage, "energy_after")
-    lost, fraction = ctx.quantity(stage, "energy_lost"), ctx.quantity(stage, "loss_fraction")
-    totals = {when: ctx.kinetic_energy(stage, when) for when in ("before", "after")}
-    lost_form = (1 - e) * (1 + e) * approach**2 / (2 * (w1 + w2))
-    # With e derived, (v_rel - v_sep) is a difference of measured quantities; once e <= 1 is
-    # checked the true loss is >= 0, so a negative result is rounding of an exact 0.
-    derived_form = sp.Max(0, (approach - separation) * (approach + separation) / (2 * (w1 + w2)))
-    return [
-        Relation("kinetic energy just before the impact", before, totals["before"],
-                 solutions={before: totals["before"]}, general=False),
-        Relation("kinetic energy just after the impact", after, totals["after"],
-                 solutions={after: totals["after"]}, general=False),
-        Relation("energy lost in the impact", lost, lost_form, solutions={lost: lost_form}, general=False,
-                 stable={lost: (Stable(lost_form, given=(e,)),
-                                Stable(derived_form))}),
-        Relation("fraction of the kinetic energy lost", fraction, lost / before,
-                 solutions={fraction: lost / before}, general=False),
+    from grader.physics.symbolic import hypot
+
+    real = _Impact.of(stage, ctx)
+    (n1, t1), (n2, t2) = real.after
+    changed: list[tuple[str, str, _Impact | None]] = [
+        ("impact.rebound_sign", f"{real.bodies[0]}'s velocity after the impact with its sign turned",
+         replace(real, after=((-n1, t1), (n2, t2)))),
     ]
+    if not (real.e.is_number and real.e in (0, 1)):  # e**2 and 1/e are e itself, or 1/0
+        changed += [("impact.e_squared", "using e² instead of e", replace(real, law="e**2")),
+                    ("impact.e_inverse", "using 1/e instead of e (approach over separation)", replace(real, law="1/e"))]
+    (u1, s1), second = real.before
+    if 0 in real.tangents:
+        changed.append(("impact.full_speed", f"{real.bodies[0]}'s full speed used instead of its normal component",
+                        replace(real, before=((hypot(u1, s1), s1), second))))
+    w1, w2 = real.inverse
+    if w2 != 0:
+        changed.append(("impact.masses_swapped", "the two masses swapped", replace(real, inverse=(w2, w1))))
+    else:
+        surface = ctx.symbol(ctx.unused_name(f"v_{real.bodies[1]}_n_after", stage))
+        changed.append(("impact.fixed_as_equal_mass", f"the fixed {real.bodies[1]} treated as a body of "
+                        f"{real.bodies[0]}'s mass", replace(real, inverse=(w1, w1), after=((n1, t1), (surface, t2)))))
+    changed += [
+        ("energy.kept_as_lost", "the energy kept (T') reported as the energy lost", replace(real, loss="kept")),
+        ("energy.fraction_for_percent", "a fraction where a percentage was asked (0.476 for 47.6 %)", None),
+        ("energy.wrong_sign", "the energy lost as T' − T, with the wrong sign", replace(real, loss="negated")),
+    ]
+    return [Mistake(id, says, tuple(impact.relations(ctx))) if impact is not None else
+            Mistake(id, says, unit="%", scale=sp.Rational(1, 100)) for id, says, impact in changed]
 
 
 @dataclass(frozen=True)
@@ -280,4 +371,5 @@ IMPACT = Effect(
     ),
     _impact,
     _simulate_impact,
+    _mistakes,
 )

@@ -4,17 +4,19 @@ the angle between two velocities.
 The angle is measured from the axis named in ``from`` toward the other one. Speeds come from
 ``hypot`` and angles from ``atan2``; the angle of a zero velocity is undefined, not zero. The angle
 between two velocities is ``atan2(|a x b|, a . b)``, 0 to 180 degrees.
+
+Mistakes: an angle reported from the other axis (``90° - θ``), or in radians where degrees were asked.
 """
 
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from grader.model.expr import to_text
 from grader.model.kernel import cosd, sind
 from grader.model.units import ANGLE, SPEED
-from grader.physics.effects.base import Condition, Effect, Field, Relation
+from grader.physics.effects.base import Condition, Effect, Field, Mistake, Relation
 
 if TYPE_CHECKING:
     from grader.model.scene import Stage
@@ -22,7 +24,8 @@ if TYPE_CHECKING:
     from grader.physics.symbolic import Context
 
 
-def _components(stage: Stage, ctx: Context) -> list[Relation]:
+def _components(stage: Stage, ctx: Context, other_axis: bool = False) -> list[Relation]:
+    """The stage's relations; ``other_axis``: its angle reported from the other axis (``90° - θ``)."""
     import sympy as sp
 
     from grader.physics.symbolic import hypot
@@ -38,15 +41,38 @@ def _components(stage: Stage, ctx: Context) -> list[Relation]:
         Relation(f"{what}: component along {across_name}", across, speed * sp.sin(angle)),
     ]
     if isinstance(speed, sp.Symbol):
+        # A component from the speed and the other component is known only up to its sign.
+        branches = {component.free_symbols.pop(): sp.sqrt(speed**2 - other**2)
+                    for component, other in ((n, t), (t, n)) if _signed_symbol(component)}
         relations.append(Relation(
             f"{what}: magnitude from its components", speed, hypot(n, t),
-            solutions={speed: hypot(n, t)}, general=False))
+            solutions={speed: hypot(n, t)}, general=False, branches=branches))
     if isinstance(angle, sp.Symbol):
+        direction = sp.atan2(across, along)
         relations.append(Relation(
-            f"{what}: direction, measured from the {along_name}-axis", sp.tan(angle), across / along,
-            solutions={angle: sp.atan2(across, along)}, general=False,
+            f"{what}: direction, measured from the {across_name if other_axis else along_name}-axis",
+            angle if other_axis else sp.tan(angle), sp.pi / 2 - direction if other_axis else across / along,
+            solutions={angle: sp.pi / 2 - direction if other_axis else direction}, general=False,
             undefined={angle: (sp.Le(hypot(n, t), 0), f"{what} is zero, so it has no direction")}))
     return relations
+
+
+def _signed_symbol(expr: Any) -> bool:
+    """Whether ``expr`` is a quantity, or one with its sign turned (``-v_n_after``)."""
+    import sympy as sp
+
+    return isinstance(expr, sp.Symbol) or isinstance(-expr, sp.Symbol)
+
+
+def _mistakes(stage: Stage, ctx: Context) -> list[Mistake]:
+    import sympy as sp
+
+    if not isinstance(ctx.sym(stage.fields["angle"]), sp.Symbol):
+        return []
+    return [Mistake("angle.other_axis", "the angle measured from the other axis (90° − θ)",
+                    tuple(_components(stage, ctx, other_axis=True))),
+            Mistake("angle.radians", "the angle in radians where degrees were asked", unit="deg",
+                    scale=sp.pi / 180)]
 
 
 def _simulate_components(stage: Stage, run: Run) -> None:
@@ -83,6 +109,7 @@ VELOCITY = Effect(
     ),
     _components,
     _simulate_components,
+    _mistakes,
 )
 
 

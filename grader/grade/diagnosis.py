@@ -1,0 +1,184 @@
+"""Partial credit from the physics: a wrong number that is right for the student's own earlier answer
+(error carried forward, verdict ``ecf``) or that matches a mistake the solver re-derives (``mistake``).
+
+For each problem of the key, its template's alternatives (:mod:`grader.solve.alternatives`) are
+evaluated at once for every student whose answer to a part is a wrong number. The template is read
+from the bank by the id the key names, and used only when it is the file the key was made from (the
+SHA-256 the key records); a problem without it is graded as before, and a note says why.
+
+Rules, in order, for one wrong number:
+
+- ``ecf`` when it matches (the part's tolerance) a chain from an earlier answer of the problem, the
+  nearest part first; only a plausible earlier answer carries forward: a number of the right sign
+  within a factor of 3 of the right value. Credit ``ecf_credit`` (0 turns this off).
+- ``mistake`` when it matches a diagnosed mistake whose value can be told from the right answer for
+  this student's numbers, the first in the effects' lists. Credit ``mistake_credit``.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from grader.bank.template import Template, load_template
+from grader.errors import GraderError
+from grader.grade.compare import is_correct, number_text
+from grader.grade.key import Key, KeyProblem
+from grader.model.tolerance import Tolerance, with_unit
+from grader.resources import bank_dir
+from grader.solve.alternatives import Alternative, Alternatives, carries_forward, values
+from grader.solve.cache import alternatives_for
+
+
+@dataclass(frozen=True)
+class ProblemPhysics:
+    """A problem's alternatives, and each student's parameters (one column per parameter, in the key's
+    order of students; NaN where the key has no number)."""
+
+    alternatives: Alternatives
+    params: Mapping[str, np.ndarray]
+
+
+@dataclass(frozen=True)
+class Physics:
+    """The problems of a key that can carry errors forward and diagnose mistakes, by problem key; and why
+    the others cannot."""
+
+    problems: Mapping[str, ProblemPhysics]
+    notes: tuple[str, ...] = ()
+
+
+@dataclass(frozen=True)
+class Earlier:
+    """An earlier part of the same problem, for every student of the key: the number each gave in the
+    part's unit and the right value (NaN where there is none)."""
+
+    label: str
+    name: str
+    unit: str
+    given: np.ndarray
+    right: np.ndarray
+
+
+@dataclass(frozen=True)
+class Finding:
+    """A wrong number reconsidered: its verdict, credit, sentence and diagnosis."""
+
+    kind: str
+    credit: float
+    feedback: str
+    diagnosis: str
+
+
+def physics_for(key: Key, bank: Path | Mapping[str, Template] | None = None) -> Physics:
+    """Each problem's template from ``bank`` (a folder, or templates loaded from one; the shipped bank by
+    default), when it is the one the key was made from, with its alternatives; a note for each problem
+    that goes without."""
+    bank = bank_dir() if bank is None else bank
+    problems, notes = {}, []
+    for problem in key.problems:
+        found = _problem_physics(key, problem, bank)
+        if isinstance(found, str):
+            notes.append(f"problem {problem.key}: {found}; its parts are graded without error carried forward "
+                         "or diagnosed mistakes")
+        else:
+            problems[problem.key] = found
+    return Physics(problems, tuple(notes))
+
+
+def _problem_physics(key: Key, problem: KeyProblem, bank: Path | Mapping[str, Template]) -> ProblemPhysics | str:
+    """The problem's physics, or why there is none."""
+    if not problem.template:
+        return "the key does not name its template"
+    recorded = key.templates.get(problem.template)
+    if not recorded:
+        return f"the key does not record which file of template {problem.template} it was made from"
+    where = "the problem bank" if isinstance(bank, Mapping) else str(bank)
+    try:
+        template = bank.get(problem.template) if isinstance(bank, Mapping) else load_template(
+            bank / f"{problem.template}.yaml")
+    except (GraderError, OSError) as error:
+        return f"template {problem.template} could not be read from {where} ({error})"
+    if template is None:
+        return f"template {problem.template} is not in {where}"
+    if template.source_hash != recorded:
+        return f"template {problem.template} in {where} has changed since the key was written"
+    given = [student.params(problem.key) for student in key.students]
+    params = {name: _column([values.get(name) for values in given]) for name in template.parameters}
+    if key.students and any(np.isnan(column).all() for column in params.values()):
+        return f"the key holds no values of {problem.template}'s parameters"
+    try:
+        return ProblemPhysics(alternatives_for(template), params)
+    except (GraderError, ArithmeticError, TypeError, ValueError, AttributeError, NotImplementedError,
+            RecursionError) as error:  # what sympy may raise on a colleague's template: grading goes on
+        return f"template {problem.template} could not be compiled ({type(error).__name__}: {error})"
+
+
+def _column(values: list[object]) -> np.ndarray:
+    """The numbers of a parameter, one per student: NaN for one the key lacks or holds as no number.
+
+    >>> _column([2.0, 3, None, "x", True, float("inf")]).tolist()
+    [2.0, 3.0, nan, nan, nan, nan]
+    """
+    if all(type(value) is float for value in values):  # what a key holds: converted at C speed
+        column = np.array(values, dtype=float)
+    else:
+        column = np.array([float(value) if isinstance(value, int | float) and not isinstance(value, bool) else math.nan
+                           for value in values])
+    return np.where(np.isfinite(column), column, math.nan)
+
+
+def reconsider(problem: ProblemPhysics, key: Key, name: str, label: str, unit: str, tolerance: Tolerance,
+               students: np.ndarray, submitted: np.ndarray, right: np.ndarray, said: Sequence[str],
+               earlier: Sequence[Earlier]) -> dict[int, Finding]:
+    """The wrong numbers ``submitted`` to part ``label`` (answer ``name``) by ``students`` (their indices in
+    the key; ``right``: the key's values, ``said``: the sentences comparing them) that earn ``ecf`` or are
+    a ``mistake``, by position in ``students``."""
+    alternatives = problem.alternatives.for_answer(name)
+    angle = unit if unit in ("deg", "rad") else None
+    found: dict[int, Finding] = {}
+    open_ = np.ones(len(students), dtype=bool)
+
+    def matches(alternative: Alternative, rows: np.ndarray,
+                given: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+        params = {parameter: column[students[rows]] for parameter, column in problem.params.items()}
+        value = values(problem.alternatives, alternative, params, given)
+        return value, is_correct(submitted[rows], value, tolerance, angle_unit=angle)
+
+    for source in reversed(earlier) if key.ecf_credit > 0 else ():
+        chains = [a for a in alternatives if a.kind == "ecf" and a.id == source.name]
+        given, was = source.given[students], source.right[students]
+        plausible = carries_forward(given, was)
+        for chain in chains:
+            rows = np.flatnonzero(open_ & plausible)
+            if not rows.size:
+                break
+            _, hit = matches(chain, rows, given[rows])
+            for row in rows[hit]:
+                found[int(row)] = Finding("ecf", key.ecf_credit, _carried(source, given[row], was[row], label,
+                                                                           right[row], unit), f"ecf:{source.label}")
+            open_[rows[hit]] = False
+    for mistake in (a for a in alternatives if a.kind == "mistake"):
+        rows = np.flatnonzero(open_)
+        if not rows.size:
+            break
+        value, hit = matches(mistake, rows)
+        hit &= ~is_correct(value, right[rows], tolerance, angle_unit=angle)  # not to be told from the right answer
+        for row in rows[hit]:
+            found[int(row)] = Finding("mistake", key.mistake_credit, f"your answer matches {mistake.says}: {said[row]}",
+                                      mistake.id)
+        open_[rows[hit]] = False
+    return found
+
+
+def _carried(source: Earlier, given: float, was: float, label: str, right: float, unit: str) -> str:
+    """``right for your 3a = 2.71 m/s (error carried forward); with 3a = 2.55 m/s, 3b is 0.631``."""
+    def quantity(value: float, unit: str) -> str:
+        return with_unit(number_text(value), unit)
+
+    return (f"right for your {source.label} = {quantity(given, source.unit)} (error carried forward); "
+            f"with {source.label} = {quantity(was, source.unit)}, {label} is {quantity(right, unit)}")

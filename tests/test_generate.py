@@ -196,12 +196,12 @@ def test_demo_writes_its_inputs_and_generate_from_them_reproduces_it(tmp_path: P
 def test_a_failure_while_rendering_leaves_nothing_behind(tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
                                                          capsys: pytest.CaptureFixture[str]) -> None:
     """Key files already written to the staging folder are removed with it; --out never appears."""
-    import grader.render.documents
+    import grader.render.pdfs
 
     def broken(*args: object, **kwargs: object) -> list[Path]:
         raise RuntimeError("disk full")
 
-    monkeypatch.setattr(grader.render.documents, "render_all", broken)
+    monkeypatch.setattr(grader.render.pdfs, "render_all", broken)
     with pytest.raises(RuntimeError, match="disk full"):
         main(["generate", str(ASSIGNMENT), "--roster", str(ROSTER), "--out", str(tmp_path / "out")])
     assert list(tmp_path.iterdir()) == []

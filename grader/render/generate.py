@@ -7,6 +7,7 @@ a previous output stays untouched, and ``--force`` replaces only what an earlier
 
 from __future__ import annotations
 
+import gc
 import shutil
 import sys
 import time
@@ -60,13 +61,42 @@ def run(job: Job, bank: Mapping[str, Template], extra: Mapping[str, Path] | None
 
         font_paths(job.font_dirs)  # refuses a --font-dir that is not a folder before any work
     with output_folder(job.out, command="grader generate", inputs=(job.assignment, job.roster),
-                       force=job.force) as staging:
-        generation = generate(assignment, roster, bank)
+                       force=job.force) as staging, _frozen_for_the_run():
+        with _collector_paused():
+            generation = generate(assignment, roster, bank)
+            written = _write_key(assignment, generation, bank, staging)
         for name, source in (extra or {}).items():
             shutil.copyfile(source, staging / name)
-        written = _write(job, assignment, generation, bank, staging)
+        if job.pdf:
+            written += _write_pdfs(job, assignment, generation, bank, staging)
     return Summary(job.out, len(roster), len(assignment.problems), generation.collisions, written,
                    time.perf_counter() - started)
+
+
+@contextmanager
+def _collector_paused() -> Iterator[None]:
+    """Python's cyclic garbage collector off while the variants and the key are made: they are
+    trees without cycles (reference counting frees them), and each pass of the collector walked
+    the whole growing heap again, so that time grew faster than the class. What exists at the
+    end (the variants, kept for the PDFs) is frozen out of later passes (:func:`_frozen_for_the_run`)."""
+    enabled = gc.isenabled()
+    gc.disable()
+    try:
+        yield
+    finally:
+        gc.freeze()
+        if enabled:
+            gc.enable()
+
+
+@contextmanager
+def _frozen_for_the_run() -> Iterator[None]:
+    """What exists now (modules, the bank) is left out of the collector's passes until the run ends."""
+    gc.freeze()
+    try:
+        yield
+    finally:
+        gc.unfreeze()
 
 
 def demo(out: Path, bank: Mapping[str, Template], jobs: int = 1, force: bool = False,
@@ -77,24 +107,23 @@ def demo(out: Path, bank: Mapping[str, Template], jobs: int = 1, force: bool = F
     return run(job, bank, {"assignment.yaml": samples / "assignment.yaml", "roster.csv": samples / "roster.csv"})
 
 
-def _write(job: Job, assignment: Assignment, generation: Generation, bank: Mapping[str, Template],
-           staging: Path) -> int:
+def _write_key(assignment: Assignment, generation: Generation, bank: Mapping[str, Template], staging: Path) -> int:
     write_atomic(staging / "key.json", key_json(key_document(assignment, generation, bank)))
     write_atomic(staging / "key.csv", key_csv(generation))
-    written = 2
-    if job.pdf:
-        from grader.render.documents import render_all
-        from grader.render.typeset import font_paths, missing_glyph_warnings
+    return 2
 
 
-        people = [(s.student.id, s.student.name) for s in generation.students]
-        for warning in missing_glyph_warnings(people, font_paths(job.font_dirs)):
-            print(warning, file=sys.stderr)
-        with _progress(len(generation.students) + 2, "PDFs") as advance:
-            written += len(render_all(assignment, generation, bank, staging, jobs=job.jobs,
-                                      keep_source=job.keep_source, progress=advance,
-                                      font_dirs=job.font_dirs))
-    return written
+def _write_pdfs(job: Job, assignment: Assignment, generation: Generation, bank: Mapping[str, Template],
+                staging: Path) -> int:
+    from grader.render.pdfs import render_all
+    from grader.render.typeset import font_paths, missing_glyph_warnings
+
+    people = [(s.student.id, s.student.name) for s in generation.students]
+    for warning in missing_glyph_warnings(people, font_paths(job.font_dirs)):
+        print(warning, file=sys.stderr)
+    with _progress(len(generation.students) + 2, "PDFs") as advance:
+        return len(render_all(assignment, generation, bank, staging, jobs=job.jobs, keep_source=job.keep_source,
+                              progress=advance, font_dirs=job.font_dirs))
 
 
 @contextmanager

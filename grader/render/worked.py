@@ -452,9 +452,46 @@ class _Context:
 
     shown: dict[str, str]
     degrees: Mapping[str, str]
-    quantities: set[str]
     symbol_units: Mapping[str, str]
     undefined: Mapping[str, str]
+
+
+@dataclass(frozen=True)
+class _Shape:
+    """What a step shows alike for every variant of its template: the relation, the equation, the
+    unknown and the solved form (math), the dimension and its unit."""
+
+    relation: Typ
+    equation: str | None
+    unknown: str
+    solved: str
+    dimension: Dimension | None
+    unit: str
+
+
+_SHAPES: dict[tuple[str, str], tuple[_Shape, ...]] = {}  # (template id, source hash) -> a shape per step
+
+
+def _shapes(template: Template, compiled: Compiled) -> tuple[_Shape, ...]:
+    """The shapes of a template's steps, made once per template (a class has many variants of it)."""
+    key = (template.id, template.source_hash)
+    if key not in _SHAPES:
+        known: dict[str, Sequence[int | Fraction]] = {n: p.unit.dimension for n, p in template.parameters.items()}
+        known.update({n: s.unit.dimension for n, s in template.symbols.items()})
+        known.update({c: (1, 0, -2, 0) for c in compiled.constants if c == "g"})
+        quantities = set(known) | {s.unknown for s in compiled.steps}
+        shapes = []
+        for step in compiled.steps:
+            # A bare number (a velocity that stays 0) says nothing about its unit.
+            dim = None if isinstance(step.solved, Num) else dimension(step.solved, known)
+            if dim is not None:
+                known[step.unknown] = dim
+            lhs, rhs = step.equation
+            equation = None if (lhs == Sym(step.unknown) and rhs == step.solved) else f"{math(lhs)} = {math(rhs)}"
+            shapes.append(_Shape(relation_markup(step.relation, quantities), equation, name(step.unknown),
+                                 math(step.solved), dim, unit_of(dim)))
+        _SHAPES[key] = tuple(shapes)
+    return _SHAPES[key]
 
 
 def worked(template: Template, variant: ProblemVariant, compiled: Compiled | None = None) -> Worked:
@@ -463,24 +500,15 @@ def worked(template: Template, variant: ProblemVariant, compiled: Compiled | Non
     si = si_parameters(template, variant)
     symbols = sorted(template.symbols)
     scaled = scalings(compiled, si, symbols)
-    known: dict[str, Sequence[int | Fraction]] = {n: p.unit.dimension for n, p in template.parameters.items()}
-    known.update({n: s.unit.dimension for n, s in template.symbols.items()})
-    known.update({c: (1, 0, -2, 0) for c in compiled.constants if c == "g"})
     shown = {n: _shown_parameter(variant.printed[n], p.unit.to_si) for n, p in template.parameters.items()}
     shown.update({c: number(v, 3) for c, v in compiled.constants.items()})
     context = _Context(
         shown, {n: f"{variant.printed[n]} degree" for n, p in template.parameters.items() if p.unit.text == "deg"},
-        set(known) | {s.unknown for s in compiled.steps},
-        {n: _si_unit(s.unit.dimension) or "1" for n, s in template.symbols.items()},
-        _undefined(template, variant))
+        {n: _si_unit(s.unit.dimension) or "1" for n, s in template.symbols.items()}, _undefined(template, variant))
     steps = []
-    for step in compiled.steps:
-        # A bare number (a velocity that stays 0) says nothing about its unit.
-        dim = None if isinstance(step.solved, Num) else dimension(step.solved, known)
-        if dim is not None:
-            known[step.unknown] = dim
+    for step, shape in zip(compiled.steps, _shapes(template, compiled), strict=True):
         scaling = scaled.get(step.unknown)
-        steps.append(_step(step, scaling, dim, context))
+        steps.append(_step(step, shape, scaling, context))
         if scaling is not None:
             shown[step.unknown] = scaling.math()
     notes = tuple(_symbol_note(s, template.symbols[s].description) for s in symbols)
@@ -503,11 +531,9 @@ def _symbol_note(symbol: str, description: str) -> Typ:
     return Typ(f"${name(symbol)}$" + text(explained))
 
 
-def _step(step: Step, scaling: Scaling | None, dim: Dimension | None, context: _Context) -> WorkedStep:
-    lhs, rhs = step.equation
-    relation = relation_markup(step.relation, context.quantities)
-    equation = None if (lhs == Sym(step.unknown) and rhs == step.solved) else f"{math(lhs)} = {math(rhs)}"
-    chain = [name(step.unknown), math(step.solved)]
+def _step(step: Step, shape: _Shape, scaling: Scaling | None, context: _Context) -> WorkedStep:
+    relation, equation = shape.relation, shape.equation
+    chain = [shape.unknown, shape.solved]
     substituted = math(step.solved, context.shown, context.degrees)
     if substituted != chain[-1]:
         chain.append(substituted)
@@ -519,14 +545,14 @@ def _step(step: Step, scaling: Scaling | None, dim: Dimension | None, context: _
     value = scaling.math()
     if value != chain[-1]:
         chain.append(value)
-    unit = unit_of(dim)
     multiple = [s for s, p in scaling.powers.items() if p]
     if multiple:
         symbols = ", ".join(f"${name(s)}$ {text('in ' + context.symbol_units[s])}" for s in multiple)
+        unit = shape.unit
         note = Typ(f"{text(f'(in {unit}, with ' if unit else '(with ')}{symbols}{text(')')}")
         return WorkedStep(relation, equation, tuple(chain), note)
-    chain[-1] += _unit_math(unit)
-    if dim == ANGLE:
+    chain[-1] += _unit_math(shape.unit)
+    if shape.dimension == ANGLE:
         chain.append(f"{number(_m.degrees(scaling.coefficient))} degree")
     return WorkedStep(relation, equation, tuple(chain), Typ(""))
 

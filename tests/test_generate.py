@@ -39,6 +39,15 @@ def test_same_inputs_give_byte_identical_keys(tmp_path: Path, capsys: pytest.Cap
         assert (tmp_path / "one" / file).read_bytes() == (tmp_path / "two" / file).read_bytes()
 
 
+def test_a_run_leaves_the_garbage_collector_as_it_found_it(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """The collector is paused while the key is made and the variants frozen out of its passes
+    for the run; afterwards it is on again and nothing stays frozen."""
+    import gc
+
+    assert run(capsys, "generate", ASSIGNMENT, "--roster", ROSTER, "--out", tmp_path / "out", "--no-pdf")[0] == 0
+    assert gc.isenabled() and gc.get_freeze_count() == 0
+
+
 def test_removing_a_student_changes_nobody_elses_numbers(bank: dict[str, Template]) -> None:
     """Variants are keyed on (seed, problem key, student id), not on positions in the roster."""
     assignment, roster = load_assignment(ASSIGNMENT), load_roster(ROSTER)

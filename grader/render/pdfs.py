@@ -39,8 +39,8 @@ from grader.render.joining import Part, join, read_part
 from grader.render.typeset import compile_typst, font_paths, one_pdf, release_memory
 from grader.render.worked import Typ
 
-STUDENTS_PER_PART = 5  # of the key: about 20 pages, some 30 MiB of Typst's memo while it compiles
-ROWS_PER_PART = 100  # of a table of answers at a glance: some 25 MiB
+STUDENTS_PER_PART = 4  # of the key: about 16 pages, some 25 MiB of Typst's memo while it compiles
+ROWS_PER_PART = 50  # of a table of answers at a glance: a page or two, some 15 MiB
 AHEAD = 2  # groups of students whose sources may wait for a thread: bounds the memory they take
 
 
@@ -180,7 +180,7 @@ class _Run:
         on, counted from the first page after the cover."""
         contents, later = [], 1
         students = self.documents.generation.students
-        for (position, rows), part in zip(self.tables, parts, strict=False):
+        for (position, rows), part in zip(self.tables, parts[:len(self.tables)], strict=True):
             if rows.start == 0:
                 contents.append((self.documents.glance_title(position), later))
             later += part.pages

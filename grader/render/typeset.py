@@ -133,7 +133,7 @@ def _malloc_trim() -> Any:
 
     try:
         return ctypes.CDLL(None).malloc_trim
-    except (AttributeError, OSError):
+    except (AttributeError, OSError, TypeError):  # no glibc (macOS, musl), or no process handle (Windows)
         return None
 
 

@@ -17,7 +17,6 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from grader.assign.sample_answers import sample_answers, submissions_csv
-from grader.assign.variants import generate
 from grader.bank.template import Template
 from grader.files import output_folder, write_atomic
 from grader.grade.run import GradeSummary, grade_into
@@ -43,10 +42,9 @@ def demo(out: Path, bank: Mapping[str, Template], jobs: int = 1, force: bool = F
     job = Job(samples / "assignment.yaml", samples / "roster.csv", out, jobs=jobs, force=force, font_dirs=font_dirs)
     assignment, roster = load_inputs(job, bank)
     with output_folder(out, command="grader demo", inputs=(job.assignment, job.roster), force=force) as staging:
-        generation = generate(assignment, roster, bank)
         for source in (job.assignment, job.roster):
             shutil.copyfile(source, staging / source.name)
-        write_outputs(job, assignment, generation, bank, staging)
+        generation, _ = write_outputs(job, assignment, roster, bank, staging)
         write_atomic(staging / SUBMISSIONS, submissions_csv(sample_answers(assignment, generation, bank)))
         graded = grade_into(staging / GRADES, staging / KEY, [staging / SUBMISSIONS], out / GRADES,
                             [str(out / SUBMISSIONS)], bank)

@@ -43,6 +43,15 @@ def test_same_inputs_give_byte_identical_keys(tmp_path: Path, capsys: pytest.Cap
         assert (tmp_path / "one" / file).read_bytes() == (tmp_path / "two" / file).read_bytes()
 
 
+def test_a_run_leaves_the_garbage_collector_as_it_found_it(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """The collector is paused while the key is made and the variants frozen out of its passes
+    for the run; afterwards it is on again and nothing stays frozen."""
+    import gc
+
+    assert run(capsys, "generate", ASSIGNMENT, "--roster", ROSTER, "--out", tmp_path / "out", "--no-pdf")[0] == 0
+    assert gc.isenabled() and gc.get_freeze_count() == 0
+
+
 def test_removing_a_student_changes_nobody_elses_numbers(bank: dict[str, Template]) -> None:
     """Variants are keyed on (seed, problem key, student id), not on positions in the roster."""
     assignment, roster = load_assignment(ASSIGNMENT), load_roster(ROSTER)
@@ -201,12 +210,12 @@ def test_demo_writes_its_inputs_and_generate_from_them_reproduces_it(tmp_path: P
 def test_a_failure_while_rendering_leaves_nothing_behind(tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
                                                          capsys: pytest.CaptureFixture[str]) -> None:
     """Key files already written to the staging folder are removed with it; --out never appears."""
-    import grader.render.documents
+    import grader.render.pdfs
 
     def broken(*args: object, **kwargs: object) -> list[Path]:
         raise RuntimeError("disk full")
 
-    monkeypatch.setattr(grader.render.documents, "render_all", broken)
+    monkeypatch.setattr(grader.render.pdfs, "render_all", broken)
     with pytest.raises(RuntimeError, match="disk full"):
         main(["generate", str(ASSIGNMENT), "--roster", str(ROSTER), "--out", str(tmp_path / "out")])
     assert list(tmp_path.iterdir()) == []

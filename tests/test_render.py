@@ -17,8 +17,9 @@ from grader.assign.variants import AnswerPart, Generation, ProblemVariant, Stude
 from grader.bank.template import Template, parse_template
 from grader.errors import GraderError
 from grader.model.expr import parse
-from grader.render.documents import file_names, render_all, render_page_png, safe_file_name, statement
+from grader.render.documents import file_names, render_page_png, safe_file_name, statement
 from grader.render.figures import figure
+from grader.render.pdfs import render_all
 from grader.render.typeset import compile_typst, font_paths, system_fonts, uncovered
 from grader.render.worked import Typ, dimension, math, unit_of, worked
 from grader.resources import sample_dir
@@ -78,7 +79,7 @@ def test_render_all_writes_every_document_and_reports_progress(rendered: tuple[P
     students = [out / "students" / f"{s.student.id}.pdf" for s in few.students]
     assert paths[:len(students) + 2] == [*students, out / "class.pdf", out / "answer-key.pdf"]
     assert all(p.is_file() and p.read_bytes().startswith(b"%PDF-") for p in paths[:len(students) + 2])
-    assert (out / "source" / "answer-key.typ").is_file() and (out / "source" / "students").is_dir()
+    assert (out / "source" / "answer-key" / "0000.typ").is_file() and (out / "source" / "students").is_dir()
     assert sum(progress) == len(students) + 2
 
 
@@ -135,6 +136,51 @@ def test_the_key_has_worked_steps_with_each_students_numbers(rendered: tuple[Pat
     drop = entry.problems[0]
     assert f"{float(drop.printed['h_drop']) / 1000:.3f}" in text  # mm shown converted to m
     assert f"{drop.answers[0].value:.4f}" in text  # e to 4 significant figures
+
+
+def footers(reader: PdfReader) -> list[tuple[str, int, int]]:
+    """Each page's footer: the section it names, and "page x of y"."""
+    found = []
+    for page in reader.pages:
+        last = page.extract_text().strip().splitlines()[-1]
+        match = re.fullmatch(r"(.*) · answer key\s*page (\d+) of (\d+)", last)
+        assert match is not None, last
+        found.append((match.group(1), int(match.group(2)), int(match.group(3))))
+    return found
+
+
+def test_a_key_typeset_in_many_parts_numbers_its_pages_and_contents_rightly(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch, assignment: Assignment, bank: dict[str, Template],
+        few: Generation) -> None:
+    """Parts of 2 students and tables of 3 rows: every section's footer counts 1..y within it, the
+    contents give the page each student and table starts on, and the bookmarks point there too."""
+    import grader.render.pdfs
+
+    monkeypatch.setattr(grader.render.pdfs, "STUDENTS_PER_PART", 2)
+    monkeypatch.setattr(grader.render.pdfs, "ROWS_PER_PART", 3)
+    render_all(assignment, few, bank, tmp_path, jobs=2)
+    reader = PdfReader(tmp_path / "answer-key.pdf")
+    pages = footers(reader)
+    for page, (section, number, count) in enumerate(pages):  # sections run 1..y, one after another
+        assert number == 1 or pages[page - 1][:2] == (section, number - 1), (page, pages[page - 1])
+        assert number < count or page + 1 == len(pages) or pages[page + 1][1] == 1
+    starts = {}  # each section's first page, from 1
+    for page, (section, number, _) in enumerate(pages):
+        if number == 1:
+            starts.setdefault(section, page + 1)
+    assert {"Answers at a glance (problem 1, students 1–3)", "Answers at a glance (problem 1, student 4)"} \
+        <= set(starts)
+    cover = "\n".join(reader.pages[i].extract_text() for i, (s, _, _) in enumerate(pages) if "class overview" in s)
+    listed = {line.rsplit(maxsplit=1)[0]: int(line.split()[-1]) for line in cover.splitlines()
+              if re.search(r"\(\d+\)|^Answers at a glance", line)}
+    for entry in few.students:
+        shown = next(page for title, page in listed.items() if f"({entry.student.id})" in title)
+        assert shown == starts[f"{entry.student.name} ({entry.student.id})"], entry.student.name
+    for key in "12345":
+        shown = next(page for title, page in listed.items() if title.startswith(f"Answers at a glance, problem {key}:"))
+        assert shown == starts[f"Answers at a glance (problem {key}, students 1–3)"]
+    marks = [(o.title, reader.get_destination_page_number(o) + 1) for o in reader.outline if not isinstance(o, list)]
+    assert sorted(page for _, page in marks) == sorted(listed.values())
 
 
 def test_a_step_that_depends_on_a_cancelling_mass_is_shown_as_a_multiple_of_it(
@@ -412,13 +458,13 @@ def test_a_name_no_font_has_is_warned_about_naming_the_student(tmp_path: Path, c
                                                               assignment: Assignment, bank: dict[str, Template],
                                                               few: Generation) -> None:
     """Without the font, a warning on stderr names the student; the PDFs are still written."""
-    from grader.render.generate import Job, write_outputs
+    from grader.render.generate import Job, _write_pdfs
 
     entry = few.students[0]
     odd = Generation((dataclasses.replace(entry, student=dataclasses.replace(entry.student, name="Amun 𓀀")),),
                      few.collisions)
     job = Job(sample_dir() / "assignment.yaml", sample_dir() / "roster.csv", tmp_path)
-    assert write_outputs(job, assignment, odd, bank, tmp_path) == 5
+    assert _write_pdfs(job, assignment, odd, bank, tmp_path) == 3
     err = capsys.readouterr().err
     assert f"warning: student {entry.student.id} (Amun 𓀀): no font has 𓀀 (U+13000)" in err
 
@@ -429,14 +475,14 @@ def test_cjk_and_hangul_names_print_with_the_system_noto_font(tmp_path: Path, ca
                                                              assignment: Assignment, bank: dict[str, Template],
                                                              few: Generation) -> None:
     """With fonts-noto-cjk, 李华 and 김민준 are text in the PDF, not boxes, and nobody is warned about."""
-    from grader.render.generate import Job, write_outputs
+    from grader.render.generate import Job, _write_pdfs
 
     entry = few.students[0]
     name = "李华 김민준"
     cjk = Generation((dataclasses.replace(entry, student=dataclasses.replace(entry.student, name=name)),),
                      few.collisions)
-    job = Job(sample_dir() / "assignment.yaml", sample_dir() / "roster.csv", tmp_path)
-    write_outputs(job, assignment, cjk, bank, tmp_path)
+    _write_pdfs(Job(sample_dir() / "assignment.yaml", sample_dir() / "roster.csv", tmp_path), assignment, cjk, bank,
+                tmp_path)
     assert "warning" not in capsys.readouterr().err
     assert name in pdf_text(tmp_path / "students" / f"{entry.student.id}.pdf")
     assert not uncovered([name], font_paths(()))

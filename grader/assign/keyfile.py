@@ -33,6 +33,7 @@ import hashlib
 import io
 import json
 from collections.abc import Mapping
+from functools import lru_cache
 from pathlib import Path
 from typing import Any
 
@@ -40,6 +41,7 @@ from grader import __version__
 from grader.assign.assignment import Assignment, ProblemSpec
 from grader.assign.variants import AnswerPart, Generation
 from grader.bank.template import Template
+from grader.model.tolerance import Tolerance
 
 SCHEMA, VERSION = "grader-key", 2
 SYMBOL_RANGE = (1.0, 10.0)  # where a symbol with no sampled range (a speed v) is drawn to compare expressions
@@ -70,6 +72,8 @@ def key_document(assignment: Assignment, generation: Generation, bank: Mapping[s
     """The key as a JSON-ready dictionary."""
     used = {p.template: bank[p.template] for p in assignment.problems}
     first = generation.students[0].problems if generation.students else ()
+    # One tolerance dict per distinct tolerance, shared by every student's part (the encoder only reads it).
+    tolerances = {t: t.to_json() for s in first for t in {a.tolerance for a in s.answers}}
     return {
         "schema": SCHEMA, "version": VERSION, "generator": f"grader {__version__}",
         "assignment": {"title": assignment.title, "course": assignment.course, "seed": assignment.seed,
@@ -86,8 +90,9 @@ def key_document(assignment: Assignment, generation: Generation, bank: Mapping[s
         "students": [{"id": s.student.id, "name": s.student.name, "email": s.student.email,
                       "section": s.student.section,
                       "problems": [{"key": v.key, "template": v.template, "variant_seed": v.variant_seed,
-                                    "params": dict(v.params), "printed": dict(v.printed),
-                                    "answers": {a.name: _answer(a) for a in v.answers}} for v in s.problems]}
+                                    "params": v.params, "printed": v.printed,
+                                    "answers": {a.name: _answer(a, tolerances) for a in v.answers}}
+                                   for v in s.problems]}
                      for s in generation.students],
     }
 
@@ -111,12 +116,18 @@ def _symbol_range(name: str, template: Template, problem: ProblemSpec) -> tuple[
     return (min(values), max(values))
 
 
-def _answer(part: AnswerPart) -> dict[str, Any]:
+def _answer(part: AnswerPart, tolerances: dict[Tolerance, dict[str, Any]]) -> dict[str, Any]:
+    tolerance = tolerances.get(part.tolerance)
     data: dict[str, Any] = {"value": part.value, "unit": part.unit, "label": part.label, "points": part.points,
-                            "tolerance": part.tolerance.to_json()}
+                            "tolerance": part.tolerance.to_json() if tolerance is None else tolerance}
     if part.undefined is not None:
         data["undefined"] = part.undefined
     return data
+
+
+@lru_cache(maxsize=256)
+def _tolerance_text(tolerance: Tolerance, unit: str) -> str:
+    return tolerance.describe(unit)
 
 
 def key_json(document: Mapping[str, Any]) -> str:
@@ -139,12 +150,17 @@ def key_csv(generation: Generation) -> str:
     writer.writerow(["student_id", "name", "section", "problem", "template", "label", "answer", "value", "unit",
                      "points", "tolerance", "parameters"])
     for entry in generation.students:
+        student = entry.student
+        who = [safe_cell(student.id), safe_cell(student.name), safe_cell(student.section)]
         for variant in entry.problems:
             given = "; ".join(f"{name}={text}" for name, text in variant.printed.items())
-            for part in variant.answers:
-                value = part.value if part.value is not None else f"undefined: {part.undefined}"
-                writer.writerow([safe_cell(entry.student.id), safe_cell(entry.student.name),
-                                 safe_cell(entry.student.section), variant.key, variant.template, part.label,
-                                 part.name, value if isinstance(value, float) else safe_cell(str(value)), part.unit,
-                                 part.points, part.tolerance.describe(part.unit), given])
+            writer.writerows([*who, variant.key, variant.template, part.label, part.name,
+                              _csv_value(part), part.unit, part.points, _tolerance_text(part.tolerance, part.unit),
+                              given] for part in variant.answers)
     return stream.getvalue()
+
+
+def _csv_value(part: AnswerPart) -> float | str:
+    if part.value is None:
+        return safe_cell(f"undefined: {part.undefined}")
+    return part.value if isinstance(part.value, float) else safe_cell(part.value)

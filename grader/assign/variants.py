@@ -17,7 +17,7 @@ from __future__ import annotations
 import hashlib
 from collections import Counter
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from decimal import MAX_EMAX, MIN_EMIN, ROUND_HALF_UP, Context, Decimal
 from typing import Any
 
@@ -39,7 +39,7 @@ PRINTED_CHARS = 24  # a printed value longer than this is no number a student ca
 _EXACT = Context(prec=1000, Emax=MAX_EMAX, Emin=MIN_EMIN)  # any float64, printed exactly
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, slots=True)
 class AnswerPart:
     """One answer of a variant, as the key stores it."""
 
@@ -53,7 +53,7 @@ class AnswerPart:
     undefined: str | None = None
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, slots=True)
 class ProblemVariant:
     """One student's numbers for one problem: parameters as printed, and the answers they give."""
 
@@ -65,7 +65,7 @@ class ProblemVariant:
     answers: tuple[AnswerPart, ...]
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, slots=True)
 class StudentVariants:
     """Everything one student gets."""
 
@@ -234,10 +234,10 @@ def generate(assignment: Assignment, roster: Sequence[Student], bank: Mapping[st
         template = bank[problem.template]
         maker = ProblemDraws(assignment, problem, template)
         rows, seeds = maker.draw(roster)
-        result = solve_columns(template, maker.compiled, maker.table(rows))
-        blanks = _blank_parts(problem, template)
-        variants = [ProblemVariant(problem.key, template.id, seed, {n: float(v) for n, v in row.items()}, dict(row),
-                                   _answer_parts(blanks, template, maker.compiled, result, index))
+        answers = _Answers(_blank_parts(problem, template), template, maker.compiled,
+                           solve_columns(template, maker.compiled, maker.table(rows)))
+        variants = [ProblemVariant(problem.key, template.id, seed, {n: float(v) for n, v in row.items()}, row,
+                                   answers.parts(index, row))
                     for index, (row, seed) in enumerate(zip(rows, seeds, strict=True))]
         shared = Counter(tuple(row.values()) for row in rows)
         collisions[problem.key] = sum(shared[tuple(row.values())] > 1 for row in rows)
@@ -267,10 +267,34 @@ def tolerance(problem: ProblemSpec, template: Template, name: str) -> Tolerance:
     return spec if override is None else Tolerance.from_json(override, base=spec)
 
 
-def _answer_parts(blanks: Sequence[AnswerPart], template: Template, compiled: Compiled, result: Columns,
-                  row: int) -> tuple[AnswerPart, ...]:
-    parts = []
-    for blank in blanks:
-        value, undefined = answer_at(template, compiled, result, blank.name, row)
-        parts.append(replace(blank, value=value, undefined=undefined))
-    return tuple(parts)
+class _Answers:
+    """The answer parts of one problem's variants, from the solved columns.
+
+    A symbolic answer's text depends only on the parameters it does not keep as symbols, and
+    many students share those (``e`` printed to two decimals): each distinct text is made once.
+    """
+
+    def __init__(self, blanks: Sequence[AnswerPart], template: Template, compiled: Compiled,
+                 result: Columns) -> None:
+        self.blanks, self.template, self.compiled, self.result = blanks, template, compiled, result
+        self.substituted = {b.name: [p for p in template.parameters if p not in template.answers[b.name].symbolic]
+                            for b in blanks if compiled.answers[b.name].symbolic is not None}
+        self.texts: dict[tuple[str, ...], tuple[float | str | None, str | None]] = {}
+
+    def parts(self, row: int, printed: Mapping[str, str]) -> tuple[AnswerPart, ...]:
+        """The answer parts of the variant in ``row`` of the result, printed as ``printed``."""
+        parts = []
+        for blank in self.blanks:
+            value, undefined = self._value(blank.name, row, printed)
+            parts.append(AnswerPart(blank.name, blank.label, value, blank.unit, blank.points, blank.tolerance,
+                                    blank.description, undefined))
+        return tuple(parts)
+
+    def _value(self, name: str, row: int, printed: Mapping[str, str]) -> tuple[float | str | None, str | None]:
+        substituted = self.substituted.get(name)
+        if substituted is None or self.result.undefined[name][row] is not None:
+            return answer_at(self.template, self.compiled, self.result, name, row)
+        key = (name, *(printed[p] for p in substituted))
+        if key not in self.texts:
+            self.texts[key] = answer_at(self.template, self.compiled, self.result, name, row)
+        return self.texts[key]

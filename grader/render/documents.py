@@ -1,4 +1,5 @@
-"""PDFs through Typst: a sheet per student, the class's sheets in one file, the instructor's key.
+"""What the PDFs show, as Typst sources: a sheet per student, the instructor's key in parts
+(:mod:`grader.render.pdfs` compiles and joins them).
 
 Sources are made from the Jinja2 templates in ``templates/`` (``student.typ.j2``, ``key.typ.j2``,
 with ``figures.typ`` and ``preamble.typ`` inlined, so each source stands alone) and compiled with
@@ -18,11 +19,10 @@ in an empty private root (:mod:`grader.render.typeset`), so no document can read
 
 from __future__ import annotations
 
-import concurrent.futures
 import hashlib
 import re
 from collections import Counter
-from collections.abc import Callable, Iterable, Mapping, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
@@ -30,13 +30,13 @@ from typing import Any
 
 import jinja2
 
-from grader.assign.assignment import Assignment
+from grader.assign.assignment import Assignment, Student
 from grader.assign.variants import AnswerPart, Generation, ProblemVariant
 from grader.bank.markup import paragraphs
 from grader.bank.template import Template, filled_statement
 from grader.errors import GraderError
 from grader.render.figures import figure
-from grader.render.typeset import compile_typst, font_paths, one_pdf
+from grader.render.typeset import compile_typst, font_paths
 from grader.render.worked import Typ, Worked, WorkedStep, answer_math, math, name, string, text, worked
 from grader.resources import templates_dir
 from grader.solve.cache import compiled_for
@@ -148,22 +148,35 @@ class KeyProblem:
 
 @dataclass(frozen=True)
 class KeyPerson:
-    """A student's section of the key."""
+    """A student's section of the key; ``title`` is its heading (and its line in the contents)."""
 
     name: str
     id: str
     section: str
+    title: Typ
     problems: tuple[KeyProblem, ...]
 
 
 @dataclass(frozen=True)
 class Glance:
-    """One problem's answers for every student, as a table."""
+    """One problem's answers for some students, as a table: a part of the overview. ``part`` names
+    it in the footer; ``continued``: the rest of a table begun in the part before."""
 
-    key: str
-    title: str
+    title: Typ
+    part: str
+    continued: bool
     header: tuple[Typ, ...]
     rows: tuple[tuple[Typ, ...], ...]
+
+
+@dataclass(frozen=True)
+class Cover:
+    """The key's first part: the problems with their points and tolerances, and the contents, each
+    entry with its page counted from the first page after the cover."""
+
+    count: str
+    summary: tuple[tuple[str, str, tuple[tuple[str, str, str, str, str], ...]], ...]
+    contents: tuple[tuple[Typ, int], ...]
 
 
 def _math(source: str) -> Typ:
@@ -178,7 +191,7 @@ def _unit_text(unit: str) -> str:
     return {"deg": "degrees", "": "(no unit)"}.get(unit, unit.replace("^2", "²").replace("^3", "³").replace("*", "·"))
 
 
-class _Documents:
+class Documents:
     """Builds the views of one generation, computing each variant's worked solution once."""
 
     def __init__(self, assignment: Assignment, generation: Generation, bank: Mapping[str, Template]) -> None:
@@ -186,6 +199,13 @@ class _Documents:
         self.compiled: dict[str, Compiled] = {}
         self.worked: dict[tuple[int, int], Worked] = {}
         self.sheets: dict[int, Sheet] = {}
+
+    def forget(self, indices: Iterable[int]) -> None:
+        """Drop what was built for these students (their documents are made): memory stays flat."""
+        for index in indices:
+            self.sheets.pop(index, None)
+            for problem in range(len(self.generation.students[index].problems)):
+                self.worked.pop((index, problem), None)
 
     def _compiled(self, template: Template) -> Compiled:
         if template.id not in self.compiled:
@@ -229,7 +249,8 @@ class _Documents:
         """A student's section of the key."""
         entry = self.generation.students[index]
         problems = tuple(self._key_problem(self.solution(index, p), v) for p, v in enumerate(entry.problems))
-        return KeyPerson(entry.student.name, entry.student.id, entry.student.section, problems)
+        student = entry.student
+        return KeyPerson(student.name, student.id, student.section, person_title(student), problems)
 
     def _key_problem(self, solution: Worked, variant: ProblemVariant) -> KeyProblem:
         template = self.bank[variant.template]
@@ -238,26 +259,39 @@ class _Documents:
         answers = tuple(_key_answer(template, part) for part in variant.answers)
         return KeyProblem(variant.key, template.title, variant.variant_seed, given, solution.notes, steps, answers)
 
-    def glances(self, indices: Sequence[int]) -> list[Glance]:
-        """Per problem, a table of every listed student's numbers and answers."""
-        tables = []
-        for position, spec in enumerate(self.assignment.problems):
-            template = self.bank[spec.template]
-            first = self.generation.students[indices[0]].problems[position]
-            header = [Typ("ID"), Typ("Student")]
-            header += [_math(_given_header(n, p.unit.text)) for n, p in template.parameters.items()]
-            header += [Typ(f"*{part.label}*" + (f" {text(_unit_text(part.unit))}" if part.unit else ""))
-                       for part in first.answers]
-            rows = []
-            for index in indices:
-                entry = self.generation.students[index]
-                variant = entry.problems[position]
-                cells = [text(entry.student.id), text(entry.student.name)]
-                cells += [text(variant.printed[n]) for n in template.parameters]
-                cells += [_glance_value(part) for part in variant.answers]
-                rows.append(tuple(cells))
-            tables.append(Glance(spec.key, template.title, tuple(header), tuple(rows)))
-        return tables
+    def glance(self, position: int, indices: Sequence[int], part: str, continued: bool) -> Glance:
+        """The table of one problem's numbers and answers for the listed students."""
+        spec = self.assignment.problems[position]
+        template = self.bank[spec.template]
+        first = self.generation.students[indices[0]].problems[position]
+        header = [Typ("ID"), Typ("Student")]
+        header += [_math(_given_header(n, p.unit.text)) for n, p in template.parameters.items()]
+        header += [Typ(f"*{part.label}*" + (f" {text(_unit_text(part.unit))}" if part.unit else ""))
+                   for part in first.answers]
+        rows = []
+        for index in indices:
+            entry = self.generation.students[index]
+            variant = entry.problems[position]
+            cells = [text(entry.student.id), text(entry.student.name)]
+            cells += [text(variant.printed[n]) for n in template.parameters]
+            cells += [_glance_value(part) for part in variant.answers]
+            rows.append(tuple(cells))
+        return Glance(self.glance_title(position), part, continued, tuple(header), tuple(rows))
+
+    def glance_title(self, position: int) -> Typ:
+        """The heading of a problem's table of answers at a glance."""
+        spec = self.assignment.problems[position]
+        return Typ(f"Answers at a glance, problem {text(spec.key)}: {text(self.bank[spec.template].title)}")
+
+
+def person_title(student: Student) -> Typ:
+    """A student's heading in the key, and their line in its contents: name, then id and section.
+
+    >>> person_title(Student("7", "Ana", "", ""))
+    '#"Ana"; #h(0.4em) #text(weight: "regular")[(#"7";)]'
+    """
+    section = f", section {text(student.section)}" if student.section else ""
+    return Typ(f'{text(student.name)} #h(0.4em) #text(weight: "regular")[({text(student.id)}){section}]')
 
 
 def _given_header(parameter: str, unit: str) -> str:
@@ -318,7 +352,7 @@ def _assignment_view(assignment: Assignment) -> dict[str, Any]:
             "instructions": paragraphs(assignment.instructions)}
 
 
-def student_source(documents: _Documents, indices: Iterable[int]) -> str:
+def student_source(documents: Documents, indices: Iterable[int]) -> str:
     """The Typst source of the sheets of the listed students (roster positions), in order."""
     sheets = [documents.sheet(i) for i in indices]
     title = documents.assignment.title + (f": {sheets[0].name}" if len(sheets) == 1 else ": class")
@@ -326,20 +360,24 @@ def student_source(documents: _Documents, indices: Iterable[int]) -> str:
         assignment=_assignment_view(documents.assignment), sheets=sheets, paper=PAPER, document_title=title)
 
 
-def key_source(documents: _Documents, indices: Sequence[int], overview: bool = True) -> str:
-    """The Typst source of the answer key for the listed students; ``overview``: with the cover and
-    the tables of everyone's answers."""
+def key_source(documents: Documents, *, cover: Cover | None = None, glances: Sequence[Glance] = (),
+               people: Sequence[int] = ()) -> str:
+    """The Typst source of a part of the answer key: the cover, tables of answers at a glance, the
+    worked solutions of the listed students (roster positions), or any of them in this order."""
     assignment = documents.assignment
-    first = documents.generation.students[indices[0]]
-    summary = [(p.key, documents.bank[p.template].title,
-                [(a.label, a.description, _unit_text(a.unit), f"{a.points:g}", a.tolerance.describe(a.unit))
-                 for a in p.answers])
-               for p in first.problems]
     return _environment().get_template("key.typ.j2").render(
-        assignment=_assignment_view(assignment), paper=PAPER, overview=overview, summary=summary,
-        glances=documents.glances(indices) if overview else [], people=[documents.person(i) for i in indices],
-        count=f"{len(indices)} student{'' if len(indices) == 1 else 's'}",
-        document_title=f"{assignment.title}: answer key")
+        assignment=_assignment_view(assignment), paper=PAPER, cover=cover, glances=glances,
+        people=[(i + 1, documents.person(i)) for i in people], document_title=f"{assignment.title}: answer key")
+
+
+def cover(documents: Documents, contents: Sequence[tuple[Typ, int]]) -> Cover:
+    """The key's cover for the whole class, with these contents."""
+    count = len(documents.generation.students)
+    summary = tuple((p.key, documents.bank[p.template].title,
+                     tuple((a.label, a.description, _unit_text(a.unit), f"{a.points:g}", a.tolerance.describe(a.unit))
+                           for a in p.answers))
+                    for p in documents.generation.students[0].problems)
+    return Cover(f"{count} student{'' if count == 1 else 's'}", summary, tuple(contents))
 
 
 def check_statements(assignment: Assignment, generation: Generation, bank: Mapping[str, Template],
@@ -356,72 +394,12 @@ def check_statements(assignment: Assignment, generation: Generation, bank: Mappi
             raise GraderError(f"{template.where}: statement: {error}") from None
 
 
-def render_all(assignment: Assignment, generation: Generation, bank: Mapping[str, Template], out: Path, *,
-               jobs: int = 1, keep_source: bool = False, progress: Callable[[int], None] | None = None,
-               font_dirs: Sequence[Path] = ()) -> list[Path]:
-    """Write ``out/students/<file name>.pdf`` per student (names from :func:`file_names`),
-    ``out/class.pdf`` (every sheet, each student from a new page) and ``out/answer-key.pdf``;
-    with ``keep_source`` also their Typst sources under ``out/source/``. Fonts: the embedded ones,
-    Noto CJK and emoji where installed, and those in ``font_dirs`` (:func:`font_paths`).
-
-    ``progress(1)`` is called as each of the ``len(students) + 2`` documents is written. Student
-    sheets compile in ``jobs`` threads (Typst releases the GIL). The class PDF is the student PDFs
-    joined (typesetting them again would double the work). With ``jobs > 1`` the answer key, one
-    large document, compiles meanwhile in a process of its own: Typst's memo cache is process-wide
-    and only grows, and after a whole key has been through it a sheet compiles 3-5 times slower.
-    Returns the paths written: students in roster order, the class file, the key, then the sources.
-    """
-    if not generation.students:
-        raise GraderError("there are no students to make PDFs for")
-    fonts = font_paths(tuple(font_dirs))
-    check_statements(assignment, generation, bank, fonts)
-    documents = _Documents(assignment, generation, bank)
-    everyone = list(range(len(generation.students)))
-    names = file_names([s.student.id for s in generation.students])
-    sheets = [(out / "students" / f"{n}.pdf", student_source(documents, [i])) for i, n in enumerate(names)]
-    key_path, key = out / "answer-key.pdf", key_source(documents, everyone)
-    (out / "students").mkdir(parents=True, exist_ok=True)
-    with concurrent.futures.ThreadPoolExecutor(max_workers=max(1, jobs)) as pool:
-        futures = {pool.submit(compile_typst, source, fonts=fonts): path for path, source in sheets}
-        for future in concurrent.futures.as_completed(futures):
-            futures[future].write_bytes(one_pdf(future.result()))
-            if progress is not None:
-                progress(1)
-        # The key typesets (without the GIL) while the class PDF is joined in this thread.
-        typesetting = pool.submit(compile_typst, key, tagged=False, fonts=fonts)
-        _join_pdfs([path for path, _ in sheets], out / "class.pdf")
-        if progress is not None:
-            progress(1)
-        key_path.write_bytes(one_pdf(typesetting.result()))
-    if progress is not None:
-        progress(1)
-    written = [path for path, _ in sheets] + [out / "class.pdf", key_path]
-    if keep_source:
-        (out / "source" / "students").mkdir(parents=True, exist_ok=True)
-        for path, source in [*sheets, (out / "class.pdf", student_source(documents, everyone)), (key_path, key)]:
-            kept = out / "source" / path.relative_to(out).with_suffix(".typ")
-            kept.write_text(source, encoding="utf-8")
-            written.append(kept)
-    return written
-
-
-def _join_pdfs(parts: Sequence[Path], target: Path) -> None:
-    """One PDF of the given ones in order (deterministic: pypdf writes no dates or random ids)."""
-    from pypdf import PdfWriter
-
-    writer = PdfWriter()
-    for part in parts:
-        writer.append(str(part))
-    with target.open("wb") as stream:
-        writer.write(stream)
-
-
 def sources(assignment: Assignment, generation: Generation, bank: Mapping[str, Template],
             indices: Sequence[int]) -> tuple[str, str]:
     """The Typst sources of the listed students' sheets (statements, figures) and of their answer key
     (worked solutions, without the class overview)."""
-    documents = _Documents(assignment, generation, bank)
-    return student_source(documents, indices), key_source(documents, indices, overview=False)
+    documents = Documents(assignment, generation, bank)
+    return student_source(documents, indices), key_source(documents, people=indices)
 
 
 def render_page_png(assignment: Assignment, generation: Generation, bank: Mapping[str, Template],
@@ -429,9 +407,8 @@ def render_page_png(assignment: Assignment, generation: Generation, bank: Mappin
                     font_dirs: Sequence[Path] = ()) -> bytes:
     """One page of a student's sheet as PNG, or with ``key`` of that student's worked solutions in
     the answer key (without the class overview)."""
-    documents = _Documents(assignment, generation, bank)
-    source = key_source(documents, [student_index], overview=False) if key else \
-        student_source(documents, [student_index])
+    documents = Documents(assignment, generation, bank)
+    source = key_source(documents, people=[student_index]) if key else student_source(documents, [student_index])
     pages = compile_typst(source, "png", ppi, fonts=font_paths(tuple(font_dirs)))
     pages = [pages] if isinstance(pages, bytes) else pages
     if not 0 <= page < len(pages):

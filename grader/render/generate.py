@@ -8,9 +8,10 @@ a previous output stays untouched, and ``--force`` replaces only what an earlier
 
 from __future__ import annotations
 
+import gc
 import sys
 import time
-from collections.abc import Callable, Iterator, Mapping
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
@@ -54,8 +55,7 @@ def run(job: Job, bank: Mapping[str, Template]) -> Summary:
     assignment, roster = load_inputs(job, bank)
     with output_folder(job.out, command="grader generate", inputs=(job.assignment, job.roster),
                        force=job.force) as staging:
-        generation = generate(assignment, roster, bank)
-        written = write_outputs(job, assignment, generation, bank, staging)
+        generation, written = write_outputs(job, assignment, roster, bank, staging)
     return Summary(job.out, len(roster), len(assignment.problems), generation.collisions, written,
                    time.perf_counter() - started)
 
@@ -72,24 +72,56 @@ def load_inputs(job: Job, bank: Mapping[str, Template]) -> tuple[Assignment, tup
     return assignment, roster
 
 
-def write_outputs(job: Job, assignment: Assignment, generation: Generation, bank: Mapping[str, Template],
-                  staging: Path) -> int:
-    """Write the key files and, unless ``job.pdf`` is off, the PDFs into ``staging``; returns how many."""
-    write_atomic(staging / "key.json", key_json(key_document(assignment, generation, bank)))
-    write_atomic(staging / "key.csv", key_csv(generation))
-    written = 2
-    if job.pdf:
-        from grader.render.documents import render_all
-        from grader.render.typeset import font_paths, missing_glyph_warnings
+def write_outputs(job: Job, assignment: Assignment, roster: Sequence[Student], bank: Mapping[str, Template],
+                  staging: Path) -> tuple[Generation, int]:
+    """Generate the variants and write the key files and, unless ``job.pdf`` is off, the PDFs into
+    ``staging``; returns the generation and how many files were written."""
+    with _frozen_for_the_run():
+        with _collector_paused():
+            generation = generate(assignment, roster, bank)
+            write_atomic(staging / "key.json", key_json(key_document(assignment, generation, bank)))
+            write_atomic(staging / "key.csv", key_csv(generation))
+        written = 2 + (_write_pdfs(job, assignment, generation, bank, staging) if job.pdf else 0)
+    return generation, written
 
-        people = [(s.student.id, s.student.name) for s in generation.students]
-        for warning in missing_glyph_warnings(people, font_paths(job.font_dirs)):
-            print(warning, file=sys.stderr)
-        with _progress(len(generation.students) + 2, "PDFs") as advance:
-            written += len(render_all(assignment, generation, bank, staging, jobs=job.jobs,
-                                      keep_source=job.keep_source, progress=advance,
-                                      font_dirs=job.font_dirs))
-    return written
+
+def _write_pdfs(job: Job, assignment: Assignment, generation: Generation, bank: Mapping[str, Template],
+                staging: Path) -> int:
+    from grader.render.pdfs import render_all
+    from grader.render.typeset import font_paths, missing_glyph_warnings
+
+    people = [(s.student.id, s.student.name) for s in generation.students]
+    for warning in missing_glyph_warnings(people, font_paths(job.font_dirs)):
+        print(warning, file=sys.stderr)
+    with _progress(len(generation.students) + 2, "PDFs") as advance:
+        return len(render_all(assignment, generation, bank, staging, jobs=job.jobs, keep_source=job.keep_source,
+                              progress=advance, font_dirs=job.font_dirs))
+
+
+@contextmanager
+def _collector_paused() -> Iterator[None]:
+    """Python's cyclic garbage collector off while the variants and the key are made: they are
+    trees without cycles (reference counting frees them), and each pass of the collector walked
+    the whole growing heap again, so that time grew faster than the class. What exists at the
+    end (the variants, kept for the PDFs) is frozen out of later passes (:func:`_frozen_for_the_run`)."""
+    enabled = gc.isenabled()
+    gc.disable()
+    try:
+        yield
+    finally:
+        gc.freeze()
+        if enabled:
+            gc.enable()
+
+
+@contextmanager
+def _frozen_for_the_run() -> Iterator[None]:
+    """What exists now (modules, the bank) is left out of the collector's passes until the run ends."""
+    gc.freeze()
+    try:
+        yield
+    finally:
+        gc.unfreeze()
 
 
 @contextmanager

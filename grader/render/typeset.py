@@ -108,6 +108,35 @@ def compile_typst(source: str, fmt: Literal["pdf", "png"] = "pdf", ppi: float | 
     return result  # type: ignore[no-any-return]
 
 
+MEMO_AGE = 10  # the typst package evicts a memo entry that this many compiles have not used
+
+
+def release_memory(forget: bool = False) -> None:
+    """Return the memory Typst has freed to the system; with ``forget``, first let go of all that
+    its memo cache holds from earlier documents (only while no other thread compiles: a document
+    being typeset would lose what it laid out so far and lay it out again).
+
+    The ``typst`` package evicts an entry once ``MEMO_AGE`` compiles have not used it, so as many
+    empty compiles age everything out. Typst works on threads of its own and glibc keeps what they
+    free in per-thread arenas, so a long run's size grew with the class although the memo cache did
+    not; ``malloc_trim`` gives those pages back. Without glibc, only the memo is let go."""
+    for age in range(MEMO_AGE if forget else 0):
+        compile_typst(f"{age}", tagged=False)
+    trim = _malloc_trim()
+    if trim is not None:
+        trim(0)
+
+
+@lru_cache(maxsize=1)
+def _malloc_trim() -> Any:
+    import ctypes
+
+    try:
+        return ctypes.CDLL(None).malloc_trim
+    except (AttributeError, OSError, TypeError):  # no glibc (macOS, musl), or no process handle (Windows)
+        return None
+
+
 def one_pdf(result: bytes | list[bytes]) -> bytes:
     """The bytes of a PDF compile (which returns one document)."""
     assert isinstance(result, bytes)  # a PDF compile returns one document, never pages

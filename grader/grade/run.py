@@ -7,10 +7,8 @@ leaves nothing behind and a previous output untouched.
 
 from __future__ import annotations
 
-import gc
 import time
-from collections.abc import Iterator, Mapping, Sequence
-from contextlib import contextmanager
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Literal
@@ -23,6 +21,7 @@ from grader.grade.grading import Graded, counts, grade
 from grader.grade.key import Key, load_key
 from grader.grade.report import write_reports
 from grader.grade.submissions import StudentRef, read_submissions
+from grader.heap import collector_paused
 
 COMMAND = "grader grade"
 
@@ -62,7 +61,7 @@ def run(key_path: Path, paths: Sequence[Path], out: Path, fmt: Literal["auto", "
     :mod:`grader.grade.canvas`).
     """
     started = time.perf_counter()
-    with _collector_paused():
+    with collector_paused():
         key = load_key(key_path)
         export = read_export(canvas, key) if canvas is not None else None
         graded = _graded(key, paths, fmt, (), bank)
@@ -78,7 +77,7 @@ def grade_into(folder: Path, key_path: Path, paths: Sequence[Path], out: Path, n
     ``grader grade --out out`` would, with the files named as in ``names`` (where they will be) and the
     manifest ``grader grade`` writes, so that ``grader grade --out out --force`` may replace it later."""
     started = time.perf_counter()
-    with _collector_paused():
+    with collector_paused():
         graded = _graded(load_key(key_path), paths, "auto", names, bank)
         write_reports(graded, folder)
         write_manifest(folder, COMMAND)
@@ -100,21 +99,3 @@ def _summary(graded: Graded, out: Path, started: float, export: CanvasExport | N
                         sum(problem.routine for problem in graded.problems), counts(graded),
                         graded.ignored_columns, (*graded.notes, *(export.notes if export else ())),
                         time.perf_counter() - started)
-
-
-@contextmanager
-def _collector_paused() -> Iterator[None]:
-    """Python's cycle collector paused while a run builds its objects: a big class makes millions
-    (keys, rows, verdicts) and no cycles worth collecting, and each collection walks all of them
-    (with it, reading 1.1 million answers took twice as long). At the end what the run made counts
-    as old (``freeze`` then ``unfreeze`` moves it to the oldest generation), or the first collection
-    after it would walk it all once more."""
-    enabled = gc.isenabled()
-    gc.disable()
-    try:
-        yield
-    finally:
-        gc.freeze()
-        gc.unfreeze()
-        if enabled:
-            gc.enable()

@@ -21,6 +21,7 @@ from grader.assign.keyfile import key_csv, key_document, key_json
 from grader.assign.variants import Generation, generate
 from grader.bank.template import Template
 from grader.files import output_folder, write_atomic
+from grader.heap import collector_paused
 
 
 @dataclass(frozen=True)
@@ -77,7 +78,7 @@ def write_outputs(job: Job, assignment: Assignment, roster: Sequence[Student], b
     """Generate the variants and write the key files and, unless ``job.pdf`` is off, the PDFs into
     ``staging``; returns the generation and how many files were written."""
     with _frozen_for_the_run():
-        with _collector_paused():
+        with collector_paused(keep_frozen=True):
             generation = generate(assignment, roster, bank)
             write_atomic(staging / "key.json", key_json(key_document(assignment, generation, bank)))
             write_atomic(staging / "key.csv", key_csv(generation))
@@ -96,22 +97,6 @@ def _write_pdfs(job: Job, assignment: Assignment, generation: Generation, bank: 
     with _progress(len(generation.students) + 2, "PDFs") as advance:
         return len(render_all(assignment, generation, bank, staging, jobs=job.jobs, keep_source=job.keep_source,
                               progress=advance, font_dirs=job.font_dirs))
-
-
-@contextmanager
-def _collector_paused() -> Iterator[None]:
-    """Python's cyclic garbage collector off while the variants and the key are made: they are
-    trees without cycles (reference counting frees them), and each pass of the collector walked
-    the whole growing heap again, so that time grew faster than the class. What exists at the
-    end (the variants, kept for the PDFs) is frozen out of later passes (:func:`_frozen_for_the_run`)."""
-    enabled = gc.isenabled()
-    gc.disable()
-    try:
-        yield
-    finally:
-        gc.freeze()
-        if enabled:
-            gc.enable()
 
 
 @contextmanager

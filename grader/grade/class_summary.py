@@ -31,8 +31,8 @@ import dataclasses
 from collections import Counter
 from collections.abc import Sequence
 from dataclasses import dataclass
-from itertools import chain, repeat
-from operator import attrgetter, eq, is_not, itemgetter
+from itertools import repeat
+from operator import eq, is_not, itemgetter
 
 import numpy as np
 import numpy.typing as npt
@@ -237,7 +237,7 @@ def _invalid(graded: Graded, students: list[int]) -> tuple[tuple[KeyStudent, tup
 def _problems(key: Key, scores: dict[str, Floats], points: dict[str, Floats],
               missing: dict[str, npt.NDArray[np.bool_]]) -> tuple[ProblemSummary, ...]:
     count = len(key.students)
-    parameters = _parameters(key.students)
+    parameters = key.parameter_columns.items()
     found = []
     for problem in key.problems:
         earned = sum((scores[label] for label in problem.labels), np.zeros(count))
@@ -250,22 +250,6 @@ def _problems(key: Key, scores: dict[str, Floats], points: dict[str, Floats],
                      for (owner, name), values in parameters if owner == problem.key)
         found.append(ProblemSummary(problem.key, problem.title, problem.labels, share, attempted, mine))
     return tuple(found)
-
-
-def _parameters(students: Sequence[KeyStudent]) -> list[tuple[tuple[str, str], Floats]]:
-    """Each (problem key, name) of a parameter any student has, with its value per student (NaN where
-    a student has none). Students share their ``parameters`` tuple: one layout is placed at a time."""
-    layouts: dict[int, tuple[tuple[tuple[str, str], ...], list[int]]] = {}
-    for index, student in enumerate(students):
-        layouts.setdefault(id(student.parameters), (student.parameters, []))[1].append(index)
-    names = list(dict.fromkeys(name for layout, _ in layouts.values() for name in layout))
-    table = np.full((len(students), len(names)), np.nan)
-    for layout, members in layouts.values():
-        if layout:
-            values = chain.from_iterable(map(attrgetter("values"), map(students.__getitem__, members)))
-            table[np.array(members)[:, None], [names.index(name) for name in layout]] = np.fromiter(
-                values, np.float64, len(members) * len(layout)).reshape(len(members), len(layout))
-    return [(name, table[:, column]) for column, name in enumerate(names)]
 
 
 def binned(values: Floats, score: Floats) -> tuple[ParameterBin, ...]:

@@ -107,8 +107,8 @@ def _problem_physics(key: Key, problem: KeyProblem, bank: Path | Mapping[str, Te
         return f"template {problem.template} is not in {where}"
     if template.source_hash != recorded:
         return f"template {problem.template} in {where} has changed since the key was written"
-    given = [student.params(problem.key) for student in key.students]
-    params = {name: _column([values.get(name) for values in given]) for name in template.parameters}
+    absent = np.full(len(key.students), math.nan)
+    params = {name: key.parameter_columns.get((problem.key, name), absent) for name in template.parameters}
     if key.students and any(np.isnan(column).all() for column in params.values()):
         return f"the key holds no values of {problem.template}'s parameters"
     try:
@@ -116,20 +116,6 @@ def _problem_physics(key: Key, problem: KeyProblem, bank: Path | Mapping[str, Te
     except (GraderError, ArithmeticError, TypeError, ValueError, AttributeError, NotImplementedError,
             RecursionError) as error:  # what sympy may raise on a colleague's template: grading goes on
         return f"template {problem.template} could not be compiled ({type(error).__name__}: {error})"
-
-
-def _column(values: list[object]) -> np.ndarray:
-    """The numbers of a parameter, one per student: NaN for one the key lacks or holds as no number.
-
-    >>> _column([2.0, 3, None, "x", True, float("inf")]).tolist()
-    [2.0, 3.0, nan, nan, nan, nan]
-    """
-    if all(type(value) is float for value in values):  # what a key holds: converted at C speed
-        column = np.array(values, dtype=float)
-    else:
-        column = np.array([float(value) if isinstance(value, int | float) and not isinstance(value, bool) else math.nan
-                           for value in values])
-    return np.where(np.isfinite(column), column, math.nan)
 
 
 def reconsider(problem: ProblemPhysics, key: Key, name: str, label: str, unit: str, tolerance: Tolerance,

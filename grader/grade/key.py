@@ -24,6 +24,8 @@ A student's printed parameters (``params``), where the key has them, are kept fo
 
 from __future__ import annotations
 
+import functools
+import itertools
 import json
 import math
 import re
@@ -32,6 +34,8 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, TypeVar
+
+import numpy as np
 
 from grader.assign.assignment import MAX_POINTS
 from grader.errors import GraderError, shown
@@ -125,6 +129,24 @@ class Key:
     def possible(self) -> float:
         """The most points a student can earn (Canvas' "points possible" of the assignment)."""
         return max((student.possible for student in self.students), default=0.0)
+
+    @functools.cached_property
+    def parameter_columns(self) -> dict[tuple[str, str], np.ndarray]:
+        """Each (problem key, name) of a parameter any student has, with its value per student (NaN where
+        a student has none); worked out once (the diagnosis and the class report both read it). Students
+        share their ``parameters`` tuple: one layout is placed at a time."""
+        students = self.students
+        layouts: dict[int, tuple[tuple[tuple[str, str], ...], list[int]]] = {}
+        for index, student in enumerate(students):
+            layouts.setdefault(id(student.parameters), (student.parameters, []))[1].append(index)
+        names = list(dict.fromkeys(name for layout, _ in layouts.values() for name in layout))
+        table = np.full((len(students), len(names)), np.nan)
+        for layout, members in layouts.values():
+            if layout:
+                values = itertools.chain.from_iterable(students[index].values for index in members)
+                table[np.array(members)[:, None], [names.index(name) for name in layout]] = np.fromiter(
+                    values, np.float64, len(members) * len(layout)).reshape(len(members), len(layout))
+        return {name: table[:, column] for column, name in enumerate(names)}
 
 
 def load_key(path: Path) -> Key:

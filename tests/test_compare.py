@@ -6,6 +6,7 @@ under test; every number is meant as the decimal it prints as.
 
 from __future__ import annotations
 
+import json
 import math
 from decimal import Decimal
 from fractions import Fraction
@@ -256,8 +257,8 @@ BAD_JSON = [
     ({"mode": "sigfigs", "digits": 0}, "tolerance.digits: expected a whole number from 1 to 17, got 0"),
     ({"mode": "sigfigs", "digits": 2.5}, "tolerance.digits: expected a whole number from 1 to 17, got 2.5"),
     ({"mode": "decimals", "digits": 18}, "tolerance.digits: expected a whole number from 0 to 17, got 18"),
-    ({"mode": "sigfigs", "rtol": 0.01}, "expected only the keys digits, mode in sigfigs mode, got rtol"),
-    ({"tol": 0.01}, "expected only the keys atol, mode, rtol in rtol mode, got tol"),
+    ({"mode": "sigfigs", "rtol": 0.01}, "expected only the keys digits, mode, reason in sigfigs mode, got rtol"),
+    ({"tol": 0.01}, "expected only the keys atol, mode, reason, rtol in rtol mode, got tol"),
 ]
 
 
@@ -383,3 +384,12 @@ def test_a_class_of_sentences_reads_as_each_alone(answers: list[tuple[float, flo
 def test_feedbacks_refuses_columns_of_different_lengths() -> None:
     with pytest.raises(ValueError, match="one length"):
         feedbacks([1.0, 2.0], [1.0], "", Tolerance(), [True, True])
+
+
+def test_a_widened_tolerance_keeps_its_reason_through_the_key_and_grades_like_its_figure() -> None:
+    widened = Tolerance(rtol=0.027, reason="rounding T and T′ to 4 figures moves loss_pct by up to 1.3 %")
+    back = Tolerance.from_json(json.loads(json.dumps(widened.to_json())))
+    assert back.reason == widened.reason and back.explained() == "±2.7 %: " + widened.reason
+    assert back == Tolerance(rtol=0.027)  # the reason does not change how answers are graded
+    with pytest.raises(ToleranceError, match=r"tolerance\.reason: expected text of at most 300 characters"):
+        Tolerance(rtol=0.02, reason="x" * 301)

@@ -293,7 +293,8 @@ def test_the_assignments_tolerance_mode_and_grading_section_reach_the_verdicts(
 
 
 @pytest.mark.parametrize("grading", ["{ecf_credit: 2}", "{mistake_credit: -0.1}", "{ecf_credit: yes}",
-                                     "{partial: 1}"])
+                                     "{partial: 1}", "{intermediate_sig_figs: 3.5}", "{intermediate_sig_figs: 1}",
+                                     "{intermediate_sig_figs: true}", "{max_tolerance: 0}", "{max_tolerance: 5}"])
 def test_a_credit_that_is_no_fraction_of_the_points_is_refused(tmp_path: Path, capsys: pytest.CaptureFixture[str],
                                                                grading: str) -> None:
     (tmp_path / "a.yaml").write_text(f"title: HW\ncourse: C\nseed: s\ngrading: {grading}\n"
@@ -349,3 +350,15 @@ def test_a_cut_key_is_refused_with_what_json_says(tmp_path: Path, key_path: Path
     with pytest.raises(GraderError) as caught:
         load_key(tmp_path / "key.json")
     assert f"got invalid JSON ({expected.value})" in str(caught.value)
+
+
+def test_the_grading_sections_rounding_settings_are_read_with_their_defaults(tmp_path: Path) -> None:
+    from grader.assign.assignment import load_assignment
+    path = tmp_path / "a.yaml"
+    path.write_text("title: HW\ncourse: C\nseed: s\nproblems:\n  - template: drop-rebound\n", encoding="utf-8")
+    grading = load_assignment(path).grading
+    assert (grading.intermediate_sig_figs, grading.max_tolerance) == (4, 0.05)
+    path.write_text("title: HW\ncourse: C\nseed: s\ngrading: {intermediate_sig_figs: 5, max_tolerance: 0.1}\n"
+                    "problems:\n  - template: drop-rebound\n", encoding="utf-8")
+    grading = load_assignment(path).grading
+    assert (grading.intermediate_sig_figs, grading.max_tolerance) == (5, 0.1)

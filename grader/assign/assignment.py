@@ -44,11 +44,17 @@ class ProblemSpec:
 class Grading:
     """How answers are read and credited: ``numeric_expressions``, whether ``sqrt(2*9.81*2)`` counts as a
     number; ``ecf_credit``, the credit of a part right for the student's own earlier answer (error carried
-    forward; 0 turns it off); ``mistake_credit``, that of a part matching a diagnosed mistake."""
+    forward; 0 turns it off); ``mistake_credit``, that of a part matching a diagnosed mistake;
+    ``intermediate_sig_figs``, the significant figures the sheet asks students to keep in intermediate
+    steps (answers are given to three), from which each variant's rounding allowance is bounded;
+    ``max_tolerance``, the widest relative tolerance a variant may get for that allowance (a variant that
+    would need more is redrawn)."""
 
     numeric_expressions: bool = True
     ecf_credit: float = 1.0
     mistake_credit: float = 0.0
+    intermediate_sig_figs: int = 4
+    max_tolerance: float = 0.05
 
 
 @dataclass(frozen=True)
@@ -104,9 +110,11 @@ def load_assignment(path: Path) -> Assignment:
 def _grading(raw: Any, where: str) -> Grading:
     if raw is None:
         return Grading()
-    if not isinstance(raw, Mapping) or set(raw) - {"numeric_expressions", "ecf_credit", "mistake_credit"}:
+    if not isinstance(raw, Mapping) or set(raw) - {"numeric_expressions", "ecf_credit", "mistake_credit",
+                                                   "intermediate_sig_figs", "max_tolerance"}:
         raise TemplateError(where, "grading", "{numeric_expressions: true or false, ecf_credit: 0 to 1, "
-                            "mistake_credit: 0 to 1}", shown(raw))
+                            "mistake_credit: 0 to 1, intermediate_sig_figs: 2 to 10, max_tolerance: 0.001 to 0.5}",
+                            shown(raw))
     value = raw.get("numeric_expressions", True)
     if not isinstance(value, bool):
         raise TemplateError(where, "grading.numeric_expressions", "true or false", shown(value))
@@ -117,7 +125,16 @@ def _grading(raw: Any, where: str) -> Grading:
             raise TemplateError(where, f"grading.{name}", "a credit from 0 to 1 (a fraction of the part's points)",
                                 shown(credit))
         credits[name] = float(credit)
-    return Grading(numeric_expressions=value, **credits)
+    figures = raw.get("intermediate_sig_figs", Grading.intermediate_sig_figs)
+    if isinstance(figures, bool) or not isinstance(figures, int) or not 2 <= figures <= 10:
+        raise TemplateError(where, "grading.intermediate_sig_figs",
+                            "a whole number of significant figures from 2 to 10", shown(figures))
+    widest = raw.get("max_tolerance", Grading.max_tolerance)
+    if not (_number(widest) and 0.001 <= widest <= 0.5):
+        raise TemplateError(where, "grading.max_tolerance",
+                            "a relative tolerance from 0.001 to 0.5 (0.05 is ±5 %)", shown(widest))
+    return Grading(numeric_expressions=value, **credits, intermediate_sig_figs=figures,
+                   max_tolerance=float(widest))
 
 
 def _text(raw: Mapping[str, Any], key: str, where: str, required: bool = True) -> str:

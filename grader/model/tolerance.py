@@ -15,13 +15,15 @@ True
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any, Literal
 
 from grader.errors import GraderError, shown
 
 Mode = Literal["rtol", "sigfigs", "decimals"]
 MODES: tuple[Mode, ...] = ("rtol", "sigfigs", "decimals")
+MAX_REASON = 300
+"""The longest reason a key may carry for a widened tolerance."""
 MAX_DIGITS = 17
 """float64 carries 17 significant digits; more cannot be told apart."""
 
@@ -60,6 +62,10 @@ class Tolerance:
     rtol: float = 0.01
     atol: float = 0.0
     digits: int = 3
+    reason: str = field(default="", compare=False)
+    """Why this tolerance is wider than the one configured (what honest rounding along a solution route
+    needs), in words that follow the figure: ``rounding T and T′ to 4 figures moves loss_pct by up to
+    1.3 %``; empty when it is as configured. It does not change how answers are graded."""
 
     def __post_init__(self) -> None:
         if self.mode not in MODES:
@@ -75,6 +81,8 @@ class Tolerance:
         if self.mode == "rtol" and self.digits != 3:
             raise ToleranceError("digits", "no digits in rtol mode (digits count only for sigfigs and decimals)",
                                  shown(self.digits))
+        if not isinstance(self.reason, str) or len(self.reason) > MAX_REASON:
+            raise ToleranceError("reason", f"text of at most {MAX_REASON} characters", shown(self.reason)[:80])
         if self.mode != "rtol" and (self.rtol, self.atol) != (0.01, 0.0):
             raise ToleranceError("rtol", f"no rtol or atol in {self.mode} mode (they count only in rtol mode)",
                                  shown({"rtol": self.rtol, "atol": self.atol}))
@@ -90,6 +98,17 @@ class Tolerance:
         absolute = with_unit(_plain(self.atol), unit)
         return f"±{relative} + {absolute}" if self.rtol else f"±{absolute}"
 
+    def explained(self, unit: str = "") -> str:
+        """:meth:`describe`, with the reason a widened tolerance carries.
+
+        >>> Tolerance(rtol=0.027, reason="rounding T and T′ to 4 figures moves loss_pct by up to 1.3 %").explained()
+        '±2.7 %: rounding T and T′ to 4 figures moves loss_pct by up to 1.3 %'
+        >>> Tolerance().explained("m/s")
+        '±1 %'
+        """
+        described = self.describe(unit)
+        return f"{described}: {self.reason}" if self.reason else described
+
     @classmethod
     def from_json(cls, data: Any, *, base: Tolerance | None = None) -> Tolerance:
         """Read any written form: ``{"rtol", "atol"}`` (either may be left out: it comes from ``base``,
@@ -100,7 +119,7 @@ class Tolerance:
         >>> Tolerance.from_json({"rtol": 0.02, "digits": 3})
         Traceback (most recent call last):
         ...
-        grader.model.tolerance.ToleranceError: tolerance: expected only the keys atol, mode, rtol in rtol mode, ...
+        grader.model.tolerance.ToleranceError: tolerance: expected only the keys atol, mode, reason, rtol in ...
         """
         if not isinstance(data, Mapping):
             raise ToleranceError("", f"a mapping like {FORMS}", shown(data))
@@ -112,15 +131,16 @@ class Tolerance:
         mode = data.get("mode", "rtol")
         if mode not in MODES:
             raise ToleranceError("mode", "'rtol', 'sigfigs' or 'decimals'", shown(mode))
-        allowed = {"mode", "rtol", "atol"} if mode == "rtol" else {"mode", "digits"}
+        allowed = ({"mode", "rtol", "atol"} if mode == "rtol" else {"mode", "digits"}) | {"reason"}
         extra = sorted(str(key) for key in data if key not in allowed)
         if extra:
             raise ToleranceError("", f"only the keys {', '.join(sorted(allowed))} in {mode} mode",
                                  shown(", ".join(extra))[1:-1])
+        reason = data.get("reason", "")
         if mode != "rtol":
-            return cls(mode, digits=data.get("digits", 3))
+            return cls(mode, digits=data.get("digits", 3), reason=reason)
         start = base if base is not None and base.mode == "rtol" else cls()
-        return cls(rtol=data.get("rtol", start.rtol), atol=data.get("atol", start.atol))
+        return cls(rtol=data.get("rtol", start.rtol), atol=data.get("atol", start.atol), reason=reason)
 
     def to_json(self) -> dict[str, Any]:
         """The key's form, with the mode named.
@@ -128,9 +148,11 @@ class Tolerance:
         >>> Tolerance().to_json(), Tolerance("decimals", digits=2).to_json()
         ({'mode': 'rtol', 'rtol': 0.01, 'atol': 0.0}, {'mode': 'decimals', 'digits': 2})
         """
-        if self.mode == "rtol":
-            return {"mode": "rtol", "rtol": self.rtol, "atol": self.atol}
-        return {"mode": self.mode, "digits": self.digits}
+        data: dict[str, Any] = ({"mode": "rtol", "rtol": self.rtol, "atol": self.atol} if self.mode == "rtol"
+                                else {"mode": self.mode, "digits": self.digits})
+        if self.reason:
+            data["reason"] = self.reason
+        return data
 
 
 def with_unit(text: str, unit: str) -> str:

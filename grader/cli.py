@@ -19,7 +19,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from grader import __version__
-from grader.errors import GraderError, UsageError, some
+from grader.errors import GraderError, UsageError, some, visible
 
 if TYPE_CHECKING:
     from grader.bank.template import Parameter, Template
@@ -32,7 +32,6 @@ if TYPE_CHECKING:  # imported when used: `grader list` must not pay for numpy
     from grader.grade.run import GradeSummary
 
 EXIT_OK, EXIT_USAGE, EXIT_REFUSED, EXIT_INTERRUPTED = 0, 2, 3, 130
-_CONTROL = re.compile(r"[\x00-\x1f\x7f-\x9f\u202a-\u202e\u2066-\u2069]")
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -223,7 +222,7 @@ def _printable(message: str) -> str:
     >>> _printable("cannot read unit '\x1b[31mred'\nsecond line")
     "cannot read unit '\\x1b[31mred'; second line"
     """
-    return _CONTROL.sub(lambda m: "; " if m.group() == "\n" else repr(m.group())[1:-1], message.strip())
+    return visible("; ".join(message.strip().split("\n")))
 
 
 def _discard_stdout() -> None:

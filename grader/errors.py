@@ -11,6 +11,7 @@ grader.errors.TemplateError: bank/x.yaml: parameters.e.domain: expected an inter
 
 from __future__ import annotations
 
+import re
 import reprlib
 from collections.abc import Sequence
 from typing import Any
@@ -31,6 +32,21 @@ def shown(value: Any, limit: int = 80) -> str:
     """
     text = _SHOWN.repr(value)
     return text if len(text) <= limit else text[:limit - 3] + "..."
+
+
+CONTROL = re.compile(r"[\x00-\x1f\x7f-\x9f\u202a-\u202e\u2066-\u2069]")
+"""Characters a terminal or a spreadsheet acts on instead of showing: C0 and C1 controls (escape
+sequences, line breaks) and the bidirectional overrides that reorder what follows them."""
+
+
+def visible(text: str) -> str:
+    r"""``text`` with each character of :data:`CONTROL` written as its escape, for a report a person
+    reads: what a student typed is shown, never acted on.
+
+    >>> visible("6.26\x1b[31m m/s"), visible("v\u202e2"), visible("6,3 m/s")
+    ('6.26\\x1b[31m m/s', 'v\\u202e2', '6,3 m/s')
+    """
+    return text if text.isprintable() else CONTROL.sub(lambda m: repr(m.group())[1:-1], text)
 
 
 def some(names: Sequence[str], most: int = 10) -> str:

@@ -201,6 +201,26 @@ def test_text_cells_in_the_reports_cannot_run_as_formulas(tmp_path: Path, capsys
     assert row["submitted"].startswith("'=") and row["verdict"] == "invalid"
 
 
+def test_control_characters_a_student_typed_are_shown_as_escapes_in_the_reports(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str], key_path: Path) -> None:
+    """An escape sequence or a right-to-left override typed into an answer (or a stray label) reaches
+    details.csv and problems.csv as visible text, never as the raw character a terminal acts on."""
+    rows = key_answers(key_path)
+    (student, label, _), (other, other_label, _) = rows[0], rows[1]
+    rows[0] = (student, label, "6.26\x1b[2J m/s")
+    rows[1] = (other, other_label, "\u202e5.1")
+    rows.append((student, "9\x1bz", "1"))
+    (tmp_path / "a.csv").write_text(long_csv(rows), encoding="utf-8")
+    run(capsys, "grade", "--key", key_path, tmp_path / "a.csv", "--out", tmp_path / "g")
+    for name in ("details.csv", "problems.csv"):
+        text = (tmp_path / "g" / name).read_text(encoding="utf-8")
+        assert "\x1b" not in text and "\u202e" not in text, name
+    details = {(row["student_id"], row["label"]): row for row in read(tmp_path / "g" / "details.csv")}
+    assert details[(student, label)]["submitted"] == "6.26\\x1b[2J m/s"
+    assert details[(other, other_label)]["submitted"] == "\\u202e5.1"
+    assert "9\\x1bz" in (tmp_path / "g" / "problems.csv").read_text(encoding="utf-8")
+
+
 def test_a_key_whose_student_lacks_a_part_is_refused(tmp_path: Path, capsys: pytest.CaptureFixture[str],
                                                      key_path: Path) -> None:
     """A hand-edited key (a part deleted for one student) is refused, not a KeyError halfway."""

@@ -1,8 +1,10 @@
 """The files a grading run writes: ``grades.csv``, ``details.csv``, ``problems.csv``, ``canvas.csv``, and
 the class report ``report.html`` (:mod:`grader.grade.class_report`).
 
-Every text cell is guarded against formula injection (:func:`grader.assign.keyfile.safe_cell`);
-numbers stay numbers and are never NaN or infinite. Rows come in the key's order, so two runs on
+Every text cell is guarded against formula injection (:func:`grader.assign.keyfile.safe_cell`), and
+what came from a student or an input file shows its control characters as escapes
+(:func:`grader.errors.visible`: an escape sequence a student typed is not run by the terminal that
+prints the file); numbers stay numbers and are never NaN or infinite. Rows come in the key's order, so two runs on
 the same inputs give byte-identical files.
 """
 
@@ -15,6 +17,7 @@ from collections.abc import Iterable, Iterator, Sequence
 from pathlib import Path
 
 from grader.assign.keyfile import safe_cell
+from grader.errors import visible
 from grader.files import write_atomic
 from grader.grade.canvas import CanvasExport
 from grader.grade.class_report import REPORT, class_report
@@ -66,11 +69,11 @@ def details_csv(graded: Graded, students_per_piece: int = 2000) -> Iterator[str]
         for label, rows in columns:
             (submitted, verdict, credit, points, expected, parsed, unit, abs_error, rel_error, tolerance, feedback,
              diagnosis, source) = rows[index]
-            writer.writerow((who, label, "" if submitted is None else safe_cell(submitted), words[verdict],
+            writer.writerow((who, label, "" if submitted is None else safe_cell(visible(submitted)), words[verdict],
                              numbers[credit], numbers[points], numbers[credit * points], safe_cell(expected),
-                             safe_cell(parsed), words[unit], "" if abs_error is None else _number(abs_error),
-                             "" if rel_error is None else _number(rel_error), words[tolerance], safe_cell(feedback),
-                             words[diagnosis], safe_cell(source)))
+                             safe_cell(visible(parsed)), words[unit], "" if abs_error is None else _number(abs_error),
+                             "" if rel_error is None else _number(rel_error), words[tolerance],
+                             safe_cell(visible(feedback)), words[diagnosis], safe_cell(visible(source))))
         if index % students_per_piece == students_per_piece - 1:
             yield stream.getvalue()
             stream.seek(0)
@@ -119,7 +122,7 @@ def _cell(value: object) -> str:
         return _number(value)
     if isinstance(value, int):
         return str(value)
-    return safe_cell(str(value))
+    return safe_cell(visible(str(value)))
 
 
 def _number(value: float) -> str:

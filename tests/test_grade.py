@@ -127,21 +127,26 @@ def test_every_row_is_accounted_for_and_nobody_is_lost(tmp_path: Path, capsys: p
 
 def test_rows_set_aside_by_rule_are_listed_but_end_the_run_with_0(tmp_path: Path, capsys: pytest.CaptureFixture[str],
                                                                    key_path: Path) -> None:
-    """A resubmission and Canvas' points-possible row are listed in problems.csv and counted apart; only a
-    row someone should look at (here none) makes the exit code 3."""
+    """A resubmission, a header row repeated where two files were pasted together and Canvas' points-possible
+    row are listed in problems.csv and counted apart; only a row someone should look at (here none) makes the
+    exit code 3."""
     rows = key_answers(key_path)
     student, label, text = rows[0]
-    (tmp_path / "a.csv").write_text(long_csv([(student, label, "999"), *rows, ("Points Possible", "", "")]),
-                                    encoding="utf-8")
+    half = len(rows) // 2  # two exports pasted into one: the second's header row is in the middle
+    (tmp_path / "a.csv").write_text(long_csv([(student, label, "999"), *rows[:half], ("Student_ID ", "label", "answer"),
+                                              *rows[half:], ("Points Possible", "", "")]), encoding="utf-8")
     code, out, err = run(capsys, "grade", "--key", key_path, tmp_path / "a.csv", "--out", tmp_path / "g", "--json")
     assert code == 0, err
     summary = json.loads(out)
-    assert (summary["rows_not_graded"], summary["rows_set_aside"]) == (0, 2)
-    assert "2 rows set aside (superseded or not a student), 0 rows not graded" in err
+    assert (summary["rows_not_graded"], summary["rows_set_aside"]) == (0, 3)
+    assert "3 rows set aside (superseded or not a student), 0 rows not graded" in err
     problems = read(tmp_path / "g" / "problems.csv")
+    resubmitted = rows.index((student, label, text)) + 3
+    assert [(p["line"], p["reason"]) for p in problems][1] == (
+        str(half + 3), "not a student row (the header repeated: were two files pasted into one?)")
     assert [(p["line"], p["reason"].split(" (")[0]) for p in problems] == [
-        ("2", f"superseded by {tmp_path / 'a.csv'} line {rows.index((student, label, text)) + 3}"),
-        (str(len(rows) + 3), "not a student row")]
+        ("2", f"superseded by {tmp_path / 'a.csv'} line {resubmitted + (resubmitted > half + 2)}"),
+        (str(half + 3), "not a student row"), (str(len(rows) + 4), "not a student row")]
     assert {row["verdict"] for row in read(tmp_path / "g" / "details.csv")} == {"correct"}
 
 

@@ -256,7 +256,10 @@ def find_label(text: str, labels: Sequence[str]) -> str | None:
 
 
 def _not_a_student(row: CsvRow, layout: Layout) -> str:
-    """Why a row that names no known student is none (Canvas' extra rows), or ""."""
+    """Why a row that names no known student is none (Canvas' extra rows, the header again where two
+    files were pasted into one), or ""."""
+    if " ".join(row.cells.get(layout.student, "").split()).lower() == " ".join(layout.student.split()).lower():
+        return "not a student row (the header repeated: were two files pasted into one?)"
     for column in (layout.student, *layout.ignored):
         value = " ".join(row.cells.get(column, "").split()).lower()
         if value in _CANVAS_ROWS:

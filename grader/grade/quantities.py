@@ -11,6 +11,11 @@ first conversion, so importing this module does not import pint.
 (True, True)
 >>> round(unit_factor("ft/sec", "m/s"), 6), unit_factor("%", ""), round(unit_factor("rad", "deg"), 4)
 (0.3048, 0.01, 57.2958)
+
+A pound is a force, as the templates' ``lb`` is, unless only a mass fits the answer:
+
+>>> round(unit_factor("lb", "N"), 4), round(unit_factor("ft*lb", "J"), 4), round(unit_factor("lbs", "kg"), 5)
+(4.4482, 1.3558, 0.45359)
 >>> unit_factor("kg", "m/s")
 Traceback (most recent call last):
 ...
@@ -40,8 +45,13 @@ _ALIASES: dict[str, Factors] = {
     "°": (("degree", 1),), "%": (("percent", 1),), "deg": (("degree", 1),), "degs": (("degree", 1),),
     "fps": (("foot", 1), ("second", -1)), "mph": (("mile", 1), ("hour", -1)),
     "kph": (("kilometer", 1), ("hour", -1)), "kmh": (("kilometer", 1), ("hour", -1)),
-    "secs": (("second", 1),), "hrs": (("hour", 1),), "lbs": (("pound", 1),),
+    "secs": (("second", 1),), "hrs": (("hour", 1),), "lbm": (("pound", 1),),
+    # In mechanics a pound is a force, as in the templates' units (grader.model.units); pint's is a mass.
+    "lb": (("pound_force", 1),), "lbs": (("pound_force", 1),), "pound": (("pound_force", 1),),
+    "pounds": (("pound_force", 1),),
 }
+_POUNDS = frozenset({"lb", "lbs", "pound", "pounds"})
+"""Words read as pound-force, or as pound-mass where only that reading has the expected dimension."""
 _L, _M, _T = "[length]", "[mass]", "[time]"
 _DESCRIPTIONS = {
     ((), 0): "a pure number", ((), 1): "an angle", (((_L, 1),), 0): "a length", (((_M, 1),), 0): "a mass",
@@ -115,6 +125,10 @@ def unit_factor(given: str, expected: str) -> float:
     if _canonical(given_factors) == _canonical(expected_factors):
         return 1.0  # the common case, without pint
     given_unit, expected_unit = _resolve(given_factors), _resolve(expected_factors)
+    if _dimension(given_unit) != _dimension(expected_unit) and _POUNDS.intersection(w for w, _ in given_factors):
+        as_mass = tuple(("lbm" if word in _POUNDS else word, power) for word, power in given_factors)
+        if _dimension(_resolve(as_mass)) == _dimension(expected_unit):  # "12 lb" where a mass is asked
+            given_factors, given_unit = as_mass, _resolve(as_mass)
     if _dimension(given_unit) != _dimension(expected_unit):
         wanted = describe(_dimension(expected_unit)) + (f" ({expected.strip()})" if expected.strip() else "")
         raise UnitMismatchError(f"expected {wanted}, got {describe(_dimension(given_unit))} ({given.strip()})")

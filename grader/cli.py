@@ -108,6 +108,8 @@ def build_parser() -> argparse.ArgumentParser:
         description="Grade one answer: against a student's part of a key (--key, --student, --label), or against "
                     "--expected with --unit, a tolerance and, for an expression, --symbols and --domain. "
                     "--batch reads one JSON object a line and prints one result a line.")
+    # argparse takes -6 and -6.3 for values but -6.3e2 for an option: widen its test (answers are often negative)
+    checking._negative_number_matcher = _NEGATIVE_NUMBER  # type: ignore[attr-defined]
     checking.add_argument("answer", nargs="?", metavar="ANSWER", help="what the student typed, e.g. \"6.3 m/s\"")
     checking.add_argument("--key", type=Path, metavar="DIR/key.json", help="the key grader generate wrote")
     checking.add_argument("--student", metavar="ID", help="a student id (or email) of the key")
@@ -638,6 +640,8 @@ def _json_line(result: dict[str, Any]) -> str:
     return _SURROGATE.sub(lambda m: f"\\u{ord(m.group()):04x}", text)
 
 
+_NEGATIVE_NUMBER = re.compile(r"^-(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?$")
+"""A negative number as argparse should take it for a value: ``-6.26``, ``-1e308``, ``-.5E-3``."""
 _SURROGATE = re.compile("[\ud800-\udfff]")
 
 

@@ -63,6 +63,14 @@ def test_an_answer_with_another_unit_against_a_given_value(capsys: pytest.Captur
     assert (wrong["verdict"], wrong["feedback"]) == ("incorrect", "expected a speed (m/s), got a mass (kg)")
 
 
+def test_negative_numbers_in_exponent_form_are_values_not_options(capsys: pytest.CaptureFixture[str]) -> None:
+    """argparse alone takes ``-6.3e0`` for an unknown option; answers and expected values are often negative."""
+    assert checked(capsys, "-6.3e0", "--expected", "-6.26e0", "--unit", "m/s")["verdict"] == "correct"
+    assert checked(capsys, "-1e308", "--expected", "-1E308")["verdict"] == "correct"
+    code, _, err = run(capsys, "1", "--expected", "1", "--atol", "-.5e-3")  # read, then refused for its sign
+    assert code == 2 and "expected one argument" not in err and "atol" in err, err
+
+
 @pytest.mark.parametrize(("answer", "mode", "verdict"), [
     ("6.3226", ["--rtol", "0.01"], "correct"),  # exactly 1 % above
     ("6.3227", ["--rtol", "0.01"], "incorrect"),

@@ -109,7 +109,7 @@ def build_parser() -> argparse.ArgumentParser:
                     "--expected with --unit, a tolerance and, for an expression, --symbols and --domain. "
                     "--batch reads one JSON object a line and prints one result a line.")
     # argparse takes -6 and -6.3 for values but -6.3e2 for an option: widen its test (answers are often negative)
-    checking._negative_number_matcher = _NEGATIVE_NUMBER  # type: ignore[attr-defined]
+    checking._negative_number_matcher = _NEGATIVE_NUMBER
     checking.add_argument("answer", nargs="?", metavar="ANSWER", help="what the student typed, e.g. \"6.3 m/s\"")
     checking.add_argument("--key", type=Path, metavar="DIR/key.json", help="the key grader generate wrote")
     checking.add_argument("--student", metavar="ID", help="a student id (or email) of the key")

@@ -80,7 +80,8 @@ class Interval:
 
 @dataclass(frozen=True)
 class Sampling:
-    """How a variant draws a parameter: ``uniform``, ``log_uniform`` over a range, or ``choice``."""
+    """How a variant draws a parameter: ``uniform``, ``log_uniform`` over a range, ``integers`` (each
+    whole number of a range, ends included, equally likely) or ``choice``."""
 
     kind: str
     values: tuple[float, ...]
@@ -97,6 +98,31 @@ class Parameter:
     decimals: int | None
     sig_figs: int | None
     description: str
+    integer: bool = False  # a count (of bounces, ...): sampled, printed and accepted as a whole number only
+
+    def admits(self, value: Any) -> Any:
+        """Whether ``value`` (a number or numpy array) may be this parameter's: in its domain, and a
+        whole number for an integer parameter.
+
+        >>> n = load_bank()["successive-bounces"].parameters["n"]
+        >>> bool(n.admits(3.0)), bool(n.admits(2.5)), bool(n.admits(0.0))
+        (True, False, False)
+        """
+        inside = self.domain.contains(value)
+        return inside & (value % 1 == 0) if self.integer else inside
+
+    def refusal(self, value: float) -> str | None:
+        """Why ``value`` cannot be this parameter's (what was expected), or None when it can.
+
+        >>> load_bank()["successive-bounces"].parameters["n"].refusal(2.5)
+        'a whole number (n is an integer parameter: number of bounces counted)'
+        """
+        if not self.domain.contains(value):
+            whole = "a whole number " if self.integer else "a value "
+            return f"{whole}in the parameter's domain {self.domain}"
+        if self.integer and value % 1 != 0:
+            return f"a whole number ({self.name} is an integer parameter: {self.description})"
+        return None
 
 
 @dataclass(frozen=True)
@@ -513,13 +539,22 @@ def _parameter(name: str, spec: Any, where: str) -> Parameter:
     key = f"parameters.{name}"
     if not isinstance(spec, Mapping):
         raise TemplateError(where, key, "a mapping with unit, domain, sample and decimals or sig_figs", shown(spec))
-    allowed = {"unit", "domain", "sample", "decimals", "sig_figs", "description"}
+    allowed = {"unit", "domain", "sample", "decimals", "sig_figs", "description", "integer"}
     if set(spec) - allowed:
         raise TemplateError(where, key, f"only {', '.join(sorted(allowed))}",
                             f"unknown key(s) {', '.join(sorted(set(spec) - allowed))}")
+    integer = spec.get("integer", False)
+    if not isinstance(integer, bool):
+        raise TemplateError(where, f"{key}.integer", "true or false", shown(integer))
     domain = Interval.parse(spec.get("domain"), where, f"{key}.domain")
-    sample = _sampling(spec.get("sample"), where, f"{key}.sample", domain)
+    sample = _sampling(spec.get("sample"), where, f"{key}.sample", domain, integer)
     decimals, sig_figs = spec.get("decimals"), spec.get("sig_figs")
+    if integer:
+        # A count prints as a whole number: decimals 0, said or not.
+        if sig_figs is not None or decimals not in (None, 0) or isinstance(decimals, bool):
+            raise TemplateError(where, key, "no printed precision, or decimals: 0 (an integer parameter prints as a "
+                                "whole number)", f"decimals={shown(decimals)}, sig_figs={shown(sig_figs)}")
+        decimals = 0
     if (decimals is None) == (sig_figs is None):
         raise TemplateError(where, key, "exactly one of decimals or sig_figs (the printed precision)",
                             f"decimals={shown(decimals)}, sig_figs={shown(sig_figs)}")
@@ -527,18 +562,23 @@ def _parameter(name: str, spec: Any, where: str) -> Parameter:
         if value is not None and (not isinstance(value, int) or isinstance(value, bool) or not least <= value <= 15):
             raise TemplateError(where, f"{key}.{label}", f"a whole number from {least} to 15", shown(value))
     return Parameter(name, _unit(spec.get("unit"), where, f"{key}.unit"), domain, sample, decimals, sig_figs,
-                     str(spec.get("description", name)))
+                     str(spec.get("description", name)), integer)
 
 
-def _sampling(spec: Any, where: str, key: str, domain: Interval) -> Sampling:
-    kinds = ("uniform", "log_uniform", "choice")
+def _sampling(spec: Any, where: str, key: str, domain: Interval, integer: bool = False) -> Sampling:
+    kinds = ("integers", "choice") if integer else ("uniform", "log_uniform", "choice")
     if not isinstance(spec, Mapping) or len(spec) != 1 or next(iter(spec)) not in kinds:
-        raise TemplateError(where, key, "one of {uniform: [a, b]}, {log_uniform: [a, b]}, {choice: [x, ...]}",
-                            shown(spec))
+        expected = ("{integers: [a, b]} (each whole number from a to b) or {choice: [n, ...]} for an integer "
+                    "parameter" if integer else
+                    "one of {uniform: [a, b]}, {log_uniform: [a, b]}, {choice: [x, ...]}, and {integers: [a, b]} "
+                    "only with integer: true")
+        raise TemplateError(where, key, expected, shown(spec))
     kind, values = next(iter(spec.items()))
     if not isinstance(values, list) or not values or not all(
             isinstance(v, (int, float)) and not isinstance(v, bool) for v in values):
         raise TemplateError(where, f"{key}.{kind}", "a list of numbers", shown(values))
+    if integer and not all(float(v).is_integer() for v in values):
+        raise TemplateError(where, f"{key}.{kind}", "whole numbers (the parameter is an integer)", shown(values))
     if kind != "choice" and (len(values) != 2 or not values[0] < values[1]):
         raise TemplateError(where, f"{key}.{kind}", "[low, high] with low < high", shown(values))
     if kind == "log_uniform" and values[0] <= 0:
@@ -623,7 +663,7 @@ def _example(raw: Any, parameters: Mapping[str, Parameter], where: str) -> dict[
     for name, value in raw.items():
         if isinstance(value, bool) or not isinstance(value, (int, float)):
             raise TemplateError(where, f"example.{name}", "a number", shown(value))
-        if not parameters[name].domain.contains(float(value)):
-            raise TemplateError(where, f"example.{name}", f"a value in the domain {parameters[name].domain}",
-                                shown(value))
+        refusal = parameters[name].refusal(float(value))
+        if refusal is not None:
+            raise TemplateError(where, f"example.{name}", refusal, shown(value))
     return {k: float(v) for k, v in raw.items()}

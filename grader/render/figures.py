@@ -20,6 +20,8 @@ The kind of figure follows from the scene's structure, never from the template's
 * direct impacts of bodies in a line (two, or a chain: 1 strikes 2, 2 strikes 3): blocks whose areas
   follow the masses, above each the velocity before it is struck, an arrow the way it moves with
   lengths in the ratio of the speeds, the bodies at rest marked so;
+* a body bouncing until it rests (``bounces``): the drop and the decaying arcs, heights and time to
+  scale (:mod:`grader.render.series`);
 * anything else: the bodies in a row, labelled.
 
 The oblique figures are :mod:`grader.render.oblique`'s, the drawing primitives
@@ -38,6 +40,7 @@ from grader.model.scene import Stage, Velocity
 from grader.render.canvas import Canvas, Point
 from grader.render.oblique import incline, offset_spheres, spheres, surface
 from grader.render.scene_view import SceneView, find_stage
+from grader.render.series import bounce_series
 from grader.render.worked import Typ, string
 
 
@@ -47,6 +50,9 @@ def figure(template: Template, variant: ProblemVariant, values: Mapping[str, flo
     stages = template.scene.stages
     impact = find_stage(stages, "impact")
     canvas = Canvas()
+    bounces = find_stage(stages, "bounces")
+    if bounces is not None and bounce_series(canvas, scene, bounces):
+        return canvas.typst()
     if impact is None:
         fall = find_stage(stages, "free_fall")
         if fall is None or not _drop(canvas, scene, fall, None, None):

@@ -49,6 +49,7 @@ class Simulation:
     phases: tuple[PhaseRecord, ...]
     contacts: tuple[ContactRecord, ...] = ()
     undefined: Mapping[str, str] = field(default_factory=dict)  # answer -> why it has no value
+    notes: tuple[str, ...] = ()  # what the force laws tell the reader (a series' tail beyond the simulated part)
 
 
 def simulate(template: Template, params: Mapping[str, float], options: Options | None = None) -> Simulation:
@@ -76,7 +77,7 @@ def simulate(template: Template, params: Mapping[str, float], options: Options |
     return Simulation(template.id, dict(params), answers, tuple(run.effects), run.steps,
                       time.perf_counter() - started, fitted, {n: 1.0 for n in template.symbols}, tuple(run.phases),
                       tuple(run.contacts), {name: _why_undefined(template, run, name) or "" for name, value
-                                            in answers.items() if value is None})
+                                            in answers.items() if value is None}, tuple(run.notes))
 
 
 def _check_force_laws(template: Template) -> None:
@@ -92,6 +93,9 @@ def _si_values(template: Template, params: Mapping[str, float]) -> dict[str, flo
         value = float(params[name])
         if not (math.isfinite(value) and parameter.domain.contains(value)):
             raise GraderError(f"{name} = {value:g} is outside its domain {parameter.domain}")
+        if not parameter.admits(value):
+            raise GraderError(f"{name} = {value:g} is not a whole number; {name} is an integer parameter "
+                              f"({parameter.description})")
         values[name] = value * parameter.unit.to_si
     values.update({name: 1.0 * spec.unit.to_si for name, spec in template.symbols.items()})
     if template.scene.gravity is not None:

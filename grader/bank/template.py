@@ -34,10 +34,11 @@ _ID = re.compile(r"[a-z0-9][a-z0-9-]*\Z")
 _TOP_KEYS = {"id", "title", "topic", "version", "gravity", "bodies", "stages", "symbols", "parameters",
              "constraints", "answers", "tolerance", "statement", "example"}
 
-TOPICS = ("direct impact", "oblique impact", "drops and rebounds")
+TOPICS = ("direct impact", "oblique impact", "drops and rebounds", "impact and a swing")
 """The topics ``grader list`` groups the bank by, in its order. A template names one (``topic:``), or
 its scene decides: an impact with t components (or a velocity from its components) is oblique; else
-a scene with a fall or a rise is drops and rebounds; else it is a direct impact."""
+a scene with a swing is an impact and a swing; else a scene with a fall, a rise or bounces is drops and
+rebounds; else it is a direct impact."""
 
 
 @dataclass(frozen=True)
@@ -517,7 +518,9 @@ def infer_topic(scene: Scene) -> str:
     effects = {stage.effect for stage in scene.stages}
     if "velocity" in effects or any(stage.is_oblique for stage in scene.stages):
         return "oblique impact"
-    if effects & {"free_fall", "rise"}:
+    if "swing" in effects:
+        return "impact and a swing"
+    if effects & {"free_fall", "rise", "bounces"}:
         return "drops and rebounds"
     return "direct impact"
 

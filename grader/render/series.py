@@ -44,10 +44,9 @@ def bounce_series(canvas: Canvas, scene: SceneView, stage: Stage) -> bool:
                     dash="dashed")
         if number == int(count) and "rebound" in stage.fields:
             apex = x + width / 2
-            canvas.circle((apex, top + radius), radius, "dashed", fill=False)
             canvas.dimension((apex, 0.0), (apex, top), [], "right")
-            canvas.label((apex + radius + 0.1, top + radius + 0.1), "sw", [math(stage.fields["rebound"])])
-        if number <= 3 or number == int(count):
+            canvas.label((apex + 0.12, top + 0.3), "sw", [math(stage.fields["rebound"])])
+        if number <= 3 or number == int(count):  # the impact that starts the arc
             canvas.label((x, -0.12), "n", [str(number)])
         x += width
     canvas.ground(0.0, max(x, x0 + fall) + 0.4, 0.0)

@@ -28,7 +28,7 @@ from scipy.optimize import brentq
 from grader.bank.template import Template
 from grader.errors import GraderError
 from grader.model.expr import Sym, names
-from grader.model.scene import Stage
+from grader.model.scene import Stage, Velocity
 from grader.physics.effects import CATALOGUE
 from grader.physics.integrate import MAX_STEPS, Budget, SimulationError
 from grader.physics.run import ContactRecord, Options, PhaseRecord, Run, UnknownQuantityError
@@ -133,7 +133,8 @@ SEARCH_PASSES = 25
 # What a search may find, by the stage field that needs it: a restitution in [0, 1]; a fall height in
 # [0, inf), bracketed by growing an upper end from the size of the outcome it must match.
 _SEARCHABLE = {("impact", "restitution"): ("coefficient of restitution", 0.0, 1.0),
-               ("free_fall", "height"): ("fall height", 0.0, math.inf)}
+               ("free_fall", "height"): ("fall height", 0.0, math.inf),
+               ("impact", "before"): ("speed before the impact", 0.0, math.inf)}
 _PROBE = 0.5  # a value of the unknown that shows which outcome it leads to
 _GROWTH, _MAX_GROWTH = 4.0, 120  # an open upper end grows 4x at a time, at most 120 times (4**120 ~ 1e72)
 
@@ -190,7 +191,7 @@ def _next_unknown(template: Template, options: Options, values: dict[str, float]
     for index, name in sorted(stalled.waiting.items()):
         stage = template.scene.stages[index]
         kind = next((_SEARCHABLE[(stage.effect, key)] for key, value in stage.fields.items()
-                     if (stage.effect, key) in _SEARCHABLE and value == Sym(name)), None)
+                     if (stage.effect, key) in _SEARCHABLE and _names(value, name)), None)
         if kind is None or name in (u for u, _ in tried):
             continue
         probe = _walk(template, options, {**values, name: _PROBE}, budget)
@@ -204,6 +205,14 @@ def _next_unknown(template: Template, options: Options, values: dict[str, float]
     name, count = tried[0]
     raise SimulationError(f"cannot simulate: finding {name} needs exactly one measured outcome that it alone "
                           f"leads to, the scene has {count}")
+
+
+def _names(field: object, name: str) -> bool:
+    """Whether a stage field is the quantity ``name`` itself: the field, or a body's velocity along n
+    alone (a bullet's speed before it strikes, found from what the block does after)."""
+    if isinstance(field, Mapping):
+        return any(isinstance(v, Velocity) and v.n == Sym(name) and v.t is None for v in field.values())
+    return field == Sym(name)
 
 
 def _search(template: Template, options: Options, values: dict[str, float], budget: Budget,

@@ -78,10 +78,13 @@ class _Impact:
         centre = (w2 * u1 + w1 * u2) / (w1 + w2)
         e_text = self.stage.text("restitution")
 
+        given_impulse = {impulse: (1 + used) * approach / (w1 + w2)}
+        if isinstance(u1, sp.Symbol) and not self.e.free_symbols:
+            # A speed before found from the impulse (a bullet's, from the block it strikes and embeds in).
+            given_impulse[u1] = u2 + impulse * sp.together(w1 + w2) / (1 + used)
         relations = [
             Relation(f"impulse along n in the impact of {first} and {second}, with restitution {e_text}",
-                     impulse, (1 + used) * approach / (w1 + w2), solutions={impulse: (1 + used) * approach / (w1 + w2)},
-                     general=False),
+                     impulse, (1 + used) * approach / (w1 + w2), solutions=given_impulse, general=False),
             Relation(f"impulse-momentum for {first} along n", a1, u1 - impulse * w1,
                      solutions={a1: u1 - impulse * w1, impulse: (u1 - a1) / w1},
                      stable={a1: (Stable(centre - used * w1 * approach / (w1 + w2)),)}),

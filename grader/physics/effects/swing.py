@@ -71,7 +71,8 @@ def _energy(stage: Stage, ctx: Context, height: str = "1 - cos") -> list[Relatio
         f"does no work): it rises L(1 − cos θ) to stop at {stage.text('angle')} from the vertical",
         speed, bottom_speed, solutions=solutions, stable=stable, general=False,
         requires=(
-            Condition(sp.Ge(speed, 0), f"{body} must move at the lowest point ({stage.text('speed')} >= 0) to swing up"),
+            Condition(sp.Ge(speed, 0), f"{body} must move at the lowest point ({stage.text('speed')} >= 0) to "
+                      "swing up"),
             Condition(sp.Gt(length, 0), f"the cord's length {stage.text('length')} must be positive"),
             Condition(sp.Ge(angle, 0), "the swing angle is {value} degrees; it is measured from the vertical and "
                       "cannot be negative", subject=degrees),

@@ -200,14 +200,15 @@ def test_a_swing_given_its_speed_stops_where_energy_says(bank: dict[str, Any]) -
     compiled = compile_template(template)
     for v in (1e-6, 2.0, 5.0):
         closed = solve_one(template, compiled, {"v": v, "L": 1.6})
-        exact = mp.degrees(2 * mp.asin(mp.mpf(v) / (2 * mp.sqrt(G * mp.mpf(1.6)))))
+        with mp.workdps(60):
+            exact = mp.degrees(2 * mp.asin(mp.mpf(v) / (2 * mp.sqrt(G * mp.mpf(1.6)))))
         assert closed.answers is not None and closed.answers["theta"].value == pytest.approx(float(exact), rel=1e-12)
         assert simulate(template, {"v": v, "L": 1.6}).answers["theta"] == pytest.approx(float(exact), rel=1e-8)
     too_fast = solve_one(template, compiled, {"v": 6.0, "L": 1.6})
     assert too_fast.error is not None and "above 90 degrees the cord would go slack" in too_fast.error
     from grader.physics.integrate import SimulationError
 
-    with pytest.raises(SimulationError, match="the cord goes slack at 1[0-9][0-9].* degrees from the vertical"):
+    with pytest.raises(SimulationError, match=r"the cord goes slack at 1[0-9][0-9].* degrees from the vertical"):
         simulate(template, {"v": 6.0, "L": 1.6})
 
 
@@ -239,3 +240,26 @@ def test_simulate_cli_prints_the_partial_sums(capsys: pytest.CaptureFixture[str]
     record = __import__("json").loads(capsys.readouterr().out)
     assert record["notes"][0].startswith("bounces of ball on floor: the first 5 simulated in time")
     assert max(row["rel_diff"] for row in record["answers"].values()) < 1e-7
+
+
+def test_a_swing_given_its_angle_is_simulated_swinging_down(bank: dict[str, Any]) -> None:
+    """Released at rest at the angle, the pendulum reaches the lowest point at the closed form's speed,
+    2 sqrt(g L) sin(theta/2), from a swing of 1e-4 degrees to one of 90."""
+    from grader.bank.template import parse_template
+    from grader.solve.solver import compile_template
+
+    raw = {"id": "swing-down", "title": "t", "version": 1, "gravity": "9.81 m/s^2", "bodies": {"bob": {"mass": "m"}},
+           "symbols": {"m": {"unit": "kg"}},
+           "parameters": {"theta": {"unit": "deg", "domain": "(0, 90]", "sample": {"uniform": [5, 60]}, "decimals": 1},
+                          "L": {"unit": "m", "domain": "(0, inf)", "sample": {"uniform": [1, 2]}, "decimals": 2}},
+           "stages": [{"effect": "swing", "body": "bob", "speed": "v", "length": "L", "angle": "theta"}],
+           "answers": {"v": {"value": "v", "unit": "m/s"}}, "statement": "theta = {{ theta }}, L = {{ L }}"}
+    template = parse_template(raw, "test:swing-down", "swing-down")
+    compiled = compile_template(template)
+    for theta in (1e-4, 30.0, 90.0):
+        with mp.workdps(60):
+            exact = mp.sqrt(2 * G * mp.mpf(1.6) * (1 - mp.cos(mp.radians(mp.mpf(theta)))))
+        closed = solve_one(template, compiled, {"theta": theta, "L": 1.6})
+        assert closed.answers is not None and closed.answers["v"].value == pytest.approx(float(exact), rel=1e-13)
+        result = simulate(template, {"theta": theta, "L": 1.6})
+        assert result.answers["v"] == pytest.approx(float(exact), rel=1e-8) and not result.fitted

@@ -27,7 +27,7 @@ def swing_figure(canvas: Canvas, scene: SceneView, swing: Stage, impact: Stage |
     theta = scene.value(swing.fields["angle"])
     if not (_m.isfinite(theta) and 0 <= theta <= _m.pi / 2):
         return False
-    canvas.ground(-1.2, 1.2 + CORD * _m.sin(theta), 0.0, below=False)
+    canvas.ground(-0.9, 0.9, 0.0, below=False)  # short: at 90 degrees the block reaches the pivot's height
     canvas.circle((0.0, 0.0), 0.06)
     low = (0.0, -CORD)
     high = (CORD * _m.sin(theta), -CORD * _m.cos(theta))
@@ -45,8 +45,10 @@ def swing_figure(canvas: Canvas, scene: SceneView, swing: Stage, impact: Stage |
         canvas.arc((0.0, 0.0), mark, -_m.pi / 2, -_m.pi / 2 + theta)
     # The angle's name left of the vertical, the cord's length right of the cord: neither crosses a line.
     canvas.label((-0.12, -mark), "e", scene.given(swing.fields["angle"]))
-    middle = (0.5 * high[0], 0.5 * high[1])
-    canvas.label((middle[0] + 0.3 + 0.2 * _m.cos(theta), middle[1]), "w", scene.given(swing.fields["length"]))
+    middle, normal = (0.5 * high[0], 0.5 * high[1]), (_m.cos(theta), _m.sin(theta))  # normal: away from the arc
+    steep = theta < _m.pi / 4
+    canvas.label((middle[0] + 0.25 * normal[0], middle[1] + 0.25 * normal[1]), "w" if steep else "s",
+                 scene.given(swing.fields["length"]))
     if impact is not None:
         _striker(canvas, scene, impact, low)
     return True

@@ -26,8 +26,9 @@ def bounce_series(canvas: Canvas, scene: SceneView, stage: Stage) -> bool:
     if not (_m.isfinite(h0) and h0 > 0 and _m.isfinite(e) and 0 <= e < 1 and _m.isfinite(count)):
         return False
     ratio = e * e
-    arcs = [h0 * ratio**k for k in range(1, 40) if ratio**k >= SMALLEST]
-    arcs = arcs[:max(int(count), 7)]
+    # The arcs that show (at most 7), and always the asked one (up to the 12th).
+    shown = sum(1 for k in range(1, 8) if ratio**k >= SMALLEST)
+    arcs = [h0 * ratio**k for k in range(1, min(max(int(count), shown), 12) + 1)]
     # Time to scale: the fall takes sqrt(h0), each arc 2 sqrt(h) (in units of sqrt(2/g)).
     span = _m.sqrt(h0) + sum(2 * _m.sqrt(h) for h in arcs)
     x_scale, y_scale = WIDE / span, TALL / h0
@@ -50,6 +51,6 @@ def bounce_series(canvas: Canvas, scene: SceneView, stage: Stage) -> bool:
             canvas.label((x, -0.12), "n", [str(number)])
         x += width
     canvas.ground(0.0, max(x, x0 + fall) + 0.4, 0.0)
-    canvas.label((x + 0.5, 0.1), "sw", [str(string(floor))])
+    canvas.label((x + 0.55, -0.05), "w", [str(string(floor))])  # past the floor's end: clear of the arcs
     canvas.label((x0 + fall + 0.15, TALL * 0.75), "w", scene.given(stage.fields["restitution"]))
     return True

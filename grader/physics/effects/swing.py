@@ -123,7 +123,7 @@ def _simulate_swing(stage: Stage, run: Run) -> None:
         # The first to reach zero: the rate (the swing stops), the tension per unit mass over g (the
         # cord goes slack), or the height left to the top (fast enough, the body loops the loop on a
         # taut cord); all start positive at the lowest point.
-        return min(y[1] * period, math.cos(y[0]) + length * y[1] * y[1] / g, math.pi - y[0])
+        return float(min(y[1] * period, math.cos(y[0]) + length * y[1] * y[1] / g, math.pi - y[0]))
 
     swing = Mode("swing", pendulum(g, length), stops_or_slackens, -1, scale=period)
     path = run.integrate([swing], np.array([0.0, speed / length]))

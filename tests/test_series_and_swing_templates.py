@@ -17,6 +17,7 @@ from grader.cli import main
 from grader.simulate.walker import simulate
 from grader.solve.cache import alternatives_for
 from grader.solve.evaluate import solve_one
+from grader.solve.solver import compile_template
 from tests import references
 from tests.test_diagnosis import graded_alone, mistake_value
 
@@ -183,20 +184,25 @@ def test_the_pendulum_simulated_finds_the_bullets_speed(bank: dict[str, Any], co
         assert value == pytest.approx(closed.answers[name].value, rel=1e-7), name
 
 
+def _bob(template_id: str, given: dict[str, tuple[str, str]], asked: tuple[str, str]) -> Any:
+    """A bob on a cord of length L: one of its speed v at the lowest point and the angle theta it stops at
+    given (unit, domain), the other asked."""
+    from grader.bank.template import parse_template
+
+    parameters = {name: {"unit": unit, "domain": domain, "sample": {"uniform": [1, 2]}, "decimals": 2}
+                  for name, (unit, domain) in {**given, "L": ("m", "(0, inf)")}.items()}
+    raw = {"id": template_id, "title": "t", "version": 1, "gravity": "9.81 m/s^2", "bodies": {"bob": {"mass": "m"}},
+           "symbols": {"m": {"unit": "kg"}}, "parameters": parameters,
+           "stages": [{"effect": "swing", "body": "bob", "speed": "v", "length": "L", "angle": "theta"}],
+           "answers": {asked[0]: {"value": asked[0], "unit": asked[1]}},
+           "statement": " ".join(f"{name} = {{{{ {name} }}}}" for name in parameters)}
+    return parse_template(raw, f"test:{template_id}", template_id)
+
+
 def test_a_swing_given_its_speed_stops_where_energy_says(bank: dict[str, Any]) -> None:
     """The swing up, forward: the pendulum released at the lowest point at v stops at the angle of the closed
     form; above 90 degrees its cord goes slack, and the simulation says so."""
-    from grader.bank.template import parse_template
-
-    raw = {"id": "swing-up", "title": "t", "version": 1, "gravity": "9.81 m/s^2", "bodies": {"bob": {"mass": "m"}},
-           "symbols": {"m": {"unit": "kg"}},
-           "parameters": {"v": {"unit": "m/s", "domain": "[0, inf)", "sample": {"uniform": [1, 2]}, "decimals": 2},
-                          "L": {"unit": "m", "domain": "(0, inf)", "sample": {"uniform": [1, 2]}, "decimals": 2}},
-           "stages": [{"effect": "swing", "body": "bob", "speed": "v", "length": "L", "angle": "theta"}],
-           "answers": {"theta": {"value": "theta", "unit": "deg"}}, "statement": "v = {{ v }}, L = {{ L }}"}
-    template = parse_template(raw, "test:swing-up", "swing-up")
-    from grader.solve.solver import compile_template
-
+    template = _bob("swing-up", {"v": ("m/s", "[0, inf)")}, ("theta", "deg"))
     compiled = compile_template(template)
     for v in (1e-6, 2.0, 5.0):
         closed = solve_one(template, compiled, {"v": v, "L": 1.6})
@@ -245,16 +251,7 @@ def test_simulate_cli_prints_the_partial_sums(capsys: pytest.CaptureFixture[str]
 def test_a_swing_given_its_angle_is_simulated_swinging_down(bank: dict[str, Any]) -> None:
     """Released at rest at the angle, the pendulum reaches the lowest point at the closed form's speed,
     2 sqrt(g L) sin(theta/2), from a swing of 1e-4 degrees to one of 90."""
-    from grader.bank.template import parse_template
-    from grader.solve.solver import compile_template
-
-    raw = {"id": "swing-down", "title": "t", "version": 1, "gravity": "9.81 m/s^2", "bodies": {"bob": {"mass": "m"}},
-           "symbols": {"m": {"unit": "kg"}},
-           "parameters": {"theta": {"unit": "deg", "domain": "(0, 90]", "sample": {"uniform": [5, 60]}, "decimals": 1},
-                          "L": {"unit": "m", "domain": "(0, inf)", "sample": {"uniform": [1, 2]}, "decimals": 2}},
-           "stages": [{"effect": "swing", "body": "bob", "speed": "v", "length": "L", "angle": "theta"}],
-           "answers": {"v": {"value": "v", "unit": "m/s"}}, "statement": "theta = {{ theta }}, L = {{ L }}"}
-    template = parse_template(raw, "test:swing-down", "swing-down")
+    template = _bob("swing-down", {"theta": ("deg", "(0, 90]")}, ("v", "m/s"))
     compiled = compile_template(template)
     for theta in (1e-4, 30.0, 90.0):
         with mp.workdps(60):

@@ -1,8 +1,8 @@
 """The problem bank: YAML templates parsed into frozen, validated :class:`Template` objects.
 
 >>> bank = load_bank()
->>> sorted(bank)[:2]
-['ball-plate', 'billiards']
+>>> sorted(bank)[:3]
+['ball-plate', 'ballistic-pendulum', 'billiards']
 >>> bank["drop-rebound"].parameters["h_drop"].unit.text
 'mm'
 """

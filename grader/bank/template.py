@@ -112,6 +112,10 @@ class Parameter:
         inside = self.domain.contains(value)
         return inside & (value % 1 == 0) if self.integer else inside
 
+    def not_whole(self, shown: str) -> str:
+        """Why a value printed as ``shown`` is refused for an integer parameter."""
+        return f"{self.name} = {shown} is not a whole number; {self.name} is an integer parameter ({self.description})"
+
     def refusal(self, value: float) -> str | None:
         """Why ``value`` cannot be this parameter's (what was expected), or None when it can.
 

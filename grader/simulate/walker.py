@@ -94,8 +94,7 @@ def _si_values(template: Template, params: Mapping[str, float]) -> dict[str, flo
         if not (math.isfinite(value) and parameter.domain.contains(value)):
             raise GraderError(f"{name} = {value:g} is outside its domain {parameter.domain}")
         if not parameter.admits(value):
-            raise GraderError(f"{name} = {value:g} is not a whole number; {name} is an integer parameter "
-                              f"({parameter.description})")
+            raise GraderError(parameter.not_whole(f"{value:g}"))
         values[name] = value * parameter.unit.to_si
     values.update({name: 1.0 * spec.unit.to_si for name, spec in template.symbols.items()})
     if template.scene.gravity is not None:

@@ -322,8 +322,8 @@ def _show(arguments: argparse.Namespace) -> int:
             "file": template.where, "statement": example_statement(template), "example": printed,
             "example_answers": None if example.answers is None else
             {name: value.to_json() for name, value in example.answers.items()},
-            "parameters": {n: {"unit": p.unit.text, "domain": str(p.domain), "description": p.description}
-                           for n, p in template.parameters.items()},
+            "parameters": {n: {"unit": p.unit.text, "domain": str(p.domain), "integer": p.integer,
+                               "description": p.description} for n, p in template.parameters.items()},
             "answers": {n: {"unit": a.unit.text, "description": a.description, "symbolic": list(a.symbolic)}
                         for n, a in template.answers.items()},
             "steps": [{"unknown": s.unknown, "relation": s.relation, "solved": to_text(readable(s.solved, names))}
@@ -345,7 +345,7 @@ def _show(arguments: argparse.Namespace) -> int:
               for s in scene.stages]
     lines += ["", "Parameters:"]
     lines += [f"  {n:<10} {p.unit.text or '-':<6} {p.domain!s:<12} {p.description}"
-              for n, p in template.parameters.items()]
+              + (" (a whole number)" if p.integer else "") for n, p in template.parameters.items()]
     lines += ["", "Answers:"]
     lines += [f"  {n:<10} {a.unit.text or '-':<6} {a.description}" for n, a in template.answers.items()]
     lines += ["", "Step chain (one equation, one unknown):"]
@@ -466,6 +466,7 @@ def _simulate(arguments: argparse.Namespace) -> int:
               "fitted": dict(result.fitted), "nominal": dict(result.nominal),
               "contacts": [{"impact": c.label, "e": c.e, "measured_e": c.measured_e, "zeta": c.zeta,
                             "duration": c.duration} for c in result.contacts],
+              "notes": list(result.notes),
               "settings": {"steps_per_contact": settings.steps, "rtol": settings.rtol,
                            "contact_duration": options.contact_duration,
                            "weight_during_contact": options.weight_during_contact}}
@@ -501,6 +502,8 @@ def _print_simulation(template: Template, record: dict[str, Any]) -> None:
     for contact in record["contacts"]:
         print(f"{contact['impact']}: Kelvin-Voigt contact of {contact['duration'] * 1e3:g} ms, zeta = "
               f"{contact['zeta']:.4f}, measured e = separation/approach = {contact['measured_e']:.10g}")
+    for note in record["notes"]:
+        print(note)
     from grader.model.expr import to_text
 
     restitutions = {to_text(s.fields["restitution"]) for s in template.scene.stages if s.effect == "impact"}

@@ -17,7 +17,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from grader.bank.template import Interval, Template, tolerance_in
+from grader.bank.template import Parameter, Template, tolerance_in
 from grader.errors import GraderError, TemplateError, shown
 from grader.inputs import read_csv, read_yaml
 from grader.model.tolerance import FORMS
@@ -209,19 +209,20 @@ def check_against_bank(assignment: Assignment, bank: Mapping[str, Template]) -> 
                 raise TemplateError(assignment.where, f"{key}.{label}", f"parameters of {template.id} "
                                     f"({', '.join(template.parameters)})", ", ".join(sorted(unknown)))
         for name, value in problem.fixed.items():
-            _inside(template.parameters[name].domain, value, assignment.where, f"{key}.fixed.{name}")
+            _admitted(template.parameters[name], value, assignment.where, f"{key}.fixed.{name}")
         for name, (low, high) in problem.narrowed.items():
             for value in (low, high):
-                _inside(template.parameters[name].domain, value, assignment.where, f"{key}.narrow.{name}")
+                _admitted(template.parameters[name], value, assignment.where, f"{key}.narrow.{name}")
         unknown = (set(problem.points) - {"*"} | set(problem.tolerances)) - set(template.answers)
         if unknown:
             raise TemplateError(assignment.where, key, f"answer names of {template.id} ({', '.join(template.answers)})",
                                 ", ".join(sorted(unknown)))
 
 
-def _inside(domain: Interval, value: float, where: str, key: str) -> None:
-    if not domain.contains(value):
-        raise TemplateError(where, key, f"a value in the parameter's domain {domain}", f"{value:g}")
+def _admitted(parameter: Parameter, value: float, where: str, key: str) -> None:
+    refusal = parameter.refusal(value)
+    if refusal is not None:
+        raise TemplateError(where, key, refusal, f"{value:g}")
 
 
 def load_roster(path: Path) -> tuple[Student, ...]:

@@ -120,7 +120,10 @@ def _draw(parameter: Parameter, problem: ProblemSpec, rng: np.random.Generator) 
         value = problem.fixed[name]
     elif name in problem.narrowed:
         low, high = problem.narrowed[name]
-        value = float(rng.uniform(low, high))
+        value = float(rng.integers(int(low), int(high), endpoint=True) if parameter.integer else rng.uniform(low, high))
+    elif parameter.sample.kind == "integers":
+        low, high = parameter.sample.values
+        value = float(rng.integers(int(low), int(high), endpoint=True))
     elif parameter.sample.kind == "choice":
         value = float(rng.choice(parameter.sample.values))
     elif parameter.sample.kind == "log_uniform":

@@ -1,8 +1,8 @@
 """The problem bank: YAML templates parsed into frozen, validated :class:`Template` objects.
 
 >>> bank = load_bank()
->>> sorted(bank)[:2]
-['ball-plate', 'billiards']
+>>> sorted(bank)[:3]
+['ball-plate', 'ballistic-pendulum', 'billiards']
 >>> bank["drop-rebound"].parameters["h_drop"].unit.text
 'mm'
 """
@@ -34,10 +34,11 @@ _ID = re.compile(r"[a-z0-9][a-z0-9-]*\Z")
 _TOP_KEYS = {"id", "title", "topic", "version", "gravity", "bodies", "stages", "symbols", "parameters",
              "constraints", "answers", "tolerance", "statement", "example"}
 
-TOPICS = ("direct impact", "oblique impact", "drops and rebounds")
+TOPICS = ("direct impact", "oblique impact", "drops and rebounds", "impact and a swing")
 """The topics ``grader list`` groups the bank by, in its order. A template names one (``topic:``), or
 its scene decides: an impact with t components (or a velocity from its components) is oblique; else
-a scene with a fall or a rise is drops and rebounds; else it is a direct impact."""
+a scene with a swing is an impact and a swing; else a scene with a fall, a rise or bounces is drops and
+rebounds; else it is a direct impact."""
 
 
 @dataclass(frozen=True)
@@ -80,7 +81,8 @@ class Interval:
 
 @dataclass(frozen=True)
 class Sampling:
-    """How a variant draws a parameter: ``uniform``, ``log_uniform`` over a range, or ``choice``."""
+    """How a variant draws a parameter: ``uniform``, ``log_uniform`` over a range, ``integers`` (each
+    whole number of a range, ends included, equally likely) or ``choice``."""
 
     kind: str
     values: tuple[float, ...]
@@ -97,6 +99,35 @@ class Parameter:
     decimals: int | None
     sig_figs: int | None
     description: str
+    integer: bool = False  # a count (of bounces, ...): sampled, printed and accepted as a whole number only
+
+    def admits(self, value: Any) -> Any:
+        """Whether ``value`` (a number or numpy array) may be this parameter's: in its domain, and a
+        whole number for an integer parameter.
+
+        >>> n = load_bank()["successive-bounces"].parameters["n"]
+        >>> bool(n.admits(3.0)), bool(n.admits(2.5)), bool(n.admits(0.0))
+        (True, False, False)
+        """
+        inside = self.domain.contains(value)
+        return inside & (value % 1 == 0) if self.integer else inside
+
+    def not_whole(self, shown: str) -> str:
+        """Why a value printed as ``shown`` is refused for an integer parameter."""
+        return f"{self.name} = {shown} is not a whole number; {self.name} is an integer parameter ({self.description})"
+
+    def refusal(self, value: float) -> str | None:
+        """Why ``value`` cannot be this parameter's (what was expected), or None when it can.
+
+        >>> load_bank()["successive-bounces"].parameters["n"].refusal(2.5)
+        'a whole number (n is an integer parameter: number of bounces counted)'
+        """
+        if not self.domain.contains(value):
+            whole = "a whole number " if self.integer else "a value "
+            return f"{whole}in the parameter's domain {self.domain}"
+        if self.integer and value % 1 != 0:
+            return f"a whole number ({self.name} is an integer parameter: {self.description})"
+        return None
 
 
 @dataclass(frozen=True)
@@ -491,7 +522,9 @@ def infer_topic(scene: Scene) -> str:
     effects = {stage.effect for stage in scene.stages}
     if "velocity" in effects or any(stage.is_oblique for stage in scene.stages):
         return "oblique impact"
-    if effects & {"free_fall", "rise"}:
+    if "swing" in effects:
+        return "impact and a swing"
+    if effects & {"free_fall", "rise", "bounces"}:
         return "drops and rebounds"
     return "direct impact"
 
@@ -513,13 +546,22 @@ def _parameter(name: str, spec: Any, where: str) -> Parameter:
     key = f"parameters.{name}"
     if not isinstance(spec, Mapping):
         raise TemplateError(where, key, "a mapping with unit, domain, sample and decimals or sig_figs", shown(spec))
-    allowed = {"unit", "domain", "sample", "decimals", "sig_figs", "description"}
+    allowed = {"unit", "domain", "sample", "decimals", "sig_figs", "description", "integer"}
     if set(spec) - allowed:
         raise TemplateError(where, key, f"only {', '.join(sorted(allowed))}",
                             f"unknown key(s) {', '.join(sorted(set(spec) - allowed))}")
+    integer = spec.get("integer", False)
+    if not isinstance(integer, bool):
+        raise TemplateError(where, f"{key}.integer", "true or false", shown(integer))
     domain = Interval.parse(spec.get("domain"), where, f"{key}.domain")
-    sample = _sampling(spec.get("sample"), where, f"{key}.sample", domain)
+    sample = _sampling(spec.get("sample"), where, f"{key}.sample", domain, integer)
     decimals, sig_figs = spec.get("decimals"), spec.get("sig_figs")
+    if integer:
+        # A count prints as a whole number: decimals 0, said or not.
+        if sig_figs is not None or decimals not in (None, 0) or isinstance(decimals, bool):
+            raise TemplateError(where, key, "no printed precision, or decimals: 0 (an integer parameter prints as a "
+                                "whole number)", f"decimals={shown(decimals)}, sig_figs={shown(sig_figs)}")
+        decimals = 0
     if (decimals is None) == (sig_figs is None):
         raise TemplateError(where, key, "exactly one of decimals or sig_figs (the printed precision)",
                             f"decimals={shown(decimals)}, sig_figs={shown(sig_figs)}")
@@ -527,18 +569,23 @@ def _parameter(name: str, spec: Any, where: str) -> Parameter:
         if value is not None and (not isinstance(value, int) or isinstance(value, bool) or not least <= value <= 15):
             raise TemplateError(where, f"{key}.{label}", f"a whole number from {least} to 15", shown(value))
     return Parameter(name, _unit(spec.get("unit"), where, f"{key}.unit"), domain, sample, decimals, sig_figs,
-                     str(spec.get("description", name)))
+                     str(spec.get("description", name)), integer)
 
 
-def _sampling(spec: Any, where: str, key: str, domain: Interval) -> Sampling:
-    kinds = ("uniform", "log_uniform", "choice")
+def _sampling(spec: Any, where: str, key: str, domain: Interval, integer: bool = False) -> Sampling:
+    kinds = ("integers", "choice") if integer else ("uniform", "log_uniform", "choice")
     if not isinstance(spec, Mapping) or len(spec) != 1 or next(iter(spec)) not in kinds:
-        raise TemplateError(where, key, "one of {uniform: [a, b]}, {log_uniform: [a, b]}, {choice: [x, ...]}",
-                            shown(spec))
+        expected = ("{integers: [a, b]} (each whole number from a to b) or {choice: [n, ...]} for an integer "
+                    "parameter" if integer else
+                    "one of {uniform: [a, b]}, {log_uniform: [a, b]}, {choice: [x, ...]}, and {integers: [a, b]} "
+                    "only with integer: true")
+        raise TemplateError(where, key, expected, shown(spec))
     kind, values = next(iter(spec.items()))
     if not isinstance(values, list) or not values or not all(
             isinstance(v, (int, float)) and not isinstance(v, bool) for v in values):
         raise TemplateError(where, f"{key}.{kind}", "a list of numbers", shown(values))
+    if integer and not all(float(v).is_integer() for v in values):
+        raise TemplateError(where, f"{key}.{kind}", "whole numbers (the parameter is an integer)", shown(values))
     if kind != "choice" and (len(values) != 2 or not values[0] < values[1]):
         raise TemplateError(where, f"{key}.{kind}", "[low, high] with low < high", shown(values))
     if kind == "log_uniform" and values[0] <= 0:
@@ -623,7 +670,7 @@ def _example(raw: Any, parameters: Mapping[str, Parameter], where: str) -> dict[
     for name, value in raw.items():
         if isinstance(value, bool) or not isinstance(value, (int, float)):
             raise TemplateError(where, f"example.{name}", "a number", shown(value))
-        if not parameters[name].domain.contains(float(value)):
-            raise TemplateError(where, f"example.{name}", f"a value in the domain {parameters[name].domain}",
-                                shown(value))
+        refusal = parameters[name].refusal(float(value))
+        if refusal is not None:
+            raise TemplateError(where, f"example.{name}", refusal, shown(value))
     return {k: float(v) for k, v in raw.items()}

@@ -73,6 +73,7 @@ class Run:
     undefined: dict[str, str] = field(default_factory=dict)  # quantity -> why it has no value
     waiting: dict[int, str] = field(default_factory=dict)  # stage index -> a quantity it needs that nothing gave
     budget: Budget = field(default_factory=Budget)
+    notes: list[str] = field(default_factory=list)  # what a force law tells the reader (a series' tail)
     steps: int = 0
     speed_scale: float = 0.0  # the largest speed an impact of this run involved (SI)
 

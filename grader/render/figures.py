@@ -20,6 +20,10 @@ The kind of figure follows from the scene's structure, never from the template's
 * direct impacts of bodies in a line (two, or a chain: 1 strikes 2, 2 strikes 3): blocks whose areas
   follow the masses, above each the velocity before it is struck, an arrow the way it moves with
   lengths in the ratio of the speeds, the bodies at rest marked so;
+* a body bouncing until it rests (``bounces``): the drop and the decaying arcs, heights and time to
+  scale (:mod:`grader.render.series`);
+* a body swinging up on a cord (``swing``), struck at the lowest point maybe: the cord at rest and at its
+  greatest angle, to scale, and the arc between (:mod:`grader.render.pendulum`);
 * anything else: the bodies in a row, labelled.
 
 The oblique figures are :mod:`grader.render.oblique`'s, the drawing primitives
@@ -37,7 +41,9 @@ from grader.model.expr import Node, Op
 from grader.model.scene import Stage, Velocity
 from grader.render.canvas import Canvas, Point
 from grader.render.oblique import incline, offset_spheres, spheres, surface
+from grader.render.pendulum import swing_figure
 from grader.render.scene_view import SceneView, find_stage
+from grader.render.series import bounce_series
 from grader.render.worked import Typ, string
 
 
@@ -47,6 +53,11 @@ def figure(template: Template, variant: ProblemVariant, values: Mapping[str, flo
     stages = template.scene.stages
     impact = find_stage(stages, "impact")
     canvas = Canvas()
+    bounces, swing = find_stage(stages, "bounces"), find_stage(stages, "swing")
+    if bounces is not None and bounce_series(canvas, scene, bounces):
+        return canvas.typst()
+    if swing is not None and swing_figure(canvas, scene, swing, impact):
+        return canvas.typst()
     if impact is None:
         fall = find_stage(stages, "free_fall")
         if fall is None or not _drop(canvas, scene, fall, None, None):

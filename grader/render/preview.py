@@ -29,6 +29,8 @@ def _middle(parameter: Parameter) -> float:
     values = parameter.sample.values
     if parameter.sample.kind == "choice":
         return values[0]
+    if parameter.sample.kind == "integers":
+        return float(math.floor((values[0] + values[1]) / 2))
     return math.sqrt(values[0] * values[1]) if parameter.sample.kind == "log_uniform" else (values[0] + values[1]) / 2
 
 

@@ -28,7 +28,7 @@ from scipy.optimize import brentq
 from grader.bank.template import Template
 from grader.errors import GraderError
 from grader.model.expr import Sym, names
-from grader.model.scene import Stage
+from grader.model.scene import Stage, Velocity
 from grader.physics.effects import CATALOGUE
 from grader.physics.integrate import MAX_STEPS, Budget, SimulationError
 from grader.physics.run import ContactRecord, Options, PhaseRecord, Run, UnknownQuantityError
@@ -49,6 +49,7 @@ class Simulation:
     phases: tuple[PhaseRecord, ...]
     contacts: tuple[ContactRecord, ...] = ()
     undefined: Mapping[str, str] = field(default_factory=dict)  # answer -> why it has no value
+    notes: tuple[str, ...] = ()  # what the force laws tell the reader (a series' tail beyond the simulated part)
 
 
 def simulate(template: Template, params: Mapping[str, float], options: Options | None = None) -> Simulation:
@@ -76,7 +77,7 @@ def simulate(template: Template, params: Mapping[str, float], options: Options |
     return Simulation(template.id, dict(params), answers, tuple(run.effects), run.steps,
                       time.perf_counter() - started, fitted, {n: 1.0 for n in template.symbols}, tuple(run.phases),
                       tuple(run.contacts), {name: _why_undefined(template, run, name) or "" for name, value
-                                            in answers.items() if value is None})
+                                            in answers.items() if value is None}, tuple(run.notes))
 
 
 def _check_force_laws(template: Template) -> None:
@@ -92,6 +93,8 @@ def _si_values(template: Template, params: Mapping[str, float]) -> dict[str, flo
         value = float(params[name])
         if not (math.isfinite(value) and parameter.domain.contains(value)):
             raise GraderError(f"{name} = {value:g} is outside its domain {parameter.domain}")
+        if not parameter.admits(value):
+            raise GraderError(parameter.not_whole(f"{value:g}"))
         values[name] = value * parameter.unit.to_si
     values.update({name: 1.0 * spec.unit.to_si for name, spec in template.symbols.items()})
     if template.scene.gravity is not None:
@@ -129,7 +132,8 @@ SEARCH_PASSES = 25
 # What a search may find, by the stage field that needs it: a restitution in [0, 1]; a fall height in
 # [0, inf), bracketed by growing an upper end from the size of the outcome it must match.
 _SEARCHABLE = {("impact", "restitution"): ("coefficient of restitution", 0.0, 1.0),
-               ("free_fall", "height"): ("fall height", 0.0, math.inf)}
+               ("free_fall", "height"): ("fall height", 0.0, math.inf),
+               ("impact", "before"): ("speed before the impact", 0.0, math.inf)}
 _PROBE = 0.5  # a value of the unknown that shows which outcome it leads to
 _GROWTH, _MAX_GROWTH = 4.0, 120  # an open upper end grows 4x at a time, at most 120 times (4**120 ~ 1e72)
 
@@ -186,7 +190,7 @@ def _next_unknown(template: Template, options: Options, values: dict[str, float]
     for index, name in sorted(stalled.waiting.items()):
         stage = template.scene.stages[index]
         kind = next((_SEARCHABLE[(stage.effect, key)] for key, value in stage.fields.items()
-                     if (stage.effect, key) in _SEARCHABLE and value == Sym(name)), None)
+                     if (stage.effect, key) in _SEARCHABLE and _names(value, name)), None)
         if kind is None or name in (u for u, _ in tried):
             continue
         probe = _walk(template, options, {**values, name: _PROBE}, budget)
@@ -200,6 +204,14 @@ def _next_unknown(template: Template, options: Options, values: dict[str, float]
     name, count = tried[0]
     raise SimulationError(f"cannot simulate: finding {name} needs exactly one measured outcome that it alone "
                           f"leads to, the scene has {count}")
+
+
+def _names(field: object, name: str) -> bool:
+    """Whether a stage field is the quantity ``name`` itself: the field, or a body's velocity along n
+    alone (a bullet's speed before it strikes, found from what the block does after)."""
+    if isinstance(field, Mapping):
+        return any(isinstance(v, Velocity) and v.n == Sym(name) and v.t is None for v in field.values())
+    return field == Sym(name)
 
 
 def _search(template: Template, options: Options, values: dict[str, float], budget: Budget,

@@ -178,4 +178,6 @@ def _sample_points(template: Template) -> dict[str, np.ndarray]:
             points[name] = np.exp(np.log(low) + where * (np.log(high) - np.log(low)))
         else:
             points[name] = low + where * (high - low)
+        if parameter.integer:  # a count takes whole values, both inside its range
+            points[name] = np.clip(np.round(points[name]), low, high)
     return points

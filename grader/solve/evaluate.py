@@ -110,6 +110,8 @@ def _check_domains(template: Template, columns: Mapping[str, Any], refusals: lis
         _refuse(refusals, ~parameter.domain.contains(values),
                 lambda row, v=values, n=name, p=parameter, u=unit:
                 f"{n} = {_show(v[row])}{u} is outside its domain {p.domain}")
+        if parameter.integer:
+            _refuse(refusals, ~parameter.admits(values), lambda row, v=values, p=parameter: p.not_whole(_show(v[row])))
 
 
 def _check_constraints(template: Template, env: Mapping[str, Any], refusals: list[str | None]) -> None:

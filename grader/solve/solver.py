@@ -132,6 +132,8 @@ class _Compiler:
             low = parameter.domain.low
             positive = low > 0 or (low == 0 and parameter.domain.low_open)
             assumptions = {"positive": True} if positive else {"nonnegative": True} if low >= 0 else {}
+            if parameter.integer:
+                assumptions["integer"] = True
             self.ctx.symbols[name] = sp.Symbol(name, real=True, **assumptions)
         for name in template.symbols:
             self.ctx.symbols[name] = sp.Symbol(name, positive=True)

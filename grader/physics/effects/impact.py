@@ -78,10 +78,13 @@ class _Impact:
         centre = (w2 * u1 + w1 * u2) / (w1 + w2)
         e_text = self.stage.text("restitution")
 
+        given_impulse = {impulse: (1 + used) * approach / (w1 + w2)}
+        if isinstance(u1, sp.Symbol) and not self.e.free_symbols:
+            # A speed before found from the impulse (a bullet's, from the block it strikes and embeds in).
+            given_impulse[u1] = u2 + impulse * sp.together(w1 + w2) / (1 + used)
         relations = [
             Relation(f"impulse along n in the impact of {first} and {second}, with restitution {e_text}",
-                     impulse, (1 + used) * approach / (w1 + w2), solutions={impulse: (1 + used) * approach / (w1 + w2)},
-                     general=False),
+                     impulse, (1 + used) * approach / (w1 + w2), solutions=given_impulse, general=False),
             Relation(f"impulse-momentum for {first} along n", a1, u1 - impulse * w1,
                      solutions={a1: u1 - impulse * w1, impulse: (u1 - a1) / w1},
                      stable={a1: (Stable(centre - used * w1 * approach / (w1 + w2)),)}),
@@ -237,7 +240,7 @@ def _simulate_impact(stage: Stage, run: Run) -> None:
                             if approach <= 0 else f"the coefficient of restitution {e:g} is outside [0, 1]")
         after = before
     else:
-        after = _contact(stage, run, (first, second), (w1, w2), e, before)
+        after = simulate_contact(stage, run, (first, second), (w1, w2), e, before)
     for index, body in enumerate((first, second)):
         given = stage.fields.get("after", {}).get(body)
         if given is not None:
@@ -247,8 +250,11 @@ def _simulate_impact(stage: Stage, run: Run) -> None:
     _output_energies(stage, run, (w1, w2), before, after)
 
 
-def _contact(stage: Stage, run: Run, bodies: tuple[str, str], inverse: tuple[float, float], e: float,
-             before: list[float]) -> list[float]:
+def simulate_contact(stage: Stage, run: Run, bodies: tuple[str, str], inverse: tuple[float, float], e: float,
+                     before: list[float], label: str | None = None) -> list[float]:
+    """One contact of two bodies (inverse masses ``inverse``) arriving with ``before`` (n and t of each)
+    under the law calibrated to ``e``; their velocities after, in the same order. Recorded under
+    ``label`` (default: the impact of the two bodies)."""
     from grader.physics.integrate import Mode  # the simulator's part: loading a template needs none of it
     from grader.physics.run import ContactRecord
 
@@ -281,7 +287,7 @@ def _contact(stage: Stage, run: Run, bodies: tuple[str, str], inverse: tuple[flo
     contact = Mode("contact", pressed, exit_event, -1, scale=duration, omega=law.omega,
                    force=lambda y: law.specific_force(y[0] - y[2], y[4] - y[6]) / (w1 + w2), sizes=lambda y: sizes)
     path = run.integrate([entry, contact], y0)
-    label = f"impact of {bodies[0]} and {bodies[1]}"
+    label = label or f"impact of {bodies[0]} and {bodies[1]}"
     run.record(label, ("x1n", "x1t", "x2n", "x2t", "v1n", "v1t", "v2n", "v2t"), path)
     after = [float(v) for v in path.y[-1][4:]]
     if law.sticks:

@@ -1,0 +1,66 @@
+"""The figure of a ``swing`` stage: a body hanging from a cord, struck (or not) at the lowest point, and
+the arc it swings up along to its greatest angle, to scale.
+
+The cord is drawn at a fixed length; the angle is the variant's own, so a swing of 8 degrees and one of
+40 look as they should. The body at rest at the lowest point is dashed, at the top of its swing solid.
+A body that strikes it (an ``impact`` stage before the swing) comes in from the left along the
+horizontal, with its velocity labelled as the statement names it.
+"""
+
+from __future__ import annotations
+
+import math as _m
+
+from grader.model.scene import Stage
+from grader.render.canvas import Canvas
+from grader.render.scene_view import SceneView
+from grader.render.worked import math, string
+
+CORD = 3.6  # cm: the cord's length on the page
+HALF_WIDTH, HALF_HEIGHT = 0.42, 0.3  # cm: the block hanging from it
+
+
+def swing_figure(canvas: Canvas, scene: SceneView, swing: Stage, impact: Stage | None) -> bool:
+    """The pivot, the cord at rest and at its greatest angle, the arc between, and the striking body;
+    False when the angle cannot be drawn."""
+    body = swing.fields["body"]
+    theta = scene.value(swing.fields["angle"])
+    if not (_m.isfinite(theta) and 0 <= theta <= _m.pi / 2):
+        return False
+    canvas.ground(-0.9, 0.9, 0.0, below=False)  # short: at 90 degrees the block reaches the pivot's height
+    canvas.circle((0.0, 0.0), 0.06)
+    low = (0.0, -CORD)
+    high = (CORD * _m.sin(theta), -CORD * _m.cos(theta))
+    canvas.line((0.0, 0.0), (low[0], low[1] + HALF_HEIGHT), width=0.4, dash="dashed", gray=True)
+    canvas.rect((low[0] - HALF_WIDTH, low[1] - HALF_HEIGHT), (low[0] + HALF_WIDTH, low[1] + HALF_HEIGHT), "dashed",
+                "none")
+    canvas.line((0.0, 0.0), high, width=0.6)
+    canvas.rect((high[0] - HALF_WIDTH, high[1] - HALF_HEIGHT), (high[0] + HALF_WIDTH, high[1] + HALF_HEIGHT))
+    canvas.label((high[0] + HALF_WIDTH + 0.12, high[1]), "w", [str(string(body)), *scene.mass(body)])
+    steps = max(6, int(theta / 0.05))
+    canvas.path([(CORD * _m.sin(theta * i / steps), -CORD * _m.cos(theta * i / steps)) for i in range(steps + 1)],
+                width=0.4, dash="dashed")
+    mark = 0.9
+    if theta > 0.02:
+        canvas.arc((0.0, 0.0), mark, -_m.pi / 2, -_m.pi / 2 + theta)
+    # The angle's name left of the vertical, the cord's length right of the cord: neither crosses a line.
+    canvas.label((-0.12, -mark), "e", scene.given(swing.fields["angle"]))
+    middle, normal = (0.5 * high[0], 0.5 * high[1]), (_m.cos(theta), _m.sin(theta))  # normal: away from the arc
+    steep = theta < _m.pi / 4
+    canvas.label((middle[0] + 0.25 * normal[0], middle[1] + 0.25 * normal[1]), "w" if steep else "s",
+                 scene.given(swing.fields["length"]))
+    if impact is not None:
+        _striker(canvas, scene, impact, low)
+    return True
+
+
+def _striker(canvas: Canvas, scene: SceneView, impact: Stage, target: tuple[float, float]) -> None:
+    """The first body of the impact, small, coming in from the left at the block's height."""
+    first = impact.fields["bodies"][0]
+    x = target[0] - HALF_WIDTH - 1.9
+    canvas.rect((x - 0.2, target[1] - 0.06), (x + 0.2, target[1] + 0.06), fill="luma(120)")
+    canvas.label((x, target[1] - 0.15), "n", [str(string(first)), *scene.mass(first)])
+    canvas.arrow((x + 0.35, target[1]), (x + 1.35, target[1]), width=0.7, head=0.18)
+    velocity = impact.fields["before"].get(first)
+    if velocity is not None:
+        canvas.label((x + 0.85, target[1] + 0.15), "s", [math(velocity.n)])

@@ -166,7 +166,7 @@ def _grade_column(cells: Sequence[tuple[KeyPart, Answer | None]], key: Key) -> _
         known = tolerances.get(id(part.tolerance))
         if known is None:
             tolerance = Tolerance.from_json(part.tolerance)
-            known = tolerances[id(part.tolerance)] = (tolerance, tolerance.describe())
+            known = tolerances[id(part.tolerance)] = (tolerance, tolerance.explained())
         outcome = _outcome(part, answer, key)
         if isinstance(outcome, CellNumber):
             group = groups.get((id(part.tolerance), part.unit))

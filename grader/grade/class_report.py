@@ -21,7 +21,6 @@ the same bytes.
 from __future__ import annotations
 
 import html
-from collections.abc import Sequence
 
 import numpy as np
 
@@ -217,10 +216,11 @@ def _tolerances(summary: ClassSummary) -> str:
             f"<td>{_tolerance_words(part)}</td><td>{_widened(part.widened, part.unit)}</td></tr>"
             for part in summary.parts]
     widened = sum(part.widened.variants for part in summary.parts if part.widened)
+    how_many = f"{widened:,} answers in all" if widened else "none was"
     return ("<h2 id=\"tolerances\">Tolerances</h2>\n<p>How each part was compared to the key (a symbolic answer: "
             "by value at random points), and what it was worth. Where rounding as the sheet asks, along a "
             "textbook's route, can move a student's answer by more than the tolerance, the key widened that "
-            f"student's tolerance: {f'{widened:,} answers in all' if widened else 'none was'}.</p>\n<table>\n<tr><th>part</th><th>answer</th>"
+            f"student's tolerance: {how_many}.</p>\n<table>\n<tr><th>part</th><th>answer</th>"
             "<th class=\"n\">points</th><th>tolerance</th><th>for rounding</th></tr>\n"
             + "\n".join(rows) + "\n</table>")
 

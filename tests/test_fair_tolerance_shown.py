@@ -26,9 +26,9 @@ from grader.cli import main
 from grader.grade.class_report import class_report
 from grader.grade.class_summary import summarize
 from grader.grade.grading import grade
-from grader.grade.key import load_key
+from grader.grade.key import Key, KeyPart, load_key
 from grader.grade.run import run
-from grader.grade.submissions import StudentRef, read_submissions
+from grader.grade.submissions import Answer, StudentRef, read_submissions
 from grader.model.tolerance import Tolerance
 from grader.render.documents import Documents, cover, key_source, student_source
 from grader.render.typeset import compile_typst
@@ -119,14 +119,16 @@ def test_key_csv_says_each_widened_tolerance_with_its_own_reason(generation: Gen
 
 @pytest.fixture(scope="module")
 def widened_key(demo_run: DemoRun, tmp_path_factory: pytest.TempPathFactory) -> Path:
-    """The demo's key with 5d widened for every other student, to 2 % + 0.05 % per student."""
+    """The demo's key with 5d widened for every other student, to 2 % + 0.05 % per student (the first 20
+    students); the later ones repeat those figures for another reason."""
     folder = tmp_path_factory.mktemp("widened")
     document = json.loads((demo_run.out / "key.json").read_text(encoding="utf-8"))
     for index, student in enumerate(document["students"]):
         if index % 2 == 0:
             rtol = round(0.02 + 0.0005 * (index % 20), 4)
             answer = next(p for p in student["problems"] if p["key"] == "5")["answers"]["loss_pct"]
-            answer["tolerance"] = {"mode": "rtol", "rtol": rtol, "atol": 0.0, "reason": reason(rtol)}
+            why = reason(rtol) if index < 20 else reason(rtol).replace("T and T′", "v₁′ and v₂′")
+            answer["tolerance"] = {"mode": "rtol", "rtol": rtol, "atol": 0.0, "reason": why}
     (folder / "key.json").write_text(json.dumps(document, ensure_ascii=False), encoding="utf-8")
     shutil.copy(demo_run.out / "submissions.csv", folder / "submissions.csv")
     return folder / "key.json"
@@ -150,6 +152,23 @@ def test_grading_a_widened_key_says_the_reason_in_details_and_the_figure_in_the_
         if row["verdict"] in ("correct", "incorrect"):  # a sentence that quotes the figure that decided
             assert row["feedback"].endswith(f"{figure} is accepted")
     assert sum("reason" in t for t in tolerances.values()) == 15
+    assert any("v₁′ and v₂′" in row["tolerance"] for row in rows)
+
+
+def test_rules_widened_alike_for_different_reasons_are_compared_together() -> None:
+    from grader.grade.grading import _grade_column  # how a part's cells are grouped is not seen outside
+
+    def part(why: str) -> KeyPart:
+        return KeyPart("1", "loss_pct", "1a", 30.0, "%", 2.0, {"mode": "rtol", "rtol": 0.027, "atol": 0.0,
+                                                               "reason": why}, None, {})
+
+    cells = [(part(why), Answer("a.csv", line, "s", "1a", typed, ",", None))
+             for line, (why, typed) in enumerate([("by T", "30.5"), ("by v", "29.5"), ("by T", "35")], start=2)]
+    key = Key("key.json", 2, "HW", True, (), ())
+    column = _grade_column(cells, key)
+    assert [indices for _, indices in column.wrong] == [[2]]  # one group: one comparison, one reconsideration
+    assert [row[9] for row in column.rows] == ["±2.7 %: by T", "±2.7 %: by v", "±2.7 %: by T"]
+    assert [row[1] for row in column.rows] == ["correct", "correct", "incorrect"]
 
 
 def test_the_class_report_counts_the_widened_per_part_and_gives_the_widest(widened_key: Path) -> None:

@@ -126,11 +126,11 @@ def _answer(part: AnswerPart, tolerances: dict[Tolerance, dict[str, Any]]) -> di
 
 
 def _tolerance_text(tolerance: Tolerance, unit: str) -> str:
-    return _explained(tolerance, tolerance.reason, unit)  # equal tolerances may differ in their reasons
+    return _explained(tolerance, tolerance.reason, unit)
 
 
 @lru_cache(maxsize=256)
-def _explained(tolerance: Tolerance, reason: str, unit: str) -> str:
+def _explained(tolerance: Tolerance, reason: str, unit: str) -> str:  # reason: equal tolerances may differ in it
     return tolerance.explained(unit)
 
 

@@ -2,8 +2,9 @@
 rounding is shown with its reason wherever a tolerance is shown: the answer key (each student's answers
 and the cover), key.csv, details.csv, the feedback's figure, ``grader check`` and the class report.
 
-The widened tolerances are made here as the generator will store them (``rtol`` widened, ``reason``), on
-a generation or on the demo's key.json, so that these tests hold whatever computes them."""
+The widened tolerances are made here as the generator stores them (``rtol`` widened, ``reason``), on a
+generation or on the demo's key.json, after every tolerance is set back to the one configured, so that
+these tests hold whatever the generator widens."""
 
 from __future__ import annotations
 
@@ -20,7 +21,7 @@ from pypdf import PdfReader
 
 from grader.assign.assignment import Assignment, load_assignment, load_roster
 from grader.assign.keyfile import key_csv
-from grader.assign.variants import Generation, StudentVariants, generate
+from grader.assign.variants import Generation, StudentVariants, generate, tolerance
 from grader.bank.template import Template
 from grader.cli import main
 from grader.grade.class_report import class_report
@@ -62,13 +63,28 @@ def widened(entry: StudentVariants, rtol: float, text: str | None = None) -> Stu
     return dataclasses.replace(entry, problems=tuple(problems))
 
 
+def configured(assignment: Assignment, bank: dict[str, Template]) -> dict[tuple[str, str], Tolerance]:
+    """Each answer's tolerance as the assignment configures it, by (problem key, answer name)."""
+    return {(spec.key, name): tolerance(spec, bank[spec.template], name)
+            for spec in assignment.problems for name in bank[spec.template].answers}
+
+
+def as_configured(entry: StudentVariants, rules: dict[tuple[str, str], Tolerance]) -> StudentVariants:
+    """The student's variants with every answer's tolerance as configured (none widened)."""
+    return dataclasses.replace(entry, problems=tuple(
+        dataclasses.replace(variant, answers=tuple(dataclasses.replace(part, tolerance=rules[variant.key, part.name])
+                                                   for part in variant.answers))
+        for variant in entry.problems))
+
+
 @pytest.fixture(scope="module")
 def generation(assignment: Assignment, bank: dict[str, Template]) -> Generation:
-    """Six students; the first, third and fifth with 5d widened to 2.7 %, 2.5 % and 2.3 %."""
-    plain = generate(assignment, load_roster(sample_dir() / "roster.csv")[:6], bank)
+    """Six students; the first, third and fifth with 5d widened to 2.7 %, 2.5 % and 2.3 %, no other widened."""
+    made = generate(assignment, load_roster(sample_dir() / "roster.csv")[:6], bank)
+    rules = configured(assignment, bank)
     students = tuple(widened(entry, 0.027 - 0.001 * index) if index % 2 == 0 else entry
-                     for index, entry in enumerate(plain.students))
-    return Generation(students, plain.collisions)
+                     for index, entry in enumerate(as_configured(entry, rules) for entry in made.students))
+    return Generation(students, made.collisions)
 
 
 def pdf_text(source: str) -> str:
@@ -117,14 +133,17 @@ def test_key_csv_says_each_widened_tolerance_with_its_own_reason(generation: Gen
     assert {row["tolerance"] for row in rows if row["label"] == "5a"} == {"±1 %"}
 
 
-@pytest.fixture(scope="module")
-def widened_key(demo_run: DemoRun, tmp_path_factory: pytest.TempPathFactory) -> Path:
-    """The demo's key with 5d widened for every other student, to 2 % + 0.05 % per student (the first 20
-    students); the later ones repeat those figures for another reason."""
-    folder = tmp_path_factory.mktemp("widened")
+def demo_key(demo_run: DemoRun, bank: dict[str, Template], folder: Path, widen: bool) -> Path:
+    """The demo's key (and submissions) in ``folder``, every tolerance as configured; with ``widen``, 5d
+    widened for every other student, to 2 % + 0.05 % per student (the first 20 students), the later ones
+    repeating those figures for another reason."""
     document = json.loads((demo_run.out / "key.json").read_text(encoding="utf-8"))
+    rules = configured(load_assignment(demo_run.out / "assignment.yaml"), bank)
     for index, student in enumerate(document["students"]):
-        if index % 2 == 0:
+        for problem in student["problems"]:
+            for name, answer in problem["answers"].items():
+                answer["tolerance"] = rules[problem["key"], name].to_json()
+        if widen and index % 2 == 0:
             rtol = round(0.02 + 0.0005 * (index % 20), 4)
             answer = next(p for p in student["problems"] if p["key"] == "5")["answers"]["loss_pct"]
             why = reason(rtol) if index < 20 else reason(rtol).replace("T and T′", "v₁′ and v₂′")
@@ -132,6 +151,11 @@ def widened_key(demo_run: DemoRun, tmp_path_factory: pytest.TempPathFactory) -> 
     (folder / "key.json").write_text(json.dumps(document, ensure_ascii=False), encoding="utf-8")
     shutil.copy(demo_run.out / "submissions.csv", folder / "submissions.csv")
     return folder / "key.json"
+
+
+@pytest.fixture(scope="module")
+def widened_key(demo_run: DemoRun, bank: dict[str, Template], tmp_path_factory: pytest.TempPathFactory) -> Path:
+    return demo_key(demo_run, bank, tmp_path_factory.mktemp("widened"), widen=True)
 
 
 def test_grading_a_widened_key_says_the_reason_in_details_and_the_figure_in_the_feedback(
@@ -187,8 +211,11 @@ def test_the_class_report_counts_the_widened_per_part_and_gives_the_widest(widen
     assert page.count("widened for ") == 1
 
 
-def test_the_plain_demo_report_says_no_tolerance_was_widened(demo_run: DemoRun) -> None:
-    page = (demo_run.out / "grades" / "report.html").read_text(encoding="utf-8")
+def test_a_report_with_no_tolerance_widened_says_so(demo_run: DemoRun, bank: dict[str, Template],
+                                                   tmp_path: Path) -> None:
+    key = demo_key(demo_run, bank, tmp_path, widen=False)
+    run(key, [tmp_path / "submissions.csv"], tmp_path / "grades")
+    page = (tmp_path / "grades" / "report.html").read_text(encoding="utf-8")
     assert "student's tolerance: none was." in page and "widened for " not in page
 
 

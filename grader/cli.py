@@ -716,7 +716,9 @@ def _print_check(result: dict[str, Any]) -> None:
             ("expected", "undefined" if result["expected"] is None else amount(result["expected"])),
             ("error", "" if result["abs_error"] is None else
              f"{amount(result['abs_error'])} ({min(100 * result['rel_error'], sys.float_info.max):.2g} %)"),
-            ("tolerance", result["tolerance"]), ("feedback", result["feedback"]), ("diagnosis", result["diagnosis"])]
+            ("tolerance", result["tolerance"] + (f" (widened: {result['tolerance_reason']})"
+                                                 if result["tolerance_reason"] else "")),
+            ("feedback", result["feedback"]), ("diagnosis", result["diagnosis"])]
     for name, text in rows:
         if text:
             print(f"{name:<10} {_printable(text)}")

@@ -57,7 +57,7 @@ def checked(capsys: pytest.CaptureFixture[str], *argv: object) -> dict[str, Any]
 def test_an_answer_with_another_unit_against_a_given_value(capsys: pytest.CaptureFixture[str]) -> None:
     result = checked(capsys, "626 cm/s", "--expected", "6.26", "--unit", "m/s")
     assert result == {"verdict": "correct", "credit": 1.0, "parsed": 6.26, "expected": 6.26, "unit": "m/s",
-                      "abs_error": 0.0, "rel_error": 0.0, "tolerance": "±1 %",
+                      "abs_error": 0.0, "rel_error": 0.0, "tolerance": "±1 %", "tolerance_reason": "",
                       "feedback": "626 cm/s = 6.26 m/s equals 6.26 m/s; within ±1 % is accepted", "diagnosis": ""}
     wrong = checked(capsys, "6.26 kg", "--expected", "6.26 m/s")
     assert (wrong["verdict"], wrong["feedback"]) == ("incorrect", "expected a speed (m/s), got a mass (kg)")

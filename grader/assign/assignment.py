@@ -25,6 +25,9 @@ from grader.model.tolerance import FORMS
 _KEY = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_-]{0,15}$")
 _ROSTER_COLUMNS = ("id", "name", "email", "section")
 MAX_POINTS = 1_000_000  # per answer part: any class's totals stay exact in float64
+ANSWER_SIG_FIGS = 3
+"""The significant figures the sheet asks answers to be given to."""
+_NUMBER_WORDS = ("zero", "one", "two", "three", "four", "five", "six", "seven", "eight", "nine", "ten")
 
 
 @dataclass(frozen=True)
@@ -55,6 +58,16 @@ class Grading:
     mistake_credit: float = 0.0
     intermediate_sig_figs: int = 4
     max_tolerance: float = 0.05
+
+    @property
+    def rounding_rule(self) -> str:
+        """How the sheet asks students to round, as its instructions print it.
+
+        >>> Grading().rounding_rule
+        'Keep four significant figures in intermediate steps; give answers to three.'
+        """
+        return (f"Keep {_NUMBER_WORDS[self.intermediate_sig_figs]} significant figures in intermediate steps; "
+                f"give answers to {_NUMBER_WORDS[ANSWER_SIG_FIGS]}.")
 
 
 @dataclass(frozen=True)

@@ -125,9 +125,13 @@ def _answer(part: AnswerPart, tolerances: dict[Tolerance, dict[str, Any]]) -> di
     return data
 
 
-@lru_cache(maxsize=256)
 def _tolerance_text(tolerance: Tolerance, unit: str) -> str:
-    return tolerance.describe(unit)
+    return _explained(tolerance, tolerance.reason, unit)
+
+
+@lru_cache(maxsize=256)
+def _explained(tolerance: Tolerance, reason: str, unit: str) -> str:  # reason: equal tolerances may differ in it
+    return tolerance.explained(unit)
 
 
 def key_json(document: Mapping[str, Any]) -> str:

@@ -37,9 +37,10 @@ _GIVEN = Key(where="the command line", version=2, title="grader check", numeric_
              problems=(), students=())
 """The context of an answer checked against a given value: arithmetic allowed, as by default."""
 
-FIELDS = ("verdict", "credit", "parsed", "expected", "unit", "abs_error", "rel_error", "tolerance", "feedback",
-          "diagnosis")
-"""The fields of a result, in order (``--json`` and ``--batch``)."""
+FIELDS = ("verdict", "credit", "parsed", "expected", "unit", "abs_error", "rel_error", "tolerance", "tolerance_reason",
+          "feedback", "diagnosis")
+"""The fields of a result, in order (``--json`` and ``--batch``): ``tolerance`` is the figure that decided
+(``±2.7 %``), ``tolerance_reason`` why the key widened it (``""`` when it is as configured)."""
 
 _BATCH_FIELDS = {"submitted", "expected", "unit", "tolerance", "symbols", "domains", "student", "label"}
 
@@ -187,9 +188,15 @@ def result(verdict: Verdict, part: KeyPart) -> dict[str, Any]:
     parsed: float | str | None = verdict.parsed or None
     if parsed is not None and not part.symbolic:
         parsed = float(parsed)
+    figure, reason = verdict.tolerance, str(part.tolerance.get("reason", ""))
+    if reason and figure.endswith(f": {reason}"):  # the words grading gives, Tolerance.explained: figure, reason
+        figure = figure[:-len(reason) - 2]
+    else:
+        reason = ""  # a symbolic answer's "equal expressions" does not use the tolerance
     return {"verdict": verdict.verdict, "credit": verdict.credit, "parsed": parsed, "expected": part.value,
             "unit": part.unit, "abs_error": verdict.abs_error, "rel_error": verdict.rel_error,
-            "tolerance": verdict.tolerance, "feedback": verdict.feedback, "diagnosis": verdict.diagnosis}
+            "tolerance": figure, "tolerance_reason": reason, "feedback": verdict.feedback,
+            "diagnosis": verdict.diagnosis}
 
 
 def batch(lines: Sequence[str], key: Key | None, physics: Physics | None = None) -> Iterator[dict[str, Any]]:

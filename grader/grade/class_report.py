@@ -21,7 +21,6 @@ the same bytes.
 from __future__ import annotations
 
 import html
-from collections.abc import Sequence
 
 import numpy as np
 
@@ -34,6 +33,7 @@ from grader.grade.class_summary import (
     summarize,
 )
 from grader.grade.grading import Graded
+from grader.model.tolerance import Widening
 
 REPORT = "report.html"
 CELL_CHARS = 60  # of a typed answer shown in the report; details.csv has it whole
@@ -213,17 +213,32 @@ def _invalid(summary: ClassSummary) -> str:
 def _tolerances(summary: ClassSummary) -> str:
     rows = [f"<tr><td>{_e(part.label)}</td><td>{_answer(part)}</td>"
             f"<td class=\"n\">{_e(' or '.join(_number(p) for p in part.points))}</td>"
-            f"<td>{_tolerance_words(part.tolerances, part.students)}</td></tr>" for part in summary.parts]
+            f"<td>{_tolerance_words(part)}</td><td>{_widened(part.widened, part.unit)}</td></tr>"
+            for part in summary.parts]
+    widened = sum(part.widened.variants for part in summary.parts if part.widened)
+    how_many = f"{widened:,} answers in all" if widened else "none was"
     return ("<h2 id=\"tolerances\">Tolerances</h2>\n<p>How each part was compared to the key (a symbolic answer: "
-            "by value at random points), and what it was worth.</p>\n<table>\n<tr><th>part</th><th>answer</th>"
-            "<th class=\"n\">points</th><th>tolerance</th></tr>\n" + "\n".join(rows) + "\n</table>")
+            "by value at random points), and what it was worth. Where rounding as the sheet asks, along a "
+            "textbook's route, can move a student's answer by more than the tolerance, the key widened that "
+            f"student's tolerance: {how_many}.</p>\n<table>\n<tr><th>part</th><th>answer</th>"
+            "<th class=\"n\">points</th><th>tolerance</th><th>for rounding</th></tr>\n"
+            + "\n".join(rows) + "\n</table>")
 
 
-def _tolerance_words(tolerances: Sequence[tuple[str, int]], students: int) -> str:
-    if len(tolerances) == 1:
+def _tolerance_words(part: PartSummary) -> str:
+    tolerances = part.tolerances
+    if len(tolerances) == 1 and not part.widened:
         return _e(tolerances[0][0])
-    return "; ".join(f"{_e(words)} <small class=\"muted\">({count:,} of {students:,})</small>"
+    return "; ".join(f"{_e(words)} <small class=\"muted\">({count:,} of {part.students:,})</small>"
                      for words, count in tolerances)
+
+
+def _widened(widened: Widening | None, unit: str) -> str:
+    """How many students' tolerance was widened, and the widest with its reason."""
+    if widened is None:
+        return "<small>–</small>"
+    return (f"{_e(widened.describe('student', unit))} <small class=\"muted\">(the widest: "
+            f"{_e(widened.widest.reason)})</small>")
 
 
 def _answer(part: PartSummary) -> str:

@@ -32,13 +32,14 @@ from collections import Counter
 from collections.abc import Sequence
 from dataclasses import dataclass
 from itertools import repeat
-from operator import eq, is_not, itemgetter
+from operator import attrgetter, eq, is_not, itemgetter
 
 import numpy as np
 import numpy.typing as npt
 
 from grader.grade.grading import VERDICTS, Graded, Row, Verdict
 from grader.grade.key import Key, KeyStudent
+from grader.model.tolerance import Tolerance, Widening, widening
 
 Floats = npt.NDArray[np.float64]
 
@@ -82,7 +83,8 @@ class PartSummary:
     points: tuple[float, ...]  # the distinct points it is worth (one, unless the key was edited)
     counts: dict[str, int]  # by verdict kind, every kind shown (0 too)
     mean_credit: float  # 0..1 over every student of the key
-    tolerances: tuple[tuple[str, int], ...]  # each tolerance in words, with how many verdicts it decided
+    tolerances: tuple[tuple[str, int], ...]  # each tolerance as configured, in words, with how many verdicts it decided
+    widened: Widening | None  # the verdicts decided by a tolerance widened for rounding, and the widest
     mistakes: tuple[tuple[str, int], ...]  # the most frequent diagnoses, with their counts
     diagnosed: int  # verdicts with a diagnosis in all
 
@@ -213,8 +215,20 @@ def _part(key: Key, problem: str, label: str, rows: Sequence[Row], verdicts: lis
     credit = float(scores.sum() / worth.sum()) if worth.sum() > 0 else 0.0
     return PartSummary(label, problem, first.name if first else "", first.unit if first else "",
                        tuple(sorted(set(worth.tolist()))), {kind: found.get(kind, 0) for kind in kinds}, credit,
-                       _by_count(Counter(map(itemgetter(_TOLERANCE), rows))),
-                       _by_count(mistakes)[:TOP_MISTAKES], sum(mistakes.values()))
+                       *_tolerances(key, label, rows), _by_count(mistakes)[:TOP_MISTAKES], sum(mistakes.values()))
+
+
+def _tolerances(key: Key, label: str, rows: Sequence[Row]) -> tuple[tuple[tuple[str, int], ...], Widening | None]:
+    """The tolerances in words of the part's verdicts that were not widened, with their counts; and the
+    :class:`~grader.model.tolerance.Widening` of those that were (the key's parts share one mapping for
+    equal tolerances, so each distinct one is read once)."""
+    rules = list(map(attrgetter("tolerance"), map(itemgetter(label), map(attrgetter("parts"), key.students))))
+    distinct = dict(zip(map(id, rules), rules, strict=True))
+    counted = [(Tolerance.from_json(distinct[found]), count) for found, count in Counter(map(id, rules)).items()]
+    widened = {rule.explained() for rule, _ in counted if rule.reason}  # the words grading gave them
+    words = Counter(map(itemgetter(_TOLERANCE), rows))
+    return _by_count(Counter({text: count for text, count in words.items() if text not in widened})), \
+        widening(counted)
 
 
 def _by_count(found: Counter[str]) -> tuple[tuple[str, int], ...]:

@@ -146,6 +146,11 @@ Outcome = tuple[str, float, str, str]
 """A verdict decided without comparing numbers: its kind, credit, sentence and what was read."""
 
 
+_Group = tuple[list[int], list[float], list[float], list[str | None], list[str]]
+"""Cells compared together: their indices, the numbers read, the key's, what was typed in another unit,
+and the words of each one's tolerance (one rule; reasons may differ)."""
+
+
 @dataclass(frozen=True)
 class _Column:
     """A part graded for a class: a row per cell; the number each cell was read as and the key's number
@@ -160,32 +165,38 @@ class _Column:
 def _grade_column(cells: Sequence[tuple[KeyPart, Answer | None]], key: Key) -> _Column:
     """A row for each (part, answer): outcomes decided cell by cell, numbers compared by group."""
     rows: list[Row | None] = [None] * len(cells)
-    tolerances: dict[int, tuple[Tolerance, str]] = {}  # by id of the key's mapping (the key shares equal ones)
-    groups: dict[tuple[int, str], tuple[list[int], list[float], list[float], list[str | None]]] = {}
+    # By id of the key's mapping (the key shares equal ones): the rule, its words, and the id of the first
+    # mapping of an equal rule: rules widened alike for different reasons are compared in one group.
+    tolerances: dict[int, tuple[Tolerance, str, int]] = {}
+    rules: dict[Tolerance, int] = {}
+    groups: dict[tuple[int, str], _Group] = {}
     for index, (part, answer) in enumerate(cells):
         known = tolerances.get(id(part.tolerance))
         if known is None:
             tolerance = Tolerance.from_json(part.tolerance)
-            known = tolerances[id(part.tolerance)] = (tolerance, tolerance.describe())
+            known = tolerances[id(part.tolerance)] = (tolerance, tolerance.explained(),
+                                                      rules.setdefault(tolerance, id(part.tolerance)))
         outcome = _outcome(part, answer, key)
         if isinstance(outcome, CellNumber):
-            group = groups.get((id(part.tolerance), part.unit))
+            group = groups.get((known[2], part.unit))
             if group is None:
-                group = groups[id(part.tolerance), part.unit] = ([], [], [], [])
-            members, submitted, expected, typed = group
+                group = groups[known[2], part.unit] = ([], [], [], [], [])
+            members, submitted, expected, typed, words = group
             members.append(index)
             submitted.append(outcome.value)
             expected.append(float(part.value))  # type: ignore[arg-type]  # a number: not symbolic, not None
             typed.append(_converted(outcome, part, answer))
+            words.append(known[1])
         else:
             rows[index] = _row(part, answer, _expected(part), "equal expressions" if part.symbolic else known[1],
                                *outcome)
     numbers, right = np.full(len(cells), np.nan), np.full(len(cells), np.nan)
     wrong = []
     for (tolerance_id, unit), group in groups.items():
-        members, submitted, expected, _ = group
+        members, submitted, expected = group[:3]
         numbers[members], right[members] = submitted, expected
-        wrong.append((tolerances[tolerance_id][0], _compare(cells, group, *tolerances[tolerance_id], unit, rows)))
+        tolerance = tolerances[tolerance_id][0]
+        wrong.append((tolerance, _compare(cells, group, tolerance, unit, rows)))
     return _Column(rows, numbers, right, wrong)  # type: ignore[arg-type]  # every row is filled, here or by _compare
 
 
@@ -196,24 +207,24 @@ def _converted(cell: CellNumber, part: KeyPart, answer: Answer | None) -> str | 
     return cut(" ".join(answer.text.split()), 40)
 
 
-def _compare(cells: Sequence[tuple[KeyPart, Answer | None]],
-             group: tuple[list[int], list[float], list[float], list[str | None]],
-             tolerance: Tolerance, words: str, unit: str, rows: list[Row | None]) -> list[int]:
+def _compare(cells: Sequence[tuple[KeyPart, Answer | None]], group: _Group, tolerance: Tolerance, unit: str,
+             rows: list[Row | None]) -> list[int]:
     """The rows of a group of cells (their indices, the numbers read, the key's, what was typed in another
-    unit) of one tolerance and unit: verdicts, errors and sentences, each in one pass over the group;
-    returns the cells found wrong."""
-    members, submitted, expected, typed = group
+    unit, the words of each one's tolerance) of one tolerance and unit: verdicts, errors and sentences, each
+    in one pass over the group; returns the cells found wrong."""
+    members, submitted, expected, typed, words = group
     angle = unit if unit in ("deg", "rad") else None
     right = is_correct(submitted, expected, tolerance, angle_unit=angle)
     absolute, relative = errors(submitted, expected, angle_unit=angle)
     said = feedbacks(submitted, expected, unit, tolerance, right, angle_unit=angle, typed=typed)
     shown: dict[float, str] = {}  # the numbers a class typed: a few thousand
     wrong = []
-    for index, value, key_value, ok, sentence, error, ratio in zip(
-            members, submitted, expected, right.tolist(), said, absolute.tolist(), relative.tolist(), strict=True):
+    for index, value, key_value, ok, sentence, error, ratio, rule in zip(
+            members, submitted, expected, right.tolist(), said, absolute.tolist(), relative.tolist(), words,
+            strict=True):
         part, answer = cells[index]
         parsed = shown.get(value) or shown.setdefault(value, number_text(value))
-        rows[index] = _row(part, answer, number_text(key_value), words, "correct" if ok else "incorrect",
+        rows[index] = _row(part, answer, number_text(key_value), rule, "correct" if ok else "incorrect",
                            1.0 if ok else 0.0, sentence, parsed, error, ratio)
         if not ok:
             wrong.append(index)

@@ -14,7 +14,7 @@ True
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
 from typing import Any, Literal
 
@@ -153,6 +153,43 @@ class Tolerance:
         if self.reason:
             data["reason"] = self.reason
         return data
+
+
+@dataclass(frozen=True)
+class Widening:
+    """How many of a part's variants got a tolerance widened for rounding, of how many, and the widest
+    of them (with its reason): what the answer key's cover and the class report say of a part.
+
+    >>> rule = Tolerance(rtol=0.027, reason="rounding T and T′ to 4 figures moves loss_pct by up to 1.3 %")
+    >>> found = widening([(Tolerance(), 18), (rule, 2), (Tolerance(rtol=0.02, reason="..."), 10)])
+    >>> found.describe("student"), found.widest.reason[:8]
+    ('widened for 12 of 30 students, up to ±2.7 %', 'rounding')
+    >>> widening([(Tolerance(), 30)]) is None
+    True
+    """
+
+    variants: int
+    of: int
+    widest: Tolerance
+
+    def describe(self, noun: str = "variant", unit: str = "") -> str:
+        """In words: ``widened for 12 of 30 students, up to ±2.7 %``."""
+        counted = f"{self.variants:,} of {self.of:,} {noun}" + ("" if self.of == 1 else "s")
+        return f"widened for {counted}, up to {self.widest.describe(unit)}"
+
+
+def widening(counted: Iterable[tuple[Tolerance, int]]) -> Widening | None:
+    """The :class:`Widening` of a part whose variants have these tolerances (each with how many variants
+    have it), or None when none is widened (none has a reason). The widest is the one with the largest
+    ``rtol``, then ``atol``."""
+    total, widened, widest = 0, 0, None
+    for tolerance, count in counted:
+        total += count
+        if tolerance.reason:
+            widened += count
+            if widest is None or (tolerance.rtol, tolerance.atol) > (widest.rtol, widest.atol):
+                widest = tolerance
+    return None if widest is None else Widening(widened, total, widest)
 
 
 def with_unit(text: str, unit: str) -> str:

@@ -31,10 +31,11 @@ from typing import Any
 import jinja2
 
 from grader.assign.assignment import Assignment, Student
-from grader.assign.variants import AnswerPart, Generation, ProblemVariant
+from grader.assign.variants import AnswerPart, Generation, ProblemVariant, tolerance
 from grader.bank.markup import paragraphs
 from grader.bank.template import Template, filled_statement
 from grader.errors import GraderError
+from grader.model.tolerance import Tolerance, widening
 from grader.render.figures import figure
 from grader.render.typeset import compile_typst, font_paths
 from grader.render.worked import Typ, Worked, WorkedStep, answer_math, math, name, string, text, worked
@@ -121,6 +122,7 @@ class KeyAnswer:
     value: Typ
     points: str
     tolerance: str
+    widened: str = ""  # a widened tolerance, with why (what honest rounding needs): a note under the answers
 
 
 @dataclass(frozen=True)
@@ -175,8 +177,20 @@ class Cover:
     entry with its page counted from the first page after the cover."""
 
     count: str
-    summary: tuple[tuple[str, str, tuple[tuple[str, str, str, str, str], ...]], ...]
+    summary: tuple[CoverProblem, ...]
     contents: tuple[tuple[Typ, int], ...]
+
+
+@dataclass(frozen=True)
+class CoverProblem:
+    """A problem on the key's cover: its parts (label, quantity, unit, points, the tolerance configured)
+    and, for each part some students' tolerances were widened for, the part's label and how
+    (:meth:`~grader.model.tolerance.Widening.describe`)."""
+
+    key: str
+    title: str
+    parts: tuple[tuple[str, str, str, str, str], ...]
+    widened: tuple[tuple[str, str], ...]
 
 
 def _math(source: str) -> Typ:
@@ -317,7 +331,9 @@ def _key_answer(template: Template, part: AnswerPart) -> KeyAnswer:
         value = Typ(f"${source}$ {text('undefined: ' + (part.undefined or 'no value'))}")
     else:
         value = _math(f"display({source} = {answer_math(part.value, part.unit)})")
-    return KeyAnswer(part.label, part.description, value, f"{part.points:g}", part.tolerance.describe(part.unit))
+    figure, reason = part.tolerance.describe(part.unit), part.tolerance.reason
+    return KeyAnswer(part.label, part.description, value, f"{part.points:g}",
+                     f"{figure} (widened)" if reason else figure, f"widened to {figure}: {reason}" if reason else "")
 
 
 # --- statements ---------------------------------------------------------------------------------
@@ -349,7 +365,8 @@ def _environment() -> jinja2.Environment:
 
 def _assignment_view(assignment: Assignment) -> dict[str, Any]:
     return {"title": assignment.title, "course": assignment.course, "due": assignment.due,
-            "instructions": paragraphs(assignment.instructions)}
+            "instructions": paragraphs(assignment.instructions), "rounding": assignment.grading.rounding_rule,
+            "widest": Tolerance(rtol=assignment.grading.max_tolerance).describe()}
 
 
 def student_source(documents: Documents, indices: Iterable[int]) -> str:
@@ -372,12 +389,21 @@ def key_source(documents: Documents, *, cover: Cover | None = None, glances: Seq
 
 def cover(documents: Documents, contents: Sequence[tuple[Typ, int]]) -> Cover:
     """The key's cover for the whole class, with these contents."""
-    count = len(documents.generation.students)
-    summary = tuple((p.key, documents.bank[p.template].title,
-                     tuple((a.label, a.description, _unit_text(a.unit), f"{a.points:g}", a.tolerance.describe(a.unit))
-                           for a in p.answers))
-                    for p in documents.generation.students[0].problems)
-    return Cover(f"{count} student{'' if count == 1 else 's'}", summary, tuple(contents))
+    students = documents.generation.students
+    summary = []
+    for position, (spec, first) in enumerate(zip(documents.assignment.problems, students[0].problems, strict=False)):
+        template = documents.bank[first.template]
+        parts, widened = [], []
+        for number, answer in enumerate(first.answers):
+            configured = tolerance(spec, template, answer.name)
+            parts.append((answer.label, answer.description, _unit_text(answer.unit), f"{answer.points:g}",
+                          configured.describe(answer.unit)))
+            found = widening((s.problems[position].answers[number].tolerance, 1) for s in students)
+            if found is not None:
+                widened.append((answer.label, found.describe("student", answer.unit)))
+        summary.append(CoverProblem(first.key, template.title, tuple(parts), tuple(widened)))
+    count = len(students)
+    return Cover(f"{count} student{'' if count == 1 else 's'}", tuple(summary), tuple(contents))
 
 
 def check_statements(assignment: Assignment, generation: Generation, bank: Mapping[str, Template],

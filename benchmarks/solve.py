@@ -525,7 +525,7 @@ def plot(rows: Sequence[KernelRow], path: Path) -> str:
               ("solve_columns", "columns_s", "#9467bd"))
     rows = [row for row in rows if row.sets == max(r.sets for r in rows)]  # the largest size
     x, width = np.arange(len(rows)), 0.15
-    figure, axes = plt.subplots(figsize=(12, 5.5), dpi=120)
+    figure, axes = plt.subplots(figsize=(max(12.0, 0.9 * len(rows)), 6), dpi=120)
     for index, (label, field, colour) in enumerate(series):
         values = [row.sets / getattr(row, field) for row in rows]
         bars = axes.bar(x + (index - 2.5) * width, values, width, label=label, color=colour)
@@ -535,7 +535,7 @@ def plot(rows: Sequence[KernelRow], path: Path) -> str:
     axes.bar_label(bars, labels=[rate(v) for v in subs], fontsize=7, padding=2, rotation=90)
     axes.set_yscale("log")
     axes.set_ylim(top=axes.get_ylim()[1] * 20)
-    axes.set_xticks(x, [row.template for row in rows])
+    axes.set_xticks(x, [row.template for row in rows], rotation=30, ha="right")
     axes.set_ylabel("parameter sets per second (log scale)")
     axes.set_title(f"Answers for {rows[0].sets:,} parameter sets per template: kernels against sympy")
     axes.legend(loc="upper right", fontsize=8, ncols=3)

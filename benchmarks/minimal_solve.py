@@ -7,7 +7,8 @@ row becomes the same JSON line ``grader`` prints (``{"template", "row", "params"
 undefined answers: that is what the comparison measures. Templates with symbolic answers
 (car-collision) are not covered.
 
-Run: ``python benchmarks/minimal_solve.py pile-driver rows.csv > answers.jsonl``.
+Run: ``python benchmarks/minimal_solve.py pile-driver rows.csv > answers.jsonl``. Adding a template (``solve.py``
+then times it too): its closed form in ``textbook.py`` and its answers' units in :data:`UNITS`.
 """
 
 from __future__ import annotations

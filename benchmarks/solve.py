@@ -3,23 +3,26 @@
 Three parts, each timed with its baseline interleaved in one run, and each printed with the machine's
 load average (``os.getloadavg()``) measured beside it:
 
-1. **Kernels**, per template of the shipped bank, on ``--sets`` parameter sets drawn from the
-   parameters' sampling specs: :class:`grader.model.kernel.Kernel` over the template's numeric answers
-   against ``sympy.lambdify(symbols, answers, "numpy")`` of the same expressions (the target: at least
-   as fast), and with ``cse=True``; both get grader's own ``sind``, ``cosd`` and numpy's ``hypot``
-   (the expressions use them). Best of ``--rounds`` interleaved rounds. Context: the tree walk
-   (:func:`grader.model.kernel.evaluate` on each tree, as the kernels were before), ``solve_columns``
-   (checks and answers) and ``expr.subs(values).evalf()`` one set at a time on ``--baseline-sets``
-   sets, extrapolated. lambdify's and subs' values must agree with the kernel's to 1e-9.
+1. **Kernels**, per template of the shipped bank, at each of ``--sets`` sizes (default 100,000 and
+   2,000 parameter sets, where a call's fixed cost counts), sets drawn from the parameters' sampling
+   specs: :class:`grader.model.kernel.Kernel` over the template's numeric answers against
+   ``sympy.lambdify(symbols, answers, "numpy")`` of the same expressions (the target: at least as fast,
+   at every size), and with ``cse=True``; both get grader's own ``sind``, ``cosd`` and numpy's ``hypot``
+   (the expressions use them). Best of ``--rounds`` interleaved rounds (on short columns each round
+   times several calls). Context: the tree walk (:func:`grader.model.kernel.evaluate` on each tree, as
+   the kernels were before), ``solve_columns`` (checks and answers) and ``expr.subs(values).evalf()``
+   one set at a time on ``--baseline-sets`` sets, extrapolated. lambdify's and subs' values must agree
+   with the kernel's to 1e-9.
 2. **``grader solve ID --batch FILE.csv --json``** against ``benchmarks/minimal_solve.py`` (numpy.loadtxt,
-   the closed form in numpy, ``json.dumps`` per row) on the same CSV of ``--batch-rows`` rows printed as a
-   sheet prints them: whole processes from start, interleaved, median of ``--runs``; the two outputs must
-   be the same JSON lines (values to 1e-9).
+   the closed form in numpy, ``json.dumps`` per row), for every template the minimal script covers, on the
+   same CSV of ``--batch-rows`` rows printed as a sheet prints them (draws grader refuses, or where an
+   answer is undefined, are left out: the minimal script has no checks): whole processes from start,
+   interleaved, median of ``--runs``; the two outputs must be the same JSON lines (values to 1e-9).
 3. **Start-up**: ``grader --help``, ``grader list`` and a warm ``grader solve pile-driver ...`` against
    ``python -c "import numpy, yaml"``, interleaved, median of ``--startup-runs``; one cold solve (empty
    compile cache) for context.
 
-Run: ``python benchmarks/solve.py [--sets 100000] [--quick]``. Writes ``benchmarks/results/solve.md``,
+Run: ``python benchmarks/solve.py [--sets 100000 2000] [--quick]``. Writes ``benchmarks/results/solve.md``,
 ``solve.csv``, ``solve_batch.csv``, ``solve_startup.csv`` and, with matplotlib, ``solve.png``.
 """
 
@@ -38,15 +41,18 @@ import tempfile
 import time
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import asdict, dataclass
+from functools import partial
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 import sympy as sp
+from minimal_solve import UNITS
 
 from grader.bank.template import Parameter, Template, load_bank
 from grader.model import kernel
 from grader.model.kernel import Kernel, evaluate
+from grader.physics import symbolic
 from grader.physics.symbolic import from_node
 from grader.solve.cache import compiled_for
 from grader.solve.compiled import Compiled
@@ -57,6 +63,8 @@ RESULTS = HERE / "results"
 MINIMAL = HERE / "minimal_solve.py"
 AGREEMENT_RTOL = 1e-9
 TARGET_LAMBDIFY = 1.0  # kernels at least as fast as lambdify
+TARGET_RATE = 1e6  # kernels: parameter sets per second
+TARGET_SUBS = 1e3  # kernels against subs().evalf() one set at a time (context)
 TARGET_BATCH = 1.5  # solve --batch --json within 1.5x of the minimal script
 TARGET_STARTUP = 2.0  # warm start-up within 2x of python -c "import numpy, yaml"
 SOLVE_ARGS = ("solve", "pile-driver", "--set", "m_ram=800", "--set", "m_pile=2400", "--set", "h_drop=2",
@@ -124,7 +132,8 @@ class StartupRow:
 def parse_args(argv: Sequence[str] | None = None) -> argparse.Namespace:
     """The command-line options."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0] if __doc__ else None)
-    parser.add_argument("--sets", type=int, default=100_000, help="parameter sets per template (default 100000)")
+    parser.add_argument("--sets", type=int, nargs="+", default=[100_000, 2_000],
+                        help="parameter sets per template, one or more sizes (default 100000 2000)")
     parser.add_argument("--rounds", type=int, default=25, help="kernel timings: best of this many interleaved "
                                                               "rounds (default 25)")
     parser.add_argument("--baseline-sets", type=int, default=200,
@@ -137,10 +146,10 @@ def parse_args(argv: Sequence[str] | None = None) -> argparse.Namespace:
     parser.add_argument("--out", type=Path, default=RESULTS, help=f"output folder (default {RESULTS})")
     arguments = parser.parse_args(argv)
     if arguments.quick:
-        arguments.sets, arguments.rounds, arguments.baseline_sets = 2_000, 3, 5
+        arguments.sets, arguments.rounds, arguments.baseline_sets = [5_000, 200], 3, 5
         arguments.batch_rows, arguments.runs, arguments.startup_runs = 2_000, 1, 3
-    if min(arguments.sets, arguments.rounds, arguments.baseline_sets, arguments.batch_rows, arguments.runs,
-           arguments.startup_runs) < 1 or arguments.baseline_sets > arguments.sets:
+    if min(*arguments.sets, arguments.rounds, arguments.baseline_sets, arguments.batch_rows, arguments.runs,
+           arguments.startup_runs) < 1 or arguments.baseline_sets > min(arguments.sets):
         parser.error("every count must be >= 1, and --baseline-sets <= --sets")
     return arguments
 
@@ -180,14 +189,16 @@ def numeric_answers(compiled: Compiled) -> dict[str, Any]:
     return {name: answer.numeric for name, answer in compiled.answers.items() if answer.numeric is not None}
 
 
-def interleaved_best(contenders: Mapping[str, Callable[[], Any]], rounds: int) -> dict[str, float]:
-    """The shortest time of each contender over ``rounds`` rounds, each round timing each once in turn."""
+def interleaved_best(contenders: Mapping[str, Callable[[], Any]], rounds: int, calls: int = 1) -> dict[str, float]:
+    """The shortest time of one call of each contender over ``rounds`` rounds, each round timing ``calls``
+    calls of each in turn."""
     best = dict.fromkeys(contenders, float("inf"))
     for _ in range(rounds):
         for name, function in contenders.items():
             start = time.perf_counter()
-            function()
-            best[name] = min(best[name], time.perf_counter() - start)
+            for _ in range(calls):
+                function()
+            best[name] = min(best[name], (time.perf_counter() - start) / calls)
     return best
 
 
@@ -204,7 +215,11 @@ def lambdified(compiled: Compiled, trees: Mapping[str, Any], cse: bool) -> tuple
 def subs_per_set(compiled: Compiled, trees: Mapping[str, Any], table: Mapping[str, np.ndarray],
                  rows: int) -> tuple[float, dict[str, np.ndarray]]:
     """Seconds per set of ``expr.subs(values).evalf()`` over the first ``rows`` sets, and the values."""
-    exprs = {name: from_node(tree, {}) for name, tree in trees.items()}
+    # sympy evaluates grader's sind and cosd only at a number, not at an angle it computes (billiards' line
+    # of centres): a user of subs() writes them with sympy's sin and cos of radians.
+    radians = {symbolic.sind: lambda x: sp.sin(x * sp.pi / 180), symbolic.cosd: lambda x: sp.cos(x * sp.pi / 180)}
+    exprs = {name: from_node(tree, {}).replace(lambda e: e.func in radians, lambda e: radians[e.func](*e.args))
+             for name, tree in trees.items()}
     symbols = {s.name: s for expr in exprs.values() for s in expr.free_symbols}
 
     def one_set(row: int) -> dict[str, float]:
@@ -240,32 +255,43 @@ def worst_difference(ours: Mapping[str, Any], theirs: Mapping[str, Any]) -> floa
     return worst
 
 
-def bench_kernels(template: Template, arguments: argparse.Namespace, rng: np.random.Generator) -> KernelRow:
-    """Kernel, lambdify (plain and cse) and tree walk interleaved; solve_columns and subs for context."""
+SHORT_CALLS = 200_000  # on short columns a round times several calls: about this many sets in all
+
+
+def bench_kernels(template: Template, arguments: argparse.Namespace, rng: np.random.Generator) -> list[KernelRow]:
+    """At each size: kernel, lambdify (plain and cse) and tree walk interleaved, solve_columns for context;
+    subs().evalf() once (its time per set does not depend on the size)."""
     compiled = compiled_for(template)
-    table = draw_table(template, arguments.sets, rng)
     trees = numeric_answers(compiled)
     ours = Kernel(trees, compiled.constants)
     plain, names = lambdified(compiled, trees, cse=False)
     shared, _ = lambdified(compiled, trees, cse=True)
-    columns = [table[name] for name in names]
-    inputs = {name: table[name] for name in ours.inputs}
-    env = {**table, **compiled.constants}
-    with np.errstate(all="ignore"):
-        best = interleaved_best({
-            "kernel": lambda: ours(inputs), "lambdify": lambda: plain(*columns),
-            "lambdify_cse": lambda: shared(*columns),
-            "tree_walk": lambda: [evaluate(tree, env) for tree in trees.values()],
-        }, arguments.rounds)
-        results = ours(inputs)
-        worst = max(worst_difference(results, dict(zip(trees, plain(*columns), strict=True))),
-                    worst_difference(results, dict(zip(trees, shared(*columns), strict=True))))
-        columns_s = min(_timed(lambda: solve_columns(template, compiled, table)) for _ in range(5))
-    per_set, subs_values = subs_per_set(compiled, trees, table, arguments.baseline_sets)
-    worst = max(worst, worst_difference(results, subs_values))
-    return KernelRow(template.id, len(trees), len(ours), arguments.sets, best["kernel"], best["lambdify"],
-                     best["lambdify_cse"], best["tree_walk"], columns_s, per_set, arguments.baseline_sets, worst,
-                     load())
+    rows: list[KernelRow] = []
+    for sets in arguments.sets:
+        table = draw_table(template, sets, rng)
+        columns = [table[name] for name in names]
+        inputs = {name: table[name] for name in ours.inputs}
+        env = {**table, **compiled.constants}
+        contenders = {"kernel": partial(ours, inputs), "lambdify": partial(plain, *columns),
+                      "lambdify_cse": partial(shared, *columns), "tree_walk": partial(_walk, trees, env)}
+        with np.errstate(all="ignore"):
+            best = interleaved_best(contenders, arguments.rounds, max(1, SHORT_CALLS // sets))
+            results = ours(inputs)
+            worst = max(worst_difference(results, dict(zip(trees, plain(*columns), strict=True))),
+                        worst_difference(results, dict(zip(trees, shared(*columns), strict=True))))
+            columns_s = min(_timed(partial(solve_columns, template, compiled, table)) for _ in range(5))
+        if not rows:  # subs().evalf() on the first size's first sets
+            per_set, subs_values = subs_per_set(compiled, trees, table, arguments.baseline_sets)
+            subs_worst = worst_difference(results, subs_values)
+        rows.append(KernelRow(template.id, len(trees), len(ours), sets, best["kernel"], best["lambdify"],
+                              best["lambdify_cse"], best["tree_walk"], columns_s, per_set, arguments.baseline_sets,
+                              max(worst, subs_worst), load()))
+    return rows
+
+
+def _walk(trees: Mapping[str, Any], env: Mapping[str, Any]) -> list[Any]:
+    """The tree walk: each tree on its own, node by node (how the kernels evaluated before)."""
+    return [evaluate(tree, env) for tree in trees.values()]
 
 
 def _timed(function: Callable[[], Any]) -> float:
@@ -284,13 +310,24 @@ def printed(parameter: Parameter, value: float) -> str:
 
 
 def write_batch(template: Template, rows: int, rng: np.random.Generator, path: Path) -> None:
-    """A comma-separated batch of sampled parameter sets, as printed on sheets."""
-    table = draw_table(template, rows, rng)
+    """A comma-separated batch of ``rows`` sampled parameter sets as printed on sheets, each one grader
+    answers in full (refused draws and undefined answers are drawn again, as ``generate`` does)."""
     parameters = list(template.parameters.values())
+    lines: list[str] = []
+    while len(lines) < rows:
+        table = draw_table(template, rows, rng)
+        text = [[printed(p, v) for p, v in zip(parameters, row, strict=True)]
+                for row in zip(*table.values(), strict=True)]
+        numbers = {name: np.array([float(row[i]) for row in text]) for i, name in enumerate(template.parameters)}
+        answered = solve_columns(template, compiled_for(template), numbers)
+        usable = [row for index, row in enumerate(text) if answered.refusals[index] is None
+                  and not any(reasons[index] for reasons in answered.undefined.values())]
+        if not usable:
+            raise RuntimeError(f"{template.id}: no sampled draw is answered in full")
+        lines += [",".join(row) for row in usable]
     with path.open("w", encoding="utf-8") as handle:
         handle.write(",".join(template.parameters) + "\n")
-        for row in zip(*table.values(), strict=True):
-            handle.write(",".join(printed(p, v) for p, v in zip(parameters, row, strict=True)) + "\n")
+        handle.write("".join(line + "\n" for line in lines[:rows]))
 
 
 def grader_command(*args: str) -> list[str]:
@@ -376,13 +413,13 @@ def verdict(ok: bool) -> str:
 
 def kernel_table(rows: Sequence[KernelRow]) -> str:
     """Sets per second through each, and the kernel's speed-ups."""
-    lines = ["| template | answers | kernel steps | kernel sets/s | lambdify sets/s | kernel / lambdify (target >= 1) "
-             "| lambdify cse=True sets/s | kernel / cse | tree walk (before) sets/s | solve_columns sets/s "
-             "| subs().evalf() sets/s | kernel / subs | max rel. diff | load |",
-             "|---|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|"]
+    lines = ["| template | sets | answers | kernel steps | kernel sets/s | lambdify sets/s "
+             "| kernel / lambdify (target >= 1) | lambdify cse=True sets/s | kernel / cse | tree walk (before) sets/s "
+             "| solve_columns sets/s | subs().evalf() sets/s | kernel / subs | max rel. diff | load |",
+             "|---|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|"]
     for row in rows:
         lines.append(
-            f"| {row.template} | {row.answers} | {row.steps} | {rate(row.sets / row.kernel_s)} "
+            f"| {row.template} | {row.sets:,} | {row.answers} | {row.steps} | {rate(row.sets / row.kernel_s)} "
             f"| {rate(row.sets / row.lambdify_s)} | {row.vs_lambdify:.2f}x | {rate(row.sets / row.lambdify_cse_s)} "
             f"| {row.lambdify_cse_s / row.kernel_s:.2f}x | {rate(row.sets / row.tree_walk_s)} "
             f"| {rate(row.sets / row.columns_s)} | {rate(1 / row.subs_s_per_set)} | {rate(row.vs_subs)}x "
@@ -411,13 +448,22 @@ def startup_table(rows: Sequence[StartupRow], cold: float) -> str:
 
 def targets(kernels: Sequence[KernelRow], batches: Sequence[BatchRow], startup: Sequence[StartupRow]) -> str:
     """One line per target, with the worst figure."""
-    slowest = min(kernels, key=lambda r: r.vs_lambdify)
+    sizes = sorted({r.sets for r in kernels}, reverse=True)
+    slowest = [min((r for r in kernels if r.sets == size), key=lambda r: r.vs_lambdify) for size in sizes]
+    fewest = min(kernels, key=lambda r: r.sets / r.kernel_s)
+    least = min(kernels, key=lambda r: r.vs_subs)
     batch = max(batches, key=lambda r: r.ratio)
     base, worst = startup[0].seconds, max(startup[1:], key=lambda r: r.seconds)
     agree = max(r.max_rel_diff for r in kernels)
     return "\n".join([
-        f"- kernels >= {TARGET_LAMBDIFY:g}x sympy.lambdify on every template: "
-        f"{verdict(slowest.vs_lambdify >= TARGET_LAMBDIFY)} (lowest: {slowest.template}, {slowest.vs_lambdify:.2f}x)",
+        *(f"- kernels >= {TARGET_LAMBDIFY:g}x sympy.lambdify on every template at {row.sets:,} sets: "
+          f"{verdict(row.vs_lambdify >= TARGET_LAMBDIFY)} (lowest: {row.template}, {row.vs_lambdify:.2f}x)"
+          for row in slowest),
+        f"- kernels >= {TARGET_RATE:,.0f} sets/s on every template at every size: "
+        f"{verdict(fewest.sets / fewest.kernel_s >= TARGET_RATE)} (lowest: {fewest.template} at {fewest.sets:,} sets, "
+        f"{rate(fewest.sets / fewest.kernel_s)} sets/s)",
+        f"- kernels >= {TARGET_SUBS:,.0f}x subs().evalf() (context): {verdict(least.vs_subs >= TARGET_SUBS)} "
+        f"(lowest: {least.template} at {least.sets:,} sets, {rate(least.vs_subs)}x)",
         f"- `solve --batch --json` within {TARGET_BATCH:g}x of the minimal numpy script: "
         f"{verdict(batch.ratio <= TARGET_BATCH)} (highest: {batch.template}, {batch.ratio:.2f}x)",
         f"- warm start-up within {TARGET_STARTUP:g}x of `python -c \"import numpy, yaml\"`: "
@@ -430,7 +476,8 @@ def targets(kernels: Sequence[KernelRow], batches: Sequence[BatchRow], startup: 
 def environment(arguments: argparse.Namespace) -> str:
     """What the numbers were measured on, and how."""
     return (f"Python {platform.python_version()}, numpy {np.__version__}, sympy {sp.__version__}, "
-            f"{os.cpu_count()} CPUs ({platform.machine()}), seed {arguments.seed}. Kernels: {arguments.sets:,} sets, "
+            f"{os.cpu_count()} CPUs ({platform.machine()}), seed {arguments.seed}. Kernels: "
+            f"{' and '.join(f'{sets:,}' for sets in arguments.sets)} sets, "
             f"best of {arguments.rounds} interleaved rounds; subs().evalf() on {arguments.baseline_sets} sets. "
             f"Batch: {arguments.batch_rows:,} rows, median of {arguments.runs} interleaved runs. Start-up: median of "
             f"{arguments.startup_runs} interleaved runs. Load: the 1-minute load average after each part.")
@@ -476,8 +523,9 @@ def plot(rows: Sequence[KernelRow], path: Path) -> str:
     series = (("kernel", "kernel_s", "#1f77b4"), ("sympy.lambdify", "lambdify_s", "#d62728"),
               ("lambdify cse=True", "lambdify_cse_s", "#ff9896"), ("tree walk (before)", "tree_walk_s", "#2ca02c"),
               ("solve_columns", "columns_s", "#9467bd"))
+    rows = [row for row in rows if row.sets == max(r.sets for r in rows)]  # the largest size
     x, width = np.arange(len(rows)), 0.15
-    figure, axes = plt.subplots(figsize=(12, 5.5), dpi=120)
+    figure, axes = plt.subplots(figsize=(max(12.0, 0.9 * len(rows)), 6), dpi=120)
     for index, (label, field, colour) in enumerate(series):
         values = [row.sets / getattr(row, field) for row in rows]
         bars = axes.bar(x + (index - 2.5) * width, values, width, label=label, color=colour)
@@ -487,7 +535,7 @@ def plot(rows: Sequence[KernelRow], path: Path) -> str:
     axes.bar_label(bars, labels=[rate(v) for v in subs], fontsize=7, padding=2, rotation=90)
     axes.set_yscale("log")
     axes.set_ylim(top=axes.get_ylim()[1] * 20)
-    axes.set_xticks(x, [row.template for row in rows])
+    axes.set_xticks(x, [row.template for row in rows], rotation=30, ha="right")
     axes.set_ylabel("parameter sets per second (log scale)")
     axes.set_title(f"Answers for {rows[0].sets:,} parameter sets per template: kernels against sympy")
     axes.legend(loc="upper right", fontsize=8, ncols=3)
@@ -508,11 +556,12 @@ def main(argv: Sequence[str] | None = None) -> int:
     kernels = []
     for template in bank.values():
         print(f"kernels: {template.id} ...", file=sys.stderr, flush=True)
-        kernels.append(bench_kernels(template, arguments, rng))
+        kernels += bench_kernels(template, arguments, rng)
+    kernels.sort(key=lambda row: -row.sets)  # one table per size, largest first
     folder = Path(tempfile.mkdtemp(prefix="grader-bench-batch-"))
     try:
         batches = []
-        for template_id in ("drop-rebound", "pile-driver", "ball-plate", "oblique-spheres"):
+        for template_id in (name for name in bank if name in UNITS):  # the templates the minimal script answers
             print(f"batch: {template_id} ...", file=sys.stderr, flush=True)
             batches.append(bench_batch(bank[template_id], arguments, rng, folder))
     finally:

@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 
 from grader.bank.template import Template
+from grader.model import kernel as kernel_module
 from grader.model.expr import Node, parse
 from grader.model.kernel import Kernel, cosd, evaluate, sind
 from grader.solve.compiled import Compiled
@@ -98,30 +99,43 @@ def trees_of(compiled: Compiled) -> dict[Any, Node]:
     return found
 
 
+# Columns shorter than the kernel's threshold take the body that allocates every result; longer ones the
+# body that writes into arrays nothing reads any more, and beyond one block that body runs a block at a
+# time (the last one partial): each must give evaluate's numbers.
+SIZES = [kernel_module._SHORT // 2, kernel_module._SHORT + 904, 2 * kernel_module._BLOCK + 904]
+SIZE_IDS = ["short", "long (in place)", "blocks"]
+
+
+@pytest.mark.parametrize("size", SIZES, ids=SIZE_IDS)
 @pytest.mark.parametrize("extreme", [False, True], ids=["sampled", "extreme"])
 def test_kernel_gives_evaluate_s_numbers_bit_for_bit_for_every_template(
-        bank: dict[str, Template], compiled: dict[str, Compiled], extreme: bool) -> None:
+        bank: dict[str, Template], compiled: dict[str, Compiled], extreme: bool, size: int) -> None:
     """Shared subtrees, folded constants and reused arrays change nothing, NaN and -0 included."""
     for template_id, template in bank.items():
-        table = columns(template, 4000, extreme)
+        table = columns(template, size, extreme)
         env = {**table, **compiled[template_id].constants}
         kernel = compiled[template_id].kernel
         with np.errstate(all="ignore"):
             results = kernel(table)
             for key, tree in trees_of(compiled[template_id]).items():
-                assert same_bits(np.broadcast_to(results[key], (4000,)),
-                                 np.broadcast_to(evaluate(tree, env), (4000,))), (template_id, key)
+                assert same_bits(np.broadcast_to(results[key], (size,)),
+                                 np.broadcast_to(evaluate(tree, env), (size,))), (template_id, key)
             scalars = {name: float(column[0]) for name, column in table.items()}  # not arrays: no out=
             one_row = kernel(scalars)
             for key, tree in trees_of(compiled[template_id]).items():
-                assert same_bits(one_row[key], evaluate(tree, {**scalars, **compiled[template_id].constants})), key
+                reference = evaluate(tree, {**scalars, **compiled[template_id].constants})
+                assert same_bits(one_row[key], reference), key
+                assert type(one_row[key]) is type(reference), key  # numbers stay numbers (no 0-d arrays)
 
 
-def test_kernel_never_writes_into_its_inputs_or_earlier_results(compiled: dict[str, Compiled]) -> None:
-    """Arrays are reused within one call only, never the caller's columns or a returned result."""
-    kernel = compiled["oblique-spheres"].kernel
+@pytest.mark.parametrize("size", SIZES, ids=SIZE_IDS)
+@pytest.mark.parametrize("template_id", ["oblique-spheres", "drop-rebound", "offset-spheres"])
+def test_kernel_never_writes_into_its_inputs_or_earlier_results(compiled: dict[str, Compiled], template_id: str,
+                                                                size: int) -> None:
+    """Arrays are reused within one call only, never the caller's columns, a constant or a returned result."""
+    kernel = compiled[template_id].kernel
     rng = np.random.default_rng(3)
-    table = {name: rng.uniform(1, 80, 1000) for name in kernel.inputs}
+    table = {name: rng.uniform(1, 80, size) for name in kernel.inputs}
     before = {name: column.copy() for name, column in table.items()}
     with np.errstate(all="ignore"):
         first = {key: np.array(value, copy=True) for key, value in kernel(table).items()}
@@ -129,6 +143,24 @@ def test_kernel_never_writes_into_its_inputs_or_earlier_results(compiled: dict[s
         kernel({name: column * 2 for name, column in table.items()})
     assert all(np.array_equal(table[name], before[name]) for name in table)
     assert all(same_bits(again[key], first[key]) for key in first)
+
+
+def test_constants_keep_their_values_and_results_that_need_no_input_are_numbers() -> None:
+    """Constants reach numpy as read-only 0-d arrays (faster than Python floats on short columns): the
+    numbers are those of Python floats, a second call sees the same constants, and a result that depends
+    on no input is returned as the number it is."""
+    kernel = Kernel({"a": parse("100*Max(0, x - y)/x"), "b": parse("2*g"), "c": parse("x/g + g")}, {"g": 9.81})
+    for size in SIZES:
+        x, y = np.linspace(-3.0, 7.0, size), np.linspace(7.0, -3.0, size)
+        with np.errstate(all="ignore"):
+            for _ in range(2):
+                results = kernel({"x": x, "y": y})
+                assert same_bits(results["a"], 100.0 * np.maximum(0.0, x - y) / x)
+                assert same_bits(results["c"], x / 9.81 + 9.81)
+    assert results["b"] == 2 * 9.81 and type(results["b"]) is type(evaluate(parse("2*g"), {"g": 9.81})) is np.float64
+    assert results["c"] is not x
+    one = kernel({"x": 2.0, "y": 1.0})
+    assert one["a"] == 50.0 and type(one["a"]) is np.float64 and type(one["b"]) is np.float64
 
 
 def test_common_subtrees_are_computed_once() -> None:
@@ -158,3 +190,19 @@ def test_a_number_first_in_max_and_min_gives_numpy_s_result(limit: float) -> Non
             kernel = Kernel({"r": parse(f"{name}(c, x)")}, {"c": limit})
             with np.errstate(all="ignore"):
                 assert same_bits(kernel({"x": values.copy()})["r"], function(limit, values)), name
+
+
+@pytest.mark.parametrize("size", SIZES, ids=SIZE_IDS)
+def test_every_kind_of_result_comes_back_whole_from_the_blocks(size: int) -> None:
+    """A result that is an input, a number, a float written in place, the same tree under two names
+    (written once, copied once) and a truth value (copied): each is the whole column, as evaluate gives it."""
+    trees = {"input": parse("x"), "number": parse("2*g"), "float": parse("sqrt(x)*g"), "again": parse("sqrt(x)*g"),
+             "truth": parse("x > 1", allow_compare=True), "angle": parse("cosd(x)")}
+    kernel = Kernel(trees, {"g": 9.81})
+    x = np.linspace(-400.0, 400.0, size)
+    with np.errstate(all="ignore"):
+        results = kernel({"x": x})
+        for name, tree in trees.items():
+            reference = evaluate(tree, {"x": x, "g": 9.81})
+            assert same_bits(results[name], reference) and np.shape(results[name]) == np.shape(reference), name
+    assert results["input"] is x

@@ -1,0 +1,145 @@
+"""The bank's answers as a textbook writes them, from first principles, for the benchmarks' baselines.
+
+Each function takes a math namespace ``xp`` (``sqrt``, ``sin``, ``cos``, ``asin``, ``atan2``, ``hypot``,
+``radians``, ``degrees``) and the template's parameters in its units, and returns the numeric answers
+in its units. With numpy (:data:`NUMPY`) on columns it is the closed form a competent user writes in a
+minimal script (``minimal_solve.py``); with mpmath at 50 digits it is the exact reference the accuracy
+benchmark measures against (``accuracy.py`` builds that namespace: importing mpmath here would slow the
+minimal script down). Nothing here comes from grader: energies are ``T - T'``, velocities the momentum
+and restitution equations solved by hand, the plain forms grader's stable forms improve on.
+
+Adding a template: write its function here and list it in :data:`FORMS`.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from types import SimpleNamespace
+from typing import Any
+
+import numpy as np
+
+G = 9.81  # the bank's g, m/s^2
+
+NUMPY = SimpleNamespace(sqrt=np.sqrt, sin=np.sin, cos=np.cos, asin=np.arcsin, atan2=np.arctan2, hypot=np.hypot,
+                        radians=np.radians, degrees=np.degrees)
+
+
+def _angle_between(xp: Any, n1: Any, t1: Any, n2: Any, t2: Any) -> Any:
+    """The angle between two velocities (n, t), 0 to 180 degrees."""
+    return xp.degrees(xp.atan2(abs(n1 * t2 - t1 * n2), n1 * n2 + t1 * t2))
+
+
+def _loss_pct(before: Any, after: Any) -> Any:
+    return 100 * (before - after) / before
+
+
+def _line(v: Any, m1: Any, m2: Any, e: Any, u2: Any = 0) -> tuple[Any, Any]:
+    """Velocities after a direct central impact of m1 at v on m2 at u2: momentum and restitution."""
+    momentum = m1 * v + m2 * u2
+    return (momentum - m2 * e * (v - u2)) / (m1 + m2), (momentum + m1 * e * (v - u2)) / (m1 + m2)
+
+
+def drop_rebound(xp: Any, h_drop: Any, h_rebound: Any) -> dict[str, Any]:
+    return {"e": xp.sqrt(h_rebound / h_drop), "loss_pct": _loss_pct(h_drop, h_rebound)}
+
+
+def pile_driver(xp: Any, m_ram: Any, m_pile: Any, h_drop: Any, h_rebound: Any) -> dict[str, Any]:
+    v_ram = xp.sqrt(2 * G * h_drop)  # just before the impact, down
+    v_back = xp.sqrt(2 * G * h_rebound)  # just after, up
+    v_pile = m_ram * (v_ram + v_back) / m_pile  # momentum
+    return {"v_pile": v_pile, "e": (v_pile + v_back) / v_ram,
+            "loss_pct": _loss_pct(m_ram * v_ram**2, m_ram * v_back**2 + m_pile * v_pile**2)}
+
+
+def car_collision(xp: Any, p: Any, e: Any) -> dict[str, Any]:
+    """The numeric answers: vA'/v = (1 - e p)/(1 + p), vB'/v = (1 + e)/(1 + p) (p = mB/mA)."""
+    return {"vA_ratio": (1 - e * p) / (1 + p), "vB_ratio": (1 + e) / (1 + p)}
+
+
+def ball_plate(xp: Any, v: Any, theta: Any, e: Any) -> dict[str, Any]:
+    normal, tangent = e * v * xp.sin(xp.radians(theta)), v * xp.cos(xp.radians(theta))
+    return {"v_out": xp.hypot(normal, tangent), "theta_out": xp.degrees(xp.atan2(normal, tangent))}
+
+
+def oblique_spheres(xp: Any, v1: Any, theta: Any, e: Any, m1: Any, m2: Any) -> dict[str, Any]:
+    normal, tangent = v1 * xp.cos(xp.radians(theta)), v1 * xp.sin(xp.radians(theta))
+    n1, n2 = _line(normal, m1, m2, e)
+    v1_out = xp.hypot(n1, tangent)
+    return {"v1_out": v1_out, "v2_out": abs(n2), "theta1_out": xp.degrees(xp.atan2(n1, tangent)),
+            "loss_pct": _loss_pct(m1 * v1**2, m1 * v1_out**2 + m2 * n2**2)}
+
+
+def head_on(xp: Any, m1: Any, m2: Any, v1: Any, v2: Any, e: Any) -> dict[str, Any]:
+    v1_out, v2_out = _line(v1, m1, m2, e, v2)
+    return {"v1_out": v1_out, "v2_out": v2_out,
+            "loss_pct": _loss_pct(m1 * v1**2 + m2 * v2**2, m1 * v1_out**2 + m2 * v2_out**2)}
+
+
+def head_on_inverse(xp: Any, m1: Any, m2: Any, v1: Any, v2: Any, v1_out: Any) -> dict[str, Any]:
+    v2_out = v2 + m1 * (v1 - v1_out) / m2  # momentum
+    return {"v2_out": v2_out, "e": (v2_out - v1_out) / (v1 - v2),
+            "loss_pct": _loss_pct(m1 * v1**2 + m2 * v2**2, m1 * v1_out**2 + m2 * v2_out**2)}
+
+
+def coupling(xp: Any, m_A: Any, m_B: Any, v_A: Any, v_B: Any) -> dict[str, Any]:  # noqa: N803 (its names)
+    """Masses in Mg, speeds in km/h; energy in kJ: (1/2) (1000 m) (v/3.6)^2 / 1000."""
+    v_common = (m_A * v_A + m_B * v_B) / (m_A + m_B)
+    before = (m_A * (v_A / 3.6) ** 2 + m_B * (v_B / 3.6) ** 2) / 2
+    after = (m_A + m_B) * (v_common / 3.6) ** 2 / 2
+    return {"v_common": v_common, "energy_lost": before - after, "loss_pct": _loss_pct(before, after)}
+
+
+def moving_plate(xp: Any, h: Any, u: Any, e: Any) -> dict[str, Any]:
+    """The ball arrives at sqrt(2 g h) down, the plate moves up at u: v_out - u = e (v + u)."""
+    v_out = u + e * (xp.sqrt(2 * G * h) + u)
+    return {"v_out": v_out, "h_out": v_out**2 / (2 * G)}
+
+
+def incline_bounce(xp: Any, h: Any, beta: Any, e: Any) -> dict[str, Any]:
+    v = xp.sqrt(2 * G * h)
+    normal, tangent = e * v * xp.cos(xp.radians(beta)), v * xp.sin(xp.radians(beta))
+    return {"v_out": xp.hypot(normal, tangent), "theta_out": xp.degrees(xp.atan2(normal, tangent))}
+
+
+def billiards(xp: Any, v: Any, r: Any, b: Any, e: Any) -> dict[str, Any]:
+    """Equal masses: the line of centres makes asin(b / 2r) with the cue ball's velocity."""
+    v_cue, v_obj, angle_cue, _, loss = _offset(xp, 1, 1, v, xp.asin(b / (2 * r)), e)
+    return {"v_cue": v_cue, "v_obj": v_obj, "angle_cue": angle_cue, "loss_pct": loss}
+
+
+def offset_spheres(xp: Any, m1: Any, m2: Any, r1: Any, r2: Any, v1: Any, b: Any, e: Any) -> dict[str, Any]:
+    answers = _offset(xp, m1, m2, v1, xp.asin(b / (r1 + r2)), e)
+    return dict(zip(("v1_out", "v2_out", "theta1_out", "theta2_out", "loss_pct"), answers, strict=True))
+
+
+def _offset(xp: Any, m1: Any, m2: Any, v: Any, theta: Any, e: Any) -> tuple[Any, ...]:
+    """Sphere 2 at rest, struck at ``theta`` from the line of centres n (t across it: unchanged for
+    sphere 1, zero for sphere 2): both speeds after, both angles from sphere 1's direction, loss in %."""
+    normal, tangent = v * xp.cos(theta), v * xp.sin(theta)
+    n1, n2 = _line(normal, m1, m2, e)
+    v1_out, v2_out = xp.hypot(n1, tangent), abs(n2)
+    return (v1_out, v2_out, _angle_between(xp, normal, tangent, n1, tangent),
+            _angle_between(xp, normal, tangent, n2, 0 * n2), _loss_pct(m1 * v**2, m1 * v1_out**2 + m2 * v2_out**2))
+
+
+def three_balls(xp: Any, m1: Any, m2: Any, m3: Any, v: Any, e: Any) -> dict[str, Any]:
+    v1_out, v2_between = _line(v, m1, m2, e)
+    v2_out, v3_out = _line(v2_between, m2, m3, e)
+    return {"v1_out": v1_out, "v2_out": v2_out, "v3_out": v3_out}
+
+
+def two_rebounds(xp: Any, h1: Any, h2: Any) -> dict[str, Any]:
+    """Each bounce keeps e^2 of the height: e^2 = h2/h1, h0 = h1/e^2; the energy left is m g h2."""
+    h0 = h1 * h1 / h2
+    return {"e": xp.sqrt(h2 / h1), "h0": h0, "loss_pct": _loss_pct(h0, h2)}
+
+
+FORMS: dict[str, Callable[..., dict[str, Any]]] = {
+    "drop-rebound": drop_rebound, "pile-driver": pile_driver, "car-collision": car_collision,
+    "ball-plate": ball_plate, "oblique-spheres": oblique_spheres, "head-on": head_on,
+    "head-on-inverse": head_on_inverse, "coupling": coupling, "moving-plate": moving_plate,
+    "incline-bounce": incline_bounce, "billiards": billiards, "offset-spheres": offset_spheres,
+    "three-balls": three_balls, "two-rebounds": two_rebounds,
+}
+"""Template id -> its textbook answers."""

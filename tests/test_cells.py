@@ -196,9 +196,9 @@ def test_hostile_cells_are_invalid_fast_and_harmless(text: str, tmp_path: Path,
                                                       monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.chdir(tmp_path)
     for read in (lambda: read_number(text, "m/s", names=NAMES), lambda: read_expression(text, ["p", "v"])):
-        start = time.perf_counter()
+        start = time.process_time()  # CPU time: the machine's other work does not count
         cell = read()
-        elapsed = time.perf_counter() - start
+        elapsed = time.process_time() - start
         assert isinstance(cell, CellInvalid), cell
         assert elapsed < 0.1, f"{elapsed:.3f} s"
     assert not (tmp_path / "F").exists()

@@ -285,9 +285,9 @@ def test_a_hostile_template_statement_is_refused_with_exit_2_before_anything_run
 
     bank_folder = hostile_bank(tmp_path, statement)
     monkeypatch.chdir(tmp_path)
-    started = time.perf_counter()
+    started = time.process_time()
     code, _, err = run(capsys, *ONLY, bank_folder, "generate", "a.yaml", "--roster", "roster.csv", "--out", "out")
-    assert time.perf_counter() - started < 1.0
+    assert time.process_time() - started < 1.0
     assert code == 2
     assert f"{bank_folder / 'drop-rebound.yaml'}: statement: expected" in err and got in err, err
     assert not (tmp_path / "F").exists() and not (tmp_path / "out").exists()

@@ -271,28 +271,28 @@ def test_work_that_would_overflow_or_not_end_is_refused_at_once(capsys: pytest.C
                                                                 argv: tuple[str, ...], message: str) -> None:
     """Regression: v=1e307 and 100000 rk4 steps per contact ran without end; now refused within a
     second, with the limit. (1 ft/s = 0.3048 m/s; 1e298 ft/s at 1 ms: omega v = pi/1e-3 * 0.3048e298.)"""
-    started = time.perf_counter()
+    started = time.process_time()
     code, _, err = _simulate_cli(capsys, "ball-plate", "--set", f"v={v}", "--set", "theta=30", "--set", "e=0.5",
                                  *argv)
-    assert time.perf_counter() - started < 1.0
+    assert time.process_time() - started < 1.0
     assert code == 2 and message in err and err.count("\n") == 1, err
 
 
 def test_a_search_that_would_exceed_the_step_limit_is_refused_before_it_starts(bank: dict[str, Template]) -> None:
     """drop-rebound searches e over about 25 passes of 3 stages: 10000 rk4 steps would be 1.5e6 steps."""
-    started = time.perf_counter()
+    started = time.process_time()
     with pytest.raises(SimulationError, match=r"up to 1,500,000 steps .* limit of 500,000; use at most 3333"):
         simulate(bank["drop-rebound"], {"h_drop": 2100, "h_rebound": 1000}, Options(Settings("rk4", steps=10_000)))
-    assert time.perf_counter() - started < 1.0
+    assert time.process_time() - started < 1.0
 
 
 def test_a_simulation_over_its_time_limit_stops_with_the_limit(bank: dict[str, Template]) -> None:
     """The wall-clock budget covers every pass of a search."""
     options = Options(Settings("rk4", steps=3000), time_limit=0.05)
-    started = time.perf_counter()
+    started = time.process_time()
     with pytest.raises(SimulationError, match=r"drop-rebound: the simulation took more than 0.05 s, the limit"):
         simulate(bank["drop-rebound"], {"h_drop": 2100, "h_rebound": 1000}, options)
-    assert time.perf_counter() - started < 1.0
+    assert time.process_time() - started < 1.0
 
 
 def test_simulate_json_is_strict_and_reports_undefined_with_a_reason(capsys: pytest.CaptureFixture[str]) -> None:

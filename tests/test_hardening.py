@@ -30,9 +30,10 @@ def run(capsys: pytest.CaptureFixture[str], *argv: object) -> tuple[int, str, st
     return code, captured.out, captured.err
 
 
-def refused(capsys: pytest.CaptureFixture[str], *argv: object, within: float = 1.0) -> str:
+def refused(capsys: pytest.CaptureFixture[str], *argv: object, within: float = 5.0) -> str:
     """Run; expect exit 2 with one line on stderr and nothing on stdout, within ``within`` seconds of this
-    process's CPU time (what catches work without end; the machine's other work does not count)."""
+    process's CPU time: what catches work without end or that grows with the input's size (the machine's
+    other work does not count; the collector walking the test session's heap can, up to a second or so)."""
     started = time.process_time()
     code, out, err = run(capsys, *argv)
     assert time.process_time() - started < within
@@ -225,10 +226,10 @@ def test_dev_zero_as_a_csv_is_refused_by_size_not_memory(tmp_path: Path, capsys:
     if not Path("/dev/zero").exists():
         pytest.skip("no /dev/zero on this system")
     if which == "batch":
-        err = refused(capsys, "solve", "drop-rebound", "--batch", "/dev/zero", within=3)
+        err = refused(capsys, "solve", "drop-rebound", "--batch", "/dev/zero")
     else:
         a = write(tmp_path / "a.yaml", ONE_PROBLEM)
-        err = refused(capsys, "generate", a, "--roster", "/dev/zero", "--out", tmp_path / "o", "--no-pdf", within=3)
+        err = refused(capsys, "generate", a, "--roster", "/dev/zero", "--out", tmp_path / "o", "--no-pdf")
     assert "/dev/zero: larger than 64 MiB" in err
 
 
@@ -241,7 +242,7 @@ def test_a_sparse_2_gb_key_is_refused_by_its_size_before_reading_it(tmp_path: Pa
     answers = write(tmp_path / "a.csv", "student_id,label,answer\n")
     tracemalloc.start()
     try:
-        err = refused(capsys, "grade", "--key", key, answers, "--out", tmp_path / "g", within=2)
+        err = refused(capsys, "grade", "--key", key, answers, "--out", tmp_path / "g")
         assert tracemalloc.get_traced_memory()[1] < 50 << 20
     finally:
         tracemalloc.stop()
@@ -440,8 +441,7 @@ def test_arbitrary_bytes_as_an_assignment(tmp_path: Path, capsys: pytest.Capture
 def test_hostile_template_structures_are_refused_naming_the_file(tmp_path: Path, capsys: pytest.CaptureFixture[str],
                                                                  old: str, new: str, message: str) -> None:
     folder = bank_with(tmp_path, "drop-rebound", old, new)
-    err = refused(capsys, *ONLY, folder, "solve", "drop-rebound", "--set", "h_drop=2000", "--set", "h_rebound=900",
-                  within=5)
+    err = refused(capsys, *ONLY, folder, "solve", "drop-rebound", "--set", "h_drop=2000", "--set", "h_rebound=900")
     assert message in err, err
 
 
@@ -464,8 +464,7 @@ def test_expressions_the_solver_cannot_handle_are_template_errors(tmp_path: Path
                                                                   capsys: pytest.CaptureFixture[str],
                                                                   template: str, old: str, new: str) -> None:
     folder = bank_with(tmp_path, template, old, new)
-    err = refused(capsys, *ONLY, folder, "solve", template, "--set", "v=1", "--set", "theta=30", "--set", "e=0.5",
-                  within=5)
+    err = refused(capsys, *ONLY, folder, "solve", template, "--set", "v=1", "--set", "theta=30", "--set", "e=0.5")
     assert f"{template}.yaml: " in err and "expected" in err
 
 

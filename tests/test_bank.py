@@ -150,7 +150,7 @@ TOPIC_OF = {
     "head-on-inverse": "direct impact", "three-balls": "direct impact",
     "ball-plate": "oblique impact", "oblique-spheres": "oblique impact",
     "drop-rebound": "drops and rebounds", "moving-plate": "drops and rebounds", "pile-driver": "drops and rebounds",
-    "two-rebounds": "drops and rebounds",
+    "two-rebounds": "drops and rebounds", "skid": "impact and sliding", "wall-throw": "impact with flight",
 }
 
 
@@ -166,7 +166,7 @@ def test_each_template_has_its_topic_and_the_scene_would_give_the_same(template_
 
 def test_a_topic_outside_the_list_is_refused_naming_the_choices() -> None:
     with pytest.raises(TemplateError, match=r"topic: expected one of direct impact, oblique impact, drops and "
-                                            r"rebounds .*got 'impacts'"):
+                                            r"rebounds, impact and sliding, impact with flight .*got 'impacts'"):
         parse_template(mutated(set_in("topic", "impacts")), "x.yaml", "hash")
 
 

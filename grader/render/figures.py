@@ -20,6 +20,8 @@ The kind of figure follows from the scene's structure, never from the template's
 * direct impacts of bodies in a line (two, or a chain: 1 strikes 2, 2 strikes 3): blocks whose areas
   follow the masses, above each the velocity before it is struck, an arrow the way it moves with
   lengths in the ratio of the speeds, the bodies at rest marked so;
+* an impact and a slide to rest after it: the bodies at the impact and at rest, the skid mark from
+  the point of impact dimensioned (:mod:`grader.render.skid`);
 * anything else: the bodies in a row, labelled.
 
 The oblique figures are :mod:`grader.render.oblique`'s, the drawing primitives
@@ -38,6 +40,7 @@ from grader.model.scene import Stage, Velocity
 from grader.render.canvas import Canvas, Point
 from grader.render.oblique import incline, offset_spheres, spheres, surface
 from grader.render.scene_view import SceneView, find_stage
+from grader.render.skid import skid
 from grader.render.worked import Typ, string
 
 
@@ -52,6 +55,9 @@ def figure(template: Template, variant: ProblemVariant, values: Mapping[str, flo
         if fall is None or not _drop(canvas, scene, fall, None, None):
             canvas = Canvas()
             _row(canvas, scene)
+        return canvas.typst()
+    slide = find_stage(stages, "slide", after=impact.index)
+    if slide is not None and skid(canvas, scene, impact, slide):
         return canvas.typst()
     first, second = impact.fields["bodies"]
     fall = find_stage(stages, "free_fall", before=impact.index, body=first)

@@ -27,8 +27,8 @@ from scipy.optimize import brentq
 
 from grader.bank.template import Template
 from grader.errors import GraderError
-from grader.model.expr import Sym, names
-from grader.model.scene import Stage
+from grader.model.expr import Sym, names, parse
+from grader.model.scene import Stage, Velocity
 from grader.physics.effects import CATALOGUE
 from grader.physics.integrate import MAX_STEPS, Budget, SimulationError
 from grader.physics.run import ContactRecord, Options, PhaseRecord, Run, UnknownQuantityError
@@ -126,10 +126,13 @@ def _walk(template: Template, options: Options, values: dict[str, float], budget
 # Passes a search for one unknown makes: two ends, brentq's iterations (about 10 to 20 on these scenes
 # at xtol 1e-15), the final run; the bound is what the fixed-step work is estimated with.
 SEARCH_PASSES = 25
-# What a search may find, by the stage field that needs it: a restitution in [0, 1]; a fall height in
-# [0, inf), bracketed by growing an upper end from the size of the outcome it must match.
+# What a search may find, by the stage field that needs it: a restitution in [0, 1]; a fall height, the
+# speed of an approach along n before an impact (a car's, from the skid after it) or at the start of a
+# slide in [0, inf), bracketed by growing an upper end from the size of the outcome it must match.
 _SEARCHABLE = {("impact", "restitution"): ("coefficient of restitution", 0.0, 1.0),
-               ("free_fall", "height"): ("fall height", 0.0, math.inf)}
+               ("free_fall", "height"): ("fall height", 0.0, math.inf),
+               ("impact", "before"): ("velocity before the impact", 0.0, math.inf),
+               ("slide", "speed"): ("speed at the start of the slide", 0.0, math.inf)}
 _PROBE = 0.5  # a value of the unknown that shows which outcome it leads to
 _GROWTH, _MAX_GROWTH = 4.0, 120  # an open upper end grows 4x at a time, at most 120 times (4**120 ~ 1e72)
 
@@ -186,11 +189,14 @@ def _next_unknown(template: Template, options: Options, values: dict[str, float]
     for index, name in sorted(stalled.waiting.items()):
         stage = template.scene.stages[index]
         kind = next((_SEARCHABLE[(stage.effect, key)] for key, value in stage.fields.items()
-                     if (stage.effect, key) in _SEARCHABLE and value == Sym(name)), None)
+                     if (stage.effect, key) in _SEARCHABLE and _names(value, name)), None)
         if kind is None or name in (u for u, _ in tried):
             continue
         probe = _walk(template, options, {**values, name: _PROBE}, budget)
-        outcomes = sorted(set(probe.observed) - set(stalled.observed))
+        # A measured outcome is one the statement gives (a skid's length); a quantity the run produced
+        # twice (the common velocity of two cars that couple) only checks the run against itself.
+        outcomes = sorted(key for key in set(probe.observed) - set(stalled.observed)
+                          if names(parse(key)) <= set(values))
         if len(outcomes) == 1:
             return _Unknown(name, stage, *kind, outcomes[0])
         tried.append((name, len(outcomes)))
@@ -200,6 +206,13 @@ def _next_unknown(template: Template, options: Options, values: dict[str, float]
     name, count = tried[0]
     raise SimulationError(f"cannot simulate: finding {name} needs exactly one measured outcome that it alone "
                           f"leads to, the scene has {count}")
+
+
+def _names(field: object, name: str) -> bool:
+    """Whether a stage field is the quantity ``name``: an expression, or a velocity along n under a body."""
+    if isinstance(field, Mapping):
+        return any(isinstance(velocity, Velocity) and velocity.n == Sym(name) for velocity in field.values())
+    return field == Sym(name)
 
 
 def _search(template: Template, options: Options, values: dict[str, float], budget: Budget,

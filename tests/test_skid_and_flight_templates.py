@@ -23,19 +23,36 @@ G = mp.mpf(9.81)  # the bank's g, as the float the kernels use
 KMH = mp.mpf(3.6)  # (km/h) per (m/s)
 ISSUE = {  # ids, parameters and answers exactly as issue 14's table names them
     "skid": (["m_A", "m_B", "d", "mu_k"], ["v_A", "loss_pct"]),
+    "wall-throw": (["h0", "D", "v0", "alpha", "e"], ["y_hit", "v_hit", "v_out", "x_land"]),
 }
 
 
 # ---- references -------------------------------------------------------------------------------
 def ref_skid(m_A, m_B, d, mu_k):  # noqa: N803 (the template's names)
-    m_A, m_B, d, mu_k = (mp.mpf(x) for x in (m_A, m_B, d, mu_k))
+    mass_a, mass_b, d, mu_k = (mp.mpf(x) for x in (m_A, m_B, d, mu_k))
     v_c = mp.sqrt(2 * mu_k * G * d)  # 1/2 (m_A + m_B) v_c^2 = mu_k (m_A + m_B) g d
-    v_A = (m_A + m_B) * v_c / m_A  # m_A v_A = (m_A + m_B) v_c
-    before, after = m_A * v_A**2 / 2, (m_A + m_B) * v_c**2 / 2
-    return {"v_A": v_A * KMH, "loss_pct": 100 * (before - after) / before}
+    v_a = (mass_a + mass_b) * v_c / mass_a  # m_A v_A = (m_A + m_B) v_c
+    before, after = mass_a * v_a**2 / 2, (mass_a + mass_b) * v_c**2 / 2
+    return {"v_A": v_a * KMH, "loss_pct": 100 * (before - after) / before}
 
 
-REFERENCES = {"skid": ref_skid}
+def ref_wall_throw(h0, D, v0, alpha, e):  # noqa: N803
+    h0, wall, v0, e = (mp.mpf(x) for x in (h0, D, v0, e))
+    angle = mp.mpf(alpha) * mp.pi / 180
+    vx, vy = v0 * mp.cos(angle), v0 * mp.sin(angle)
+    t1 = wall / vx  # x = v_x t reaches the wall
+    y_hit = h0 + vy * t1 - G * t1**2 / 2
+    vy_hit = vy - G * t1
+    # The smooth wall turns the horizontal component round, times e, and keeps the vertical one. The
+    # landing is the later root of y_hit + vy_hit t - g t^2/2 = 0 (the other is at or before the wall);
+    # at 60 digits the textbook's formula loses nothing that matters, whatever the sign of vy_hit.
+    root = mp.sqrt(vy_hit**2 + 2 * G * y_hit)
+    t2 = max((vy_hit + root) / G, (vy_hit - root) / G)
+    return {"y_hit": y_hit, "v_hit": mp.sqrt(vx**2 + vy_hit**2), "v_out": mp.sqrt((e * vx) ** 2 + vy_hit**2),
+            "x_land": e * vx * t2}
+
+
+REFERENCES = {"skid": ref_skid, "wall-throw": ref_wall_throw}
 
 
 def check(bank, compiled, template_id, params):
@@ -51,6 +68,11 @@ def test_ids_parameters_and_answers_are_the_issues(bank):
     # v_c = sqrt(2(0.6)(9.81)(8.5)) = 10.003 m/s; v_A = 10.003(2700/1500) = 18.006 m/s = 64.82 km/h;
     # the plastic impact keeps m_A/(m_A + m_B) of the energy: 1200/2700 of it is lost
     ("skid", {"m_A": 1500, "m_B": 1200, "d": 8.5, "mu_k": 0.6}, {"v_A": 64.82, "loss_pct": 44.44}),
+    # v_x = 15 cos 25 = 13.59, v_y = 6.339; t1 = 6/13.59 = 0.4414 s; y = 1.5 + 6.339(0.4414) - 4.905(0.4414)^2;
+    # at the wall v_y = 6.339 - 9.81(0.4414) = 2.010 m/s; after it (0.7)(13.59) = 9.516 m/s back; the landing
+    # t2 = (2.010 + sqrt(2.010^2 + 2(9.81)(3.342)))/9.81 = 1.055 s, x = 9.516(1.055)
+    ("wall-throw", {"h0": 1.5, "D": 6, "v0": 15, "alpha": 25, "e": 0.7},
+     {"y_hit": 3.342, "v_hit": 13.74, "v_out": 9.726, "x_land": 10.04}),
 ])
 def test_known_answers(bank, compiled, template_id, params, answers):
     """The hand-worked values to four figures, and the reference to 1e-9."""
@@ -64,6 +86,65 @@ def test_known_answers(bank, compiled, template_id, params, answers):
                          ids=["skid", "tiny-mu-d", "tiny-d", "large-d"])
 def test_skid(bank, compiled, m_A, m_B, d, mu_k):  # noqa: N803
     check(bank, compiled, "skid", {"m_A": m_A, "m_B": m_B, "d": d, "mu_k": mu_k})
+
+
+@pytest.mark.parametrize("e", [0.0, 1.0, 0.55])
+@pytest.mark.parametrize("h0, D, v0, alpha", [
+    pytest.param(1.5, 6.0, 15.0, 25.0, id="rising-at-the-wall"),
+    pytest.param(1.5, 6.0, 15.0, 0.0, id="alpha0"),
+    pytest.param(0.0, 8.0, 12.0, 40.0, id="from-the-ground-falling-at-the-wall"),
+    pytest.param(2.0, 0.5, 20.0, 80.0, id="steep"),
+    pytest.param(1e-6, 1e-6, 0.01, 30.0, id="tiny"),
+    pytest.param(1e150, 1e150, 1e76, 30.0, id="large"),
+])
+def test_wall_throw(bank, compiled, h0, D, v0, alpha, e):  # noqa: N803
+    """e = 0 lands at the wall (x_land exactly 0); e = 1 keeps the speed; a throw along the horizontal."""
+    check(bank, compiled, "wall-throw", {"h0": h0, "D": D, "v0": v0, "alpha": alpha, "e": e})
+
+
+@pytest.mark.parametrize("grazing", [1e-3, 1e-6])
+@pytest.mark.parametrize("e", [0.0, 0.7])
+def test_wall_throw_grazing_the_ground_at_the_wall(bank, compiled, grazing, e):
+    """Thrown level from just above h = g D^2/(2 v0^2): it strikes the wall a hair above the ground and
+    lands a hair from it. The landing time is the root of a quadratic whose v_y is negative: written as
+    (v_y + sqrt(v_y^2 + 2 g y))/g it would lose every digit, the kernel's form keeps them (the inputs'
+    own rounding, amplified 1/grazing times in y_hit, is what is left)."""
+    h0 = float(G) * 16 / 200 * (1 + grazing)
+    check(bank, compiled, "wall-throw", {"h0": h0, "D": 4.0, "v0": 10.0, "alpha": 0.0, "e": e})
+
+
+def test_an_answer_of_zero_is_graded_with_the_absolute_band(bank):
+    """e = 0 for everyone: x_land is 0 in every variant; the template's atol lets generate draw them and
+    grading accept 0 (and 3 mm), where a purely relative band would accept nothing but an exact 0."""
+    from grader.assign.assignment import Assignment, ProblemSpec, Student
+    from grader.assign.variants import generate
+    from grader.grade.compare import is_correct
+
+    problem = ProblemSpec("1", "wall-throw", {"*": 1.0}, {"e": 0.0}, {}, {})
+    assignment = Assignment("a.yaml", "Zero", "", "seed", "", "", (problem,))
+    students = [Student(f"s{i}", f"S {i}", "", "") for i in range(5)]
+    generation = generate(assignment, students, {"wall-throw": bank["wall-throw"]})
+    for entry in generation.students:
+        (part,) = [a for a in entry.problems[0].answers if a.name == "x_land"]
+        assert part.value == 0.0
+    tolerance = bank["wall-throw"].answers["x_land"].tolerance
+    assert is_correct([0.0, 0.003, 0.02], [0.0] * 3, tolerance).tolist() == [True, True, False]
+
+
+# ---- the flight's force law -----------------------------------------------------------------
+@pytest.mark.parametrize("e", [0.0, 0.7, 1.0])
+def test_wall_throw_simulation_integrates_gravity_and_the_contact_only(bank, compiled, e):
+    """Gravity in the flights, the contact at the wall, no friction; the events (the wall, the ground)
+    are located, so the simulated answers agree with the closed form to 1e-8."""
+    params = {"h0": 1.5, "D": 6.0, "v0": 15.0, "alpha": 25.0, "e": e}
+    result = simulate(bank["wall-throw"], params)
+    assert result.effects == ("gravity", "contact (Kelvin-Voigt)")
+    closed = solve_one(bank["wall-throw"], compiled["wall-throw"], params)
+    for name, value in result.answers.items():
+        expected = closed.answers[name].value
+        assert value == pytest.approx(expected, rel=1e-8, abs=1e-12), name
+    landing = next(phase for phase in result.phases if "to the ground" in phase.label)
+    assert landing.path.y[-1][1] == pytest.approx(0.0, abs=1e-9)
 
 
 # ---- the slide's force law ------------------------------------------------------------------
@@ -100,6 +181,10 @@ def test_slide_declares_its_mistakes(bank):
 
 # ---- refusals name the reason -----------------------------------------------------------------
 @pytest.mark.parametrize("template_id, params, reason", [
+    ("wall-throw", {"h0": 0.5, "D": 6, "v0": 5, "alpha": 0, "e": 0.5},
+     "ball reaches the ground before it gets to the wall (its height at the wall, y_hit, would be -6.5632)"),
+    ("wall-throw", {"h0": 0.5, "D": 6, "v0": 5, "alpha": 90, "e": 0.5}, "alpha = 90 deg is outside its domain"),
+    ("wall-throw", {"h0": 0.5, "D": 6, "v0": 15, "alpha": 10, "e": 1.2}, "e = 1.2 is outside its domain [0, 1]"),
     ("skid", {"m_A": 1500, "m_B": 1200, "d": 8.5, "mu_k": 0}, "mu_k = 0 is outside its domain (0, inf)"),
     ("skid", {"m_A": 1500, "m_B": 1200, "d": 0, "mu_k": 0.6}, "d = 0 m is outside its domain (0, inf)"),
 ])

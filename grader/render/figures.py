@@ -22,6 +22,8 @@ The kind of figure follows from the scene's structure, never from the template's
   lengths in the ratio of the speeds, the bodies at rest marked so;
 * an impact and a slide to rest after it: the bodies at the impact and at rest, the skid mark from
   the point of impact dimensioned (:mod:`grader.render.skid`);
+* a projectile's flight to a wall, its rebound and its flight to the ground: the path to scale
+  (:mod:`grader.render.trajectory`);
 * anything else: the bodies in a row, labelled.
 
 The oblique figures are :mod:`grader.render.oblique`'s, the drawing primitives
@@ -41,6 +43,7 @@ from grader.render.canvas import Canvas, Point
 from grader.render.oblique import incline, offset_spheres, spheres, surface
 from grader.render.scene_view import SceneView, find_stage
 from grader.render.skid import skid
+from grader.render.trajectory import trajectory
 from grader.render.worked import Typ, string
 
 
@@ -55,6 +58,10 @@ def figure(template: Template, variant: ProblemVariant, values: Mapping[str, flo
         if fall is None or not _drop(canvas, scene, fall, None, None):
             canvas = Canvas()
             _row(canvas, scene)
+        return canvas.typst()
+    flight = find_stage(stages, "flight", before=impact.index)
+    if flight is not None and flight.fields["until"] == "wall" and trajectory(
+            canvas, scene, flight, find_stage(stages, "flight", after=impact.index)):
         return canvas.typst()
     slide = find_stage(stages, "slide", after=impact.index)
     if slide is not None and skid(canvas, scene, impact, slide):

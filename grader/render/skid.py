@@ -27,7 +27,7 @@ def car_length(mass: float) -> float:
     """
     if not (_m.isfinite(mass) and mass > 0):
         return CAR_LENGTH
-    return min(6.0, max(3.5, CAR_LENGTH * (mass / CAR_MASS) ** (1 / 3)))
+    return min(6.0, max(3.5, CAR_LENGTH * _m.cbrt(mass / CAR_MASS)))
 
 
 def skid(canvas: Canvas, scene: SceneView, impact: Stage, slide: Stage) -> bool:
@@ -68,7 +68,7 @@ def skid(canvas: Canvas, scene: SceneView, impact: Stage, slide: Stage) -> bool:
     for x, body in ((d + a / 2, first), (d + a + b / 2, second)):
         canvas.label((x, 0.2 + tall / 2), "c", [str(string(body))])
     canvas.label((-0.3, tall + 0.9), "w", [str(string("at rest"))])
-    _horizontal_dimension(canvas, a, a + d, -0.55, scene.given(slide.fields["distance"]))
+    horizontal_dimension(canvas, a, a + d, -0.55, scene.given(slide.fields["distance"]))
     return True
 
 
@@ -85,7 +85,7 @@ def _car(canvas: Canvas, x0: float, x1: float, road: float, height: float, dash:
         canvas.circle((x, road + wheel), wheel, dash, fill=dash is None)
 
 
-def _horizontal_dimension(canvas: Canvas, x0: float, x1: float, y: float, lines: list[str]) -> None:
+def horizontal_dimension(canvas: Canvas, x0: float, x1: float, y: float, lines: list[str]) -> None:
     """A horizontal dimension line from ``x0`` to ``x1`` at height ``y``, labelled below."""
     middle = (x0 + x1) / 2
     if x1 - x0 > 0.6:

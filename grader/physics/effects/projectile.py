@@ -91,8 +91,9 @@ def _flight(stage: Stage, ctx: Context, law: str = "y0 + vy t - g t^2/2", root: 
     else:
         ground = text["end_height"] == "0"
         fallen = text["height"] if ground else f"({text['height']} − {text['end_height']})"
-        label = (f"vertical motion of {body} until it lands {'on the ground' if ground else 'at ' + text['end_height']}"
-                 f": a quadratic in {t}, whose roots are ({text['vertical']} ± √({text['vertical']}² + 2 g {fallen}))/g;"
+        where = "on the ground" if ground else f"at {text['end_height']}"
+        label = (f"vertical motion of {body} until it lands {where}: a quadratic in {t}, whose roots are "
+                 f"({text['vertical']} ± √({text['vertical']}² + 2 g {fallen}))/g;"
                  f" the landing is the root with +, since the root with − is not positive (at or before the start: "
                  f"where the path, run backwards, meets {'the ground' if ground else 'that height'})")
         requires = (Condition(sp.Ge(drop, 0), f"{body} starts below the height it is to land at "

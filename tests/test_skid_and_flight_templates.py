@@ -131,6 +131,95 @@ def test_an_answer_of_zero_is_graded_with_the_absolute_band(bank):
     assert is_correct([0.0, 0.003, 0.02], [0.0] * 3, tolerance).tolist() == [True, True, False]
 
 
+# ---- the effects alone, in scenes of their own ---------------------------------------------------
+def scene(raw_yaml):
+    import yaml
+
+    from grader.bank.template import parse_template
+    from grader.solve.solver import compile_template
+
+    template = parse_template(yaml.safe_load(raw_yaml), "test.yaml", raw_yaml)
+    return template, compile_template(template)
+
+
+LEDGE = """
+id: ledge
+title: A ball thrown down from a ledge
+version: 1
+gravity: 9.81 m/s^2
+bodies: {ball: {mass: m}}
+symbols: {m: {unit: kg}}
+parameters:
+  h: {unit: m, domain: "[0, inf)", sample: {uniform: [1, 2]}, decimals: 2}
+  u: {unit: m/s, domain: "(-inf, inf)", sample: {uniform: [-5, 5]}, decimals: 2}
+  w: {unit: m/s, domain: "[0, inf)", sample: {uniform: [1, 5]}, decimals: 2}
+stages:
+  - {effect: flight, body: ball, until: ground, horizontal: w, vertical: u, height: h, distance: x,
+     end_height: 0, end_vertical: u_land, time: t}
+answers:
+  t: {value: t, unit: s}
+  x: {value: x, unit: m}
+  u_land: {value: u_land, unit: m/s}
+statement: A ball is thrown from a ledge {{ h }} m high.
+"""
+
+
+@pytest.mark.parametrize("h, u", [
+    pytest.param(1e-12, -10.0, id="thrown-down-a-hair-above-the-ground"),
+    pytest.param(1e-12, 10.0, id="thrown-up-a-hair-above-the-ground"),
+    pytest.param(0.0, -3.0, id="on-the-ground-moving-down"),
+    pytest.param(0.0, 3.0, id="from-the-ground-up"),
+    pytest.param(2.0, 0.0, id="level"),
+    pytest.param(1e150, -1e70, id="large"),
+])
+def test_landing_time_is_the_later_root_to_full_accuracy(h, u):
+    """Thrown down at 10 m/s from 1e-12 m: the textbook's (u + sqrt(u^2 + 2 g h))/g cancels (fewer than 4
+    digits left); the kernel's form gives the landing time 2h/(sqrt(u^2 + 2 g h) - u) to 1e-9."""
+    template, compiled = scene(LEDGE)
+    solution = solve_one(template, compiled, {"h": h, "u": u, "w": 2.0})
+    with mp.workdps(60):
+        h_, u_ = mp.mpf(h), mp.mpf(u)
+        roots = [(u_ + sign * mp.sqrt(u_**2 + 2 * G * h_)) / G for sign in (1, -1)]
+        t = max(roots)
+        expected = {"t": t, "x": 2 * t, "u_land": u_ - G * t}
+        for name, value in expected.items():
+            got = solution.answers[name].value
+            assert got == value == 0 or abs(mp.mpf(got) - value) <= 1e-9 * abs(value), (name, got, value)
+    textbook = (u + np.sqrt(u * u + 2 * 9.81 * h)) / 9.81
+    if h == 1e-12 and u < 0:
+        assert abs(textbook - float(t)) > 1e-4 * float(t)  # what the kernel's form avoids
+
+
+SKID_ALONE = """
+id: skid-alone
+title: A car skids to rest
+version: 1
+gravity: 9.81 m/s^2
+bodies: {car: {mass: m}}
+symbols: {m: {unit: kg}}
+parameters:
+  d: {unit: m, domain: "(0, inf)", sample: {uniform: [5, 20]}, decimals: 1}
+  mu_k: {unit: "", domain: "(0, inf)", sample: {uniform: [0.4, 0.8]}, decimals: 2}
+stages:
+  - {effect: slide, body: car, speed: v, distance: d, friction: mu_k}
+answers:
+  v: {value: v, unit: km/h}
+statement: A car leaves a skid mark {{ d }} m long.
+"""
+
+
+@pytest.mark.parametrize("d, mu_k", [(12.0, 0.7), (1e-9, 1e-6), (1e6, 0.5)])
+def test_a_slide_alone_finds_its_speed_from_the_distance(d, mu_k):
+    """The closed form v = sqrt(2 mu_k g d); the simulation searches the speed at which the simulated
+    slide, stopped at its located event v = 0, is d long."""
+    template, compiled = scene(SKID_ALONE)
+    expected = mp.sqrt(2 * mp.mpf(mu_k) * G * mp.mpf(d)) * KMH
+    assert abs(mp.mpf(solve_one(template, compiled, {"d": d, "mu_k": mu_k}).answers["v"].value) / expected - 1) < 1e-12
+    simulated = simulate(template, {"d": d, "mu_k": mu_k})
+    assert simulated.effects == ("kinetic friction (Coulomb)",)
+    assert simulated.answers["v"] == pytest.approx(float(expected), rel=1e-9)
+
+
 # ---- the flight's force law -----------------------------------------------------------------
 @pytest.mark.parametrize("e", [0.0, 0.7, 1.0])
 def test_wall_throw_simulation_integrates_gravity_and_the_contact_only(bank, compiled, e):

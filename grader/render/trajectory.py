@@ -72,30 +72,32 @@ def trajectory(canvas: Canvas, scene: SceneView, to_wall: Stage, to_ground: Stag
             canvas.strokes += list(pairwise(drawn))  # labels keep clear of the path
         canvas.circle(at(after[-1]), 0.09, fill=True)
     canvas.circle((wall - 0.09, hit), 0.09, fill=True)
-    _release(canvas, scene, to_wall, h0 * scale, _m.atan2(vy, vx), (left, top * scale + 0.3))
-    canvas.dimension((wall - 0.3, 0.0), (wall - 0.3, hit), [], "left")
-    canvas.label((wall - 0.45, hit / 2), "e", scene.given(to_wall.fields["end_height"]))
+    _release(canvas, scene, to_wall, h0 * scale, _m.atan2(vy, vx), (left, top * scale + 0.3), min(1.1, 0.7 * wall))
+    canvas.dimension((wall + 0.5, 0.0), (wall + 0.5, hit), scene.given(to_wall.fields["end_height"]), "right")
+    canvas.line((wall, hit), (wall + 0.65, hit), width=0.3)
     horizontal_dimension(canvas, 0.0, wall, -0.5, scene.given(to_wall.fields["distance"]))
     if after and to_ground is not None:
         horizontal_dimension(canvas, after[-1][0] * scale, wall, -1.25, scene.given(to_ground.fields["distance"]))
     restitution = _restitution(scene)
     if restitution:
-        canvas.label((wall + 0.3, top * scale + 0.2), "w", restitution)
+        canvas.label((wall + 0.3, max(top * scale, hit + 0.9) + 0.2), "w", restitution)
     return True
 
 
-def _release(canvas: Canvas, scene: SceneView, stage: Stage, height: float, angle: float, corner: Point) -> None:
-    """The thrower's point at ``height`` (cm) above the ground, dimensioned, and the throw's velocity,
-    labelled beside it, or at ``corner`` (above the path) where the path leaves no room."""
+def _release(canvas: Canvas, scene: SceneView, stage: Stage, height: float, angle: float, corner: Point,
+             length: float) -> None:
+    """The thrower's point at ``height`` (cm) above the ground, dimensioned, and the throw's velocity (an
+    arrow ``length`` cm long), labelled beside it, or at ``corner`` (above the path) where the path leaves
+    no room."""
     canvas.circle((0.0, height), 0.09, fill=True)
     if height > 0:
         canvas.line((0.0, 0.0), (0.0, height), width=0.4, dash="dashed", gray=True)
         canvas.dimension((-0.35, 0.0), (-0.35, height), scene.given(stage.fields["height"]), "left")
-    tip = (1.1 * _m.cos(angle), height + 1.1 * _m.sin(angle))
+    tip = (length * _m.cos(angle), height + length * _m.sin(angle))
     canvas.arrow((0.0, height), tip)
     if angle > 0.02:  # the angle from the horizontal, marked
-        canvas.line((0.0, height), (0.8, height), width=0.4, dash="dashed", gray=True)
-        canvas.arc((0.0, height), 0.6, 0.0, angle)
+        canvas.line((0.0, height), (0.75 * length, height), width=0.4, dash="dashed", gray=True)
+        canvas.arc((0.0, height), 0.55 * length, 0.0, angle)
     lines = _launch(scene, stage)
     places = [((-0.15, height + 0.2), "se"), ((-0.5, height + 0.1), "e")]
     spot, anchor = next((p for p in places if canvas.fits(*p, lines)), (corner, "sw"))

@@ -25,6 +25,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from grader.model.expr import Sym
 from grader.model.units import LENGTH, SPEED, dimension_from
 from grader.physics.effects.base import Condition, Effect, Field, Mistake, Relation, Stable
 
@@ -150,8 +151,6 @@ def _simulate_flight(stage: Stage, run: Run) -> None:
         run.output(fields["distance"], x)
     run.output(fields["end_vertical"], vy_end)
     if isinstance(fields.get("time"), str):
-        from grader.model.expr import Sym
-
         run.output(Sym(fields["time"]), time)
 
 
@@ -163,14 +162,14 @@ def _to_wall(stage: Stage, run: Run, vx: float, vy: float, y0: float, g: float) 
         run.problems.append(f"{stage.fields['body']} does not move toward the wall (horizontal velocity {vx:g} m/s)"
                             if vx <= 0 else f"the distance to the wall {distance:g} m is negative")
         return None
+    if distance == 0:  # thrown from the foot of the wall: it strikes it at once
+        return 0.0, np.array([0.0, y0, vx, vy])
     run.uses("gravity")
     duration = distance / vx
     speed = max(vx, abs(vy), g * duration)
-    sizes = np.array([distance or speed * duration, max(y0, speed * duration), speed, speed])
-    flight = Mode("flight to the wall", gravity_2d(g), lambda y: y[0] - distance, +1, scale=duration or 1.0,
+    sizes = np.array([distance, max(y0, speed * duration), speed, speed])
+    flight = Mode("flight to the wall", gravity_2d(g), lambda y: y[0] - distance, +1, scale=duration,
                   sizes=lambda y: sizes)
-    if distance == 0:
-        return 0.0, np.array([0.0, y0, vx, vy])
     path = run.integrate([flight], np.array([0.0, y0, vx, vy]))
     run.record(f"{stage.fields['body']} flies to the wall", ("x", "y", "v_x", "v_y"), path)
     return path.t[-1], path.y[-1]
@@ -181,8 +180,9 @@ def _to_ground(stage: Stage, run: Run, vx: float, vy: float, y0: float, g: float
 
     y1 = run.value(stage.fields["end_height"])
     drop = y0 - y1
-    if drop < 0:
-        run.problems.append(f"{stage.fields['body']} starts below the height it is to land at")
+    if drop < 0 or vx < 0:
+        run.problems.append(f"{stage.fields['body']} starts below the height it is to land at" if drop < 0 else
+                            f"the horizontal velocity {vx:g} m/s is negative (x is measured the way the body moves)")
         return None
     if drop == 0 and vy <= 0:  # it is there already, moving down or level: it lands at once
         return 0.0, np.array([0.0, y0, vx, vy])

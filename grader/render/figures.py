@@ -24,6 +24,10 @@ The kind of figure follows from the scene's structure, never from the template's
   scale (:mod:`grader.render.series`);
 * a body swinging up on a cord (``swing``), struck at the lowest point maybe: the cord at rest and at its
   greatest angle, to scale, and the arc between (:mod:`grader.render.pendulum`);
+* an impact and a slide to rest after it: the bodies at the impact and at rest, the skid mark from
+  the point of impact dimensioned (:mod:`grader.render.skid`);
+* a projectile's flight to a wall, its rebound and its flight to the ground: the path to scale
+  (:mod:`grader.render.trajectory`);
 * anything else: the bodies in a row, labelled.
 
 The oblique figures are :mod:`grader.render.oblique`'s, the drawing primitives
@@ -44,6 +48,8 @@ from grader.render.oblique import incline, offset_spheres, spheres, surface
 from grader.render.pendulum import swing_figure
 from grader.render.scene_view import SceneView, find_stage
 from grader.render.series import bounce_series
+from grader.render.skid import skid
+from grader.render.trajectory import trajectory
 from grader.render.worked import Typ, string
 
 
@@ -63,6 +69,13 @@ def figure(template: Template, variant: ProblemVariant, values: Mapping[str, flo
         if fall is None or not _drop(canvas, scene, fall, None, None):
             canvas = Canvas()
             _row(canvas, scene)
+        return canvas.typst()
+    flight = find_stage(stages, "flight", before=impact.index)
+    if flight is not None and flight.fields["until"] == "wall" and trajectory(
+            canvas, scene, flight, find_stage(stages, "flight", after=impact.index)):
+        return canvas.typst()
+    slide = find_stage(stages, "slide", after=impact.index)
+    if slide is not None and skid(canvas, scene, impact, slide):
         return canvas.typst()
     first, second = impact.fields["bodies"]
     fall = find_stage(stages, "free_fall", before=impact.index, body=first)

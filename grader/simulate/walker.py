@@ -27,7 +27,7 @@ from scipy.optimize import brentq
 
 from grader.bank.template import Template
 from grader.errors import GraderError
-from grader.model.expr import Sym, names
+from grader.model.expr import Sym, names, parse
 from grader.model.scene import Stage, Velocity
 from grader.physics.effects import CATALOGUE
 from grader.physics.integrate import MAX_STEPS, Budget, SimulationError
@@ -129,11 +129,13 @@ def _walk(template: Template, options: Options, values: dict[str, float], budget
 # Passes a search for one unknown makes: two ends, brentq's iterations (about 10 to 20 on these scenes
 # at xtol 1e-15), the final run; the bound is what the fixed-step work is estimated with.
 SEARCH_PASSES = 25
-# What a search may find, by the stage field that needs it: a restitution in [0, 1]; a fall height in
-# [0, inf), bracketed by growing an upper end from the size of the outcome it must match.
+# What a search may find, by the stage field that needs it: a restitution in [0, 1]; a fall height, the
+# speed of an approach along n before an impact (a car's, from the skid after it) or at the start of a
+# slide in [0, inf), bracketed by growing an upper end from the size of the outcome it must match.
 _SEARCHABLE = {("impact", "restitution"): ("coefficient of restitution", 0.0, 1.0),
                ("free_fall", "height"): ("fall height", 0.0, math.inf),
-               ("impact", "before"): ("speed before the impact", 0.0, math.inf)}
+               ("impact", "before"): ("velocity before the impact", 0.0, math.inf),
+               ("slide", "speed"): ("speed at the start of the slide", 0.0, math.inf)}
 _PROBE = 0.5  # a value of the unknown that shows which outcome it leads to
 _GROWTH, _MAX_GROWTH = 4.0, 120  # an open upper end grows 4x at a time, at most 120 times (4**120 ~ 1e72)
 
@@ -194,7 +196,10 @@ def _next_unknown(template: Template, options: Options, values: dict[str, float]
         if kind is None or name in (u for u, _ in tried):
             continue
         probe = _walk(template, options, {**values, name: _PROBE}, budget)
-        outcomes = sorted(set(probe.observed) - set(stalled.observed))
+        # A measured outcome is one the statement gives (a skid's length); a quantity the run produced
+        # twice (the common velocity of two cars that couple) only checks the run against itself.
+        outcomes = sorted(key for key in set(probe.observed) - set(stalled.observed)
+                          if names(parse(key)) <= set(values))
         if len(outcomes) == 1:
             return _Unknown(name, stage, *kind, outcomes[0])
         tried.append((name, len(outcomes)))
@@ -208,7 +213,7 @@ def _next_unknown(template: Template, options: Options, values: dict[str, float]
 
 def _names(field: object, name: str) -> bool:
     """Whether a stage field is the quantity ``name`` itself: the field, or a body's velocity along n
-    alone (a bullet's speed before it strikes, found from what the block does after)."""
+    alone (a bullet's or a car's speed before it strikes, found from what happens after)."""
     if isinstance(field, Mapping):
         return any(isinstance(v, Velocity) and v.n == Sym(name) and v.t is None for v in field.values())
     return field == Sym(name)

@@ -1,7 +1,8 @@
 """The catalogue of physical effects a scene's stages are made of, one module per effect.
 
 >>> sorted(CATALOGUE)
-['angle_between', 'bounces', 'free_fall', 'impact', 'impact_geometry', 'rise', 'swing', 'velocity']
+['angle_between', 'bounces', 'flight', 'free_fall', 'impact', 'impact_geometry', 'rise', 'slide', 'swing',
+ 'velocity']
 """
 
 from grader.physics.effects.base import Condition, Effect, Field, Mistake, Relation, Stable
@@ -9,10 +10,12 @@ from grader.physics.effects.bounces import BOUNCES
 from grader.physics.effects.flight import FREE_FALL, RISE
 from grader.physics.effects.geometry import IMPACT_GEOMETRY
 from grader.physics.effects.impact import IMPACT
+from grader.physics.effects.projectile import FLIGHT
+from grader.physics.effects.slide import SLIDE
 from grader.physics.effects.swing import SWING
 from grader.physics.effects.velocity import ANGLE_BETWEEN, VELOCITY
 
 CATALOGUE: dict[str, Effect] = {effect.name: effect for effect in (FREE_FALL, RISE, IMPACT_GEOMETRY, IMPACT, VELOCITY,
-                                                                   ANGLE_BETWEEN, BOUNCES, SWING)}
+                                                                   ANGLE_BETWEEN, BOUNCES, SWING, SLIDE, FLIGHT)}
 
 __all__ = ["CATALOGUE", "Condition", "Effect", "Field", "Mistake", "Relation", "Stable"]

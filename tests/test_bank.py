@@ -218,3 +218,18 @@ def test_no_bank_at_all_is_a_usage_error() -> None:
 
     with pytest.raises(UsageError, match=r"without the shipped bank .*give --bank DIR"):
         load_banks([], shipped=False)
+
+
+def test_libyaml_and_pythons_parser_read_every_template_alike() -> None:
+    """Templates are read with libyaml's parser where PyYAML has it (the bank is read on every command);
+    PyYAML's own, all in Python, must give the same data (and gives the messages for broken files)."""
+    import yaml
+
+    from grader.inputs import _Loader, _PyLoader
+
+    if not yaml.__with_libyaml__:
+        pytest.skip("PyYAML was built without libyaml here: both loaders are Python's")
+    assert _Loader is not _PyLoader
+    for path in sorted(bank_dir().glob("*.yaml")):
+        text = path.read_text(encoding="utf-8")
+        assert yaml.load(text, Loader=_Loader) == yaml.load(text, Loader=_PyLoader), path

@@ -4,7 +4,7 @@
 ['angle_between', 'free_fall', 'impact', 'impact_geometry', 'rise', 'velocity']
 """
 
-from grader.physics.effects.base import Condition, Effect, Field, Mistake, Relation, Stable
+from grader.physics.effects.base import Condition, Effect, Field, Mistake, Relation, Route, Stable
 from grader.physics.effects.flight import FREE_FALL, RISE
 from grader.physics.effects.geometry import IMPACT_GEOMETRY
 from grader.physics.effects.impact import IMPACT
@@ -13,4 +13,4 @@ from grader.physics.effects.velocity import ANGLE_BETWEEN, VELOCITY
 CATALOGUE: dict[str, Effect] = {effect.name: effect for effect in (FREE_FALL, RISE, IMPACT_GEOMETRY, IMPACT, VELOCITY,
                                                                    ANGLE_BETWEEN)}
 
-__all__ = ["CATALOGUE", "Condition", "Effect", "Field", "Mistake", "Relation", "Stable"]
+__all__ = ["CATALOGUE", "Condition", "Effect", "Field", "Mistake", "Relation", "Route", "Stable"]

@@ -54,17 +54,18 @@ def fair_tolerances(routes: Routes, configured: Mapping[str, Tolerance], units: 
     """The tolerance of every answer of every parameter set (``values``: the key's answers; ``answered``:
     whether each row has a value for each answer, ``answered[name][row]``)."""
     size = len(next(iter(params.values()))) if params else 0
-    needed: dict[str, np.ndarray] = {}
 
-    def band(name: str) -> np.ndarray:
-        tolerance, value = configured[name], np.abs(np.asarray(values[name], dtype=float))
-        width: np.ndarray = tolerance.atol + tolerance.rtol * value
-        return width
+    def short(name: str, bound: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """What honest rounding needs of the answer, and where the configured band is narrower (or it is NaN)."""
+        tolerance, value = configured[name], np.asarray(values[name], dtype=float)
+        needed: np.ndarray = SAFETY * bound + half_unit(value, ANSWER_FIGURES)
+        with np.errstate(invalid="ignore"):
+            return needed, ~(needed <= tolerance.atol + tolerance.rtol * np.abs(value))
 
     def doubtful(name: str, bound: np.ndarray) -> Any:
         if name not in values or configured[name].mode != "rtol":
             return np.zeros(size, dtype=bool)
-        return ~(SAFETY * bound + half_unit(values[name], ANSWER_FIGURES) <= band(name))
+        return short(name, bound)[1]
 
     moves = rounding_bounds(routes, params, figures, doubtful)
     flaws: list[str | None] = [None] * size
@@ -73,13 +74,10 @@ def fair_tolerances(routes: Routes, configured: Mapping[str, Tolerance], units: 
         tolerances[name] = [tolerance] * size
         if name not in moves or tolerance.mode != "rtol":
             continue
+        needed, wider = short(name, moves[name].bound)
         value = np.asarray(values[name], dtype=float)
-        needed[name] = SAFETY * moves[name].bound + half_unit(value, ANSWER_FIGURES)
-        ok = np.asarray(answered[name], dtype=bool)
-        with np.errstate(invalid="ignore"):
-            wider = ok & ~(needed[name] <= band(name))
-        for row in np.flatnonzero(wider):
-            tolerances[name][row], flaw = _widen(name, tolerance, float(value[row]), float(needed[name][row]),
+        for row in np.flatnonzero(wider & np.asarray(answered[name], dtype=bool)):
+            tolerances[name][row], flaw = _widen(name, tolerance, float(value[row]), float(needed[row]),
                                                  moves[name], routes, int(row), units[name], figures, cap)
             flaws[row] = flaws[row] or flaw
     return Fair(tolerances, flaws)

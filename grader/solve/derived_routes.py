@@ -93,7 +93,7 @@ class RouteCompiler(_Compiler):
             return None
         alias: dict[Any, Any] = {}
         steps = []
-        symbols = {self.ctx.symbols[name] for name in self.template.symbols}
+        symbols = {self.ctx.symbols[symbol] for symbol in self.template.symbols}
         for solved in _needed(chain, [wanted]):
             expr = solved.display.doit().xreplace(alias)
             # A value over a symbol (a mass m not given) is worked with as a symbol, never a number written down.
@@ -119,7 +119,7 @@ class RouteCompiler(_Compiler):
         steps, answer = written
         composed = answer.xreplace(_composition(steps))
         parameters = [self.ctx.symbols[p] for p in self.template.parameters]
-        if not composed.has(sp.sqrt(sp.Symbol("x")).func) or composed.is_rational_function(*parameters):
+        if composed.is_rational_function(*parameters):  # nothing to take a root of
             return None
         square = sp.cancel(sp.powsimp(sp.expand(composed**2), force=True))
         if not (square.free_symbols <= set(parameters) and square.is_rational_function(*parameters)

@@ -241,3 +241,26 @@ def test_sigfigs_and_decimals_tolerances_are_kept_as_set(bank: dict[str, Templat
     assert fair.tolerances["loss_pct"] == [configured["loss_pct"]]
     assert fair.tolerances["v1_out"] == [configured["v1_out"]]
     assert fair.flaws == [None]
+
+
+def test_an_absolute_tolerance_is_widened_in_the_answers_unit(bank: dict[str, Template]) -> None:
+    """An answer graded with only an atol (an angle to ±0.001°) gets a wider atol, explained in degrees;
+    a relative tolerance on the same variant gets a wider rtol, explained in percent."""
+    from grader.solve.cache import compiled_for
+    from grader.solve.evaluate import solve_columns
+
+    template = bank["oblique-spheres"]
+    params = {"v1": np.array([9.8]), "theta": np.array([46.0]), "e": np.array([0.43]), "m1": np.array([1.0]),
+              "m2": np.array([2.5])}
+    result = solve_columns(template, compiled_for(template), params)
+    units = {name: spec.unit.text for name, spec in template.answers.items()}
+    answered = {name: [True] for name in template.answers}
+    for configured, field in ((Tolerance(rtol=0.0, atol=0.001), "atol"), (Tolerance(rtol=0.001), "rtol")):
+        fair = fair_tolerances(routes_for(template), {**{n: Tolerance() for n in template.answers},
+                                                      "theta1_out": configured},
+                               units, params, result.values, answered, FIGURES, 0.05)
+        widened = fair.tolerances["theta1_out"][0]
+        assert getattr(widened, field) > getattr(configured, field)
+        assert widened.rtol == 0.0 if field == "atol" else widened.atol == 0.0
+        assert widened.reason.endswith("°") if field == "atol" else widened.reason.endswith(" %")
+        assert fair.flaws == [None]

@@ -9,7 +9,8 @@ and the tolerance's ``mode``: its tolerances are ``{"rtol", "atol"}``; a version
 
     {"schema": "grader-key", "version": 2, "generator": "grader X.Y.Z",
      "assignment": {"title", "course", "seed", "due", "instructions", "source_sha256",
-                    "grading": {"numeric_expressions": true, "ecf_credit": 1.0, "mistake_credit": 0.0}},
+                    "grading": {"numeric_expressions": true, "ecf_credit": 1.0, "mistake_credit": 0.0,
+                                "intermediate_sig_figs": 4, "max_tolerance": 0.05}},
      "templates": {ID: {"version", "sha256"}},
      "problems": [{"key", "template", "title",
                    "answers": [{"name", "label", "unit", "points",
@@ -23,6 +24,7 @@ and the tolerance's ``mode``: its tolerances are ``{"rtol", "atol"}``; a version
                                  "answers": {NAME: {"value", "unit", "label", "points",
                                                     "tolerance": {"mode": "rtol", "rtol", "atol"}
                                                         or {"mode": "sigfigs" | "decimals", "digits"},
+                                                        with "reason" where it was widened for rounding,
                                                     "undefined": reason (only when there is no value)}}}]}]}
 """
 
@@ -72,8 +74,9 @@ def key_document(assignment: Assignment, generation: Generation, bank: Mapping[s
     """The key as a JSON-ready dictionary."""
     used = {p.template: bank[p.template] for p in assignment.problems}
     first = generation.students[0].problems if generation.students else ()
-    # One tolerance dict per distinct tolerance, shared by every student's part (the encoder only reads it).
-    tolerances = {t: t.to_json() for s in first for t in {a.tolerance for a in s.answers}}
+    # One tolerance dict per distinct tolerance (and reason: equality leaves it out), shared by every
+    # student's part (the encoder only reads it).
+    tolerances = {(t, t.reason): t.to_json() for s in first for t in {a.tolerance for a in s.answers}}
     return {
         "schema": SCHEMA, "version": VERSION, "generator": f"grader {__version__}",
         "assignment": {"title": assignment.title, "course": assignment.course, "seed": assignment.seed,
@@ -81,7 +84,9 @@ def key_document(assignment: Assignment, generation: Generation, bank: Mapping[s
                        "source_sha256": hashlib.sha256(Path(assignment.where).read_bytes()).hexdigest(),
                        "grading": {"numeric_expressions": assignment.grading.numeric_expressions,
                                    "ecf_credit": assignment.grading.ecf_credit,
-                                   "mistake_credit": assignment.grading.mistake_credit}},
+                                   "mistake_credit": assignment.grading.mistake_credit,
+                                   "intermediate_sig_figs": assignment.grading.intermediate_sig_figs,
+                                   "max_tolerance": assignment.grading.max_tolerance}},
         "templates": {t.id: {"version": t.version, "sha256": t.source_hash} for t in used.values()},
         "problems": [{"key": v.key, "template": v.template, "title": used[v.template].title,
                       "answers": [_part(a, used[v.template], spec) for a in v.answers]}
@@ -116,8 +121,8 @@ def _symbol_range(name: str, template: Template, problem: ProblemSpec) -> tuple[
     return (min(values), max(values))
 
 
-def _answer(part: AnswerPart, tolerances: dict[Tolerance, dict[str, Any]]) -> dict[str, Any]:
-    tolerance = tolerances.get(part.tolerance)
+def _answer(part: AnswerPart, tolerances: dict[tuple[Tolerance, str], dict[str, Any]]) -> dict[str, Any]:
+    tolerance = tolerances.get((part.tolerance, part.tolerance.reason))
     data: dict[str, Any] = {"value": part.value, "unit": part.unit, "label": part.label, "points": part.points,
                             "tolerance": part.tolerance.to_json() if tolerance is None else tolerance}
     if part.undefined is not None:

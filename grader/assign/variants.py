@@ -4,8 +4,10 @@ A variant's generator is keyed on ``(assignment seed, problem key, student id)``
 into ``numpy.random.SeedSequence``: adding or removing a student changes nobody else's numbers.
 Parameters are rounded to their printed precision before anything is computed. A draw that the
 solver refuses, or whose answer sits near a degenerate point (an answer near zero, where a
-relative tolerance breaks; a derived ``e`` at 0 or 1), is redrawn from the same generator, at
-most ``MAX_DRAWS`` times. Whether a draw is degenerate never depends on the rest of the class.
+relative tolerance breaks; a derived ``e`` at 0 or 1), or whose tolerance, widened for honest
+rounding along a solution route (:mod:`grader.assign.fair`), would pass ``grading.max_tolerance``,
+is redrawn from the same generator, at most ``MAX_DRAWS`` times. Whether a draw is degenerate or
+too loose never depends on the rest of the class.
 
 >>> from decimal import Decimal
 >>> printed_text(2.345, decimals=2, sig_figs=None), printed_text(2398.7, decimals=None, sig_figs=3)
@@ -19,18 +21,21 @@ from collections import Counter
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from decimal import MAX_EMAX, MIN_EMIN, ROUND_HALF_UP, Context, Decimal
+from functools import cached_property
 from typing import Any
 
 import numpy as np
 
 from grader.assign.assignment import Assignment, ProblemSpec, Student
+from grader.assign.fair import Fair, fair_tolerances
 from grader.bank.template import Parameter, Template
 from grader.errors import GraderError
 from grader.model.expr import Sym
 from grader.model.tolerance import Tolerance
-from grader.solve.cache import compiled_for
+from grader.solve.cache import compiled_for, routes_for
 from grader.solve.compiled import Compiled
 from grader.solve.evaluate import Columns, answer_at, solve_columns
+from grader.solve.routes import Routes
 
 MAX_DRAWS = 25
 NEAR_ZERO = 0.02  # an answer below 2% of its typical size is too close to zero to grade relatively
@@ -159,6 +164,24 @@ class ProblemDraws:
         self.compiled: Compiled = compiled_for(template)
         self.restitution = _restitution_answers(template)
         self.typical = self._typical_sizes()
+        self.configured = {name: tolerance(problem, template, name) for name in template.answers}
+        self.tolerances: dict[str, dict[str, Tolerance]] = {}  # per student drawn: each answer's tolerance
+
+    @cached_property
+    def routes(self) -> Routes:
+        """The template's solution routes (compiled on first use: ``check-bank`` needs none)."""
+        return routes_for(self.template)
+
+    def fair(self, result: Columns) -> Fair:
+        """Each answer's tolerance per row of a result, widened for honest rounding, and the rows whose
+        widened tolerance would pass the cap."""
+        answered = {name: [refused is None and missing is None for refused, missing in
+                           zip(result.refusals, result.undefined[name], strict=True)] for name in result.values}
+        grading = self.assignment.grading
+        return fair_tolerances(self.routes, self.configured,
+                               {name: spec.unit.text for name, spec in self.template.answers.items()},
+                               result.params, result.values, answered, grading.intermediate_sig_figs,
+                               grading.max_tolerance)
 
     def _typical_sizes(self) -> dict[str, float]:
         rng, _ = variant_generator(self.assignment.seed, self.problem.key, "\x00pilot")
@@ -204,10 +227,11 @@ class ProblemDraws:
                                   "of 0 or 1 (a variant at a limit of e is a special case, not the problem asked)")
         return flaws
 
-    def _flaws(self, rows: Sequence[Mapping[str, str]]) -> list[str | None]:
+    def _flaws(self, rows: Sequence[Mapping[str, str]]) -> tuple[list[str | None], Fair]:
         result = solve_columns(self.template, self.compiled, self.table(rows))
-        return [refused or degenerate for refused, degenerate in zip(result.refusals, self.degeneracies(result),
-                                                                    strict=True)]
+        fair = self.fair(result)
+        return [refused or degenerate or loose for refused, degenerate, loose in
+                zip(result.refusals, self.degeneracies(result), fair.flaws, strict=True)], fair
 
     def draw(self, students: Sequence[Student]) -> tuple[list[dict[str, str]], list[str]]:
         """Each student's parameters as printed, and each variant's seed."""
@@ -216,7 +240,10 @@ class ProblemDraws:
         rows = {s.id: self.draw_row(generators[s.id]) for s in students}
         pending = [s.id for s in students]
         for _ in range(MAX_DRAWS):
-            flaws = self._flaws([rows[i] for i in pending])
+            flaws, fair = self._flaws([rows[i] for i in pending])
+            for index, (student_id, flaw) in enumerate(zip(pending, flaws, strict=True)):
+                if flaw is None:
+                    self.tolerances[student_id] = {name: fair.tolerances[name][index] for name in fair.tolerances}
             pending = [i for i, flaw in zip(pending, flaws, strict=True) if flaw is not None]
             if not pending:
                 return [rows[s.id] for s in students], [keyed[s.id][1] for s in students]
@@ -224,9 +251,11 @@ class ProblemDraws:
             for student_id in pending:
                 rows[student_id] = self.draw_row(generators[student_id])
         first = pending[0]
+        advice = ("narrow the parameters toward variants that rounding moves less, or raise grading.max_tolerance"
+                  if "max_tolerance" in last[first] else
+                  "check fixed/narrowed parameters against the template's constraints")
         raise GraderError(f"{self.where}: no valid variant for student {first} in {MAX_DRAWS} draws; the last was "
-                          f"refused because {last[first]} (check fixed/narrowed parameters against the template's "
-                          "constraints)")
+                          f"refused because {last[first]} ({advice})")
 
 
 def generate(assignment: Assignment, roster: Sequence[Student], bank: Mapping[str, Template]) -> Generation:
@@ -240,8 +269,8 @@ def generate(assignment: Assignment, roster: Sequence[Student], bank: Mapping[st
         answers = _Answers(_blank_parts(problem, template), template, maker.compiled,
                            solve_columns(template, maker.compiled, maker.table(rows)))
         variants = [ProblemVariant(problem.key, template.id, seed, {n: float(v) for n, v in row.items()}, row,
-                                   answers.parts(index, row))
-                    for index, (row, seed) in enumerate(zip(rows, seeds, strict=True))]
+                                   answers.parts(index, row, maker.tolerances[student.id]))
+                    for index, (row, seed, student) in enumerate(zip(rows, seeds, roster, strict=True))]
         shared = Counter(tuple(row.values()) for row in rows)
         collisions[problem.key] = sum(shared[tuple(row.values())] > 1 for row in rows)
         per_problem.append(variants)
@@ -284,12 +313,14 @@ class _Answers:
                             for b in blanks if compiled.answers[b.name].symbolic is not None}
         self.texts: dict[tuple[str, ...], tuple[float | str | None, str | None]] = {}
 
-    def parts(self, row: int, printed: Mapping[str, str]) -> tuple[AnswerPart, ...]:
-        """The answer parts of the variant in ``row`` of the result, printed as ``printed``."""
+    def parts(self, row: int, printed: Mapping[str, str],
+              tolerances: Mapping[str, Tolerance]) -> tuple[AnswerPart, ...]:
+        """The answer parts of the variant in ``row`` of the result, printed as ``printed``, with each
+        answer's tolerance for this variant."""
         parts = []
         for blank in self.blanks:
             value, undefined = self._value(blank.name, row, printed)
-            parts.append(AnswerPart(blank.name, blank.label, value, blank.unit, blank.points, blank.tolerance,
+            parts.append(AnswerPart(blank.name, blank.label, value, blank.unit, blank.points, tolerances[blank.name],
                                     blank.description, undefined))
         return tuple(parts)
 

@@ -32,6 +32,7 @@ from numpy.typing import ArrayLike
 
 from grader.model.expr import Node, from_json, to_json
 from grader.model.kernel import evaluate
+from grader.solve.compiled import PerAnswer
 
 GIVEN = "_given"
 """The name of the earlier answer in an ECF tree, in that answer's unit (no parameter can be named so)."""
@@ -70,17 +71,9 @@ class Alternative:
 
 
 @dataclass(frozen=True)
-class Alternatives:
-    """A template's alternatives, ECF and mistakes, each in the order they are tried."""
-
-    template_id: str
-    source_hash: str
-    constants: Mapping[str, float]
-    items: tuple[Alternative, ...]
-
-    def for_answer(self, name: str) -> tuple[Alternative, ...]:
-        """The alternatives of one answer: mistakes in the effects' order, ECF in the answers' order."""
-        return tuple(item for item in self.items if item.answer == name)
+class Alternatives(PerAnswer[Alternative]):
+    """A template's alternatives, ECF and mistakes, each in the order they are tried (an answer's: mistakes
+    in the effects' order, ECF in the answers' order)."""
 
     def to_json(self) -> dict[str, Any]:
         """A JSON-ready dictionary."""

@@ -21,6 +21,7 @@ from grader import __version__
 from grader.bank.template import Template
 from grader.solve.alternatives import Alternatives
 from grader.solve.compiled import FORMAT, Compiled
+from grader.solve.routes import Routes
 
 # Every stage folder whose source can change what the solver compiles: editing any file in them
 # recompiles (a test checks that everything the solver imports is inside).
@@ -69,6 +70,17 @@ def alternatives_for(template: Template) -> Alternatives:
         return compile_alternatives(template)
 
     return _cached(template, "-alternatives", Alternatives.from_json, compile_now)
+
+
+def routes_for(template: Template) -> Routes:
+    """A template's solution routes with their rounding slopes: from the cache, or compiled now and
+    cached beside its compiled form."""
+    def compile_now() -> Routes:
+        from grader.solve.derived_routes import compile_routes
+
+        return compile_routes(template)
+
+    return _cached(template, "-routes", Routes.from_json, compile_now)
 
 
 class _Stored(Protocol):

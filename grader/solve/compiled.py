@@ -8,12 +8,35 @@ from __future__ import annotations
 from collections.abc import Mapping
 from dataclasses import dataclass
 from functools import cached_property
-from typing import Any
+from typing import Any, Generic, Protocol, TypeVar
 
 from grader.model.expr import Node, from_json, to_json, to_text
 from grader.model.kernel import Kernel
 
 FORMAT = 1
+
+
+class _OfAnswer(Protocol):
+    @property
+    def answer(self) -> str: ...
+
+
+_Item = TypeVar("_Item", bound=_OfAnswer)
+
+
+@dataclass(frozen=True)
+class PerAnswer(Generic[_Item]):
+    """What a template derives beside its compiled form, answer by answer (its alternatives, its
+    routes): compiled with its constants, kept in the cache under its source hash."""
+
+    template_id: str
+    source_hash: str
+    constants: Mapping[str, float]
+    items: tuple[_Item, ...]
+
+    def for_answer(self, name: str) -> tuple[_Item, ...]:
+        """The items of one answer, in order."""
+        return tuple(item for item in self.items if item.answer == name)
 
 
 @dataclass(frozen=True)

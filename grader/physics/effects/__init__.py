@@ -4,7 +4,7 @@
 angle_between bounces flight free_fall impact impact_geometry rise slide swing velocity
 """
 
-from grader.physics.effects.base import Condition, Effect, Field, Mistake, Relation, Stable
+from grader.physics.effects.base import Condition, Effect, Field, Mistake, Relation, Route, Stable
 from grader.physics.effects.bounces import BOUNCES
 from grader.physics.effects.flight import FREE_FALL, RISE
 from grader.physics.effects.geometry import IMPACT_GEOMETRY
@@ -17,4 +17,4 @@ from grader.physics.effects.velocity import ANGLE_BETWEEN, VELOCITY
 CATALOGUE: dict[str, Effect] = {effect.name: effect for effect in (FREE_FALL, RISE, IMPACT_GEOMETRY, IMPACT, VELOCITY,
                                                                    ANGLE_BETWEEN, BOUNCES, SWING, SLIDE, FLIGHT)}
 
-__all__ = ["CATALOGUE", "Condition", "Effect", "Field", "Mistake", "Relation", "Stable"]
+__all__ = ["CATALOGUE", "Condition", "Effect", "Field", "Mistake", "Relation", "Route", "Stable"]

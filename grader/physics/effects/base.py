@@ -105,10 +105,23 @@ class Mistake:
 
 
 @dataclass(frozen=True)
+class Route:
+    """Another correct way through a stage, as the textbook also solves it: the stage's relations as
+    a student who takes it writes them (all of them, one or more changed). Every value such a student
+    writes down is rounded as the sheet asks, so the rounding allowance covers this route too.
+    ``says`` completes "along ...": ``the energy route (T − T′)``."""
+
+    id: str
+    says: str
+    relations: tuple[Relation, ...]
+
+
+@dataclass(frozen=True)
 class Effect:
     """An entry of the catalogue: its name, what it means, its fields, its relations (the
-    closed form), how to simulate it (its force law in the time domain; None: it has none) and
-    the mistakes students make with it, first the most telling (None: none declared)."""
+    closed form), how to simulate it (its force law in the time domain; None: it has none),
+    the mistakes students make with it, first the most telling (None: none declared), and the
+    other correct routes through it (None: none)."""
 
     name: str
     summary: str
@@ -116,3 +129,4 @@ class Effect:
     relations: Callable[[Stage, Context], list[Relation]]
     simulate: Callable[[Stage, Run], None] | None = None
     mistakes: Callable[[Stage, Context], list[Mistake]] | None = None
+    routes: Callable[[Stage, Context], list[Route]] | None = None

@@ -29,7 +29,7 @@ import numpy as np
 
 from grader.model.expr import Sym
 from grader.model.units import PURE, SPEED, dimension_from
-from grader.physics.effects.base import Condition, Effect, Field, Mistake, Relation, Stable
+from grader.physics.effects.base import Condition, Effect, Field, Mistake, Relation, Route, Stable
 
 if TYPE_CHECKING:
     from grader.model.scene import Stage
@@ -50,7 +50,7 @@ class _Impact:
     after: tuple[tuple[Any, Any], tuple[Any, Any]]
     tangents: tuple[int, ...]  # the bodies whose t-velocity the impact leaves unchanged (movable, oblique)
     law: str = "e"  # how the equations use e: "e", "e**2" or "1/e"
-    loss: str = "lost"  # the energy lost as "lost", the energy "kept" instead, or T' - T ("negated")
+    loss: str = "lost"  # the loss as "lost", the energy "kept", T' - T ("negated"), or T - T' ("difference")
 
     @classmethod
     def of(cls, stage: Stage, ctx: Context) -> _Impact:
@@ -142,6 +142,9 @@ class _Impact:
         if self.loss == "kept":
             loss = Relation("energy lost in the impact", lost, totals["after"], solutions={lost: totals["after"]},
                             general=False)
+        elif self.loss == "difference":  # the textbook's route (Sample Problem 3/30): T and T' written down first
+            loss = Relation("energy lost in the impact", lost, before - after, solutions={lost: before - after},
+                            general=False)
         else:
             loss = Relation("energy lost in the impact", lost, sign * lost_form, solutions={lost: sign * lost_form},
                             general=False, stable={lost: (Stable(sign * lost_form, given=(self.e,)),
@@ -194,6 +197,14 @@ def _mistakes(stage: Stage, ctx: Context) -> list[Mistake]:
     ]
     return [Mistake(id, says, tuple(impact.relations(ctx))) if impact is not None else
             Mistake(id, says, unit="%", scale=sp.Rational(1, 100)) for id, says, impact in changed]
+
+
+def _routes(stage: Stage, ctx: Context) -> list[Route]:
+    """The textbook's energy route: the kinetic energies before and after written down, then their
+    difference (which cancels when little is lost: what rounding them costs is what this route is for)."""
+    real = _Impact.of(stage, ctx)
+    return [Route("energy", "the energy route (T − T′)",
+                  tuple(replace(real, loss="difference").relations(ctx)))]
 
 
 @dataclass(frozen=True)
@@ -378,4 +389,5 @@ IMPACT = Effect(
     _impact,
     _simulate_impact,
     _mistakes,
+    _routes,
 )

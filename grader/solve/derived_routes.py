@@ -1,0 +1,168 @@
+"""The sympy side of :mod:`grader.solve.routes`: each answer's routes derived from the scene, and the
+slope of the answer in each value written down along them.
+
+Imported only when routes are compiled (the cache spares later runs the sympy import).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import sympy as sp
+
+from grader.bank.template import Template
+from grader.model.expr import Node
+from grader.physics.effects import CATALOGUE
+from grader.physics.symbolic import cosd, from_node, hypot, sind, to_node
+from grader.solve.derived import _FAILURES
+from grader.solve.routes import Route, Routes
+from grader.solve.solver import _Compiler, _needed, _si_factor, _Solved, derive
+from grader.solve.stable import numeric_order
+
+RATIO = "ratio"
+"""The name of the ratio a square-root route writes down first (no step of a chain is named so)."""
+
+
+def compile_routes(template: Template) -> Routes:
+    """Derive and compile a template's routes (sympy; then cached, see :func:`grader.solve.cache.routes_for`).
+    A route the solver cannot derive or differentiate is left out; the chain of the worked solution never is."""
+    compiler = RouteCompiler(template)
+    return Routes(template.id, template.source_hash,
+                  {"g": float(template.scene.gravity.si)} if template.scene.gravity else {},
+                  tuple(compiler.routes()), tuple(template.symbols))
+
+
+class RouteCompiler(_Compiler):
+    """Compiles one template's routes."""
+
+    def __init__(self, template: Template) -> None:
+        super().__init__(template)
+        self.stages = [CATALOGUE[stage.effect].relations(stage, self.ctx) for stage in template.scene.stages]
+        self.numeric = [name for name, spec in template.answers.items() if not spec.symbolic]
+
+    def chains(self) -> list[tuple[str, str, list[_Solved]]]:
+        """The worked solution's chain, then one per route an effect declares, with its stage's relations
+        changed as the route writes them."""
+        found = [("chain", "the worked solution", derive(self.relations, self.inputs, self.inputs))]
+        for index, stage in enumerate(self.template.scene.stages):
+            declared = CATALOGUE[stage.effect].routes
+            for route in declared(stage, self.ctx) if declared is not None else ():
+                relations = [r for at, real in enumerate(self.stages)
+                             for r in (route.relations if at == index else real)]
+                try:
+                    found.append((route.id, route.says, derive(relations, self.inputs, self.inputs)))
+                except _FAILURES:
+                    continue
+        return found
+
+    def routes(self) -> list[Route]:
+        """Every numeric answer's routes, each once (a route that writes down the same values the same way
+        as an earlier one is left out)."""
+        chains = self.chains()
+        found = []
+        for name in self.numeric:
+            seen: set[tuple[tuple[str, ...], str]] = set()
+            for id, says, chain in chains:
+                try:
+                    route = self._route(name, id, says, chain)
+                except _FAILURES:
+                    if id == "chain":
+                        raise
+                    continue
+                if route is not None and (route.names, str(route.steps)) not in seen:
+                    seen.add((route.names, str(route.steps)))
+                    found.append(route)
+            try:
+                ratio = self._ratio_route(name, chains[0][2])
+            except _FAILURES:
+                ratio = None
+            if ratio is not None:
+                found.append(ratio)
+        return found
+
+    def _unit(self, name: str) -> Any:
+        return _si_factor(self.template.answers[name].unit)
+
+    def _written(self, name: str, chain: list[_Solved]) -> tuple[list[tuple[Any, Any]], Any] | None:
+        """The values a route to ``name`` writes down (each over the inputs and earlier values, template
+        units in) and the answer over them, or None where the chain does not reach it. A step that only
+        copies a value or is a number writes nothing new down."""
+        wanted = from_node(self.template.answers[name].value, self.ctx.symbols)
+        known = self.inputs | {s.unknown for s in chain}
+        if not wanted.free_symbols <= known:
+            return None
+        alias: dict[Any, Any] = {}
+        steps = []
+        symbols = {self.ctx.symbols[symbol] for symbol in self.template.symbols}
+        for solved in _needed(chain, [wanted]):
+            expr = solved.display.doit().xreplace(alias)
+            # A value over a symbol (a mass m not given) is worked with as a symbol, never a number written down.
+            if expr.is_Symbol or expr.is_number or (-expr).is_Symbol or expr.free_symbols & symbols:
+                alias[solved.unknown] = expr
+                continue
+            steps.append((solved.unknown, self._user_units(expr)))
+        return steps, self._user_units(wanted.xreplace(alias)) / self._unit(name)
+
+    def _route(self, name: str, id: str, says: str, chain: list[_Solved]) -> Route | None:
+        written = self._written(name, chain)
+        if written is None:
+            return None
+        steps, answer = written
+        return self._compiled(name, id, says, steps, answer)
+
+    def _ratio_route(self, name: str, chain: list[_Solved]) -> Route | None:
+        """``e`` from ``√(h_rebound/h_drop)``: for an answer with a square root whose square is a rational
+        function of the parameters, that ratio written down, then its root."""
+        written = self._written(name, chain)
+        if written is None:
+            return None
+        steps, answer = written
+        composed = answer.xreplace(_composition(steps))
+        parameters = [self.ctx.symbols[p] for p in self.template.parameters]
+        if composed.is_rational_function(*parameters):  # nothing to take a root of
+            return None
+        square = sp.cancel(sp.powsimp(sp.expand(composed**2), force=True))
+        if not (square.free_symbols <= set(parameters) and square.is_rational_function(*parameters)
+                and not square.is_Symbol and composed.is_nonnegative):
+            return None
+        ratio = sp.Symbol(RATIO, positive=True)
+        return self._compiled(name, "ratio", f"{name} = √({sp.sstr(square)})",
+                              [(ratio, square)], sp.sqrt(ratio))
+
+    def _compiled(self, name: str, id: str, says: str, steps: list[tuple[Any, Any]], answer: Any) -> Route:
+        """A route with the slope of the answer in each value written down, later values recomputed."""
+        slopes: list[Any] = [None] * len(steps)
+        outcome = _smooth(answer)
+        for index in reversed(range(len(steps))):
+            symbol, expr = steps[index]
+            slopes[index] = outcome.diff(symbol)
+            outcome = outcome.xreplace({symbol: _smooth(expr)})
+        composition = _composition(steps)
+        composed = [expr.xreplace(composition) for _, expr in steps]
+        slope_trees = [_tree(slope.xreplace({s: _smooth(c) for (s, _), c in zip(steps, composed, strict=True)})
+                             .replace(sp.DiracDelta, lambda *args: 0)) for slope in slopes]
+        return Route(name, id, says, tuple(str(s) for s, _ in steps), tuple(_tree(e) for _, e in steps), _tree(answer),
+                     tuple(_tree(c) for c in composed), tuple(slope_trees))
+
+
+def _composition(steps: list[tuple[Any, Any]]) -> dict[Any, Any]:
+    """Each value written down over the parameters alone."""
+    composed: dict[Any, Any] = {}
+    for symbol, expr in steps:
+        composed[symbol] = expr.xreplace(composed)
+    return composed
+
+
+def _smooth(expr: Any) -> Any:
+    """A form sympy differentiates: ``hypot``, ``sind``, ``cosd`` written out; ``Max(0, x)`` as ``x``
+    (a route does not clip what it computes)."""
+    return sp.sympify(expr).replace(hypot, lambda x, y: sp.sqrt(x**2 + y**2)).replace(
+        sind, lambda x: sp.sin(x * sp.pi / 180)).replace(cosd, lambda x: sp.cos(x * sp.pi / 180)).replace(
+        lambda e: isinstance(e, sp.Max) and len(e.args) == 2 and sp.S.Zero in e.args,
+        lambda e: next(a for a in e.args if a != 0))
+
+
+def _tree(expr: Any) -> Node:
+    if sp.sympify(expr).has(sp.Derivative, sp.Subs, sp.Heaviside, sp.DiracDelta, sp.zoo, sp.nan, sp.oo):
+        raise ValueError(f"no numeric form for {expr}")
+    return numeric_order(to_node(sp.sympify(expr)))

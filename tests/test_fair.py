@@ -17,9 +17,9 @@ from grader.bank.template import Template
 from grader.cli import main
 from grader.errors import GraderError
 from grader.grade.compare import is_correct
-from grader.model.tolerance import Tolerance
+from grader.model.tolerance import ANSWER_SIG_FIGS, Tolerance
 from grader.solve.cache import routes_for
-from grader.solve.routes import ANSWER_FIGURES, half_unit, moved_route, round_figures, rounding_bounds, walk_route
+from grader.solve.routes import half_unit, moved_route, round_figures, rounding_bounds, walk_route
 from tests.test_golden import GOLDEN
 
 STUDENTS = 200
@@ -82,7 +82,7 @@ def test_every_route_rounded_to_four_figures_grades_correct(whole_bank: Generati
         for route in routes.items:
             expected = values[route.answer]
             given = round_figures(walk_route(routes, route, params, lambda _, v: round_figures(v, FIGURES)),
-                                  ANSWER_FIGURES)
+                                  ANSWER_SIG_FIGS)
             defined = np.isfinite(expected)
             verdicts = _graded(given[defined], expected[defined], [t for t, d in zip(tolerances[route.answer], defined,
                                                                                      strict=True) if d],
@@ -182,7 +182,7 @@ def test_a_widened_loss_names_the_energy_route_and_its_values(bank: dict[str, Te
     routes = routes_for(bank["oblique-spheres"])
     bound = float(rounding_bounds(routes, {k: np.array([float(v)]) for k, v in fixed.items()}, FIGURES)["loss_pct"]
                   .bound[0])
-    needed = (SAFETY * bound + float(half_unit(loss.value, ANSWER_FIGURES))) / loss.value
+    needed = (SAFETY * bound + float(half_unit(loss.value, ANSWER_SIG_FIGS))) / loss.value
     assert needed > 0.01
     assert needed <= loss.tolerance.rtol < needed * 1.1
     rounded, _, rest = loss.tolerance.reason.removeprefix("rounding ").partition(f" to {FIGURES} figures along ")

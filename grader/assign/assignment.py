@@ -20,13 +20,11 @@ from typing import Any
 from grader.bank.template import Parameter, Template, tolerance_in
 from grader.errors import GraderError, TemplateError, shown
 from grader.inputs import read_csv, read_yaml
-from grader.model.tolerance import FORMS
+from grader.model.tolerance import ANSWER_SIG_FIGS, FORMS
 
 _KEY = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_-]{0,15}$")
 _ROSTER_COLUMNS = ("id", "name", "email", "section")
 MAX_POINTS = 1_000_000  # per answer part: any class's totals stay exact in float64
-ANSWER_SIG_FIGS = 3
-"""The significant figures the sheet asks answers to be given to."""
 _NUMBER_WORDS = ("zero", "one", "two", "three", "four", "five", "six", "seven", "eight", "nine", "ten")
 
 

@@ -24,8 +24,8 @@ from typing import Any
 
 import numpy as np
 
-from grader.model.tolerance import Tolerance, with_unit
-from grader.solve.routes import ANSWER_FIGURES, Moves, Routes, half_unit, rounding_bounds
+from grader.model.tolerance import ANSWER_SIG_FIGS, Tolerance, with_unit
+from grader.solve.routes import Moves, Routes, half_unit, rounding_bounds
 
 SAFETY = 2.0
 """How many times the first-order rounding bound a tolerance allows."""
@@ -58,7 +58,7 @@ def fair_tolerances(routes: Routes, configured: Mapping[str, Tolerance], units: 
     def short(name: str, bound: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """What honest rounding needs of the answer, and where the configured band is narrower (or it is NaN)."""
         tolerance, value = configured[name], np.asarray(values[name], dtype=float)
-        needed: np.ndarray = SAFETY * bound + half_unit(value, ANSWER_FIGURES)
+        needed: np.ndarray = SAFETY * bound + half_unit(value, ANSWER_SIG_FIGS)
         with np.errstate(invalid="ignore"):
             return needed, ~(needed <= tolerance.atol + tolerance.rtol * np.abs(value))
 

@@ -22,6 +22,8 @@ from grader.errors import GraderError, shown
 
 Mode = Literal["rtol", "sigfigs", "decimals"]
 MODES: tuple[Mode, ...] = ("rtol", "sigfigs", "decimals")
+ANSWER_SIG_FIGS = 3
+"""The significant figures the sheet asks answers to be given to (what rounding bounds assume)."""
 MAX_REASON = 300
 """The longest reason a key may carry for a widened tolerance."""
 MAX_DIGITS = 17

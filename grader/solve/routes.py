@@ -46,9 +46,6 @@ from grader.model.expr import Node, from_json, to_json
 from grader.model.kernel import Kernel, evaluate
 from grader.solve.compiled import PerAnswer
 
-ANSWER_FIGURES = 3
-"""The significant figures an answer is given to (the sheet says so)."""
-
 
 def half_unit(values: Any, figures: int) -> np.ndarray:
     """Half a unit in the ``figures``-th significant figure of each value: the most rounding it to that

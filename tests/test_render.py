@@ -21,7 +21,7 @@ from grader.render.documents import file_names, render_page_png, safe_file_name,
 from grader.render.figures import figure
 from grader.render.pdfs import render_all
 from grader.render.typeset import compile_typst, font_paths, system_fonts, uncovered
-from grader.render.worked import Typ, dimension, math, unit_of, worked
+from grader.render.worked import Typ, dimension, math, unit_of, worked, worked_form
 from grader.resources import sample_dir
 from grader.solve.cache import compiled_for
 from grader.solve.evaluate import solve_one
@@ -192,6 +192,19 @@ def test_a_step_that_depends_on_a_cancelling_mass_is_shown_as_a_multiple_of_it(
     assert energy.chain[-1].endswith(" m") and "in kg" in energy.note
     ratio = next(s for s in solution.steps if s.chain[0] == 'f_"loss"')
     assert not ratio.chain[-1].endswith("m") and not ratio.note
+
+
+def test_one_worked_form_per_template_gives_every_variant_its_solution_from_scratch(
+        bank: dict[str, Template], generation: Generation) -> None:
+    """The documents make a template's step forms once (worked_form) and substitute each student's numbers:
+    every student's solution is the one worked() makes on its own, numbers, notes and values alike."""
+    forms = {}
+    for entry in generation.students:
+        for variant in entry.problems:
+            template = bank[variant.template]
+            form = forms.setdefault(template.id, worked_form(template))
+            assert worked(template, variant, form=form) == worked(template, variant)
+    assert len(forms) == 5
 
 
 @pytest.mark.parametrize(("expression", "dimensions", "unit"), [

@@ -38,7 +38,19 @@ from grader.errors import GraderError
 from grader.model.tolerance import Tolerance, widening
 from grader.render.figures import figure
 from grader.render.typeset import compile_typst, font_paths
-from grader.render.worked import Typ, Worked, WorkedStep, answer_math, math, name, string, text, worked
+from grader.render.worked import (
+    Typ,
+    Worked,
+    WorkedForm,
+    WorkedStep,
+    answer_math,
+    math,
+    name,
+    string,
+    text,
+    worked,
+    worked_form,
+)
 from grader.resources import templates_dir
 from grader.solve.cache import compiled_for
 from grader.solve.compiled import Compiled
@@ -211,6 +223,7 @@ class Documents:
     def __init__(self, assignment: Assignment, generation: Generation, bank: Mapping[str, Template]) -> None:
         self.assignment, self.generation, self.bank = assignment, generation, bank
         self.compiled: dict[str, Compiled] = {}
+        self.forms: dict[str, WorkedForm] = {}
         self.worked: dict[tuple[int, int], Worked] = {}
         self.sheets: dict[int, Sheet] = {}
 
@@ -231,7 +244,10 @@ class Documents:
         if (student, problem) not in self.worked:
             variant = self.generation.students[student].problems[problem]
             template = self.bank[variant.template]
-            self.worked[(student, problem)] = worked(template, variant, self._compiled(template))
+            if template.id not in self.forms:
+                self.forms[template.id] = worked_form(template, self._compiled(template))
+            self.worked[(student, problem)] = worked(template, variant, self._compiled(template),
+                                                     self.forms[template.id])
         return self.worked[(student, problem)]
 
     def sheet(self, index: int) -> Sheet:

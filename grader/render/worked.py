@@ -37,7 +37,7 @@ from grader.model.expr import FUNCTIONS, Node, Num, Op, Sym, format_number, pars
 from grader.model.kernel import evaluate
 from grader.render.readable import Names, counted, readable
 from grader.solve.cache import compiled_for
-from grader.solve.compiled import Compiled, Step
+from grader.solve.compiled import Compiled
 
 
 class Typ(str):
@@ -450,40 +450,79 @@ def relation_markup(label: str, quantities: set[str]) -> Typ:
 
 
 @dataclass(frozen=True)
+class StepForm:
+    """What one step shows whatever the numbers: its relation (markup), its equation when it is not
+    already the solved form (math), the solved form written for a reader and as math."""
+
+    unknown: str
+    relation: Typ
+    equation: str | None
+    solved: Node
+    solved_math: str
+
+
+@dataclass(frozen=True)
+class WorkedForm:
+    """What every worked solution of one template shares (:func:`worked_form`): the steps' forms,
+    the quantities' dimensions, and the symbols without value with their SI units and notes. Made
+    once per template, so a class's worked solutions only substitute their numbers."""
+
+    steps: tuple[StepForm, ...]
+    dimensions: Mapping[str, Dimension]
+    symbols: tuple[str, ...]
+    symbol_units: Mapping[str, str]
+    notes: tuple[Typ, ...]
+
+
+def worked_form(template: Template, compiled: Compiled | None = None) -> WorkedForm:
+    """The parts of ``template``'s worked solutions that do not depend on a variant's numbers."""
+    compiled = compiled or compiled_for(template)
+    dimensions = quantity_dimensions(template, compiled)
+    names = reader_names(template, compiled, dimensions)
+    quantities = set(dimensions) | {s.unknown for s in compiled.steps}
+    steps = []
+    for step in compiled.steps:
+        lhs, rhs, solved = (readable(side, names) for side in (*step.equation, step.solved))
+        equation = None if (lhs == Sym(step.unknown) and rhs == solved) else f"{math(lhs)} = {math(rhs)}"
+        steps.append(StepForm(step.unknown, relation_markup(step.relation, quantities), equation, solved,
+                              math(solved)))
+    symbols = tuple(sorted(template.symbols))
+    return WorkedForm(tuple(steps), dimensions, symbols,
+                      {n: _si_unit(s.unit.dimension) or "1" for n, s in template.symbols.items()},
+                      tuple(_symbol_note(s, template.symbols[s].description) for s in symbols))
+
+
+@dataclass(frozen=True)
 class _Context:
     """What every step of one variant is shown with."""
 
     shown: dict[str, str]
     degrees: Mapping[str, str]
-    quantities: set[str]
     symbol_units: Mapping[str, str]
     undefined: Mapping[str, str]
-    names: Names
 
 
-def worked(template: Template, variant: ProblemVariant, compiled: Compiled | None = None) -> Worked:
-    """The worked solution of one variant (``compiled``: the template's, if the caller has it)."""
+def worked(template: Template, variant: ProblemVariant, compiled: Compiled | None = None,
+           form: WorkedForm | None = None) -> Worked:
+    """The worked solution of one variant (``compiled`` and ``form``: the template's, if the caller
+    has them)."""
     compiled = compiled or compiled_for(template)
+    form = form or worked_form(template, compiled)
     si = si_parameters(template, variant)
-    symbols = sorted(template.symbols)
-    scaled = scalings(compiled, si, symbols)
-    dimensions = quantity_dimensions(template, compiled)
+    scaled = scalings(compiled, si, form.symbols)
     shown = {n: _shown_parameter(variant.printed[n], p.unit.to_si) for n, p in template.parameters.items()}
     shown.update({c: number(v, 3) for c, v in compiled.constants.items()})
     context = _Context(
         shown, {n: f"{variant.printed[n]} degree" for n, p in template.parameters.items() if p.unit.text == "deg"},
-        set(dimensions) | {s.unknown for s in compiled.steps},
-        {n: _si_unit(s.unit.dimension) or "1" for n, s in template.symbols.items()},
-        _undefined(template, variant), reader_names(template, compiled, dimensions))
+        form.symbol_units, _undefined(template, variant))
     steps = []
-    for step in compiled.steps:
+    for step in form.steps:
         scaling = scaled.get(step.unknown)
-        steps.append(_step(step, scaling, dimensions.get(step.unknown), context))
+        steps.append(_step(step, scaling, form.dimensions.get(step.unknown), context))
         if scaling is not None:
             shown[step.unknown] = scaling.math()
-    notes = tuple(_symbol_note(s, template.symbols[s].description) for s in symbols)
-    values = chain_values(compiled, {**si, **{s: 1.0 for s in symbols}})
-    return Worked(tuple(given_lines(template, variant, compiled)), notes, tuple(steps), values)
+    values = chain_values(compiled, {**si, **{s: 1.0 for s in form.symbols}})
+    return Worked(tuple(given_lines(template, variant, compiled)), form.notes, tuple(steps), values)
 
 
 def quantity_dimensions(template: Template, compiled: Compiled) -> dict[str, Dimension]:
@@ -521,12 +560,10 @@ def _symbol_note(symbol: str, description: str) -> Typ:
     return Typ(f"${name(symbol)}$" + text(explained))
 
 
-def _step(step: Step, scaling: Scaling | None, dim: Dimension | None, context: _Context) -> WorkedStep:
-    lhs, rhs, solved = (readable(side, context.names) for side in (*step.equation, step.solved))
-    relation = relation_markup(step.relation, context.quantities)
-    equation = None if (lhs == Sym(step.unknown) and rhs == solved) else f"{math(lhs)} = {math(rhs)}"
-    chain = [name(step.unknown), math(solved)]
-    substituted = math(solved, context.shown, context.degrees)
+def _step(step: StepForm, scaling: Scaling | None, dim: Dimension | None, context: _Context) -> WorkedStep:
+    relation, equation = step.relation, step.equation
+    chain = [name(step.unknown), step.solved_math]
+    substituted = math(step.solved, context.shown, context.degrees)
     if substituted != chain[-1]:
         chain.append(substituted)
     if step.unknown in context.undefined:

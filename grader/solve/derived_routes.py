@@ -121,7 +121,10 @@ class RouteCompiler(_Compiler):
         parameters = [self.ctx.symbols[p] for p in self.template.parameters]
         if composed.is_rational_function(*parameters):  # nothing to take a root of
             return None
-        square = sp.cancel(sp.powsimp(sp.expand(composed**2), force=True))
+        square = sp.powsimp(composed**2, force=True)
+        if not square.is_rational_function(*parameters):  # before expanding: a sum of roots squared can
+            return None  # take sympy's polynomial gcd half a minute to cancel (pile-driver's e)
+        square = sp.cancel(sp.powsimp(sp.expand(square), force=True))
         if not (square.free_symbols <= set(parameters) and square.is_rational_function(*parameters)
                 and not square.is_Symbol and composed.is_nonnegative):
             return None

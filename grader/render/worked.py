@@ -33,7 +33,7 @@ import numpy as np
 
 from grader.assign.variants import ProblemVariant
 from grader.bank.template import Template
-from grader.model.expr import FUNCTIONS, Node, Num, Op, Sym, format_number, parse
+from grader.model.expr import FUNCTIONS, Node, Num, Op, Sym, format_number, names, parse
 from grader.model.kernel import evaluate
 from grader.render.readable import Names, counted, readable
 from grader.solve.cache import compiled_for
@@ -180,7 +180,9 @@ class _Math:
             if not pieces and _is_fraction(factor):  # 1/2 m v^2: Typst's fraction takes the 2 alone
                 pieces.append((shown, False))
                 continue
-            if level <= 5 or (pieces and shown.startswith("-")):
+            # A fraction among factors stays bare: Typst's slash takes the group just before it, so
+            # sqrt(x) (1 + e)/(1 - e) is the root times the fraction.
+            if (level <= 5 and not _is_quotient(factor)) or (pieces and shown.startswith("-")):
                 shown = f"({shown})"
             pieces.append((shown, numeric or shown[:1].isdigit()))
         result = pieces[0][0]
@@ -209,6 +211,10 @@ class _Math:
             right = f"({right})"
         sign = " + " if node.op == "add" else " - "
         return left + sign + right, level, False
+
+
+def _is_quotient(node: Node) -> bool:
+    return isinstance(node, Op) and node.op == "div"
 
 
 def _is_fraction(node: Node) -> bool:
@@ -481,7 +487,9 @@ def worked(template: Template, variant: ProblemVariant, compiled: Compiled | Non
         steps.append(_step(step, scaling, dimensions.get(step.unknown), context))
         if scaling is not None:
             shown[step.unknown] = scaling.math()
-    notes = tuple(_symbol_note(s, template.symbols[s].description) for s in symbols)
+    # A symbol no step uses (a mass the scene needs only for its simulation) gets no note.
+    used = set().union(*(names(step.solved) for step in compiled.steps))
+    notes = tuple(_symbol_note(s, template.symbols[s].description) for s in symbols if s in used)
     values = chain_values(compiled, {**si, **{s: 1.0 for s in symbols}})
     return Worked(tuple(given_lines(template, variant, compiled)), notes, tuple(steps), values)
 

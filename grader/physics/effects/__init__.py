@@ -1,6 +1,6 @@
 """The catalogue of physical effects a scene's stages are made of, one module per effect.
 
->>> sorted(CATALOGUE)
+>>> sorted(CATALOGUE)  # doctest: +NORMALIZE_WHITESPACE
 ['angle_between', 'bounces', 'flight', 'free_fall', 'impact', 'impact_geometry', 'rise', 'slide', 'swing',
  'velocity']
 """

@@ -4,7 +4,9 @@ The solver's forms come out of sympy in sympy's order, with square roots split
 (``-sqrt(2)*sqrt(h)*sqrt(g)``) and sums sorted by name (``e + 1``). A reader expects what the
 textbook writes, and :func:`readable` rewrites a tree into that, changing its value nowhere:
 
-- one square root of a product: ``√2·√g·√h`` is ``√(2 g h)``;
+- one square root of a product: ``√2·√g·√h`` is ``√(2 g h)``, and of a quotient: ``√2·√h/√g`` is
+  ``√(2 h/g)``, which stands in front of a fraction of the other factors (``√(2 h/g) (1 + e)/(1 - e)``);
+- a sum of names of one kind stands with them, after them: ``(m1 + m2) v'``, ``m (u + v)``;
 - factors in the textbook's order: the number first, then dimensionless symbols (``e``, ``p``), masses,
   ``g``, lengths, velocities, other quantities, functions (``cos θ``, roots), sums with a dimension
   (``v1 - v2``), and last the dimensionless sums (``1 + e``); names of one kind in the order the problem
@@ -130,6 +132,7 @@ def _product(node: Node, names: Names) -> Node:
         return Num(Fraction(0))
     product.numerator = [_unsquared(f, names) for f in _powers(_one_root(product.numerator, names))]
     product.denominator = [_unsquared(f, names) for f in _powers(_one_root(product.denominator, names))]
+    _root_of_quotient(product, names)
     if product.negative:
         product.negative = not _turn_a_sum_round(product.numerator) and \
             not _turn_a_sum_round(product.denominator)
@@ -138,7 +141,25 @@ def _product(node: Node, names: Names) -> Node:
     return _built(product, sorted(product.numerator, key=key), sorted(product.denominator, key=key))
 
 
+def _root_of_quotient(product: _Product, names: Names) -> None:
+    """A root above and a root below as one root of their quotient: ``√(2 h)/√g`` is ``√(2 h/g)``."""
+    above = [f for f in product.numerator if _is_root(f)]
+    below = [f for f in product.denominator if _is_root(f)]
+    if not (above and below):
+        return
+    quotient = Op("div", tuple(root.args[0] for root in (above[0], below[0]) if isinstance(root, Op)))
+    product.numerator = [f for f in product.numerator if not _is_root(f)] + [Op("sqrt", (readable(quotient, names),))]
+    product.denominator = [f for f in product.denominator if not _is_root(f)]
+
+
 def _built(product: _Product, numerator: list[Node], denominator: list[Node]) -> Node:
+    roots = [f for f in numerator if _is_root(f)]
+    if roots and len(numerator) > 1 and denominator and product.coefficient == 1:
+        # √(2 h/g) (1 + e)/(1 - e): a root of the whole stands in front of the fraction of the rest.
+        numerator.remove(roots[0])
+        rest = _built(_Product(), numerator, denominator)
+        whole = Op("mul", (roots[0], rest))
+        return Op("neg", (whole,)) if product.negative else whole
     coefficient = product.coefficient
     if _decimal(coefficient):  # a number of the problem's data (0.1 p), not of the physics (1/2 m v^2)
         numerator.insert(0, Num(coefficient))
@@ -259,11 +280,11 @@ def _turn_a_sum_round(factors: list[Node]) -> bool:
     return False
 
 
-def _factor_key(names: Names) -> Callable[[Node], tuple[int, int, str]]:
-    def key(factor: Node) -> tuple[int, int, str]:
+def _factor_key(names: Names) -> Callable[[Node], tuple[int, bool, int, str]]:
+    def key(factor: Node) -> tuple[int, bool, int, str]:
         used = _names_of(factor)
         first = min((names.position(n) for n in used), default=0)
-        return _kind(factor, names), first, to_text(factor)
+        return _kind(factor, names), _is_sum(factor), first, to_text(factor)
     return key
 
 
@@ -275,10 +296,23 @@ def _kind(factor: Node, names: Names) -> int:
     if factor.op == "pow":
         return _kind(factor.args[0], names)
     if factor.op in ("add", "sub"):
-        pure = any(isinstance(term, Num) for term in _terms(factor)) or \
-            all(names.kind(n) == _DIMENSIONLESS for n in _names_of(factor))
-        return _PURE_SUM if pure else _SUM
+        terms = _terms(factor)
+        if any(isinstance(term, Num) for term in terms) or \
+                all(names.kind(n) == _DIMENSIONLESS for n in _names_of(factor)):
+            return _PURE_SUM
+        # A sum of names of one kind stands with them: (m1 + m2) v' as a mass, after the masses alone.
+        kinds = {_kind(_unsigned(term), names) if isinstance(_unsigned(term), Sym) else _SUM for term in terms}
+        return kinds.pop() if len(kinds) == 1 and _SUM not in kinds else _SUM
     return _CALL if factor.op in FUNCTIONS else _OTHER
+
+
+def _unsigned(term: Node) -> Node:
+    return term.args[0] if isinstance(term, Op) and term.op == "neg" else term
+
+
+def _is_sum(factor: Node) -> bool:
+    base = factor.args[0] if isinstance(factor, Op) and factor.op == "pow" else factor
+    return isinstance(base, Op) and base.op in ("add", "sub")
 
 
 def _names_of(node: Node) -> list[str]:

@@ -33,7 +33,7 @@ import numpy as np
 
 from grader.assign.variants import ProblemVariant
 from grader.bank.template import Template
-from grader.model.expr import FUNCTIONS, Node, Num, Op, Sym, format_number, parse
+from grader.model.expr import FUNCTIONS, Node, Num, Op, Sym, format_number, names, parse
 from grader.model.kernel import evaluate
 from grader.render.readable import Names, counted, readable
 from grader.solve.cache import compiled_for
@@ -180,7 +180,9 @@ class _Math:
             if not pieces and _is_fraction(factor):  # 1/2 m v^2: Typst's fraction takes the 2 alone
                 pieces.append((shown, False))
                 continue
-            if level <= 5 or (pieces and shown.startswith("-")):
+            # A fraction among factors stays bare: Typst's slash takes the group just before it, so
+            # sqrt(x) (1 + e)/(1 - e) is the root times the fraction.
+            if (level <= 5 and not _is_quotient(factor)) or (pieces and shown.startswith("-")):
                 shown = f"({shown})"
             pieces.append((shown, numeric or shown[:1].isdigit()))
         result = pieces[0][0]
@@ -209,6 +211,10 @@ class _Math:
             right = f"({right})"
         sign = " + " if node.op == "add" else " - "
         return left + sign + right, level, False
+
+
+def _is_quotient(node: Node) -> bool:
+    return isinstance(node, Op) and node.op == "div"
 
 
 def _is_fraction(node: Node) -> bool:
@@ -478,18 +484,20 @@ def worked_form(template: Template, compiled: Compiled | None = None) -> WorkedF
     """The parts of ``template``'s worked solutions that do not depend on a variant's numbers."""
     compiled = compiled or compiled_for(template)
     dimensions = quantity_dimensions(template, compiled)
-    names = reader_names(template, compiled, dimensions)
+    reader = reader_names(template, compiled, dimensions)
     quantities = set(dimensions) | {s.unknown for s in compiled.steps}
     steps = []
     for step in compiled.steps:
-        lhs, rhs, solved = (readable(side, names) for side in (*step.equation, step.solved))
+        lhs, rhs, solved = (readable(side, reader) for side in (*step.equation, step.solved))
         equation = None if (lhs == Sym(step.unknown) and rhs == solved) else f"{math(lhs)} = {math(rhs)}"
         steps.append(StepForm(step.unknown, relation_markup(step.relation, quantities), equation, solved,
                               math(solved)))
     symbols = tuple(sorted(template.symbols))
+    # A symbol no step uses (a mass the scene needs only for its simulation) gets no note.
+    used = set().union(*(names(step.solved) for step in compiled.steps))
     return WorkedForm(tuple(steps), dimensions, symbols,
                       {n: _si_unit(s.unit.dimension) or "1" for n, s in template.symbols.items()},
-                      tuple(_symbol_note(s, template.symbols[s].description) for s in symbols))
+                      tuple(_symbol_note(s, template.symbols[s].description) for s in symbols if s in used))
 
 
 @dataclass(frozen=True)

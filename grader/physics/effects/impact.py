@@ -9,6 +9,8 @@ with inverse masses ``w = 1/m`` (``w = 0`` for a fixed surface); after-impact ve
 mass-centre form ``v1' = v_c - e w1 (v1 - v2)/(w1 + w2)``, which equals ``v1 - J w1`` but keeps its
 accuracy when ``e`` is small or the masses are very unequal; energy lost as
 ``1/2 mu (1 - e)(1 + e) v_rel^2``, or ``1/2 mu (v_rel - v_sep)(v_rel + v_sep)`` when ``e`` itself is derived.
+When the bodies move on together (a perfectly plastic impact) the worked solution takes a speed before from
+conservation of momentum, ``m1 v1 + m2 v2 = (m1 + m2) v'``, as the textbook does; its kernel is the impulse form's.
 
 Force law (simulation): a Kelvin-Voigt contact calibrated to ``e`` (:class:`ContactLaw`), plus the
 weight during contact only where asked for.
@@ -89,6 +91,8 @@ class _Impact:
                      solutions={a1: u1 - impulse * w1, impulse: (u1 - a1) / w1},
                      stable={a1: (Stable(centre - used * w1 * approach / (w1 + w2)),)}),
         ]
+        if w1 != 0 and w2 != 0 and sp.simplify(a1 - a2) == 0:
+            relations.append(self._momentum(used))
         if w2 != 0:
             relations.append(Relation(
                 f"impulse-momentum for {second} along n", a2, u2 + impulse * w2,
@@ -113,6 +117,29 @@ class _Impact:
             relations.append(Relation(f"smooth surfaces: no impulse along t, so {self.bodies[index]}'s t-velocity is "
                                       "unchanged", after, before, solutions={after: before}))
         return relations + self._energy(ctx, used, approach, separation)
+
+    def _momentum(self, used: Any) -> Relation:
+        """Conservation of momentum along n when the bodies move on together (a perfectly plastic
+        impact): ``m1 v1 + m2 v2 = (m1 + m2) v'``, the textbook's route to a speed before from the
+        common speed after (a bullet's, from the block it embeds in; a car's, from the skid).
+
+        The kernels keep the impulse form's composition (``v1 = v2 + J (w1 + w2)/(1 + e)`` with
+        ``J = (v' - v2)/w2``): the relation changes what the reader sees, not what computes."""
+        import sympy as sp
+
+        (first, second), (w1, w2) = self.bodies, self.inverse
+        (u1, u2), common = (self.before[0][0], self.before[1][0]), self.after[0][0]
+        m1, m2 = 1 / w1, 1 / w2
+        together = sp.together(w1 + w2) / (1 + used)
+        return Relation(
+            f"conservation of momentum along n: {first} and {second} move on together", m1 * u1 + m2 * u2,
+            (m1 + m2) * common,
+            solutions={u1: ((m1 + m2) * common - m2 * u2) / m1, u2: ((m1 + m2) * common - m1 * u1) / m2,
+                       common: (m1 * u1 + m2 * u2) / (m1 + m2)},
+            stable={u1: (Stable(u2 + (common - u2) / w2 * together),),
+                    u2: (Stable(u1 - (u1 - common) / w1 * together),),
+                    common: (Stable((w2 * u1 + w1 * u2) / (w1 + w2)),)},
+            general=False)
 
     def _kinetic(self, when: str) -> Any:
         """Sum of ``(v_n^2 + v_t^2) / (2 w)`` over the movable bodies."""

@@ -2,9 +2,8 @@
 
 As DifferentialEquations.jl's ``WorkPrecisionSet``: for every forward scene of the bank (a template whose
 simulation finds nothing by search, at its example numbers), plus ballistic-pendulum, skid and drop-rebound
-asked forward (the speed or ``e`` they search for given instead: the swing and the slide are swept too), and each
-method,
-the error of the simulated answers against a reference simulation (adaptive, rtol 1e-13) versus the
+asked forward (the speed or ``e`` they search for given instead: the swing and the slide are swept too), and
+each method, the error of the simulated answers against a reference simulation (adaptive, rtol 1e-13) versus the
 median wall time of ``simulate``: ``euler`` and ``rk4`` over a geometric sweep of steps per contact N,
 ``adaptive`` over rtol 1e-3..1e-13. Each point runs at ``--shifts`` contact durations
 ``tau (1 + k/(shifts N))`` (N = 16 for adaptive), moving the step grid against the contact; the errors

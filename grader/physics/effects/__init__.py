@@ -1,8 +1,7 @@
 """The catalogue of physical effects a scene's stages are made of, one module per effect.
 
->>> sorted(CATALOGUE)
-['angle_between', 'bounces', 'flight', 'free_fall', 'impact', 'impact_geometry', 'rise', 'slide', 'swing',
- 'velocity']
+>>> print(*sorted(CATALOGUE))
+angle_between bounces flight free_fall impact impact_geometry rise slide swing velocity
 """
 
 from grader.physics.effects.base import Condition, Effect, Field, Mistake, Relation, Stable

@@ -1,8 +1,9 @@
 """Benchmark: what accuracy costs in time, simulation against closed form (a work-precision diagram).
 
 As DifferentialEquations.jl's ``WorkPrecisionSet``: for every forward scene of the bank (a template whose
-simulation finds nothing by search, at its example numbers), plus drop-rebound asked forward, and each method,
-the error of the simulated answers against a reference simulation (adaptive, rtol 1e-13) versus the
+simulation finds nothing by search, at its example numbers), plus ballistic-pendulum, skid and drop-rebound
+asked forward (the speed or ``e`` they search for given instead: the swing and the slide are swept too), and
+each method, the error of the simulated answers against a reference simulation (adaptive, rtol 1e-13) versus the
 median wall time of ``simulate``: ``euler`` and ``rk4`` over a geometric sweep of steps per contact N,
 ``adaptive`` over rtol 1e-3..1e-13. Each point runs at ``--shifts`` contact durations
 ``tau (1 + k/(shifts N))`` (N = 16 for adaptive), moving the step grid against the contact; the errors
@@ -10,7 +11,7 @@ are averaged. Corners: the closed-form kernels, and a 50-digit mpmath evaluation
 formulas (``textbook.py``; a template without one there gets no exact corner). Second panel: the drop's
 rebound with the weight acting during contact, against contact stiffness (modelling error) beside the
 same without weight (integration error). A small table times the inverse templates (every template
-whose simulation finds ``e`` or a height by root search). Run: ``python benchmarks/accuracy.py [--quick]``;
+whose simulation finds ``e``, a height or a speed by root search). Run: ``python benchmarks/accuracy.py [--quick]``;
 writes ``benchmarks/results/accuracy.md``, ``accuracy.csv`` and ``accuracy.png``.
 """
 
@@ -35,7 +36,7 @@ from typing import Any
 import mpmath as mp
 import numpy as np
 import yaml
-from textbook import FORMS
+from textbook import FORMS, skid_length, swing_angle
 
 from grader.bank.template import Template, load_bank, parse_template
 from grader.model.kernel import evaluate
@@ -62,7 +63,8 @@ KERNEL_REPEAT = 301
 ROUNDING = 1e-9  # a spread of the error over the onset shifts above this is not rounding
 Exact = Callable[[Mapping[str, Any]], dict[str, Any]]
 MPMATH = SimpleNamespace(sqrt=mp.sqrt, sin=mp.sin, cos=mp.cos, asin=mp.asin, atan2=mp.atan2, hypot=mp.hypot,
-                         radians=mp.radians, degrees=mp.degrees)  # textbook.py's math, at 50 digits
+                         radians=mp.radians, degrees=mp.degrees,
+                         where=lambda condition, a, b: a if condition else b)  # textbook.py's math, at 50 digits
 
 
 @dataclass(frozen=True)
@@ -141,17 +143,49 @@ def _exact_drop(p: Mapping[str, Any]) -> dict[str, Any]:
     return {"h_rebound": p["e"] ** 2 * p["h_drop"]}
 
 
-def drop_forward() -> Template:
-    """The drop-rebound scene asked forward: e given, the rebound height found."""
-    raw = yaml.safe_load((bank_dir() / "drop-rebound.yaml").read_text(encoding="utf-8"))
+@dataclass(frozen=True)
+class Asked:
+    """An inverse template asked forward: what it is given instead (parameter specs), what it then
+    asks (answer specs), its numbers, and its answers written from first principles."""
+
+    template: str
+    given: Mapping[str, Any]
+    asked: Mapping[str, Any]
+    params: Mapping[str, float]
+    exact: Exact
+
+
+ASKED_FORWARD = (
+    Asked("ballistic-pendulum",  # the swing: a nonlinear ODE, no closed-form trajectory
+          {"v_bullet": {"unit": "m/s", "domain": "(0, inf)", "sample": {"uniform": [300, 700]}, "decimals": 0}},
+          {"theta_max": {"value": "theta_max", "unit": "deg", "description": "greatest angle of the cord"},
+           "loss_pct": {"value": "f_loss", "unit": "%", "description": "kinetic energy lost"}},
+          {"m_b": 12, "m_blk": 4, "L": 1.6, "v_bullet": 460}, lambda p: swing_angle(MPMATH, **p)),
+    Asked("skid",  # Coulomb friction: a force that stops at v = 0
+          {"v_A": {"unit": "km/h", "domain": "(0, inf)", "sample": {"uniform": [40, 90]}, "decimals": 0}},
+          {"d": {"value": "d", "unit": "m", "description": "length of the skid mark"},
+           "loss_pct": {"value": "f_loss", "unit": "%", "description": "kinetic energy lost"}},
+          {"m_A": 1500, "m_B": 1200, "mu_k": 0.6, "v_A": 65}, lambda p: skid_length(MPMATH, **p)),
+    Asked("drop-rebound",  # last: the stiffness panel's scene
+          {"e": {"unit": "", "domain": "[0, 1]", "sample": {"uniform": [0.3, 0.9]}, "decimals": 2}},
+          {"h_rebound": {"value": "h_rebound", "unit": "mm", "description": "rebound height"}},
+          {"h_drop": 2000, "e": 0.6}, _exact_drop),
+)
+"""Inverse templates asked forward: the quantity the bank's template finds by search given instead, so the
+scene's effect (the swing, the slide, the drop) sits in the work-precision sweep."""
+
+
+def asked_forward(asked: Asked) -> Template:
+    """The bank's template with ``asked.given`` as parameters instead of the answers ``asked.asked`` names."""
+    raw = yaml.safe_load((bank_dir() / f"{asked.template}.yaml").read_text(encoding="utf-8"))
     for key in ("constraints", "example"):
         raw.pop(key, None)
-    raw["id"] = "drop-rebound-forward"
-    raw["parameters"] = {"h_drop": raw["parameters"]["h_drop"], "e": {
-        "unit": "", "domain": "[0, 1]", "sample": {"uniform": [0.3, 0.9]}, "decimals": 2}}
-    raw["answers"] = {"h_rebound": {"value": "h_rebound", "unit": "mm", "description": "rebound height"}}
-    raw["statement"] = "Dropped from {{ h_drop }} mm with e = {{ e }}."
-    return parse_template(raw, "benchmarks/accuracy.py (drop-rebound, forward)", "benchmark-drop-forward")
+    raw["id"] = f"{asked.template}-forward"
+    kept = {name: spec for name, spec in raw["parameters"].items() if name not in asked.asked}
+    raw["parameters"] = {**kept, **asked.given}
+    raw["answers"] = dict(asked.asked)
+    raw["statement"] = "Given " + ", ".join(f"{{{{ {name} }}}}" for name in raw["parameters"]) + "."
+    return parse_template(raw, f"benchmarks/accuracy.py ({asked.template}, forward)", f"benchmark-{raw['id']}")
 
 
 def example(template: Template) -> dict[str, float]:
@@ -182,11 +216,13 @@ def classify(bank: Mapping[str, Template]) -> tuple[list[Template], list[Templat
 
 
 def scenes(forward: Sequence[Template]) -> list[Scene]:
-    """The forward scenes: each forward template at its example, and drop-rebound asked forward (last)."""
-    drop = drop_forward()
-    specs: list[tuple[Template, Compiled, dict[str, float], Exact | None]] = [
+    """The forward scenes: each forward template at its example, then the inverse ones asked forward
+    (drop-rebound last)."""
+    specs: list[tuple[Template, Compiled, Mapping[str, float], Exact | None]] = [
         (t, compiled_for(t), example(t), textbook_exact(t.id)) for t in forward]
-    specs.append((drop, compile_template(drop), {"h_drop": 2000, "e": 0.6}, _exact_drop))
+    for asked in ASKED_FORWARD:
+        template = asked_forward(asked)
+        specs.append((template, compile_template(template), asked.params, asked.exact))
     return [Scene(t.id, t, c, {k: float(v) for k, v in p.items()}, x) for t, c, p, x in specs]
 
 
@@ -436,8 +472,11 @@ def report(points: Sequence[Point], rows: Sequence[Stiffness], inverse_rows: Seq
                                       f"the end, on {os.cpu_count()} CPUs." if loads else ""),
         "## Target: adaptive within 1e-8 of the closed form in ≤ 5 ms per scene", targets_table(points, names),
         "Forward scenes: every template of the bank whose simulation finds nothing by search (e given), at its "
-        "example numbers as its sheet prints them, and drop-rebound asked forward (e given, the rebound height "
-        "found). The inverse templates are timed below." + "".join(f" Not simulated: {reason}." for reason in skipped),
+        "example numbers as its sheet prints them, then three inverse templates asked forward, with what their "
+        "simulation searches for given instead: " + "; ".join(
+            f"{a.template}-forward ({', '.join(f'{k} {v:g}' for k, v in a.params.items())}: "
+            f"{', '.join(a.asked)} found)" for a in ASKED_FORWARD)
+        + ". The inverse templates are timed below." + "".join(f" Not simulated: {reason}." for reason in skipped),
         "## Work-precision: error vs the adaptive rtol 1e-13 reference (mean over onset shifts) / median ms",
         sweep_table(sweep, names),
         f"Against the closed form instead of the reference every error differs by at most {gap:.1e} (the "
@@ -451,11 +490,16 @@ def report(points: Sequence[Point], rows: Sequence[Stiffness], inverse_rows: Seq
         "## Modelling vs integration error: drop-rebound (h_drop 2000 mm, e 0.6), adaptive rtol 1e-12", stiff,
         f"Modelling error ∝ duration^{power:.2f} (least-squares slope); the integration error stays at the floor.",
         "## Inverse templates (found by root search, example parameters)", inverse_table(inverse_rows),
-        "The root search puts the contact's integration error into the calibrated e; the answer e is the e the "
-        "contact produced, and fall and rise (quadratic in time) and momentum are integrated exactly, so the "
+        "The root search for e puts the contact's integration error into the calibrated e; the answer e is the e "
+        "the contact produced, and fall and rise (quadratic in time) and momentum are integrated exactly, so the "
         "answers match the closed form to rounding at any rtol. The rtol changes the calibrated e and the time; "
         "a scene searches once per unknown (two-rebounds: e, then the drop height), each search about 14 "
-        "simulations.",
+        "simulations. A search for an approach speed (ballistic-pendulum's v_bullet, skid's v_A) finds the speed "
+        "whose simulated outcome matches the given one: the slide (constant deceleration, quadratic in time) is "
+        "integrated exactly, so skid matches to rounding; the swing is a nonlinear ODE whose integration error "
+        "the search carries into the speed it finds, so ballistic-pendulum's error follows the rtol"
+        + "".join(f" ({r.error:.1e} at rtol {r.rtol:.0e})" for r in inverse_rows
+                  if r.template == "ballistic-pendulum" and r.rtol == max(x.rtol for x in inverse_rows)) + ".",
     ]) + "\n"
 
 

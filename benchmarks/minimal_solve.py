@@ -33,6 +33,10 @@ UNITS: dict[str, dict[str, str]] = {
     "offset-spheres": {"v1_out": "m/s", "v2_out": "m/s", "theta1_out": "deg", "theta2_out": "deg", "loss_pct": "%"},
     "three-balls": {"v1_out": "m/s", "v2_out": "m/s", "v3_out": "m/s"},
     "two-rebounds": {"e": "", "h0": "m", "loss_pct": "%"},
+    "successive-bounces": {"h_n": "m", "distance": "m", "t_total": "s"},
+    "ballistic-pendulum": {"v_bullet": "m/s", "loss_pct": "%"},
+    "skid": {"v_A": "km/h", "loss_pct": "%"},
+    "wall-throw": {"y_hit": "m", "v_hit": "m/s", "v_out": "m/s", "x_land": "m"},
 }
 """The templates this script answers, with each answer's unit as the template prints it."""
 

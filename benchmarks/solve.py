@@ -170,6 +170,8 @@ def sample_column(parameter: Parameter, count: int, rng: np.random.Generator) ->
         column = np.exp(rng.uniform(np.log(values[0]), np.log(values[1]), count))
     elif kind == "choice":
         column = rng.choice(np.asarray(values, dtype=float), count)
+    elif kind == "integers":  # each whole number from a to b
+        column = rng.integers(int(values[0]), int(values[1]), count, endpoint=True).astype(float)
     else:
         raise ValueError(f"{parameter.name}: unknown sampling kind {kind!r}")
     # exp(log(b)) can land one ulp past b: clip to the sampling range, which lies inside the domain.

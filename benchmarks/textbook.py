@@ -1,14 +1,16 @@
 """The bank's answers as a textbook writes them, from first principles, for the benchmarks' baselines.
 
 Each function takes a math namespace ``xp`` (``sqrt``, ``sin``, ``cos``, ``asin``, ``atan2``, ``hypot``,
-``radians``, ``degrees``) and the template's parameters in its units, and returns the numeric answers
-in its units. With numpy (:data:`NUMPY`) on columns it is the closed form a competent user writes in a
-minimal script (``minimal_solve.py``); with mpmath at 50 digits it is the exact reference the accuracy
-benchmark measures against (``accuracy.py`` builds that namespace: importing mpmath here would slow the
-minimal script down). Nothing here comes from grader: energies are ``T - T'``, velocities the momentum
-and restitution equations solved by hand, the plain forms grader's stable forms improve on.
+``radians``, ``degrees``, and ``where(condition, a, b)``, a choice made per row) and the template's
+parameters in its units, and returns the numeric answers in its units. With numpy (:data:`NUMPY`) on
+columns it is the closed form a competent user writes in a minimal script (``minimal_solve.py``); with
+mpmath at 50 digits it is the exact reference the accuracy benchmark measures against (``accuracy.py``
+builds that namespace: importing mpmath here would slow the minimal script down). Nothing here comes
+from grader: energies are ``T - T'``, velocities the momentum and restitution equations solved by hand,
+the plain forms grader's stable forms improve on.
 
-Adding a template: write its function here and list it in :data:`FORMS`.
+Adding a template: write its function here and list it in :data:`FORMS`. ``swing_angle`` and ``skid_length``
+are two inverse templates asked forward (the speed they find given), for the accuracy benchmark's sweep.
 """
 
 from __future__ import annotations
@@ -22,7 +24,7 @@ import numpy as np
 G = 9.81  # the bank's g, m/s^2
 
 NUMPY = SimpleNamespace(sqrt=np.sqrt, sin=np.sin, cos=np.cos, asin=np.arcsin, atan2=np.arctan2, hypot=np.hypot,
-                        radians=np.radians, degrees=np.degrees)
+                        radians=np.radians, degrees=np.degrees, where=np.where)
 
 
 def _angle_between(xp: Any, n1: Any, t1: Any, n2: Any, t2: Any) -> Any:
@@ -135,11 +137,66 @@ def two_rebounds(xp: Any, h1: Any, h2: Any) -> dict[str, Any]:
     return {"e": xp.sqrt(h2 / h1), "h0": h0, "loss_pct": _loss_pct(h0, h2)}
 
 
+def successive_bounces(xp: Any, h0: Any, e: Any, n: Any) -> dict[str, Any]:
+    """Each rebound leaves at e times the speed it arrived with, so it rises e^2 times as high: h_n = h0 e^(2n).
+    To rest: the drop, then each rebound height up and down (geometric, ratio e^2); the fall time
+    sqrt(2 h0/g), then each rebound's rise and fall (geometric, ratio e)."""
+    fall = xp.sqrt(2 * h0 / G)
+    return {"h_n": h0 * e ** (2 * n), "distance": h0 * (1 + e**2) / (1 - e**2), "t_total": fall * (1 + e) / (1 - e)}
+
+
+def ballistic_pendulum(xp: Any, m_b: Any, m_blk: Any, L: Any, theta_max: Any) -> dict[str, Any]:  # noqa: N803
+    """Bullet in g, block in kg. The swing: V^2 = 2 g L (1 - cos theta) = (2 sqrt(g L) sin(theta/2))^2; the
+    impact (plastic): momentum m v = (m + M) V; the loss as T - T' over T."""
+    bullet = m_b / 1000
+    swing = 2 * xp.sqrt(G * L) * xp.sin(xp.radians(theta_max) / 2)
+    v_bullet = (bullet + m_blk) / bullet * swing
+    return {"v_bullet": v_bullet, "loss_pct": _loss_pct(bullet * v_bullet**2, (bullet + m_blk) * swing**2)}
+
+
+def swing_angle(xp: Any, m_b: Any, m_blk: Any, L: Any, v_bullet: Any) -> dict[str, Any]:  # noqa: N803
+    """ballistic-pendulum asked forward (the bullet's speed given): V = m v / (m + M), then
+    sin(theta/2) = V / (2 sqrt(g L)); the loss as T - T' over T."""
+    bullet = m_b / 1000
+    swing = bullet * v_bullet / (bullet + m_blk)
+    return {"theta_max": xp.degrees(2 * xp.asin(swing / (2 * xp.sqrt(G * L)))),
+            "loss_pct": _loss_pct(bullet * v_bullet**2, (bullet + m_blk) * swing**2)}
+
+def skid(xp: Any, m_A: Any, m_B: Any, d: Any, mu_k: Any) -> dict[str, Any]:  # noqa: N803 (its names)
+    """The skid: (m_A + m_B) v^2 / 2 = mu_k (m_A + m_B) g d; the impact (plastic): m_A v_A = (m_A + m_B) v;
+    v_A in km/h (3.6 km/h per m/s); the loss as T - T' over T."""
+    after = xp.sqrt(2 * mu_k * G * d)
+    before = (m_A + m_B) / m_A * after
+    return {"v_A": 3.6 * before, "loss_pct": _loss_pct(m_A * before**2, (m_A + m_B) * after**2)}
+
+
+def skid_length(xp: Any, m_A: Any, m_B: Any, mu_k: Any, v_A: Any) -> dict[str, Any]:  # noqa: N803 (its names)
+    """skid asked forward (car A's speed given, in km/h): V = m_A v_A / (m_A + m_B), then d = V^2 / (2 mu_k g)."""
+    before = v_A / 3.6
+    after = m_A * before / (m_A + m_B)
+    return {"d": after**2 / (2 * mu_k * G), "loss_pct": _loss_pct(m_A * before**2, (m_A + m_B) * after**2)}
+
+def wall_throw(xp: Any, h0: Any, D: Any, v0: Any, alpha: Any, e: Any) -> dict[str, Any]:  # noqa: N803
+    """To the wall in t1 = D / (v0 cos alpha); the smooth wall reverses e times the horizontal velocity and
+    keeps the vertical; then y_hit + v_y t - g t^2/2 = 0 for the landing. Its positive root
+    (v_y + s)/g, s = sqrt(v_y^2 + 2 g y_hit), is the same as 2 y_hit / (s - v_y); each is a sum of
+    positive terms on one side of v_y = 0, so the landing takes (s + |v_y|)/g rising and 2 y_hit/(s + |v_y|)
+    falling: no difference of nearly equal numbers."""
+    v_x, v_y = v0 * xp.cos(xp.radians(alpha)), v0 * xp.sin(xp.radians(alpha))
+    t1 = D / v_x
+    y_hit, v_y_hit = h0 + v_y * t1 - G * t1**2 / 2, v_y - G * t1
+    both = xp.sqrt(v_y_hit**2 + 2 * G * y_hit) + abs(v_y_hit)
+    t2 = xp.where(v_y_hit >= 0, both / G, 2 * y_hit / both)
+    return {"y_hit": y_hit, "v_hit": xp.hypot(v_x, v_y_hit), "v_out": xp.hypot(e * v_x, v_y_hit),
+            "x_land": e * v_x * t2}
+
+
 FORMS: dict[str, Callable[..., dict[str, Any]]] = {
     "drop-rebound": drop_rebound, "pile-driver": pile_driver, "car-collision": car_collision,
     "ball-plate": ball_plate, "oblique-spheres": oblique_spheres, "head-on": head_on,
     "head-on-inverse": head_on_inverse, "coupling": coupling, "moving-plate": moving_plate,
     "incline-bounce": incline_bounce, "billiards": billiards, "offset-spheres": offset_spheres,
-    "three-balls": three_balls, "two-rebounds": two_rebounds,
+    "three-balls": three_balls, "two-rebounds": two_rebounds, "successive-bounces": successive_bounces,
+    "ballistic-pendulum": ballistic_pendulum, "skid": skid, "wall-throw": wall_throw,
 }
 """Template id -> its textbook answers."""

@@ -206,3 +206,16 @@ def test_every_kind_of_result_comes_back_whole_from_the_blocks(size: int) -> Non
             reference = evaluate(tree, {"x": x, "g": 9.81})
             assert same_bits(results[name], reference) and np.shape(results[name]) == np.shape(reference), name
     assert results["input"] is x
+
+
+def test_angles_within_45_degrees_skip_the_reduction_with_the_same_bits() -> None:
+    """sind and cosd of angles all within ±45° take a short path; one angle outside sends the same angles
+    through the quadrant reduction, which must give every value to the bit (signed zeros included)."""
+    inside = np.concatenate([np.random.default_rng(7).uniform(-45, 45, 5000),
+                             [45.0, -45.0, 0.0, -0.0, 1e-300, -5e-324, 30.0, -15.0, np.nextafter(45.0, 0.0)]])
+    with_outside = np.append(inside, 100.0)
+    for function in (sind, cosd):
+        short, reduced = function(inside), function(with_outside)[:-1]
+        assert np.array_equal(short.view(np.int64), reduced.view(np.int64)), function.__name__
+        assert all(np.float64(function(float(x))).view(np.int64) == r.view(np.int64)
+                   for x, r in zip(inside[-9:], reduced[-9:], strict=True))

@@ -18,13 +18,14 @@ a*(1 + m/M)
 
 from __future__ import annotations
 
+import itertools
 from collections.abc import Iterable
 from fractions import Fraction
 from typing import Any
 
 import sympy as sp
 
-from grader.model.expr import Node, Num, Op, Sym
+from grader.model.expr import Node, Num, Op, Sym, names
 from grader.physics.symbolic import common_positive_factor, cosd, sind
 
 
@@ -142,7 +143,7 @@ def drop_common_factors(expr: Any) -> Any:
 # --- the numeric tree ---------------------------------------------------------------------------
 
 def numeric_order(node: Node) -> Node:
-    """A compiled tree with both rewrites below applied, innermost first.
+    """A compiled tree with the rewrites below applied, innermost first.
 
     >>> from grader.model.expr import parse
     >>> numeric_order(parse("h1**2/h2")) == parse("(h1/h2)*h1")
@@ -154,10 +155,64 @@ def numeric_order(node: Node) -> Node:
         return node
     node = Op(node.op, tuple(numeric_order(arg) for arg in node.args))
     if node.op == "div":
-        return balance_quotient(node)
+        return constants_over(balance_quotient(node))
     if node.op in ("add", "sub"):
         return differences_first(node)
+    if node.op == "mul":
+        return constants_first(node)
     return node
+
+
+CONSTANT_NAMES = frozenset({"g", "pi"})
+"""Names a compiled tree may hold that are no parameter: their values are known when it is compiled."""
+
+
+def constants_first(node: Op) -> Node:
+    """A product whose constant factors (numbers, ``g``, ``pi``) are not all in front, with them in front
+    and in their order, then the others in theirs: the kernel multiplies the constants once, when it is
+    built, instead of one numpy call per constant on every evaluation (sympy's order puts ``sqrt(g)``
+    among the parameters' roots).
+
+    >>> from grader.model.expr import parse, to_text
+    >>> to_text(constants_first(parse("18*sqrt(2)*sqrt(d)*sqrt(g)*sqrt(mu)*(a + b)")))
+    '18*sqrt(2)*sqrt(g)*sqrt(d)*sqrt(mu)*(a + b)'
+    >>> constants_first(parse("2*sqrt(g)*h")) == parse("2*sqrt(g)*h")
+    True
+    """
+    factors = _factors(node, powers=False)
+    fixed = [factor for factor in factors if names(factor) <= CONSTANT_NAMES]
+    if not fixed or len(fixed) == len(factors) or factors[:len(fixed)] == fixed:
+        return node
+    return _product(fixed + [factor for factor in factors if not names(factor) <= CONSTANT_NAMES])
+
+
+def constants_over(node: Node) -> Node:
+    """A quotient whose numerator starts with constants and whose denominator holds some too, with the
+    denominator's constants divided into the numerator's: one constant the kernel makes when it is
+    built, instead of a numpy call for ``5*m_A`` on every evaluation.
+
+    >>> from grader.model.expr import parse, to_text
+    >>> to_text(constants_over(parse("18*sqrt(g)*d*(a + b)/(5*a)")))
+    '18*sqrt(g)/5*d*(a + b)/a'
+    """
+    if not (isinstance(node, Op) and node.op == "div"):
+        return node
+    over, under = (_factors(side, powers=False) for side in node.args)
+    fixed_over = len(list(itertools.takewhile(lambda factor: names(factor) <= CONSTANT_NAMES, over)))
+    fixed_under = [factor for factor in under if names(factor) <= CONSTANT_NAMES]
+    if not fixed_over or fixed_over == len(over) or not fixed_under or len(fixed_under) == len(under):
+        return node
+    constant = Op("div", (_product(over[:fixed_over]), _product(fixed_under)))
+    rest = [factor for factor in under if not names(factor) <= CONSTANT_NAMES]
+    return Op("div", (_product([constant, *over[fixed_over:]]), _product(rest)))
+
+
+def _product(factors: list[Node]) -> Node:
+    """The factors multiplied left to right."""
+    product = factors[0]
+    for factor in factors[1:]:
+        product = Op("mul", (product, factor))
+    return product
 
 
 def _factors(node: Node, powers: bool = True) -> list[Node]:

@@ -185,13 +185,18 @@ class _Bounded(_Mixin):
     def __init__(self, stream: str) -> None:
         super().__init__(stream)
         self._depth = 0
+        self._nodes = 0  # nodes composed: the document's size when it has no alias
+        self._aliases = False
 
     def compose_node(self, parent: Any, index: Any) -> Any:
         self._depth += 1
+        self._nodes += 1
         if self._depth > YAML_DEPTH:
             mark = self.peek_event().start_mark  # type: ignore[no-untyped-call]
             raise GraderError(f"line {mark.line + 1}: nested deeper than {YAML_DEPTH} levels; expected a "
                               "template-sized structure")
+        if self.check_event(yaml.AliasEvent):
+            self._aliases = True
         try:
             return super().compose_node(parent, index)
         finally:
@@ -199,8 +204,10 @@ class _Bounded(_Mixin):
 
     def get_single_node(self) -> Any:
         node = super().get_single_node()
-        if node is not None:
+        if node is not None and self._aliases:  # without one, the document is as large as it was written
             _check_expanded_size(node)
+        elif node is not None and self._nodes > YAML_NODES:
+            raise GraderError(f"line 1: holds more than {YAML_NODES:,} values; expected a template-sized structure")
         return node
 
     def construct_mapping(self, node: Any, deep: bool = False) -> dict[Hashable, Any]:

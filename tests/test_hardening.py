@@ -90,6 +90,13 @@ def test_a_yaml_alias_bomb_is_refused_at_once_not_expanded(tmp_path: Path, capsy
     assert "expands to more than 100,000 values through aliases" in err and len(err) < 300
 
 
+def test_a_yaml_document_of_too_many_values_without_aliases_is_refused(tmp_path: Path,
+                                                                       capsys: pytest.CaptureFixture[str]) -> None:
+    """Without an alias the composer's count is the document's size; 100,001 values fit in 1 MiB."""
+    err = generate_refused(capsys, tmp_path, "title: [" + "1," * 100_001 + "]\n")
+    assert "line 1: holds more than 100,000 values; expected a template-sized structure" in err
+
+
 def test_yaml_nested_100k_deep_is_refused_not_a_recursion_error(tmp_path: Path,
                                                                   capsys: pytest.CaptureFixture[str]) -> None:
     err = generate_refused(capsys, tmp_path, "title: " + "[" * 100_000 + "]" * 100_000 + "\n")

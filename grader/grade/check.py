@@ -188,11 +188,10 @@ def result(verdict: Verdict, part: KeyPart) -> dict[str, Any]:
     parsed: float | str | None = verdict.parsed or None
     if parsed is not None and not part.symbolic:
         parsed = float(parsed)
-    figure, reason = verdict.tolerance, str(part.tolerance.get("reason", ""))
-    if reason and figure.endswith(f": {reason}"):  # the words grading gives, Tolerance.explained: figure, reason
-        figure = figure[:-len(reason) - 2]
-    else:
-        reason = ""  # a symbolic answer's "equal expressions" does not use the tolerance
+    # Grading's words are Tolerance.explained's, "figure: reason"; a symbolic answer's ("equal expressions")
+    # use no tolerance.
+    reason = "" if part.symbolic else str(part.tolerance.get("reason", ""))
+    figure = verdict.tolerance.removesuffix(f": {reason}") if reason else verdict.tolerance
     return {"verdict": verdict.verdict, "credit": verdict.credit, "parsed": parsed, "expected": part.value,
             "unit": part.unit, "abs_error": verdict.abs_error, "rel_error": verdict.rel_error,
             "tolerance": figure, "tolerance_reason": reason, "feedback": verdict.feedback,

@@ -161,11 +161,12 @@ def rounding_bounds(routes: Routes, params: Mapping[str, Any], figures: int,
         by_answer.setdefault(route.answer, []).append(index)
     result = {}
     for answer, indices in by_answer.items():
-        shares = {}
+        shares, halves = {}, {}
         with np.errstate(all="ignore"):
             for index in indices:
                 steps = range(len(routes.items[index].names))
-                shares[index] = np.array([np.abs(column("slope", index, i)) * half_unit(column("q", index, i), figures)
+                halves[index] = [half_unit(column("q", index, i), figures) for i in steps]
+                shares[index] = np.array([np.abs(column("slope", index, i)) * halves[index][i]
                                           for i in steps]).reshape(len(steps), size)
         table = np.array([shares[index].sum(axis=0) for index in indices])
         doubtful = ~np.isfinite(table).all(axis=0)
@@ -175,9 +176,9 @@ def rounding_bounds(routes: Routes, params: Mapping[str, Any], figures: int,
         if rows.size:
             subset = {name: values[rows] for name, values in env.items()}
             for position, index in enumerate(indices):
-                moves = [np.sign(column("slope", index, i)[rows]) * half_unit(column("q", index, i)[rows], figures)
-                         for i in range(len(routes.items[index].names))]
-                direct = np.fmax(*(np.abs(moved_route(routes, routes.items[index], subset, sign, moves))
+                moves = [np.sign(column("slope", index, i)[rows]) * half[rows] for i, half in enumerate(halves[index])]
+                exact = walk_route(routes, routes.items[index], subset)
+                direct = np.fmax(*(np.abs(moved_route(routes, routes.items[index], subset, sign, moves, exact))
                                    for sign in (1.0, -1.0)))
                 table[position, rows] = np.fmax(table[position, rows], direct)
         with np.errstate(invalid="ignore"):
@@ -188,11 +189,12 @@ def rounding_bounds(routes: Routes, params: Mapping[str, Any], figures: int,
 
 
 def moved_route(routes: Routes, route: Route, env: Mapping[str, np.ndarray], sign: float,
-                moves: list[np.ndarray]) -> np.ndarray:
+                moves: list[np.ndarray], exact: np.ndarray | None = None) -> np.ndarray:
     """How far the answer moves along ``route`` when each value written down is moved by ``sign`` times
     its ``moves`` (a half unit, signed the way its slope moves the answer up), each moved value used by
-    the later steps."""
-    exact = walk_route(routes, route, env)
+    the later steps; ``exact``: the answer along the route unmoved, when the caller has it."""
+    if exact is None:
+        exact = walk_route(routes, route, env)
     moved = walk_route(routes, route, env, lambda step, value: value + sign * moves[step])
     difference: np.ndarray = moved - exact
     return difference

@@ -6,6 +6,7 @@ any more; none of that may change a bit of any result, on ordinary or extreme in
 
 from __future__ import annotations
 
+from concurrent.futures import ThreadPoolExecutor
 from typing import Any
 
 import numpy as np
@@ -139,10 +140,28 @@ def test_kernel_never_writes_into_its_inputs_or_earlier_results(compiled: dict[s
     before = {name: column.copy() for name, column in table.items()}
     with np.errstate(all="ignore"):
         first = {key: np.array(value, copy=True) for key, value in kernel(table).items()}
-        again = kernel(table)
+        again = kernel(table)  # held, not copied: the next call's scratch arrays must not be these
         kernel({name: column * 2 for name, column in table.items()})
     assert all(np.array_equal(table[name], before[name]) for name in table)
     assert all(same_bits(again[key], first[key]) for key in first)
+
+
+def test_kernel_called_from_threads_at_once_gives_each_call_its_own_numbers(compiled: dict[str, Compiled]) -> None:
+    """Scratch arrays are kept between calls: two calls at once (numpy lets threads run in its loops)
+    must each get their own, so each call's numbers are those it gives alone."""
+    kernel = compiled["offset-spheres"].kernel
+    rng = np.random.default_rng(5)
+    tables = [{name: rng.uniform(1, 80, 3 * kernel_module._BLOCK) for name in kernel.inputs} for _ in range(4)]
+
+    def call(table: dict[str, Any]) -> dict[Any, Any]:
+        with np.errstate(all="ignore"):  # numpy's error state is the thread's own
+            return kernel(table)
+
+    alone = [call(table) for table in tables]
+    with ThreadPoolExecutor(4) as pool:
+        together = list(pool.map(call, tables * 5))
+    for index, results in enumerate(together):
+        assert all(same_bits(results[key], alone[index % 4][key]) for key in results), index
 
 
 def test_constants_keep_their_values_and_results_that_need_no_input_are_numbers() -> None:

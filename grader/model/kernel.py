@@ -8,8 +8,8 @@ keeps full relative accuracy.
 named trees once into one function of numpy calls for the solver's hot path: a subtree that occurs
 more than once is computed once, constants are folded when it is built, the sine and cosine of
 one angle share their reduction, and on long float64 columns each call writes into an array no
-later step reads (``out=``) instead of allocating. None of this changes a number: every step is the
-same numpy operation on the same operands as in :func:`evaluate`.
+later step reads, or a scratch array the kernel keeps (``out=``), instead of allocating. None of this
+changes a number: every step is the same numpy operation on the same operands as in :func:`evaluate`.
 
 >>> import numpy as np
 >>> from grader.model.expr import parse
@@ -57,9 +57,10 @@ class _Quadrant(NamedTuple):
     shape: tuple[int, ...]  # the angle's own shape: () for a number
 
 
-def _quadrant(degrees: Any) -> _Quadrant:
+def _quadrant(degrees: Any, with_sine: bool = True, with_cosine: bool = True) -> _Quadrant:
     """Reduce an angle in degrees exactly: ``fmod`` is exact, and ``r`` is the difference of two
-    close numbers. Arrays are written in place where they are this function's own."""
+    close numbers. Arrays are written in place where they are this function's own. Where every angle is
+    within ±45°, ``with_sine`` or ``with_cosine`` false leaves that one out (None): it is not asked for."""
     x = np.asarray(degrees, dtype=float)
     shape = x.shape
     x = x.reshape(-1)  # a view: never written
@@ -72,7 +73,8 @@ def _quadrant(degrees: Any) -> _Quadrant:
         # r is the angle itself (k = 0): the steps below would give these values to the bit (an
         # incline's or a swing's half angle), in 2 numpy calls instead of 9.
         radians = np.multiply(x, np.pi / 180.0)
-        return _Quadrant(None, np.sin(radians), np.cos(radians, out=radians), shape)
+        return _Quadrant(None, np.sin(radians, out=None if with_cosine else radians) if with_sine else None,
+                         np.cos(radians, out=radians) if with_cosine else None, shape)
     # fmod(x, 360) is x itself when |x| < 360, as textbook angles are: skip its cost on long arrays.
     inside = every and x.size >= _SHORT and low > -360.0 and high < 360.0
     reduced = x if inside else np.fmod(x, 360.0)
@@ -130,6 +132,16 @@ def _cosine_of(quadrant: _Quadrant, out: Any = None) -> Any:
     return _sine_of(quadrant, 1, out)  # cos x = sin(x + 90)
 
 
+def _for_sine(degrees: Any) -> _Quadrant:
+    """The quadrant of an angle only the sine of is taken."""
+    return _quadrant(degrees, with_cosine=False)
+
+
+def _for_cosine(degrees: Any) -> _Quadrant:
+    """The quadrant of an angle only the cosine of is taken."""
+    return _quadrant(degrees, with_sine=False)
+
+
 def sind(degrees: Any) -> Any:
     """Sine of an angle in degrees."""
     return _sine_of(_quadrant(degrees))
@@ -158,7 +170,8 @@ def _at_most(limit: Any, x: Any, out: Any = None) -> Any:
 
 
 _SHORT = 4096  # elements below which allocating is cheap, and numpy's own loops beat planning around them
-_BLOCK = 32768  # rows per block on long columns: 256 KiB arrays; 8,192 made four times the numpy calls
+_BLOCK = 32768  # rows per block on long columns at most: 256 KiB arrays; 8,192 made four times the numpy calls
+_ALIGN = 1024  # a block's length is a multiple of this: every element meets the numpy loop it meets on the column
 _NUMBER, _WRITTEN, _COPIED = -1, -2, -3  # how a root is assembled from blocks (>= 0: it is that input)
 
 
@@ -171,14 +184,14 @@ def _limited(wins: Any, limit: Any, x: Any, out: Any) -> Any:
     return out
 
 
-def _power(base: Any, exponent: Any) -> Any:
+def _power(base: Any, exponent: Any, out: Any = None) -> Any:
     if np.ndim(exponent) == 0 and float(exponent) == 2.0:
-        return base * base
-    return np.power(base, exponent)
+        return np.multiply(base, base, out=out)
+    return np.power(base, exponent, out=out)
 
 
 _LIMITS = {np.maximum: _at_least, np.minimum: _at_most}
-_WRITERS = {*_NUMERIC.values(), np.power, *_LIMITS.values(), _sine_of, _cosine_of}  # functions that take out=
+_WRITERS = {*_NUMERIC.values(), np.power, _power, *_LIMITS.values(), _sine_of, _cosine_of}  # functions taking out=
 
 OPERATIONS: dict[str, Callable[..., Any]] = {**_NUMERIC, **_TRUTH, "pow": _power, "sind": sind, "cosd": cosd}
 """Every operation of a tree by name (``and`` and ``or`` take two arguments here; a tree's may take more)."""
@@ -219,6 +232,7 @@ class _Step(NamedTuple):
     function: Callable[..., Any]
     args: tuple[int, ...]
     out: int  # a slot whose array nothing reads any more, to write the result into; -1: allocate
+    scratch: int = -1  # else the kernel's scratch array to write it into (>= 0), when no such slot is free
 
 
 class Kernel:
@@ -234,7 +248,8 @@ class Kernel:
     template enters it, and it runs with no builtins, so it can only call this kernel's own functions
     on its own values. When every input is a float64 array of one shape, and a long one
     (``solve_columns`` gives such columns), a step whose function takes ``out=`` writes into the
-    array of a step that nothing reads any more, planned here; otherwise each step allocates its result.
+    array of a step that nothing reads any more, or else into a scratch array of the kernel's, planned
+    here (:meth:`_by_blocks`); otherwise each step allocates its result.
     For float64 inputs (arrays, or Python or numpy numbers) results are those of :func:`evaluate` bit
     for bit, and numbers stay numbers. A result may be an input array itself, or a
     number when it depends on no input.
@@ -248,9 +263,11 @@ class Kernel:
         self._steps: list[_Step] = []
         self.inputs: list[str] = []
         self.roots = {name: self._slot(tree) for name, tree in trees.items()}
+        self._one_sided()
         in_place = self._plan_buffers()
         self._kinds = self._root_kinds(in_place)
         self._no_outs = (None,) * len(self._kinds)
+        self._spares: list[list[Any]] = []  # scratch arrays of _BLOCK elements for long columns, kept between calls
         self._run, self._block = self._functions(self._steps, in_place)
 
     def _root_kinds(self, in_place: list[_Step]) -> list[int]:
@@ -282,23 +299,41 @@ class Kernel:
 
     def _by_blocks(self, arrays: tuple[Any, ...]) -> dict[Any, Any]:
         """The in-place steps on long columns, a block of ``_BLOCK`` rows at a time (numexpr's way): the
-        block's arrays stay in the processor's cache and come from the allocator's free blocks, where
-        whole columns of new arrays would cost the operating system a page fault per 4 KiB on every call
-        (three quarters of the time at 100,000 rows). A float result is written by its step straight
-        into its block of the result; any other is copied there. Every element meets the same numpy
-        loop as on the whole column, since blocks start at multiples of the block size, so the numbers
-        are the same to the bit."""
+        block's arrays stay in the processor's cache, and the steps no result of theirs could be written
+        over for write into scratch arrays this kernel keeps between calls. New arrays of that size
+        (256 KiB) come from the operating system, a page fault per 4 KiB on every call: at 100,000 rows
+        that was three times the arithmetic. A float result is written by its step straight into its
+        block of the result; any other is copied there. Every element meets the same numpy loop as on
+        the whole column, since blocks start at multiples of ``_ALIGN`` elements (vector loops take a few
+        at a time), so the numbers are the same to the bit. Calls at once (threads) each take a set of
+        scratch arrays of their own."""
+        size, shape = arrays[0].size, arrays[0].shape
+        if size > _BLOCK and (len(shape) != 1 or not all(a.flags.c_contiguous for a in arrays)):
+            scratch = [np.empty(shape) for _ in range(self._scratch)]  # one block, with scratch arrays of its own
+            return dict(zip(self.roots, self._block(*arrays, *self._no_outs, *scratch), strict=True))
+        spare = self._spares.pop() if self._spares else [np.empty(_BLOCK) for _ in range(self._scratch)]
+        try:
+            if size <= _BLOCK:
+                scratch = [array[:size].reshape(shape) for array in spare]
+                return dict(zip(self.roots, self._block(*arrays, *self._no_outs, *scratch), strict=True))
+            return self._blocks(arrays, spare)
+        finally:
+            self._spares.append(spare)
+
+    def _blocks(self, arrays: tuple[Any, ...], spare: list[Any]) -> dict[Any, Any]:
         size = arrays[0].size
-        if size <= _BLOCK or arrays[0].ndim != 1 or not all(a.flags.c_contiguous for a in arrays):
-            return dict(zip(self.roots, self._block(*arrays, *self._no_outs), strict=True))
         # Per root: an array the block's step writes into, one to copy into (its dtype is known after
         # the first block), the input itself, or the number it is.
         results: list[Any] = [np.empty(size) if kind == _WRITTEN else None for kind in self._kinds]
-        for start in range(0, size, _BLOCK):
-            stop = start + _BLOCK
+        blocks = -(-size // _BLOCK)
+        length = -(-size // blocks // _ALIGN) * _ALIGN  # blocks of one length (the last shorter), none tiny
+        full = [array[:length] for array in spare]
+        for start in range(0, size, length):
+            stop = start + length
             outs = [None if result is None or kind != _WRITTEN else result[start:stop]
                     for kind, result in zip(self._kinds, results, strict=True)]
-            values = self._block(*(a[start:stop] for a in arrays), *outs)
+            scratch = full if stop <= size else [array[:size - start] for array in spare]
+            values = self._block(*(a[start:stop] for a in arrays), *outs, *scratch)
             for index, (kind, value) in enumerate(zip(self._kinds, values, strict=True)):
                 if kind == _COPIED:
                     if results[index] is None:
@@ -341,6 +376,8 @@ class Kernel:
                 called = functions.setdefault(step.function, f"f{len(functions)}")
                 namespace[called] = step.function
                 out = outs.get(step.target) or (value(step.out) if step.out >= 0 else None)
+                if step.scratch >= 0:
+                    out = f"s{step.scratch}"
                 args = [value(arg) for arg in step.args] + ([f"out={out}"] if out else [])
                 lines.append(f"    v{step.target} = {called}({', '.join(args)})")
             return lines
@@ -356,7 +393,8 @@ class Kernel:
         lines += calls(plain, {})
         lines.append(f"    return {{{', '.join(f'r{index}: {value(slot, False)}' for index, slot in roots)}}}")
         outs = {slot: f"o{index}" for (index, slot), kind in zip(roots, self._kinds, strict=True) if kind == _WRITTEN}
-        lines.append(f"def block({every}{''.join(f'o{index}, ' for index, _ in roots)}):")
+        scratch = "".join(f"s{index}, " for index in range(self._scratch))
+        lines.append(f"def block({every}{''.join(f'o{index}, ' for index, _ in roots)}{scratch}):")
         lines += calls(in_place, outs)
         lines.append(f"    return ({''.join(value(slot, False) + ', ' for _, slot in roots)})")
         exec(compile("\n".join(lines), "<grader kernel>", "exec"), namespace)  # noqa: S102  (text of slot numbers)
@@ -418,24 +456,44 @@ class Kernel:
         self._steps.append(_Step(slot, function, args, -1))
         return slot
 
+    def _one_sided(self) -> None:
+        """An angle only the sine or only the cosine of is taken has its quadrant without the other: for
+        angles within ±45° (a half angle, a small incline) one numpy call fewer, the sine's own."""
+        taken: dict[int, set[Callable[..., Any]]] = {}
+        for step in self._steps:
+            if step.function in (_sine_of, _cosine_of):
+                taken.setdefault(step.args[0], set()).add(step.function)
+        for index, step in enumerate(self._steps):
+            if step.function is _quadrant and len(taken[step.target]) == 1:
+                one = _for_sine if _sine_of in taken[step.target] else _for_cosine
+                self._steps[index] = step._replace(function=one)
+
     def _plan_buffers(self) -> list[_Step]:
-        """The steps again, each ufunc writing into the array of a step no later step reads."""
+        """The steps again, each ufunc writing into the array of a step no later step reads, else into a
+        scratch array of the kernel's (a root's step writes into its block of the result instead)."""
         last_use: dict[int, int] = {}
         for index, step in enumerate(self._steps):
             for arg in step.args:
                 last_use[arg] = index
-        for slot in self.roots.values():
+        roots = set(self.roots.values())
+        for slot in roots:
             last_use[slot] = len(self._steps)  # results are returned: never written over
         computed = {step.target for step in self._steps}
         free: list[int] = []
         planned = []
+        self._scratch = 0
         for index, step in enumerate(self._steps):
             for arg in dict.fromkeys(step.args):  # an argument read for the last time may be the output
                 if arg in computed and self._floats[arg] and last_use[arg] == index:
                     free.append(arg)
             step = self._faster(step)
-            writes = step.function in _WRITERS and self._floats[step.target] and free
-            planned.append(step._replace(out=free.pop()) if writes else step)
+            if step.function not in _WRITERS or not self._floats[step.target] or step.target in roots:
+                planned.append(step)
+            elif free:
+                planned.append(step._replace(out=free.pop()))
+            else:
+                planned.append(step._replace(scratch=self._scratch))
+                self._scratch += 1
         return planned
 
     def _faster(self, step: _Step) -> _Step:

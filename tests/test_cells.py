@@ -58,6 +58,10 @@ NUMBERS = [
     ("10 pounds", "N", 44.482216152605),
     ("10 ft*lb", "J", 13.558179483314004), ("10 ft·lb", "J", 13.558179483314004), ("10 lb", "kg", 4.5359237),
     ("10 lbm", "kg", 4.5359237), ("10 lb*s", "N*s", 44.482216152605),
+    # a hyphen between two unit words is their product, as textbooks print ft-lb and N-s
+    ("10 ft-lb", "J", 13.558179483314004), ("10 lb-ft", "J", 13.558179483314004), ("29.4 N-m", "J", 29.4),
+    ("5 N-s", "N*s", 5.0), ("5 kg-m/s", "N*s", 5.0), ("10 lb-s", "N*s", 44.482216152605),
+    ("-10 ft-lb", "J", -13.558179483314004),
 ]
 
 # (text, expected unit, part of the reason)
@@ -72,6 +76,7 @@ REFUSED_NUMBERS = [
     ("v_pile =", "", "no value"), ("undefined", "", "cannot read 'undefined'"),
     ("6.26 furlongz", "m", "unknown unit 'furlongz'"), ("m/s", "m/s", "cannot read 'm'"),
     ("abc", "", "cannot read"), ("2 +", "", "not a valid expression"), ("6.26 $", "", "unexpected character '$'"),
+    ("10 ft -lb", "J", "cannot read"), ("10 ft- lb", "J", "cannot read"),
     ("x" * (MAX_CELL + 1), "", "at most 1,000"),
 ]
 

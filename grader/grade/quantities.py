@@ -37,7 +37,7 @@ MAX_POWER = 9  # no unit of mechanics needs more
 Factors = tuple[tuple[str, int], ...]
 """A unit as (word, power) pairs: ``m/s^2`` is ``(("m", 1), ("s", -2))``."""
 
-_TOKEN = re.compile(r"\s*(?:(?P<power>(?:\^|\*\*)\s*[-+]?\s*\d{1,2})|(?P<op>[*/·])"
+_TOKEN = re.compile(r"\s*(?:(?P<power>(?:\^|\*\*)\s*[-+]?\s*\d{1,2})|(?P<op>[*/·]|(?<=[A-Za-zµμ])-(?=[A-Za-zµμ]))"
                     r"|(?P<name>[A-Za-zµμ]+|°|%)(?P<bare>[1-9](?!\d))?)")
 # Words pint knows that are constants or letters of a number (2e3, 6x10^3, 2 pi), never a student's unit.
 _NOT_UNITS = frozenset({"e", "E", "x", "X", "c", "k", "G", "R", "a", "per", *CONSTANTS, *FUNCTIONS})
@@ -73,8 +73,9 @@ class UnknownUnitError(ValueError):
 def unit_factors(text: str) -> Factors | None:
     """The (word, power) pairs of a unit as students write it, or None when ``text`` is not one.
 
-    Words are letters (``°``, ``%`` and ``µ`` included), joined by ``*``, ``·``, ``/``, ``per`` or a
-    space; a power follows ``^`` or ``**`` (``m/s^2``), or is one digit glued to the word (``m/s2``).
+    Words are letters (``°``, ``%`` and ``µ`` included), joined by ``*``, ``·``, ``/``, ``per``, a
+    space or a hyphen between two letters (``ft-lb``, ``N-s``, as textbooks print them); a power follows
+    ``^`` or ``**`` (``m/s^2``), or is one digit glued to the word (``m/s2``).
     A ``/`` or ``per`` divides by the next word only.
     """
     text = text.strip()

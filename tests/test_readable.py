@@ -45,8 +45,7 @@ GOLDEN: dict[str, list[tuple[str | None, str]]] = {
     "ball-plate": [
         (None, "v_t = v cos(theta)"),
         (None, "v_n = v sin(theta)"),
-        (None, "J = m v_n (1 + e)"),
-        (None, "v'_n = v_n - J/m"),
+        ("e = -v'_n/v_n", "v'_n = -e v_n"),  # the textbook's (1): e applied to the normal components
         (None, "v'_t = v_t"),
         (None, 'v_"out" = sqrt(v\'_n^2 + v\'_t^2)'),
         ('tan(theta_"out") = -v\'_n/v\'_t', 'theta_"out" = op("atan2")(-v\'_n, v\'_t)'),
@@ -105,8 +104,7 @@ GOLDEN_BANK_II: dict[str, list[tuple[str | None, str]]] = {
         (None, 'y_"hit" = h_0 + v_y t_1 - 1/2 g t_1^2'),
         (None, 'v_(y, "hit") = v_y - g t_1'),
         (None, 'v_"hit" = sqrt(v_x^2 + v_(y, "hit")^2)'),
-        (None, "J = m v_x (1 + e)"),
-        (None, "v'_x = v_x - J/m"),
+        ("e = -v'_x/v_x", "v'_x = -e v_x"),
         (None, 'v\'_y = v_(y, "hit")'),
         (None, 'v_"out" = sqrt(v\'_x^2 + v\'_y^2)'),
         ('0 = y_"hit" + v\'_y t_2 - 1/2 g t_2^2', 't_2 = (v\'_y + sqrt(v\'_y^2 + 2 g y_"hit"))/g'),

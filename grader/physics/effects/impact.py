@@ -98,7 +98,7 @@ class _Impact:
                 f"impulse-momentum for {second} along n", a2, u2 + impulse * w2,
                 solutions={a2: u2 + impulse * w2, impulse: (a2 - u2) / w2},
                 stable={a2: (Stable(centre + used * w2 * approach / (w1 + w2)),)}))
-        relations.append(Relation(
+        restitution = Relation(
             "coefficient of restitution: separation over approach along n", used, ratio,
             solutions={e: {"e": ratio, "e**2": sp.sqrt(ratio), "1/e": 1 / ratio}[self.law],
                        a1: a2 - used * approach, a2: a1 + used * approach},
@@ -111,7 +111,10 @@ class _Impact:
                 # height rounded) is 1, not a refusal; a real excess is far larger.
                 Condition(sp.Le(e, 1 + sp.Rational(1, 10**12)), "the coefficient of restitution is {value}; above 1 "
                           "the impact would create energy", subject=e),
-            )))
+            ))
+        # Against a fixed body (a floor, a wall, a plate moving on regardless) a textbook writes the rebound
+        # from e first (v' = -e v): the impulse is then a step only where it is asked for.
+        relations.insert(0, restitution) if w2 == 0 else relations.append(restitution)
         for index in self.tangents:
             (_, before), (_, after) = self.before[index], self.after[index]
             relations.append(Relation(f"smooth surfaces: no impulse along t, so {self.bodies[index]}'s t-velocity is "

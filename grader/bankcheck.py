@@ -9,7 +9,9 @@ A template is checked in stages, and its report names the first that fails:
    are each answered or refused with a reason (a domain, a constraint, a physics check), never by an
    exception, and at least one is answered;
 4. **degenerate draws**: no answered draw has an answer too close to zero to grade with a relative
-   tolerance, or a derived ``e`` at 0 or 1 (``generate`` would have to draw it again);
+   tolerance, or a derived ``e`` at 0 or 1 (``generate`` would have to draw it again); the draws whose
+   tolerance, widened for rounding along a solution route, would pass the default
+   ``grading.max_tolerance`` are counted (``generate`` draws those again too), and how many are widened;
 5. **simulation**: the time-domain simulation agrees with the closed form to ``AGREEMENT`` on
    ``SIMULATED`` of those draws;
 6. **typesetting**: one variant's sheet (statement, figure) and answer key (worked solution) compile.
@@ -121,8 +123,9 @@ class _Checks:
         worst = _stage("simulation", lambda: self._simulate(draws, [rows[i] for i in usable[:SIMULATED]]))
         _stage("typesetting", self._typeset)
         refused = sum(reason is not None for reason in result.refusals)
-        return (f"{DRAWS} draws: {len(usable)} usable, {refused} refused, {self.degenerate} degenerate; simulation "
-                f"within {worst:.0e} on {SIMULATED}; sheet and key typeset")
+        return (f"{DRAWS} draws: {len(usable)} usable, {refused} refused, {self.degenerate} degenerate, "
+                f"{self.capped} past the ±{self.cap * 100:g} % tolerance cap ({self.widened} with a widened "
+                f"tolerance); simulation within {worst:.0e} on {SIMULATED}; sheet and key typeset")
 
     def _answered(self, rows: Sequence[dict[str, str]], result: Columns, draws: ProblemDraws) -> list[int]:
         """The rows answered and not degenerate; a failure when too few are (see ``MOST_DEGENERATE``)."""
@@ -139,12 +142,20 @@ class _Checks:
                               f"degenerate point, e.g. {flaws[first]} at {self._shown(rows[first])}; generate draws "
                               "them again, but a sampling that reaches where an answer vanishes this often should be "
                               f"narrowed (at most {MOST_DEGENERATE:.0%} of the draws may)")
-        usable = [row for row in answered if flaws[row] is None]
+        fair = _stage("tolerances", lambda: draws.fair(result))
+        capped = [row for row in answered if flaws[row] is None and fair.flaws[row] is not None]
+        usable = [row for row in answered if flaws[row] is None and fair.flaws[row] is None]
+        self.cap, self.capped = self.assignment.grading.max_tolerance, len(capped)
+        self.widened = sum(any(fair.tolerances[name][row].reason for name in fair.tolerances) for row in usable)
         if len(usable) < (1 - MOST_UNUSABLE) * DRAWS:
+            example = f", e.g. {fair.flaws[capped[0]]} at {self._shown(rows[capped[0]])}" if capped else ""
+            advice = ("narrow the sampling toward variants that rounding moves less, or raise grading.max_tolerance"
+                      if len(capped) > DRAWS - len(answered) + len(degenerate) else "widen what the constraints allow")
             raise _CheckError(f"draws: only {len(usable)} of {DRAWS} sampled draws are usable ({DRAWS - len(answered)} "
-                              f"refused, {len(degenerate)} degenerate); generate draws at most {MAX_DRAWS} times per "
-                              f"student, so in a class of 2,000 some student would get no variant (at most "
-                              f"{MOST_UNUSABLE:.0%} of the draws may be unusable: widen what the constraints allow)")
+                              f"refused, {len(degenerate)} degenerate, {len(capped)} past the tolerance cap{example}); "
+                              f"generate draws at most {MAX_DRAWS} times per student, so in a class of 2,000 some "
+                              f"student would get no variant (at most {MOST_UNUSABLE:.0%} of the draws may be "
+                              f"unusable: {advice})")
         self.degenerate = len(degenerate)
         return usable
 

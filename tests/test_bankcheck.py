@@ -2,8 +2,11 @@
 
 from __future__ import annotations
 
+import dataclasses
 import json
+import re
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -36,6 +39,36 @@ def test_the_shipped_bank_passes(capsys: pytest.CaptureFixture[str]) -> None:
     assert set(reports) == {path.stem for path in bank_dir().glob("*.yaml")}
     assert all(line.startswith("ok    200 draws: ") and "sheet and key typeset" in line for line in reports.values())
     assert out.splitlines()[-1] == f"{len(reports)} templates: all passed" and code == 0
+    # Each draw counted once; head-on's draws near a zero speed include some that rounding moves past ±5 %,
+    # which generate draws again, and some whose tolerance is widened.
+    pattern = re.compile(r"200 draws: (\d+) usable, (\d+) refused, (\d+) degenerate, (\d+) past the ±5 % tolerance "
+                         r"cap \((\d+) with a widened tolerance\)")
+    counts = {}
+    for template, line in reports.items():
+        found = pattern.search(line)
+        assert found is not None, line
+        counts[template] = usable, refused, degenerate, capped, widened = tuple(map(int, found.groups()))
+        assert usable + refused + degenerate + capped == 200 and widened <= usable, (template, line)
+    assert counts["head-on"][3] >= 1 and counts["head-on"][4] >= 1
+
+
+def test_a_template_most_of_whose_draws_pass_the_tolerance_cap_fails(monkeypatch: pytest.MonkeyPatch) -> None:
+    """With a cap of ±0.5 % (an assignment's grading.max_tolerance) half of oblique-spheres' draws would be
+    redrawn: the report says how many and shows one with its reason."""
+    from grader.assign.assignment import Grading
+    from grader.bank.template import load_bank
+
+    checks = bankcheck._Checks.__init__
+
+    def strict(self: bankcheck._Checks, *args: Any) -> None:
+        checks(self, *args)
+        self.assignment = dataclasses.replace(self.assignment, grading=Grading(max_tolerance=0.005))
+
+    monkeypatch.setattr(bankcheck._Checks, "__init__", strict)
+    report = bankcheck.check_template(load_bank()["oblique-spheres"])
+    assert report.problem is not None and report.problem.startswith("draws: only ")
+    assert "past the tolerance cap, e.g. answer " in report.problem
+    assert "more than grading.max_tolerance (±0.5 %) at v1 = " in report.problem
 
 
 def broken(folder: Path, name: str, old: str = "", new: str = "", source: str = "drop-rebound") -> None:

@@ -296,7 +296,7 @@ def _list(arguments: argparse.Namespace) -> int:
 
 def _by_topic(templates: Iterable[Template]) -> list[Template]:
     """Templates grouped by topic, in the order of :data:`TOPICS`, each group by id."""
-    from grader.bank.template import TOPICS
+    from grader.bank.folders import TOPICS
 
     return sorted(templates, key=lambda t: (TOPICS.index(t.topic), t.id))
 
@@ -725,7 +725,7 @@ def _print_check(result: dict[str, Any]) -> None:
 
 
 def _check_bank(arguments: argparse.Namespace) -> int:
-    from grader.bank.template import bank_folders, template_files
+    from grader.bank.folders import bank_folders, template_files
     from grader.bankcheck import check_bank
 
     folders = [*arguments.banks_global, *arguments.banks]

@@ -25,6 +25,7 @@ import contextlib
 import hashlib
 import json
 import os
+import sys
 from collections.abc import Iterable
 from pathlib import Path
 from typing import Any
@@ -42,9 +43,10 @@ def cache_dir() -> Path:
     return Path(base) / "grader"
 
 
-def source_fingerprint(package: Path, sources: Iterable[str], salt: str) -> str:
+def source_fingerprint(package: Path, sources: Iterable[str], salt: str, libraries: Iterable[str] = ()) -> str:
     """A digest of grader's version, ``salt`` (an entry's format) and the source of ``sources``: folders
-    of ``package`` (every ``*.py`` in them, at any depth) and single files, by their path in it.
+    of ``package`` (every ``*.py`` in them, at any depth) and single files, by their path in it; with
+    ``libraries``, also Python's version and each library's installed copy (:func:`library_stamp`).
 
     >>> source_fingerprint(PACKAGE, ["errors.py"], "1") == source_fingerprint(PACKAGE, ["errors.py"], "2")
     False
@@ -55,7 +57,29 @@ def source_fingerprint(package: Path, sources: Iterable[str], salt: str) -> str:
         for source in sorted(where.rglob("*.py")) if where.is_dir() else [where]:
             digest.update(source.relative_to(package).as_posix().encode())
             digest.update(source.read_bytes())
+    libraries = list(libraries)
+    if libraries:
+        digest.update(f"{sys.version}/{[library_stamp(name) for name in libraries]}".encode())
     return digest.hexdigest()
+
+
+def library_stamp(name: str) -> tuple[str, int, int] | None:
+    """Where a library's package file is, its size and modification time, found without importing it
+    (installing another version rewrites the file); None when it is not installed.
+
+    >>> library_stamp("yaml")[0].endswith("__init__.py"), library_stamp("no_such_library")
+    (True, None)
+    """
+    from importlib.util import find_spec
+
+    spec = find_spec(name)
+    if spec is None or spec.origin is None:
+        return None
+    try:
+        status = os.stat(spec.origin)
+    except OSError:
+        return None
+    return spec.origin, status.st_size, status.st_mtime_ns
 
 
 def read_entry(path: Path) -> Any:

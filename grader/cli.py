@@ -22,6 +22,7 @@ from grader import __version__
 from grader.errors import GraderError, UsageError, some, visible
 
 if TYPE_CHECKING:
+    from grader.bank.listing import Listed
     from grader.bank.template import Parameter, Template
 
 # Each command imports what it needs when it runs: `grader --help` and `grader list` do not pay for
@@ -275,7 +276,9 @@ def _template(arguments: argparse.Namespace) -> Template:
 
 
 def _list(arguments: argparse.Namespace) -> int:
-    by_topic = _by_topic(_bank(arguments).values())
+    from grader.bank.listing import listing
+
+    by_topic = _by_topic(listing(*_bank_sources(arguments)))
     if arguments.json:
         for template in by_topic:
             print(json.dumps({"id": template.id, "title": template.title, "topic": template.topic,
@@ -294,7 +297,7 @@ def _list(arguments: argparse.Namespace) -> int:
     return EXIT_OK
 
 
-def _by_topic(templates: Iterable[Template]) -> list[Template]:
+def _by_topic(templates: Iterable[Listed]) -> list[Listed]:
     """Templates grouped by topic, in the order of :data:`TOPICS`, each group by id."""
     from grader.bank.folders import TOPICS
 

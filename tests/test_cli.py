@@ -160,6 +160,25 @@ def test_commands_import_no_heavy_library_they_do_not_need(argv: list[str], comp
     assert result.stderr.strip().splitlines()[-1] == "[]", result.stderr
 
 
+@pytest.mark.parametrize(("argv", "unused"), [
+    (["list"], ("yaml", "numpy", "grader.physics", "grader.bank.template")), (["list", "--json"], ("yaml", "numpy")),
+    (["solve", "pile-driver", *PILE], ("yaml", "csv", "difflib", "grader.physics.integrate", "grader.solve.routes")),
+], ids=["list", "list --json", "solve"])
+def test_a_warm_command_reads_no_yaml_it_read_before(argv: list[str], unused: tuple[str, ...],
+                                                     compiled: dict[str, Any]) -> None:
+    """A second `grader list` takes the listing from the cache (no template read, no numpy), and a second
+    `grader solve` what the template's YAML reads as (no PyYAML); run twice, the second run is measured."""
+    import subprocess
+    import sys
+
+    code = ("import sys\nfrom grader.cli import main\ntry:\n    main(sys.argv[1:])\nexcept SystemExit:\n    pass\n"
+            f"print(sorted(m for m in {unused!r} if m in sys.modules), file=sys.stderr)")
+    for _ in range(2):
+        result = subprocess.run([sys.executable, "-c", code, *argv], capture_output=True, text=True, timeout=60,
+                                check=True)
+    assert result.stderr.strip().splitlines()[-1] == "[]", result.stderr
+
+
 def test_list_groups_the_bank_by_topic(capsys: pytest.CaptureFixture[str]) -> None:
     """A heading per topic, in the order of the list (direct, oblique, drops and rebounds, impact and a swing,
     impact and sliding, impact with flight: each topic the bank has); each template under its own."""

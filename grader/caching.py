@@ -82,17 +82,30 @@ def library_stamp(name: str) -> tuple[str, int, int] | None:
     return spec.origin, status.st_size, status.st_mtime_ns
 
 
-def read_entry(path: Path) -> Any:
+def entry(name: str) -> Path | None:
+    """Where the entry ``name`` is kept: in :func:`cache_dir`, or nowhere (None) when there is no folder to
+    keep it in (no ``$HOME``, and no home folder for the user)."""
+    try:
+        return cache_dir() / name
+    except RuntimeError:  # Path.home() found none
+        return None
+
+
+def read_entry(path: Path | None) -> Any:
     """An entry's JSON, or None when it is missing, cannot be read or is not JSON."""
+    if path is None:
+        return None
     try:
         return json.loads(path.read_text(encoding="utf-8"))
     except (OSError, ValueError):  # a bad UTF-8 byte is a ValueError too
         return None
 
 
-def write_entry(path: Path, data: Any) -> None:
+def write_entry(path: Path | None, data: Any) -> None:
     """Keep ``data`` as JSON at ``path``, atomically (a reader never sees half an entry); a folder that
     cannot be written is left as it is."""
+    if path is None:
+        return
     from grader.files import write_atomic  # only a miss writes: a hit does not pay for its imports
 
     with contextlib.suppress(OSError):

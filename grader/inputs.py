@@ -176,7 +176,7 @@ def parse_yaml(data: bytes, path: Path) -> Any:
     gives back exactly is kept (:func:`plain_data`: all a template or an assignment holds); a file that is
     refused is read, and refused with its message, every time.
     """
-    entry = caching.cache_dir() / f"yaml-{_yaml_key(data)}.json"
+    entry = caching.entry(f"yaml-{_yaml_key(data)}.json")
     stored = caching.read_entry(entry)
     if isinstance(stored, dict) and set(stored) == {"data"}:
         return stored["data"]

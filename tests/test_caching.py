@@ -123,3 +123,21 @@ PLAIN = st.recursive(
 def test_json_gives_back_exactly_what_plain_data_accepts(data: Any) -> None:
     assert plain_data(data)
     assert same(json.loads(json.dumps(data)), data)
+
+
+def test_without_a_home_folder_nothing_is_kept_and_everything_works(monkeypatch: pytest.MonkeyPatch) -> None:
+    """No $GRADER_CACHE_DIR, no $XDG_CACHE_HOME, and Path.home() finds none (no $HOME, a user id without a
+    password entry): files are read, and the bank listed, each time."""
+    from grader.bank.listing import listing
+    from grader.bank.template import load_banks
+
+    def no_home(cls: type[Path]) -> Path:
+        raise RuntimeError("Could not determine home directory.")
+
+    for name in ("GRADER_CACHE_DIR", "XDG_CACHE_HOME"):
+        monkeypatch.delenv(name, raising=False)
+    monkeypatch.setattr(Path, "home", classmethod(no_home))
+    assert caching.entry("anything.json") is None
+    for _ in range(2):
+        assert parse_yaml(b"h: 1\n", Path("a.yaml")) == {"h": 1}
+        assert [row.id for row in listing()] == list(load_banks())

@@ -25,7 +25,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from grader.bank.folders import bank_folders, template_files
-from grader.caching import PACKAGE, cache_dir, read_entry, source_fingerprint, write_entry
+from grader.caching import PACKAGE, entry, read_entry, source_fingerprint, write_entry
 from grader.errors import GraderError
 from grader.inputs import YAML_BYTES, read_bytes
 
@@ -75,10 +75,10 @@ def listing(folders: Sequence[Path] = (), shipped: bool = True) -> list[Listed]:
     them, in its order; refused as it refuses them."""
     sources = bank_folders(folders, shipped)
     named = _digest("\n".join(map(str, sources)))[:20]
-    entry = cache_dir() / f"bank-{named}.json"
+    kept = entry(f"bank-{named}.json")
     files = _files(sources)
     if files is not None:
-        listed = _read(entry, files)
+        listed = _read(kept, files)
         if listed is not None:
             return listed
     from grader.bank.template import load_banks
@@ -86,7 +86,7 @@ def listing(folders: Sequence[Path] = (), shipped: bool = True) -> list[Listed]:
     bank = load_banks(folders, shipped)
     listed = [Listed.of(template) for template in bank.values()]
     # The bytes each template was read from, not those hashed above: a file edited meanwhile is read again.
-    write_entry(entry, {"key": _key(), "files": [[t.where, t.source_hash] for t in bank.values()],
+    write_entry(kept, {"key": _key(), "files": [[t.where, t.source_hash] for t in bank.values()],
                         "templates": [asdict(row) for row in listed]})
     return listed
 
@@ -101,8 +101,8 @@ def _files(sources: Sequence[Path]) -> list[list[str]] | None:
         return None
 
 
-def _read(entry: Path, files: list[list[str]]) -> list[Listed] | None:
-    stored = read_entry(entry)
+def _read(kept: Path | None, files: list[list[str]]) -> list[Listed] | None:
+    stored = read_entry(kept)
     if not isinstance(stored, dict) or stored.get("files") != files or stored.get("key") != _key():
         return None
     try:

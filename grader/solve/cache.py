@@ -85,7 +85,7 @@ _T = TypeVar("_T", bound=_Stored)
 def _cached(template: Template, kind: str, read: Callable[[Any], _T], compile_now: Callable[[], _T]) -> _T:
     """What ``compile_now`` makes for a template, kept as ``<id>-<hash><kind>.json`` (``read`` reads it back)."""
     key = hashlib.sha256(f"{template.source_hash}/{_fingerprint()}".encode()).hexdigest()[:20]
-    path = cache_dir() / f"{template.id}-{key}{kind}.json"
+    path = caching.entry(f"{template.id}-{key}{kind}.json")
     stored = caching.read_entry(path)
     if stored is not None:
         try:

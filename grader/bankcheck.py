@@ -31,7 +31,8 @@ from typing import Any
 
 from grader.assign.assignment import Assignment, ProblemSpec, Student
 from grader.assign.variants import MAX_DRAWS, ProblemDraws, generate, variant_generator
-from grader.bank.template import Template, bank_folders, load_template, same_id, template_files
+from grader.bank.folders import bank_folders, template_files
+from grader.bank.template import Template, load_template, same_id
 from grader.errors import GraderError
 from grader.physics.integrate import Settings
 from grader.physics.run import Options

@@ -13,7 +13,6 @@ import re
 import shlex
 import signal
 import sys
-import threading
 from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -22,6 +21,7 @@ from grader import __version__
 from grader.errors import GraderError, UsageError, some, visible
 
 if TYPE_CHECKING:
+    from grader.bank.listing import Listed
     from grader.bank.template import Parameter, Template
 
 # Each command imports what it needs when it runs: `grader --help` and `grader list` do not pay for
@@ -34,9 +34,42 @@ if TYPE_CHECKING:  # imported when used: `grader list` must not pay for numpy
 EXIT_OK, EXIT_USAGE, EXIT_REFUSED, EXIT_INTERRUPTED = 0, 2, 3, 130
 
 
+class _HelpFormatter(argparse.HelpFormatter):
+    """argparse's help formatter, as wide as the terminal as :func:`shutil.get_terminal_size` finds it, without
+    importing shutil (and with it bz2 and lzma: argparse makes a formatter for each option it is given, and
+    every command would pay for them)."""
+
+    def __init__(self, prog: str, indent_increment: int = 2, max_help_position: int = 24,
+                 width: int | None = None) -> None:
+        super().__init__(prog, indent_increment, max_help_position, _columns() - 2 if width is None else width)
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse's parser with :class:`_HelpFormatter`, its commands' parsers too."""
+
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        kwargs.setdefault("formatter_class", _HelpFormatter)
+        super().__init__(*args, **kwargs)
+
+
+def _columns() -> int:
+    """The terminal's width as :func:`shutil.get_terminal_size` finds it: ``$COLUMNS``, else standard output's
+    terminal, else 80."""
+    try:
+        columns = int(os.environ.get("COLUMNS", ""))
+    except ValueError:
+        columns = 0
+    if columns > 0:
+        return columns
+    try:
+        return os.get_terminal_size(sys.__stdout__.fileno()).columns or 80  # type: ignore[union-attr]
+    except (AttributeError, ValueError, OSError):  # no standard output, or not a terminal
+        return 80
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser, with one subparser per command."""
-    parser = argparse.ArgumentParser(prog="grader", description="Impact-problem generator and auto-grader.")
+    parser = _Parser(prog="grader", description="Impact-problem generator and auto-grader.")
     parser.add_argument("--version", action="version", version=f"grader {__version__}")
     _bank_options(parser, "_global")
     commands = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
@@ -175,7 +208,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     arguments = build_parser().parse_args(argv)
     if sys.stdout is None:  # started with standard output closed (`grader ... >&-`)
         return _error("standard output is closed; send the output to a file or a program")
-    previous = signal.signal(signal.SIGTERM, _terminated) if _main_thread() else None
+    previous = _handle_sigterm()
     try:
         code = _COMMANDS[arguments.command](arguments)
         sys.stdout.flush()
@@ -204,8 +237,13 @@ def main(argv: Sequence[str] | None = None) -> int:
             signal.signal(signal.SIGTERM, previous)
 
 
-def _main_thread() -> bool:
-    return threading.current_thread() is threading.main_thread()
+def _handle_sigterm() -> Any:
+    """Handle SIGTERM with :func:`_terminated`; the handler it replaces, or None in a thread other than the
+    main one (where Python sets none: tests run the CLI in threads)."""
+    try:
+        return signal.signal(signal.SIGTERM, _terminated)
+    except ValueError:  # not the main thread
+        return None
 
 
 def _terminated(signum: int, frame: object) -> None:
@@ -259,8 +297,6 @@ def _bank_sources(arguments: argparse.Namespace) -> tuple[list[Path], bool]:
 
 def _template(arguments: argparse.Namespace) -> Template:
     """The template the command names: read from its own file, or else the bank's error."""
-    import difflib
-
     from grader.bank.template import load_named
 
     template = load_named(arguments.template, *_bank_sources(arguments))
@@ -268,6 +304,8 @@ def _template(arguments: argparse.Namespace) -> Template:
         return template
     bank = _bank(arguments)  # an unusable folder is refused as such; a missing template gets suggestions
     if arguments.template not in bank:
+        import difflib
+
         close = difflib.get_close_matches(arguments.template, list(bank), n=3, cutoff=0.5)
         hint = f"; did you mean {' or '.join(close)}?" if close else f"; the bank has {', '.join(sorted(bank))}"
         raise UsageError(f"unknown template '{arguments.template}'{hint}")
@@ -275,7 +313,9 @@ def _template(arguments: argparse.Namespace) -> Template:
 
 
 def _list(arguments: argparse.Namespace) -> int:
-    by_topic = _by_topic(_bank(arguments).values())
+    from grader.bank.listing import listing
+
+    by_topic = _by_topic(listing(*_bank_sources(arguments)))
     if arguments.json:
         for template in by_topic:
             print(json.dumps({"id": template.id, "title": template.title, "topic": template.topic,
@@ -294,9 +334,9 @@ def _list(arguments: argparse.Namespace) -> int:
     return EXIT_OK
 
 
-def _by_topic(templates: Iterable[Template]) -> list[Template]:
+def _by_topic(templates: Iterable[Listed]) -> list[Listed]:
     """Templates grouped by topic, in the order of :data:`TOPICS`, each group by id."""
-    from grader.bank.template import TOPICS
+    from grader.bank.folders import TOPICS
 
     return sorted(templates, key=lambda t: (TOPICS.index(t.topic), t.id))
 
@@ -725,7 +765,7 @@ def _print_check(result: dict[str, Any]) -> None:
 
 
 def _check_bank(arguments: argparse.Namespace) -> int:
-    from grader.bank.template import bank_folders, template_files
+    from grader.bank.folders import bank_folders, template_files
     from grader.bankcheck import check_bank
 
     folders = [*arguments.banks_global, *arguments.banks]

@@ -15,12 +15,15 @@ beyond float64, NUL bytes and cells too long to be an answer.
 Traceback (most recent call last):
 ...
 grader.errors.GraderError: ...b.yaml: line 2: the key 'h' appears twice (expected each key once)
+
+YAML is read by :mod:`grader.yaml_loader`, and what a file's bytes read as is remembered on disk (see
+:func:`parse_yaml`): a second run with the same bytes imports no PyYAML.
 """
 
 from __future__ import annotations
 
 import codecs
-import csv
+import hashlib
 import io
 import itertools
 import math
@@ -28,20 +31,18 @@ import os
 import re
 import stat
 from collections import Counter
-from collections.abc import Hashable, Iterator
+from collections.abc import Iterator
 from dataclasses import dataclass
+from functools import lru_cache
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
-import yaml
-
-from grader.errors import GraderError, shown
+from grader import caching
+from grader.errors import GraderError
 
 YAML_BYTES = 1 << 20  # 1 MiB: a template or an assignment is a few kB
 CSV_BYTES = 64 << 20  # 64 MiB: 100,000 rows of 50 cells
 CELL_CHARS = 1000  # no answer, id or parameter value is longer
-YAML_NODES = 100_000  # nodes after alias expansion
-YAML_DEPTH = 64
 
 
 def read_bytes(path: Path, limit: int) -> bytes:
@@ -158,190 +159,70 @@ def _clean_cp1252(data: bytes) -> str | None:
 
 # --- YAML ---------------------------------------------------------------------------------------
 
-# YAML 1.2's core schema, which every other reader of these files uses: `on`, `no`, `off`, `yes` and
-# dates stay text (YAML 1.1 made a parameter named `on` the boolean true), `010` is ten, and `1e308`
-# is a number.
-_CORE = {
-    "tag:yaml.org,2002:null": (r"^(?:~|null|Null|NULL|)$", [*"~nN", None]),  # None: the empty scalar
-    "tag:yaml.org,2002:bool": (r"^(?:true|True|TRUE|false|False|FALSE)$", [*"tTfF"]),
-    "tag:yaml.org,2002:int": (r"^(?:[-+]?[0-9]+|0o[0-7]+|0x[0-9a-fA-F]+)$", [*"-+0123456789"]),
-    "tag:yaml.org,2002:float": (r"^(?:[-+]?(?:\.[0-9]+|[0-9]+(?:\.[0-9]*)?)(?:[eE][-+]?[0-9]+)?"
-                                r"|[-+]?\.(?:inf|Inf|INF)|\.(?:nan|NaN|NAN))$", [*"-+0123456789."]),
-}
-
-
-if TYPE_CHECKING:
-    _Mixin = yaml.SafeLoader  # what _Bounded's methods reach through super()
-else:
-    _Mixin = object
-
-
-class _Bounded(_Mixin):
-    """What our YAML loaders add to PyYAML's safe loader: YAML 1.2's core schema, and bounds on depth,
-    expanded size, text keys each given once, finite numbers."""
-
-    yaml_implicit_resolvers = {}  # noqa: RUF012  (PyYAML's own class attribute: filled with _CORE below)
-
-    def __init__(self, stream: str) -> None:
-        super().__init__(stream)
-        self._depth = 0
-        self._nodes = 0  # nodes composed: the document's size when it has no alias
-        self._aliases = False
-
-    def compose_node(self, parent: Any, index: Any) -> Any:
-        self._depth += 1
-        self._nodes += 1
-        if self._depth > YAML_DEPTH:
-            mark = self.peek_event().start_mark  # type: ignore[no-untyped-call]
-            raise GraderError(f"line {mark.line + 1}: nested deeper than {YAML_DEPTH} levels; expected a "
-                              "template-sized structure")
-        if self.check_event(yaml.AliasEvent):
-            self._aliases = True
-        try:
-            return super().compose_node(parent, index)
-        finally:
-            self._depth -= 1
-
-    def get_single_node(self) -> Any:
-        node = super().get_single_node()
-        if node is not None and self._aliases:  # without one, the document is as large as it was written
-            _check_expanded_size(node)
-        elif node is not None and self._nodes > YAML_NODES:
-            raise GraderError(f"line 1: holds more than {YAML_NODES:,} values; expected a template-sized structure")
-        return node
-
-    def construct_mapping(self, node: Any, deep: bool = False) -> dict[Hashable, Any]:
-        seen: set[str] = set()
-        for key_node, _ in node.value:
-            key = self.construct_object(key_node, deep=True)
-            line = key_node.start_mark.line + 1
-            if not isinstance(key, str):
-                raise GraderError(f"line {line}: expected a key that is a name, got {shown(key)} (write a name, "
-                                  "or quote it)")
-            if key in seen:
-                raise GraderError(f"line {line}: the key {shown(key)} appears twice (expected each key once)")
-            seen.add(key)
-        return super().construct_mapping(node, deep=deep)
-
-    def construct_yaml_int(self, node: Any) -> int:
-        text = str(self.construct_scalar(node))
-        value = int(text, 16 if text.startswith("0x") else 8 if text.startswith("0o") else 10)
-        _check_finite(value, node)
-        return value
-
-    def construct_yaml_float(self, node: Any) -> float:
-        value: float = super().construct_yaml_float(node)
-        _check_finite(value, node)
-        return value
-
-
-class _PyLoader(_Bounded, yaml.SafeLoader):
-    """The bounded loader, all in Python: PyYAML's own scanner and parser, whose messages are clearer."""
-
-
-def _fast_loader() -> type[_Bounded]:
-    """The bounded loader with libyaml's scanner and parser, where PyYAML was built with it: eight times
-    faster (the bank's templates are read on every command). The composer and all after it stay
-    PyYAML's Python, so the bounds hold whichever parser reads the text."""
-    try:
-        from yaml._yaml import CParser
-    except ImportError:  # PyYAML without libyaml
-        return _PyLoader
-    from yaml.composer import Composer
-    from yaml.constructor import SafeConstructor
-    from yaml.resolver import Resolver
-
-    class SafeLoader(Composer, CParser, SafeConstructor, Resolver):
-        def __init__(self, stream: str) -> None:
-            CParser.__init__(self, stream)
-            Composer.__init__(self)
-            SafeConstructor.__init__(self)
-            Resolver.__init__(self)
-
-    return type("_Loader", (_Bounded, SafeLoader), {"__doc__": _fast_loader.__doc__})
-
-
-_Loader = _fast_loader()
-_LOADERS: tuple[type[_Bounded], ...] = tuple(dict.fromkeys((_Loader, _PyLoader)))  # one without libyaml
-for _loader in _LOADERS:
-    _loader.add_constructor("tag:yaml.org,2002:int", _Bounded.construct_yaml_int)
-    _loader.add_constructor("tag:yaml.org,2002:float", _Bounded.construct_yaml_float)
-    for _tag, (_pattern, _first) in _CORE.items():
-        _loader.add_implicit_resolver(_tag, re.compile(_pattern), _first)
-
-
-def _check_finite(value: float, node: Any) -> None:
-    try:
-        finite = math.isfinite(float(value))
-    except OverflowError:
-        finite = False
-    if not finite:
-        raise GraderError(f"line {node.start_mark.line + 1}: expected a finite number within float64 "
-                          f"(about ±1.8e308), got {shown(node.value)}")
-
-
-def _check_expanded_size(root: Any) -> None:
-    """Count the nodes the document expands to, aliases included, without expanding it."""
-    sizes: dict[int, int] = {}
-    stack: list[tuple[Any, bool]] = [(root, False)]
-    while stack:
-        node, children_done = stack.pop()
-        if id(node) in sizes:
-            continue
-        children = _children(node)
-        if not children_done:
-            stack.append((node, True))
-            stack.extend((child, False) for child in children if id(child) not in sizes)
-            continue
-        size = 1 + sum(sizes.get(id(child), 0) for child in children)
-        if size > YAML_NODES:
-            raise GraderError(f"line {node.start_mark.line + 1}: expands to more than {YAML_NODES:,} values "
-                              "through aliases (*name); expected a template-sized structure")
-        sizes[id(node)] = size
-
-
-def _children(node: Any) -> list[Any]:
-    if isinstance(node, yaml.MappingNode):
-        return [part for pair in node.value for part in pair]
-    if isinstance(node, yaml.SequenceNode):
-        return list(node.value)
-    return []
+YAML_SOURCES = ("inputs.py", "yaml_loader.py")
+"""The source of what a YAML file reads as (with grader's version, Python's and the installed PyYAML)."""
 
 
 def read_yaml(path: Path) -> Any:
-    """A YAML file's data, with the bounds above; errors name the file and the line."""
+    """A YAML file's data, with the bounds of :mod:`grader.yaml_loader`; errors name the file and the line."""
     return parse_yaml(read_bytes(path, YAML_BYTES), path)
 
 
 def parse_yaml(data: bytes, path: Path) -> Any:
-    """YAML data read from ``path`` (for messages), with the bounds above."""
-    text = decode_text(data, path)
-    try:
-        return yaml.load(text, Loader=_Loader)  # noqa: S506  (_Loader is a bounded SafeLoader)
-    except GraderError as error:
-        raise GraderError(f"{path}: {error}") from None
-    except yaml.YAMLError as error:
-        raise GraderError(f"{path}: expected valid YAML, got {_yaml_problem(_in_python(text, error))}") from None
+    """YAML data read from ``path`` (for messages), with the bounds of :mod:`grader.yaml_loader`.
+
+    What the bytes read as is kept in the cache folder (:mod:`grader.caching`), keyed by their SHA-256 and
+    by :data:`YAML_SOURCES`: the same bytes again are read back from JSON, without PyYAML. Only data JSON
+    gives back exactly is kept (:func:`plain_data`: all a template or an assignment holds); a file that is
+    refused is read, and refused with its message, every time.
+    """
+    entry = caching.entry(f"yaml-{_yaml_key(data)}.json")
+    stored = caching.read_entry(entry)
+    if isinstance(stored, dict) and set(stored) == {"data"}:
+        return stored["data"]
+    from grader.yaml_loader import load_yaml
+
+    raw = load_yaml(decode_text(data, path), path)
+    if plain_data(raw):
+        caching.write_entry(entry, {"data": raw})
+    return raw
 
 
-def _in_python(text: str, error: yaml.YAMLError) -> yaml.YAMLError:
-    """What PyYAML's own parser says of text libyaml refused (``expected ',' or ']', but got '<stream end>'``
-    where libyaml says ``did not find expected ',' or ']'``); ``error`` if it says nothing."""
-    if _Loader is _PyLoader:
-        return error
-    try:
-        yaml.load(text, Loader=_PyLoader)  # noqa: S506  (_PyLoader is a bounded SafeLoader)
-    except yaml.YAMLError as python_error:
-        return python_error
-    except GraderError:
-        pass
-    return error
+def plain_data(data: Any) -> bool:
+    """Whether JSON gives ``data`` back exactly: mappings with text keys, lists, text, whole numbers,
+    finite floats, booleans and None, no container twice (YAML's aliases share one, JSON would copy it).
+
+    >>> plain_data({"h": [1, 2.5, -0.0, True, None, "x"]}), plain_data({"h": (1,)}), plain_data({1: 2})
+    (True, False, False)
+    >>> shared = [1]
+    >>> plain_data({"a": shared, "b": shared}), plain_data({"h": float("inf")})
+    (False, False)
+    """
+    seen: set[int] = set()
+    todo = [data]
+    while todo:
+        value = todo.pop()
+        kind = type(value)
+        if kind is dict or kind is list:
+            if id(value) in seen or (kind is dict and not all(type(key) is str for key in value)):
+                return False
+            seen.add(id(value))
+            todo.extend(value.values() if kind is dict else value)
+        elif kind is float:
+            if not math.isfinite(value):
+                return False
+        elif kind not in (str, int, bool, type(None)):
+            return False
+    return True
 
 
-def _yaml_problem(error: yaml.YAMLError) -> str:
-    mark = getattr(error, "problem_mark", None)
-    problem = getattr(error, "problem", None) or str(error).splitlines()[0]
-    return f"{problem} (line {mark.line + 1}, column {mark.column + 1})" if mark else str(problem)
+def _yaml_key(data: bytes) -> str:
+    return hashlib.sha256(_yaml_reader().encode() + data).hexdigest()[:32]
+
+
+@lru_cache(maxsize=1)
+def _yaml_reader() -> str:
+    return caching.source_fingerprint(caching.PACKAGE, YAML_SOURCES, "yaml 1", ("yaml",))
 
 
 # --- CSV ----------------------------------------------------------------------------------------
@@ -527,6 +408,8 @@ def _check_cell_lengths(cells: list[str], path: Path, line: int) -> None:
 def _records(stream: io.StringIO, path: Path, delimiter: str, offset: int) -> Iterator[tuple[int, list[str]]]:
     """The non-blank records of the text and the line each starts on; an error names the line of the
     record it is in (where a quote left open begins, not the end of the file it ran to)."""
+    import csv  # here: `grader solve --set` and `grader list` read no CSV
+
     # The csv module's own limit (131,072 characters a cell) would refuse a whole export for one pasted
     # essay; cells are measured by the caller instead, so the limit is the largest file's.
     csv.field_size_limit(max(csv.field_size_limit(), CSV_BYTES))

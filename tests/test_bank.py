@@ -225,7 +225,7 @@ def test_libyaml_and_pythons_parser_read_every_template_alike() -> None:
     PyYAML's own, all in Python, must give the same data (and gives the messages for broken files)."""
     import yaml
 
-    from grader.inputs import _Loader, _PyLoader
+    from grader.yaml_loader import _Loader, _PyLoader
 
     if not yaml.__with_libyaml__:
         pytest.skip("PyYAML was built without libyaml here: both loaders are Python's")

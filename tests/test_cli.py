@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import ast
 import json
+import os
 from pathlib import Path
 from typing import Any
 
@@ -158,6 +160,37 @@ def test_commands_import_no_heavy_library_they_do_not_need(argv: list[str], comp
     result = subprocess.run([sys.executable, "-c", code, *argv], capture_output=True, text=True, timeout=60,
                             check=True)
     assert result.stderr.strip().splitlines()[-1] == "[]", result.stderr
+
+
+def _imported(argv: list[str], modules: tuple[str, ...], env: dict[str, str] | None = None) -> list[str]:
+    """Which of ``modules`` a run of ``grader ARGV``, in a process of its own, imported."""
+    import subprocess
+    import sys
+
+    code = ("import sys\nfrom grader.cli import main\ntry:\n    main(sys.argv[1:])\nexcept SystemExit:\n    pass\n"
+            f"print(sorted(m for m in {modules!r} if m in sys.modules), file=sys.stderr)")
+    result = subprocess.run([sys.executable, "-c", code, *argv], capture_output=True, text=True, timeout=60,
+                            check=True, env=env)
+    return list(ast.literal_eval(result.stderr.strip().splitlines()[-1]))
+
+
+@pytest.mark.parametrize("argv", [["list"], ["list", "--json"]], ids=" ".join)
+def test_a_cold_list_imports_no_heavy_library_and_a_warm_one_reads_no_template(argv: list[str],
+                                                                              tmp_path: Path) -> None:
+    """The first `grader list` with an empty cache reads the bank (numpy and PyYAML, none of the heavy
+    libraries); the second takes the listing from the cache: no YAML read, no numpy, no physics."""
+    env = {**os.environ, "GRADER_CACHE_DIR": str(tmp_path / "cache")}
+    assert _imported(argv, HEAVY, env) == []
+    assert _imported(argv, ("yaml", "numpy", "grader.physics", "grader.bank.template"), env) == []
+
+
+def test_a_warm_solve_reads_no_yaml(compiled: dict[str, Any]) -> None:
+    """A second `grader solve` reads what the template's YAML reads as from the cache (no PyYAML), and
+    imports nothing only some commands need."""
+    argv = ["solve", "pile-driver", *PILE]
+    _imported(argv, ())
+    assert _imported(argv, ("yaml", "csv", "difflib", "shutil", "grader.physics.integrate",
+                            "grader.solve.routes", "grader.solve.alternatives", *HEAVY)) == []
 
 
 def test_list_groups_the_bank_by_topic(capsys: pytest.CaptureFixture[str]) -> None:

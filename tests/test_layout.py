@@ -16,13 +16,14 @@ import pytest
 PACKAGE = Path(__file__).resolve().parent.parent / "grader"
 
 # The pipeline, bottom to top: a folder may import only folders of a lower rank. Stages of one rank
-# are peers and import neither each other. The top-level modules errors, files, heap, inputs, resources and
-# grader/__init__ sit below everything; cli, __main__, demo (which generates and grades) and bankcheck
-# (which samples, solves, simulates and typesets) above everything.
+# are peers and import neither each other. The top-level modules caching, errors, files, heap, inputs,
+# resources, yaml_loader and grader/__init__ sit below everything; cli, __main__, demo (which generates and
+# grades) and bankcheck (which samples, solves, simulates and typesets) above everything.
 RANKS = {"base": 0, "model": 1, "physics": 2, "bank": 3, "solve": 4, "simulate": 4, "assign": 5,
          "render": 6, "grade": 6, "cli": 7}
 TOP_LEVEL = {"grader": "base", "grader.errors": "base", "grader.files": "base", "grader.inputs": "base",
-             "grader.resources": "base", "grader.heap": "base",
+             "grader.resources": "base", "grader.heap": "base", "grader.caching": "base",
+             "grader.yaml_loader": "base",
              "grader.cli": "cli", "grader.__main__": "cli", "grader.demo": "cli", "grader.bankcheck": "cli"}
 
 

@@ -17,8 +17,9 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from grader.bank.folders import TOPICS, bank_folders, template_files
 from grader.bank.scene_parser import IDENTIFIER, parse_scene
-from grader.errors import ExpressionError, GraderError, TemplateError, UsageError, shown
+from grader.errors import ExpressionError, GraderError, TemplateError, shown
 from grader.inputs import YAML_BYTES, parse_yaml, read_bytes
 from grader.model.expr import Node, Num, Op, Sym, names, parse, to_text
 from grader.model.scene import Gravity, Scene
@@ -33,15 +34,6 @@ _INTERVAL = re.compile(rf"^\s*([\[(])\s*{_BOUND}\s*,\s*{_BOUND}\s*([\])])\s*$")
 _ID = re.compile(r"[a-z0-9][a-z0-9-]*\Z")
 _TOP_KEYS = {"id", "title", "topic", "version", "gravity", "bodies", "stages", "symbols", "parameters",
              "constraints", "answers", "tolerance", "statement", "example"}
-
-TOPICS = ("direct impact", "oblique impact", "drops and rebounds", "impact and a swing", "impact and sliding",
-          "impact with flight")
-"""The topics ``grader list`` groups the bank by, in its order. A template names one (``topic:``), or
-its scene decides: a scene with a slide is impact and sliding, one with a projectile's flight impact
-with flight; else an impact with t components (or a velocity from its components) is oblique; else
-a scene with a swing is an impact and a swing; else a scene with a fall, a rise or bounces is drops and
-rebounds; else it is a direct impact."""
-
 
 @dataclass(frozen=True)
 class Interval:
@@ -190,32 +182,6 @@ def load_bank(directory: Path | None = None) -> dict[str, Template]:
             raise TemplateError(str(path), "id", "an id no other template uses", shown(template.id))
         templates[template.id] = template
     return templates
-
-
-def template_files(folder: Path) -> list[Path]:
-    """The ``*.yaml`` files of a bank folder, by name; a folder that is missing or has none is refused."""
-    if not folder.is_dir():
-        raise GraderError(f"{folder}: problem bank folder not found")
-    paths = sorted(folder.glob("*.yaml"))
-    if not paths:
-        raise GraderError(f"{folder}: no templates in this folder; expected problem templates as *.yaml files")
-    for path in paths:
-        if not path.is_file():  # a named pipe would block the run, a folder cannot be read
-            kind = "a folder" if path.is_dir() else "a special file (a pipe or a device)"
-            raise GraderError(f"{path}: expected a template file, got {kind}")
-    return paths
-
-
-def bank_folders(folders: Sequence[Path] = (), shipped: bool = True) -> list[Path]:
-    """The shipped bank's folder (unless ``shipped`` is false), then ``folders``, each once."""
-    sources, seen = [], set()
-    for folder in ([bank_dir()] if shipped else []) + list(folders):
-        if folder.resolve() not in seen:
-            seen.add(folder.resolve())
-            sources.append(folder)
-    if not sources:
-        raise UsageError("no problem bank: without the shipped bank (--no-shipped-bank), give --bank DIR")
-    return sources
 
 
 def load_banks(folders: Sequence[Path] = (), shipped: bool = True) -> dict[str, Template]:

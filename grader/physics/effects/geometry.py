@@ -22,7 +22,6 @@ import numpy as np
 from grader.model.expr import to_text
 from grader.model.units import ANGLE, LENGTH
 from grader.physics.effects.base import Condition, Effect, Field, Relation, Stable
-from grader.physics.integrate import Mode
 
 if TYPE_CHECKING:
     from grader.model.scene import Stage
@@ -72,6 +71,7 @@ def _simulate_line_of_centres(stage: Stage, run: Run) -> None:
         run.output(stage.fields["angle"], math.pi / 2)
         return
     run.uses("uniform motion to contact")
+    from grader.physics.integrate import Mode  # the simulator's: loading a template needs only the catalogue
 
     # The state is sphere 2's centre seen from sphere 1's: [along the line of travel, across it, and
     # their rates]. The event is the squared distance less reach**2, written so that near grazing

@@ -14,7 +14,6 @@ import math
 from typing import TYPE_CHECKING, Any
 
 from grader.model.expr import to_text
-from grader.model.kernel import cosd, sind
 from grader.model.units import ANGLE, SPEED
 from grader.physics.effects.base import Condition, Effect, Field, Mistake, Relation
 
@@ -82,6 +81,8 @@ def _simulate_components(stage: Stage, run: Run) -> None:
     if run.known(fields["speed"]) and run.known(fields["angle"]):
         # In degrees, reduced exactly (as the closed form does): cos 90 deg is 0, not 6e-17, so a
         # head-on impact has no tangential motion to give a stopped ball a direction.
+        from grader.model.kernel import cosd, sind  # numpy's: loading a template needs only the catalogue
+
         speed, degrees = run.value(fields["speed"]), math.degrees(run.value(fields["angle"]))
         run.output(fields[along_key], speed * float(cosd(degrees)))
         run.output(fields[across_key], speed * float(sind(degrees)))

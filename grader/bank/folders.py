@@ -1,0 +1,48 @@
+"""Where a bank's templates are (the shipped folder and the ones given, each template file of each), and
+the topics ``grader list`` groups them by: what a listing needs before any template is read.
+
+>>> [path.name for path in template_files(bank_folders()[0])][:2]
+['ball-plate.yaml', 'ballistic-pendulum.yaml']
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from pathlib import Path
+
+from grader.errors import GraderError, UsageError
+from grader.resources import bank_dir
+
+TOPICS = ("direct impact", "oblique impact", "drops and rebounds", "impact and a swing", "impact and sliding",
+          "impact with flight")
+"""The topics ``grader list`` groups the bank by, in its order. A template names one (``topic:``), or
+its scene decides: a scene with a slide is impact and sliding, one with a projectile's flight impact
+with flight; else an impact with t components (or a velocity from its components) is oblique; else
+a scene with a swing is an impact and a swing; else a scene with a fall, a rise or bounces is drops and
+rebounds; else it is a direct impact."""
+
+
+def template_files(folder: Path) -> list[Path]:
+    """The ``*.yaml`` files of a bank folder, by name; a folder that is missing or has none is refused."""
+    if not folder.is_dir():
+        raise GraderError(f"{folder}: problem bank folder not found")
+    paths = sorted(folder.glob("*.yaml"))
+    if not paths:
+        raise GraderError(f"{folder}: no templates in this folder; expected problem templates as *.yaml files")
+    for path in paths:
+        if not path.is_file():  # a named pipe would block the run, a folder cannot be read
+            kind = "a folder" if path.is_dir() else "a special file (a pipe or a device)"
+            raise GraderError(f"{path}: expected a template file, got {kind}")
+    return paths
+
+
+def bank_folders(folders: Sequence[Path] = (), shipped: bool = True) -> list[Path]:
+    """The shipped bank's folder (unless ``shipped`` is false), then ``folders``, each once."""
+    sources, seen = [], set()
+    for folder in ([bank_dir()] if shipped else []) + list(folders):
+        if folder.resolve() not in seen:
+            seen.add(folder.resolve())
+            sources.append(folder)
+    if not sources:
+        raise UsageError("no problem bank: without the shipped bank (--no-shipped-bank), give --bank DIR")
+    return sources

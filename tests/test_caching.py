@@ -1,0 +1,143 @@
+"""What YAML files read as, kept on disk by grader.inputs.parse_yaml through grader.caching: the same bytes read
+back exactly, refusals made every time with their messages, damaged entries read as misses."""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+from typing import Any
+
+import pytest
+from hypothesis import given
+from hypothesis import strategies as st
+
+import grader.yaml_loader
+from grader import caching
+from grader.errors import GraderError
+from grader.inputs import parse_yaml, plain_data
+from grader.resources import bank_dir, sample_dir
+from grader.yaml_loader import load_yaml
+
+SHIPPED = sorted(bank_dir().glob("*.yaml")) + sorted(sample_dir().glob("*.yaml"))
+
+
+@pytest.fixture
+def cache(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
+    """An empty cache folder of this test's own."""
+    folder = tmp_path / "cache"
+    monkeypatch.setenv("GRADER_CACHE_DIR", str(folder))
+    return folder
+
+
+def same(a: Any, b: Any) -> bool:
+    """Equal, and of the same types throughout (1 is not 1.0 nor True; -0.0 is not 0.0)."""
+    if type(a) is not type(b):
+        return False
+    if isinstance(a, dict):
+        return list(a) == list(b) and all(same(a[key], b[key]) for key in a)
+    if isinstance(a, list):
+        return len(a) == len(b) and all(same(x, y) for x, y in zip(a, b, strict=True))
+    if isinstance(a, float):
+        return a == b and math.copysign(1, a) == math.copysign(1, b)
+    return bool(a == b)
+
+
+def no_loading(monkeypatch: pytest.MonkeyPatch) -> None:
+    """From here on, reading YAML with PyYAML fails the test: the data must come from the entry."""
+    def fail(*args: object) -> None:
+        raise AssertionError("the YAML was read again")
+
+    monkeypatch.setattr(grader.yaml_loader, "load_yaml", fail)
+
+
+@pytest.mark.parametrize("path", SHIPPED, ids=lambda path: path.name)
+def test_each_shipped_file_reads_back_as_pyyaml_reads_it(cache: Path, path: Path,
+                                                        monkeypatch: pytest.MonkeyPatch) -> None:
+    data = path.read_bytes()
+    fresh = load_yaml(data.decode("utf-8"), path)
+    assert same(parse_yaml(data, path), fresh)
+    assert len(list(cache.glob("yaml-*.json"))) == 1
+    no_loading(monkeypatch)
+    assert same(parse_yaml(data, path), fresh)
+
+
+@pytest.mark.parametrize(("text", "message"), [
+    ("h: 1\nh: 2\n", "a.yaml: line 2: the key 'h' appears twice (expected each key once)"),
+    ("h: [1, 2\n", "a.yaml: expected valid YAML, got expected ',' or ']', but got '<stream end>'"),
+    ("h: 1e999\n", "a.yaml: line 1: expected a finite number within float64"),
+], ids=["duplicate key", "broken", "overflow"])
+def test_a_refused_file_is_refused_every_time_and_kept_nowhere(cache: Path, text: str, message: str) -> None:
+    for _ in range(2):
+        with pytest.raises(GraderError, match=message.replace("[", r"\[").replace("(", r"\(").replace(")", r"\)")):
+            parse_yaml(text.encode(), Path("a.yaml"))
+    assert not list(cache.glob("yaml-*.json"))
+
+
+@pytest.mark.parametrize("text", ["a: &x [1, 2]\nb: *x\n", "t: !!timestamp 2024-01-01\n", "s: !!set {a, b}\n",
+                                  "b: !!binary aGVsbG8=\n"], ids=["alias", "timestamp", "set", "binary"])
+def test_data_json_would_not_give_back_is_read_each_time(cache: Path, text: str) -> None:
+    first = parse_yaml(text.encode(), Path("a.yaml"))
+    assert not list(cache.glob("yaml-*.json"))
+    assert parse_yaml(text.encode(), Path("a.yaml")) == first
+
+
+@pytest.mark.parametrize("damage", ["", '{"data": ', "[1]", '{"data": 1, "more": 2}', '{"other": {}}'],
+                         ids=["empty", "cut short", "a list", "extra key", "no data"])
+def test_a_damaged_entry_is_a_miss(cache: Path, damage: str) -> None:
+    text = b"h: 1\nlist: [1, 2.5]\n"
+    first = parse_yaml(text, Path("a.yaml"))
+    (entry,) = cache.glob("yaml-*.json")
+    entry.write_text(damage, encoding="utf-8")
+    assert same(parse_yaml(text, Path("a.yaml")), first)
+    assert same(json.loads(entry.read_text(encoding="utf-8"))["data"], first)  # written again
+
+
+def test_a_cache_that_cannot_be_written_only_costs_time(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    blocked = tmp_path / "a-file"
+    blocked.write_text("not a folder", encoding="utf-8")
+    monkeypatch.setenv("GRADER_CACHE_DIR", str(blocked / "cache"))
+    for _ in range(2):
+        assert parse_yaml(b"h: 1\n", Path("a.yaml")) == {"h": 1}
+
+
+def test_an_edit_of_the_yaml_reader_reads_files_again(tmp_path: Path) -> None:
+    """The key covers the reader's source: the same bytes under an edited reader are another entry."""
+    import shutil
+
+    copy = tmp_path / "grader"
+    shutil.copytree(caching.PACKAGE, copy, ignore=shutil.ignore_patterns("__pycache__"))
+    sources, salt = ("inputs.py", "yaml_loader.py"), "yaml 1"
+    before = caching.source_fingerprint(copy, sources, salt, ("yaml",))
+    loader = copy / "yaml_loader.py"
+    loader.write_text(loader.read_text(encoding="utf-8") + "\n# reads differently\n", encoding="utf-8")
+    assert caching.source_fingerprint(copy, sources, salt, ("yaml",)) != before
+
+
+PLAIN = st.recursive(
+    st.none() | st.booleans() | st.integers() | st.floats(allow_nan=False, allow_infinity=False) | st.text(),
+    lambda inner: st.lists(inner, max_size=4) | st.dictionaries(st.text(), inner, max_size=4), max_leaves=20)
+
+
+@given(PLAIN)
+def test_json_gives_back_exactly_what_plain_data_accepts(data: Any) -> None:
+    assert plain_data(data)
+    assert same(json.loads(json.dumps(data)), data)
+
+
+def test_without_a_home_folder_nothing_is_kept_and_everything_works(monkeypatch: pytest.MonkeyPatch) -> None:
+    """No $GRADER_CACHE_DIR, no $XDG_CACHE_HOME, and Path.home() finds none (no $HOME, a user id without a
+    password entry): files are read, and the bank listed, each time."""
+    from grader.bank.listing import listing
+    from grader.bank.template import load_banks
+
+    def no_home(cls: type[Path]) -> Path:
+        raise RuntimeError("Could not determine home directory.")
+
+    for name in ("GRADER_CACHE_DIR", "XDG_CACHE_HOME"):
+        monkeypatch.delenv(name, raising=False)
+    monkeypatch.setattr(Path, "home", classmethod(no_home))
+    assert caching.entry("anything.json") is None
+    for _ in range(2):
+        assert parse_yaml(b"h: 1\n", Path("a.yaml")) == {"h": 1}
+        assert [row.id for row in listing()] == list(load_banks())

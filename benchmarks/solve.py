@@ -27,8 +27,8 @@ load average (``os.getloadavg()``) measured beside it:
 
 Run: ``python benchmarks/solve.py [--sets 100000 2000] [--quick]``. Writes ``benchmarks/results/solve.md``,
 ``solve.csv``, ``solve_batch.csv``, ``solve_startup.csv`` and, with matplotlib, ``solve.png``.
-``--only startup`` measures part 3 alone, as the whole run measures it, and prints its table (the result
-files are left as they are).
+``--only startup`` (or ``kernels``: part 1) measures that part alone, as the whole run measures it, and
+prints its table (the result files are left as they are).
 """
 
 from __future__ import annotations
@@ -147,8 +147,8 @@ def parse_args(argv: Sequence[str] | None = None) -> argparse.Namespace:
     parser.add_argument("--runs", type=int, default=5, help="batch commands: median of this many (default 5)")
     parser.add_argument("--startup-runs", type=int, default=15, help="start-up: median of this many (default 15)")
     parser.add_argument("--quick", action="store_true", help="a smoke run: few sets, rows and runs")
-    parser.add_argument("--only", choices=("startup",), help="measure this part alone and print its table (the "
-                                                             "result files are not written)")
+    parser.add_argument("--only", choices=("startup", "kernels"), help="measure this part alone and print its "
+                        "table (the result files are not written)")
     parser.add_argument("--seed", type=int, default=20240601, help="numpy random seed (default 20240601)")
     parser.add_argument("--out", type=Path, default=RESULTS, help=f"output folder (default {RESULTS})")
     arguments = parser.parse_args(argv)
@@ -575,6 +575,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(f"kernels: {template.id} ...", file=sys.stderr, flush=True)
         kernels += bench_kernels(template, arguments, rng)
     kernels.sort(key=lambda row: -row.sets)  # one table per size, largest first
+    if arguments.only == "kernels":
+        print(kernel_table(kernels))
+        return 0
     folder = Path(tempfile.mkdtemp(prefix="grader-bench-batch-"))
     try:
         batches = []

@@ -65,6 +65,9 @@ from grader.solve.evaluate import solve_columns
 
 HERE = Path(__file__).resolve().parent
 RESULTS = HERE / "results"
+# The commands run as an installed copy runs: Python writes bytecode (a sandbox that sets
+# PYTHONDONTWRITEBYTECODE made every command compile grader from source, ~30 ms a process).
+os.environ.pop("PYTHONDONTWRITEBYTECODE", None)
 MINIMAL = HERE / "minimal_solve.py"
 AGREEMENT_RTOL = 1e-9
 TARGET_LAMBDIFY = 1.0  # kernels at least as fast as lambdify

@@ -299,8 +299,8 @@ class Kernel:
 
     def _by_blocks(self, arrays: tuple[Any, ...]) -> dict[Any, Any]:
         """The in-place steps on long columns, a block of ``_BLOCK`` rows at a time (numexpr's way): the
-        block's arrays stay in the processor's cache, and the steps no result of theirs could be written
-        over for write into scratch arrays this kernel keeps between calls. New arrays of that size
+        block's arrays stay in the processor's cache, and a step that finds no array it may write over
+        writes into a scratch array this kernel keeps between calls. New arrays of that size
         (256 KiB) come from the operating system, a page fault per 4 KiB on every call: at 100,000 rows
         that was three times the arithmetic. A float result is written by its step straight into its
         block of the result; any other is copied there. Every element meets the same numpy loop as on
@@ -311,7 +311,10 @@ class Kernel:
         if size > _BLOCK and (len(shape) != 1 or not all(a.flags.c_contiguous for a in arrays)):
             scratch = [np.empty(shape) for _ in range(self._scratch)]  # one block, with scratch arrays of its own
             return dict(zip(self.roots, self._block(*arrays, *self._no_outs, *scratch), strict=True))
-        spare = self._spares.pop() if self._spares else [np.empty(_BLOCK) for _ in range(self._scratch)]
+        try:
+            spare = self._spares.pop()  # atomic: two threads never take one set
+        except IndexError:
+            spare = [np.empty(_BLOCK) for _ in range(self._scratch)]
         try:
             if size <= _BLOCK:
                 scratch = [array[:size].reshape(shape) for array in spare]

@@ -1,4 +1,4 @@
-"""Figures of a scene, to one variant's scale: an SVG drawing with Typst labels over it (``templates/figures.typ``).
+"""Figures of a scene, to one variant's scale, as Typst drawing calls (see ``templates/figures.typ``).
 
 The kind of figure follows from the scene's structure, never from the template's id:
 

@@ -550,8 +550,7 @@ def test_the_line_of_centres_is_drawn_at_the_variants_angle(assignment: Assignme
     """The two circles touch, and the line through their centres makes asin(b/(r1 + r2)) with the path
     (horizontal), to the figure's 0.01 cm."""
     drawn = _figure_of(assignment, bank, template_id, fixed)
-    circles = re.findall(r"<circle cx='([-0-9.]+)' cy='([-0-9.]+)' r='([0-9.]+)' stroke='#000' "
-                         r"stroke-width='0.0282' fill=", drawn)
+    circles = re.findall(r"fig-circle\(\(([-0-9.]+), ([-0-9.]+)\), ([0-9.]+), w: 0.8pt, fill", drawn)
     (x1, y1, r1), (x2, y2, r2) = [tuple(map(float, found)) for found in circles]
     assert abs(((x2 - x1) ** 2 + (y2 - y1) ** 2) ** 0.5 - (r1 + r2)) < 0.02
     assert abs((y1 - y2) / (r1 + r2) - sine) < 0.02  # Typst's y points down

@@ -1,26 +1,20 @@
-"""Drawings in centimetres, y up: the primitives the problem figures (:mod:`grader.render.figures`)
-are built from, as a Typst ``fig-canvas`` (see ``templates/figures.typ``). Nothing here knows about physics.
+"""Drawing calls in centimetres, y up, as Typst (see ``templates/figures.typ``): the primitives the
+problem figures (:mod:`grader.render.figures`) are built from. Nothing here knows about physics.
 
 Geometry is built in centimetres with y up, then shifted so the drawing's bounding box (labels
-included, by an estimate of their size) starts at the origin, and flipped. The lines and shapes
-become one SVG image, the labels Typst math placed over it: Typst typesets an image of a hundred
-shapes in a fraction of the time it takes for a hundred placed shapes of its own.
+included, by an estimate of their size) starts at the origin, and flipped for Typst.
 
 >>> canvas = Canvas()
 >>> canvas.line((0, 0), (2, 1))
->>> drawn = canvas.typst()
->>> drawn.startswith("fig-canvas(2.10, 1.10, ")
+>>> canvas.typst().startswith("fig-canvas(2.10, 1.10")
 True
->>> import re
->>> re.findall("<path [^>]*>", drawn)
-["<path d='M0.05 1.05L2.05 0.05' stroke='#000' stroke-width='0.0212'/>"]
 """
 
 from __future__ import annotations
 
 import itertools
 import math as _m
-from collections.abc import Callable, Iterable, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 from grader.render.worked import Typ, string
@@ -30,60 +24,46 @@ PAD = 0.05
 MAX_WIDTH = 7.6
 CHAR = 0.15  # cm per character of a label at the figure's text size, an estimate for the bounding box
 LINE = 0.42  # cm per line of a label
-PT = 2.54 / 72  # cm per point
 
 
 def _fmt(value: float) -> str:
     return f"{value:.2f}"
 
 
-@dataclass(frozen=True)
-class _Shape:
-    """A line, open path, polygon, circle or rectangle: its points (cm, y up), radius and SVG style."""
-
-    kind: str
-    points: tuple[Point, ...]
-    radius: float
-    style: str
-
-
 @dataclass
 class Canvas:
-    """Shapes and labels with their coordinates (cm, y up), what they cover, and what labels must avoid."""
+    """Drawing calls with their coordinates (cm, y up), what they cover, and what labels must avoid."""
 
-    shapes: list[_Shape] = field(default_factory=list)
-    calls: list[str] = field(default_factory=list)  # the labels, as Typst, with {place(point)} to fill in
-    label_points: list[Point] = field(default_factory=list)
+    calls: list[tuple[str, list[Point], float, str]] = field(default_factory=list)
     points: list[Point] = field(default_factory=list)
     labels: list[tuple[Point, tuple[float, float, float, float]]] = field(default_factory=list)
     occupied: list[tuple[float, float, float, float]] = field(default_factory=list)
     strokes: list[tuple[Point, Point]] = field(default_factory=list)
 
-    def _add(self, kind: str, points: Sequence[Point], style: str, radius: float = 0.0) -> None:
+    def _add(self, kind: str, points: Sequence[Point], options: str = "", radius: float = 0.0) -> None:
         for x, y in points:
             self.points += [(x - radius, y - radius), (x + radius, y + radius)]
-        self.shapes.append(_Shape(kind, tuple(points), radius, style))
+        self.calls.append((kind, list(points), radius, options))
 
     def line(self, a: Point, b: Point, width: float = 0.6, dash: str | None = None, gray: bool = False) -> None:
         """A straight line."""
-        self._add("line", [a, b], _stroke(width, dash, gray))
+        self._add("fig-line", [a, b], _stroke(width, dash, gray))
 
     def path(self, points: Sequence[Point], width: float = 0.6, dash: str | None = None) -> None:
         """An open polyline."""
-        self._add("path", points, _stroke(width, dash, False))
+        self._add("fig-path", points, _stroke(width, dash, False))
 
-    def polygon(self, points: Sequence[Point], fill: int = 0) -> None:
-        """A filled polygon without outline, black or of the gray level ``fill`` (0 to 255)."""
-        self._add("polygon", points, f"fill='{_gray(fill)}'")
+    def polygon(self, points: Sequence[Point], gray: bool = False, fill: str | None = None) -> None:
+        """A filled polygon (black, gray, or ``fill``), without outline."""
+        self._add("fig-poly", points, f"fill: {fill}" if fill else "fill: luma(150)" if gray else "")
 
     def circle(self, center: Point, radius: float, dash: str | None = None, fill: bool = True) -> None:
         """A circle (a body)."""
-        self._add("circle", [center], _stroke(0.8, dash, False) + (f" fill='{_gray(235)}'" if fill else ""), radius)
+        self._add("fig-circle", [center], f"{_stroke(0.8, dash, False)}{', fill: luma(235)' if fill else ''}", radius)
 
-    def rect(self, low: Point, high: Point, dash: str | None = None, fill: int | None = 235) -> None:
-        """A rectangle between two corners (a block, a plate), filled with the gray level ``fill`` or empty."""
-        self._add("rect", [(low[0], high[1]), (high[0], low[1])],
-                  _stroke(0.8, dash, False) + (f" fill='{_gray(fill)}'" if fill is not None else ""))
+    def rect(self, low: Point, high: Point, dash: str | None = None, fill: str = "luma(235)") -> None:
+        """A rectangle between two corners (a block, a plate)."""
+        self._add("fig-rect", [(low[0], high[1]), (high[0], low[1])], f"{_stroke(0.8, dash, False)}, fill: {fill}")
         self.occupied.append((low[0], low[1], high[0], high[1]))
 
     def reserve(self, low: Point, high: Point) -> None:
@@ -112,8 +92,7 @@ class Canvas:
         self.labels.append((at, (box[0] - at[0], box[1] - at[1], box[2] - at[0], box[3] - at[1])))
         self.occupied.append(box)
         body = ", ".join(f"${line}$" for line in lines)
-        self.label_points.append(at)
-        self.calls.append(f"fig-label({{}}, {string(anchor)}, ({body},))")
+        self.calls.append(("fig-label", [at], 0.0, f"{string(anchor)}, ({body},)"))
 
     def arrow(self, tail: Point, tip: Point, width: float = 0.9, head: float = 0.22) -> None:
         """An arrow: a line and a triangular head."""
@@ -170,46 +149,27 @@ class Canvas:
         return (min(xs), min(ys), max(xs), max(ys)) if xs else (0.0, 0.0, 0.0, 0.0)
 
     def typst(self) -> Typ:
-        """A ``fig-canvas`` call: the shapes as an SVG image and the labels over it, everything shifted
-        to start at the origin; a drawing wider than ``MAX_WIDTH`` has its geometry (not its labels)
-        scaled down until it fits."""
+        """A ``fig-canvas`` call drawing everything, shifted to start at the origin; a drawing wider
+        than ``MAX_WIDTH`` has its geometry (not its labels) scaled down until it fits."""
         scale = 1.0
         while scale > 0.5 and self._extent(scale)[2] - self._extent(scale)[0] + 2 * PAD > MAX_WIDTH:
             scale -= 0.05
         x0, y0, x1, y1 = self._extent(scale)
-        width, height = _fmt(x1 - x0 + 2 * PAD), _fmt(y1 - y0 + 2 * PAD)
 
-        def place(point: Point) -> tuple[str, str]:
-            return _fmt(point[0] * scale - x0 + PAD), _fmt(y1 - point[1] * scale + PAD)
-        svg = (f"<svg xmlns='http://www.w3.org/2000/svg' width='{width}cm' height='{height}cm' "
-               f"viewBox='0 0 {width} {height}' fill='none' stroke-linecap='round' stroke-linejoin='round'>"
-               + "".join(_svg(kind, style, shapes, place, scale)
-                         for (kind, style), shapes in itertools.groupby(self.shapes, lambda s: (s.kind, s.style)))
-               + "</svg>")
-        labels = [call.format("({}, {})".format(*place(at))) for call, at in zip(self.calls, self.label_points,
-                                                                                   strict=True)]
-        return Typ(f"fig-canvas({width}, {height}, {string(svg)}, {{\n" + "".join(f"  {c}\n" for c in labels) + "})")
-
-
-def _svg(kind: str, style: str, shapes: Iterable[_Shape], place: Callable[[Point], tuple[str, str]],
-         scale: float) -> str:
-    """SVG of shapes of one kind and style drawn one after another: lines, paths and polygons as one
-    path (the ground's hatching: 25 lines), circles and rectangles one element each."""
-    def to(points: Sequence[Point]) -> str:
-        return "L".join("{} {}".format(*place(p)) for p in points)
-    if kind in ("line", "path", "polygon"):
-        close = "Z" if kind == "polygon" else ""
-        return f"<path d='{''.join(f'M{to(s.points)}{close}' for s in shapes)}' {style}/>"
-    elements = []
-    for shape in shapes:
-        (x, y), = [place(p) for p in shape.points[:1]]
-        if kind == "circle":
-            elements.append(f"<circle cx='{x}' cy='{y}' r='{_fmt(shape.radius * scale)}' {style}/>")
-        else:
-            right, bottom = place(shape.points[1])
-            elements.append(f"<rect x='{x}' y='{y}' width='{_fmt(float(right) - float(x))}' "
-                            f"height='{_fmt(float(bottom) - float(y))}' {style}/>")
-    return "".join(elements)
+        def place(point: Point) -> str:
+            return f"({_fmt(point[0] * scale - x0 + PAD)}, {_fmt(y1 - point[1] * scale + PAD)})"
+        body = []
+        # Lines drawn one after another with one stroke are one curve (the ground's hatching: 25 lines).
+        for (kind, options), calls in itertools.groupby(self.calls, key=lambda call: (call[0], call[3])):
+            if kind == "fig-line":
+                arguments = [f"({place(a)}, {place(b)})" for _, (a, b), _, _ in calls]
+                body.append(f"  fig-lines({', '.join([*arguments, options])})")
+                continue
+            for _, points, radius, _ in calls:
+                arguments = [place(p) for p in points] + ([_fmt(radius * scale)] if radius else []) + \
+                    ([options] if options else [])
+                body.append(f"  {kind}({', '.join(arguments)})")
+        return Typ(f"fig-canvas({_fmt(x1 - x0 + 2 * PAD)}, {_fmt(y1 - y0 + 2 * PAD)}, {{\n" + "\n".join(body) + "\n})")
 
 
 def _crosses(box: tuple[float, float, float, float], a: Point, b: Point) -> bool:
@@ -232,23 +192,12 @@ def _crosses(box: tuple[float, float, float, float], a: Point, b: Point) -> bool
 
 
 def _stroke(width: float, dash: str | None, gray: bool) -> str:
-    """SVG stroke attributes: ``width`` in pt (the drawing's unit is the cm), Typst's ``dashed`` (3 pt on,
-    3 pt off) or none, black or gray."""
-    style = f"stroke='{_gray(140 if gray else 0)}' stroke-width='{width * PT:.4f}'"
-    if dash == "dashed":
-        style += f" stroke-dasharray='{3 * PT:.4f} {3 * PT:.4f}'"
-    elif dash:
-        raise ValueError(f"a figure's line is solid or dashed, got dash {dash!r}")
-    return style
-
-
-def _gray(level: int) -> str:
-    """A gray level (0 black to 255 white) as an SVG colour, as Typst's ``luma(level)``.
-
-    >>> _gray(0), _gray(235)
-    ('#000', '#ebebeb')
-    """
-    return "#000" if level == 0 else f"#{level:02x}{level:02x}{level:02x}"
+    parts = [f"w: {width}pt"]
+    if dash:
+        parts.append(f"dash: {string(dash)}")
+    if gray:
+        parts.append("paint: luma(140)")
+    return ", ".join(parts)
 
 
 def _visible(line: str) -> int:

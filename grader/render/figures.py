@@ -125,7 +125,7 @@ def _drop(canvas: Canvas, scene: SceneView, fall: Stage, impact: Stage | None, r
         if fixed:
             canvas.circle((x, bottom + 0.3), 0.3, dash, fill=dash is None)
             return bottom + 0.6
-        canvas.rect((x - 0.4, bottom), (x + 0.4, bottom + 0.5), dash, 235 if dash is None else None)
+        canvas.rect((x - 0.4, bottom), (x + 0.4, bottom + 0.5), dash, "luma(235)" if dash is None else "none")
         return bottom + 0.5
 
     top = body(x_body, drop * scale, None)
@@ -143,7 +143,7 @@ def _drop(canvas: Canvas, scene: SceneView, fall: Stage, impact: Stage | None, r
         canvas.line((x_ghost + 0.35, rebound * scale), (4.9, rebound * scale), width=0.3)
     moving = impact.fields["before"].get(second) if impact is not None and second is not None else None
     if fixed and moving is not None:  # a driven plate: a slab, with its velocity (n points down)
-        canvas.rect((0.9, -0.35), (5.2, 0.0), fill=215)
+        canvas.rect((0.9, -0.35), (5.2, 0.0), fill="luma(215)")
         canvas.label((3.3, -0.4), "n", [str(string(second))])
         _vertical_velocity(canvas, scene, (5.75, -0.2), -scene.value(moving.n), moving.n)
     elif fixed:

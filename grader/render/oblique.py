@@ -102,7 +102,7 @@ def surface(canvas: Canvas, scene: SceneView, impact: Stage) -> bool:
     scale = 2.3 / max(speeds)
     radius = 0.28
     center = (0.0, radius)
-    canvas.rect((-3.0, -0.3), (3.0, 0.0), fill=215)
+    canvas.rect((-3.0, -0.3), (3.0, 0.0), fill="luma(215)")
     canvas.label((2.9, -0.35), "ne", [str(string(impact.fields["bodies"][1]))])
     canvas.line((-2.9, radius), (2.9, radius), width=0.4, dash="dashed", gray=True)
     canvas.circle(center, radius)
@@ -177,7 +177,7 @@ def incline(canvas: Canvas, scene: SceneView, impact: Stage) -> bool:
     length, radius, drop = 4.4, 0.25, 2.6
     top, bottom = (-0.6 * length * down[0], -0.6 * length * down[1]), (0.4 * length * down[0], 0.4 * length * down[1])
     corner = (top[0], bottom[1])
-    canvas.polygon([top, bottom, corner], fill=215)
+    canvas.polygon([top, bottom, corner], fill="luma(215)")
     canvas.path([corner, top, bottom, corner], width=0.6)
     canvas.label(((corner[0] + bottom[0]) / 2, bottom[1] - 0.1), "n", [str(string(surface))])
     stages = scene.template.scene.stages

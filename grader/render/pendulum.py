@@ -33,7 +33,7 @@ def swing_figure(canvas: Canvas, scene: SceneView, swing: Stage, impact: Stage |
     high = (CORD * _m.sin(theta), -CORD * _m.cos(theta))
     canvas.line((0.0, 0.0), (low[0], low[1] + HALF_HEIGHT), width=0.4, dash="dashed", gray=True)
     canvas.rect((low[0] - HALF_WIDTH, low[1] - HALF_HEIGHT), (low[0] + HALF_WIDTH, low[1] + HALF_HEIGHT), "dashed",
-                fill=None)
+                "none")
     canvas.line((0.0, 0.0), high, width=0.6)
     canvas.rect((high[0] - HALF_WIDTH, high[1] - HALF_HEIGHT), (high[0] + HALF_WIDTH, high[1] + HALF_HEIGHT))
     canvas.label((high[0] + HALF_WIDTH + 0.12, high[1]), "w", [str(string(body)), *scene.mass(body)])
@@ -58,7 +58,7 @@ def _striker(canvas: Canvas, scene: SceneView, impact: Stage, target: tuple[floa
     """The first body of the impact, small, coming in from the left at the block's height."""
     first = impact.fields["bodies"][0]
     x = target[0] - HALF_WIDTH - 1.9
-    canvas.rect((x - 0.2, target[1] - 0.06), (x + 0.2, target[1] + 0.06), fill=120)
+    canvas.rect((x - 0.2, target[1] - 0.06), (x + 0.2, target[1] + 0.06), fill="luma(120)")
     canvas.label((x, target[1] - 0.15), "n", [str(string(first)), *scene.mass(first)])
     canvas.arrow((x + 0.35, target[1]), (x + 1.35, target[1]), width=0.7, head=0.18)
     velocity = impact.fields["before"].get(first)

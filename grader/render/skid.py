@@ -80,7 +80,7 @@ def _car(canvas: Canvas, x0: float, x1: float, road: float, height: float, dash:
     """A car from ``x0`` to ``x1`` on the road at height ``road``: a body ``height`` tall over two wheels."""
     wheel = 0.12
     canvas.rect((x0, road + 2 * wheel - 0.04), (x1, road + 2 * wheel - 0.04 + height), dash,
-                235 if dash is None else None)
+                "luma(235)" if dash is None else "none")
     for x in (x0 + 0.22 * (x1 - x0), x1 - 0.22 * (x1 - x0)):
         canvas.circle((x, road + wheel), wheel, dash, fill=dash is None)
 

@@ -12,6 +12,7 @@ True
 
 from __future__ import annotations
 
+import itertools
 import math as _m
 from collections.abc import Sequence
 from dataclasses import dataclass, field
@@ -158,10 +159,16 @@ class Canvas:
         def place(point: Point) -> str:
             return f"({_fmt(point[0] * scale - x0 + PAD)}, {_fmt(y1 - point[1] * scale + PAD)})"
         body = []
-        for kind, points, radius, options in self.calls:
-            arguments = [place(p) for p in points] + ([_fmt(radius * scale)] if radius else []) + \
-                ([options] if options else [])
-            body.append(f"  {kind}({', '.join(arguments)})")
+        # Lines drawn one after another with one stroke are one curve (the ground's hatching: 25 lines).
+        for (kind, options), calls in itertools.groupby(self.calls, key=lambda call: (call[0], call[3])):
+            if kind == "fig-line":
+                arguments = [f"({place(a)}, {place(b)})" for _, (a, b), _, _ in calls]
+                body.append(f"  fig-lines({', '.join([*arguments, options])})")
+                continue
+            for _, points, radius, _ in calls:
+                arguments = [place(p) for p in points] + ([_fmt(radius * scale)] if radius else []) + \
+                    ([options] if options else [])
+                body.append(f"  {kind}({', '.join(arguments)})")
         return Typ(f"fig-canvas({_fmt(x1 - x0 + 2 * PAD)}, {_fmt(y1 - y0 + 2 * PAD)}, {{\n" + "\n".join(body) + "\n})")
 
 

@@ -159,6 +159,16 @@ class KeyProblem:
     steps: tuple[KeyStep, ...]
     answers: tuple[KeyAnswer, ...]
 
+    @property
+    def tolerance_width(self) -> Typ:
+        """The width of the answers' tolerance column: its longest text (or heading), half an em a
+        character (a little more than Libertinus takes).
+
+        >>> KeyProblem("1", "", "", Typ(""), (), (), (KeyAnswer("1a", "", Typ(""), "2", "±1 %"),)).tolerance_width
+        '4.5em'
+        """
+        return Typ(f"{0.5 * max(len('Tolerance'), *(len(a.tolerance) for a in self.answers)):g}em")
+
 
 @dataclass(frozen=True)
 class KeyPerson:

@@ -27,6 +27,7 @@ import re
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from fractions import Fraction
+from functools import lru_cache
 from typing import Any
 
 import numpy as np
@@ -70,6 +71,7 @@ def _atom(word: str) -> str:
     return str(string(word))
 
 
+@lru_cache(maxsize=4096)  # a class's worked solutions name the same few quantities thousands of times
 def name(quantity: str) -> str:
     """A quantity's name in Typst math: ``h_drop`` -> ``h_"drop"``, ``v1_n_after`` -> ``v'_(1, n)``.
 

@@ -25,6 +25,7 @@ import contextlib
 import hashlib
 import json
 import os
+import stat
 import sys
 from collections.abc import Iterable
 from pathlib import Path
@@ -33,6 +34,10 @@ from typing import Any
 from grader import __version__
 
 PACKAGE = Path(__file__).resolve().parent
+
+ENTRY_BYTES = 16 << 20
+"""The largest entry written or read (16 MiB): what a 1 MiB YAML file reads as is at most a few times its size
+as JSON (``\\u`` escapes); a compiled template is tens of kB."""
 
 
 def cache_dir() -> Path:
@@ -92,21 +97,37 @@ def entry(name: str) -> Path | None:
 
 
 def read_entry(path: Path | None) -> Any:
-    """An entry's JSON, or None when it is missing, cannot be read or is not JSON."""
+    """An entry's JSON, or None when it is missing, cannot be read, is not a regular file (a named pipe
+    would block the read, a device never end it), is larger than :data:`ENTRY_BYTES`, or is not JSON (or
+    JSON nested deeper than Python reads)."""
     if path is None:
         return None
     try:
-        return json.loads(path.read_text(encoding="utf-8"))
-    except (OSError, ValueError):  # a bad UTF-8 byte is a ValueError too
+        handle = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0))  # a FIFO opens without a writer
+        with os.fdopen(handle, "rb") as stream:
+            status = os.fstat(handle)
+            if not stat.S_ISREG(status.st_mode) or status.st_size > ENTRY_BYTES:
+                return None
+            data = stream.read(ENTRY_BYTES + 1)
+    except OSError:
+        return None
+    if len(data) > ENTRY_BYTES:  # grown since
+        return None
+    try:
+        return json.loads(data)
+    except (ValueError, RecursionError):  # a bad UTF-8 byte is a ValueError too
         return None
 
 
 def write_entry(path: Path | None, data: Any) -> None:
     """Keep ``data`` as JSON at ``path``, atomically (a reader never sees half an entry); a folder that
-    cannot be written is left as it is."""
+    cannot be written is left as it is, and data larger than :data:`ENTRY_BYTES` is not kept."""
     if path is None:
+        return
+    text = json.dumps(data)
+    if len(text) > ENTRY_BYTES:  # ASCII: as many bytes as characters
         return
     from grader.files import write_atomic  # only a miss writes: a hit does not pay for its imports
 
     with contextlib.suppress(OSError):
-        write_atomic(path, json.dumps(data))
+        write_atomic(path, text)

@@ -141,3 +141,65 @@ def test_without_a_home_folder_nothing_is_kept_and_everything_works(monkeypatch:
     for _ in range(2):
         assert parse_yaml(b"h: 1\n", Path("a.yaml")) == {"h": 1}
         assert [row.id for row in listing()] == list(load_banks())
+
+
+def _yaml_entry(cache: Path, text: bytes) -> Path:
+    """Where parse_yaml keeps what ``text`` reads as (after reading it once)."""
+    parse_yaml(text, Path("a.yaml"))
+    (entry,) = cache.glob("yaml-*.json")
+    return entry
+
+
+def _in_time(work: Any, seconds: float = 20) -> Any:
+    """``work()``'s result, failing the test if it has none within ``seconds`` (a blocked read never returns)."""
+    import threading
+
+    results: list[Any] = []
+    thread = threading.Thread(target=lambda: results.append(work()), daemon=True)
+    thread.start()
+    thread.join(seconds)
+    assert results, f"still running after {seconds} s"
+    return results[0]
+
+
+def test_an_entry_that_is_a_named_pipe_is_a_miss_not_a_hang(cache: Path) -> None:
+    """Opening a FIFO for reading waits for a writer: `grader list` hung for good on one."""
+    import os
+
+    text = b"h: 1\n"
+    entry = _yaml_entry(cache, text)
+    entry.unlink()
+    os.mkfifo(entry)
+    assert _in_time(lambda: parse_yaml(text, Path("a.yaml"))) == {"h": 1}
+
+
+@pytest.mark.parametrize("device", ["/dev/zero", "/dev/urandom"])
+def test_an_entry_that_is_a_device_is_a_miss_not_a_memory_error(cache: Path, device: str) -> None:
+    """An entry linked to an endless device was read whole: MemoryError."""
+    text = b"h: 1\n"
+    entry = _yaml_entry(cache, text)
+    entry.unlink()
+    entry.symlink_to(device)
+    assert _in_time(lambda: parse_yaml(text, Path("a.yaml"))) == {"h": 1}
+
+
+def test_an_entry_nested_deeper_than_json_reads_is_a_miss_not_a_recursion_error(cache: Path) -> None:
+    text = b"h: 1\n"
+    entry = _yaml_entry(cache, text)
+    entry.write_text('{"data": ' + "[" * 100_000 + "]" * 100_000 + "}", encoding="utf-8")
+    assert parse_yaml(text, Path("a.yaml")) == {"h": 1}
+
+
+def test_an_entry_larger_than_any_grader_writes_is_not_read(cache: Path) -> None:
+    text = b"h: 1\n"
+    entry = _yaml_entry(cache, text)
+    with entry.open("r+b") as stream:
+        stream.truncate(caching.ENTRY_BYTES + 1)  # what is in it is never looked at
+    assert parse_yaml(text, Path("a.yaml")) == {"h": 1}
+
+
+def test_data_larger_than_an_entry_may_be_is_not_kept(cache: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(caching, "ENTRY_BYTES", 100)
+    caching.write_entry(cache / "big.json", {"text": "x" * 100})
+    caching.write_entry(cache / "small.json", {"text": "x"})
+    assert [path.name for path in cache.iterdir()] == ["small.json"]

@@ -3,9 +3,10 @@ entry from ever being read back.
 
 The folder is ``$GRADER_CACHE_DIR``, else ``$XDG_CACHE_HOME/grader``, else ``~/.cache/grader``. An entry
 is a JSON file whose name or contents carry its key: a digest of everything the result depends on (the
-input's bytes, grader's version, the source of the code that made it). An entry that is missing,
-unreadable, not JSON or made for another key is a miss, and the work is done again; a folder that cannot
-be written only costs time.
+input's bytes, grader's version, the source of the code that made it). It is sealed with a digest of its
+name and its contents, and written by the user alone: an entry that is missing, unreadable, not a regular
+file, not JSON, made for another key, changed since, or that another user wrote or could have written is a
+miss, and the work is done again; a folder that cannot be written only costs time.
 
 >>> import tempfile, pathlib
 >>> entry = pathlib.Path(tempfile.mkdtemp()) / "sub" / "entry.json"
@@ -14,7 +15,7 @@ True
 >>> write_entry(entry, {"key": "k1", "rows": [1, 2]})
 >>> read_entry(entry)
 {'key': 'k1', 'rows': [1, 2]}
->>> _ = entry.write_text('{"key": "k1", "ro')  # cut short: a miss, not an error
+>>> _ = entry.write_bytes(entry.read_bytes()[:-5])  # cut short: a miss, not an error
 >>> read_entry(entry) is None
 True
 """
@@ -97,37 +98,79 @@ def entry(name: str) -> Path | None:
 
 
 def read_entry(path: Path | None) -> Any:
-    """An entry's JSON, or None when it is missing, cannot be read, is not a regular file (a named pipe
-    would block the read, a device never end it), is larger than :data:`ENTRY_BYTES`, or is not JSON (or
-    JSON nested deeper than Python reads)."""
+    """What :func:`write_entry` kept at ``path``, or None when there is nothing grader kept there for this user:
+    a file missing or unreadable; not a regular file (a named pipe would block the read, a device never end
+    it); larger than :data:`ENTRY_BYTES`; written by another user, or writable by one (only the user and root
+    can have written what is read); kept under another name, or changed since (:func:`seal`); JSON nested
+    deeper than Python reads."""
     if path is None:
         return None
     try:
         handle = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0))  # a FIFO opens without a writer
         with os.fdopen(handle, "rb") as stream:
-            status = os.fstat(handle)
-            if not stat.S_ISREG(status.st_mode) or status.st_size > ENTRY_BYTES:
+            if not _mine(os.fstat(handle)):
                 return None
-            data = stream.read(ENTRY_BYTES + 1)
+            sealed = stream.read(ENTRY_BYTES + 1)
     except OSError:
         return None
-    if len(data) > ENTRY_BYTES:  # grown since
+    text = unsealed(path.name, sealed)
+    if text is None:
         return None
     try:
-        return json.loads(data)
-    except (ValueError, RecursionError):  # a bad UTF-8 byte is a ValueError too
+        return json.loads(text)
+    except (ValueError, RecursionError):
         return None
 
 
 def write_entry(path: Path | None, data: Any) -> None:
-    """Keep ``data`` as JSON at ``path``, atomically (a reader never sees half an entry); a folder that
-    cannot be written is left as it is, and data larger than :data:`ENTRY_BYTES` is not kept."""
+    """Keep ``data`` as JSON at ``path``, sealed (:func:`seal`), atomically (a reader never sees half an entry)
+    and writable by this user alone; a folder that cannot be written is left as it is, and data larger than
+    :data:`ENTRY_BYTES` is not kept."""
     if path is None:
         return
-    text = json.dumps(data)
-    if len(text) > ENTRY_BYTES:  # ASCII: as many bytes as characters
+    sealed = seal(path.name, json.dumps(data).encode())
+    if len(sealed) > ENTRY_BYTES:
         return
     from grader.files import write_atomic  # only a miss writes: a hit does not pay for its imports
 
     with contextlib.suppress(OSError):
-        write_atomic(path, text)
+        write_atomic(path, sealed, mode=0o644)
+
+
+_HEAD = b'{"grader cache entry": 1, "sha256": "'
+_DATA = b'", "data": '
+
+
+def seal(name: str, text: bytes) -> bytes:
+    """JSON ``text`` as an entry named ``name`` holds it: in a JSON object with the SHA-256 of the name and the
+    text, so that an entry read under another name (copied, renamed, linked), cut short or changed since
+    is a miss, and grader's entries are told from any other file.
+
+    >>> sealed = seal("yaml-1.json", b"[1]")
+    >>> sealed[:60]
+    b'{"grader cache entry": 1, "sha256": "b0676677d4515849b7bf85d'
+    >>> unsealed("yaml-1.json", sealed), unsealed("yaml-2.json", sealed), unsealed("yaml-1.json", sealed[:-2])
+    (b'[1]', None, None)
+    """
+    return _HEAD + _digest(name, text) + _DATA + text + b"}"
+
+
+def unsealed(name: str, sealed: bytes) -> bytes | None:
+    """The JSON text :func:`seal` sealed under ``name``, or None when ``sealed`` is not that."""
+    start = len(_HEAD) + 64 + len(_DATA)
+    text = sealed[start:-1]
+    return text if sealed.endswith(b"}") and sealed[:start] == _HEAD + _digest(name, text) + _DATA else None
+
+
+def _digest(name: str, text: bytes) -> bytes:
+    return hashlib.sha256(name.encode() + b"\0" + text).hexdigest().encode()
+
+
+def _mine(status: os.stat_result) -> bool:
+    """Whether a file is a regular one of at most :data:`ENTRY_BYTES` that no one but this user (or root) can
+    have written: theirs, and writable by no one else. Where files have no owner (Windows), any."""
+    if not stat.S_ISREG(status.st_mode) or status.st_size > ENTRY_BYTES:
+        return False
+    if not hasattr(os, "geteuid"):
+        return True
+    return status.st_uid in (os.geteuid(), 0) and not status.st_mode & 0o022

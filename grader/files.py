@@ -57,9 +57,10 @@ def usual_mode(path: Path, folder: bool = False) -> None:
     os.chmod(path, (0o777 if folder else 0o666) & ~UMASK)
 
 
-def write_atomic(path: Path, text: str | bytes | Iterable[str]) -> None:
-    """Write ``text`` (UTF-8), bytes, or text in pieces (written as they come) to ``path`` atomically.
-    An ``OSError`` it raises names a path (a failed ``write()``, say on a full disk, names none by itself)."""
+def write_atomic(path: Path, text: str | bytes | Iterable[str], mode: int = 0o666) -> None:
+    """Write ``text`` (UTF-8), bytes, or text in pieces (written as they come) to ``path`` atomically, with
+    the permissions ``mode`` less the umask. An ``OSError`` it raises names a path (a failed ``write()``, say
+    on a full disk, names none by itself)."""
     path.parent.mkdir(parents=True, exist_ok=True)
     try:
         handle, temporary = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
@@ -72,7 +73,7 @@ def write_atomic(path: Path, text: str | bytes | Iterable[str]) -> None:
             else:
                 for piece in text:
                     stream.write(piece.encode("utf-8"))
-        usual_mode(Path(temporary))
+        os.chmod(temporary, mode & ~UMASK)
         os.replace(temporary, path)
     except BaseException as error:
         Path(temporary).unlink(missing_ok=True)

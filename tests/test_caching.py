@@ -90,7 +90,19 @@ def test_a_damaged_entry_is_a_miss(cache: Path, damage: str) -> None:
     (entry,) = cache.glob("yaml-*.json")
     entry.write_text(damage, encoding="utf-8")
     assert same(parse_yaml(text, Path("a.yaml")), first)
-    assert same(json.loads(entry.read_text(encoding="utf-8"))["data"], first)  # written again
+    assert same(caching.read_entry(entry)["data"], first)  # written again
+
+
+@pytest.mark.parametrize("stored", [[1], {"data": 1, "more": 2}, {"other": {}}, None],
+                         ids=["a list", "extra key", "no data", "null"])
+def test_an_entry_of_the_wrong_shape_is_a_miss(cache: Path, stored: Any) -> None:
+    """Written as grader writes entries (under its name, with its digest): only its shape is wrong."""
+    text = b"h: 1\nlist: [1, 2.5]\n"
+    first = parse_yaml(text, Path("a.yaml"))
+    (entry,) = cache.glob("yaml-*.json")
+    caching.write_entry(entry, stored)
+    assert same(parse_yaml(text, Path("a.yaml")), first)
+    assert same(caching.read_entry(entry)["data"], first)
 
 
 def test_a_cache_that_cannot_be_written_only_costs_time(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
@@ -199,7 +211,68 @@ def test_an_entry_larger_than_any_grader_writes_is_not_read(cache: Path) -> None
 
 
 def test_data_larger_than_an_entry_may_be_is_not_kept(cache: Path, monkeypatch: pytest.MonkeyPatch) -> None:
-    monkeypatch.setattr(caching, "ENTRY_BYTES", 100)
+    monkeypatch.setattr(caching, "ENTRY_BYTES", 200)  # 113 bytes of seal
     caching.write_entry(cache / "big.json", {"text": "x" * 100})
     caching.write_entry(cache / "small.json", {"text": "x"})
     assert [path.name for path in cache.iterdir()] == ["small.json"]
+
+
+def test_an_entry_moved_under_another_files_name_is_a_miss(cache: Path) -> None:
+    """What another file reads as, under this file's name (copied, restored from a backup): this file's data was
+    taken to be the other's."""
+    parse_yaml(b"h: 2\n", Path("b.yaml"))
+    (other,) = cache.glob("yaml-*.json")
+    entry = _yaml_entry_beside(cache, b"h: 1\n")
+    entry.write_bytes(other.read_bytes())
+    assert parse_yaml(b"h: 1\n", Path("a.yaml")) == {"h": 1}
+
+
+def _yaml_entry_beside(cache: Path, text: bytes) -> Path:
+    before = set(cache.glob("yaml-*.json"))
+    parse_yaml(text, Path("a.yaml"))
+    (entry,) = set(cache.glob("yaml-*.json")) - before
+    return entry
+
+
+def test_an_entry_changed_since_it_was_written_is_a_miss(cache: Path) -> None:
+    """A number changed in an entry that stays JSON of the right shape (a flipped bit, a hand edit) changed the
+    result."""
+    entry = _yaml_entry(cache, b"h: 12345\n")
+    entry.write_bytes(entry.read_bytes().replace(b"12345", b"12945"))
+    assert parse_yaml(b"h: 12345\n", Path("a.yaml")) == {"h": 12345}
+
+
+def test_an_entry_another_user_wrote_is_a_miss(cache: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """Whoever can write the cache folder decided what a template read as: only this user's entries (or root's)
+    are read."""
+    import os
+
+    entry = _yaml_entry(cache, b"h: 1\n")
+    caching.write_entry(entry, {"data": {"h": 7}})  # what another user could write
+    assert parse_yaml(b"h: 1\n", Path("a.yaml")) == {"h": 7}  # mine: read
+    if os.geteuid() == 0:
+        os.chown(entry, 65534, 65534)
+    else:
+        monkeypatch.setattr(os, "geteuid", lambda: os.getuid() + 1)
+    assert parse_yaml(b"h: 1\n", Path("a.yaml")) == {"h": 1}
+
+
+@pytest.mark.parametrize("mode", [0o666, 0o646, 0o664], ids=["anyone", "others", "the group"])
+def test_an_entry_others_may_write_is_a_miss_and_written_again_for_me_alone(cache: Path, mode: int) -> None:
+    import os
+
+    caching_entry = _yaml_entry(cache, b"h: 1\n")
+    caching.write_entry(caching_entry, {"data": {"h": 7}})
+    os.chmod(caching_entry, mode)
+    assert parse_yaml(b"h: 1\n", Path("a.yaml")) == {"h": 1}
+    assert caching_entry.stat().st_mode & 0o022 == 0
+    assert caching.read_entry(caching_entry) == {"data": {"h": 1}}
+
+
+def test_entries_are_written_for_me_alone_whatever_the_umask(cache: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """Under umask 002 (many distributions' default for users) entries were group-writable."""
+    import grader.files
+
+    monkeypatch.setattr(grader.files, "UMASK", 0o002)
+    entry = _yaml_entry(cache, b"h: 1\n")
+    assert entry.stat().st_mode & 0o777 == 0o644

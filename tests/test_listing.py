@@ -3,15 +3,16 @@ anything else reads and checks the banks again, with their messages."""
 
 from __future__ import annotations
 
-import json
 import os
 import shutil
 from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 import pytest
 
 import grader.bank.template
+from grader import caching
 from grader.bank import listing as listing_module
 from grader.bank.listing import Listed, listing
 from grader.bank.template import load_banks
@@ -119,24 +120,41 @@ def test_folders_that_cannot_be_listed_are_refused_as_loading_refuses_them(cache
         assert str(listed.value) == str(loading.value)
 
 
-def _rows_retyped(text: str) -> str:
+def _rows_retyped(entry: Any) -> Any:
     """The right key and files, a row whose version is text: read as a miss, not trusted."""
-    entry = json.loads(text)
     entry["templates"][0]["version"] = str(entry["templates"][0]["version"])
-    return json.dumps(entry)
+    return entry
 
 
-DAMAGE = {"empty": lambda text: "", "cut short": lambda text: text[:len(text) // 2], "a list": lambda text: "[]",
-          "null": lambda text: "null", "no key": lambda text: '{"templates": []}', "bad rows": _rows_retyped,
-          "a row missing": lambda text: text.replace('"where": ', '"there": ', 1)}
+def _row_renamed(entry: Any) -> Any:
+    entry["templates"][0]["there"] = entry["templates"][0].pop("where")
+    return entry
+
+
+CUT = {"empty": lambda text: b"", "cut short": lambda text: text[:len(text) // 2],
+       "a digit changed": lambda text: text.replace(b'"version": 1', b'"version": 2', 1)}
+DAMAGE = {"a list": lambda entry: [], "null": lambda entry: None, "no key": lambda entry: {"templates": []},
+          "bad rows": _rows_retyped, "a row missing": _row_renamed}
+
+
+@pytest.mark.parametrize("damage", CUT.values(), ids=CUT.keys())
+def test_a_damaged_entry_is_a_miss(cache: Path, mine: Path, monkeypatch: pytest.MonkeyPatch,
+                                   damage: Callable[[bytes], bytes]) -> None:
+    good = listing([mine], False)
+    (entry,) = cache.glob("bank-*.json")
+    entry.write_bytes(damage(entry.read_bytes()))
+    assert listing([mine], False) == good
+    no_reading(monkeypatch)
+    assert listing([mine], False) == good  # and written again
 
 
 @pytest.mark.parametrize("damage", DAMAGE.values(), ids=DAMAGE.keys())
-def test_a_damaged_entry_is_a_miss(cache: Path, mine: Path, monkeypatch: pytest.MonkeyPatch,
-                                   damage: Callable[[str], str]) -> None:
+def test_an_entry_of_the_wrong_shape_is_a_miss(cache: Path, mine: Path, monkeypatch: pytest.MonkeyPatch,
+                                               damage: Callable[[Any], Any]) -> None:
+    """Written as grader writes entries (under its name, with its digest): only what it holds is wrong."""
     good = listing([mine], False)
     (entry,) = cache.glob("bank-*.json")
-    entry.write_text(damage(entry.read_text(encoding="utf-8")), encoding="utf-8")
+    caching.write_entry(entry, damage(caching.read_entry(entry)))
     assert listing([mine], False) == good
     no_reading(monkeypatch)
     assert listing([mine], False) == good  # and written again
@@ -160,7 +178,10 @@ def test_a_cache_that_cannot_be_written_only_costs_time(tmp_path: Path, mine: Pa
 def test_an_entry_made_by_another_grader_is_a_miss(cache: Path, mine: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     listing([mine], False)
     (entry,) = cache.glob("bank-*.json")
-    entry.write_text(entry.read_text(encoding="utf-8").replace('"title": "', '"title": "stale '), encoding="utf-8")
+    stale = caching.read_entry(entry)
+    for row in stale["templates"]:
+        row["title"] = "stale " + row["title"]
+    caching.write_entry(entry, stale)
     monkeypatch.setattr(listing_module, "_key", lambda: "another grader's key")
     assert all(not row.title.startswith("stale") for row in listing([mine], False))
 

@@ -173,12 +173,12 @@ def parse_yaml(data: bytes, path: Path) -> Any:
 
     What the bytes read as is kept in the cache folder (:mod:`grader.caching`), keyed by their SHA-256 and
     by :data:`YAML_SOURCES`: the same bytes again are read back from JSON, without PyYAML. Only data JSON
-    gives back exactly is kept (:func:`plain_data`: all a template or an assignment holds); a file that is
-    refused is read, and refused with its message, every time.
+    gives back exactly is kept (:func:`plain_data`: all a template or an assignment holds), and only such data
+    is read back; a file that is refused is read, and refused with its message, every time.
     """
     entry = caching.entry(f"yaml-{_yaml_key(data)}.json")
     stored = caching.read_entry(entry)
-    if isinstance(stored, dict) and set(stored) == {"data"}:
+    if isinstance(stored, dict) and set(stored) == {"data"} and plain_data(stored["data"]):  # JSON has NaN
         return stored["data"]
     from grader.yaml_loader import load_yaml
 

@@ -276,3 +276,13 @@ def test_entries_are_written_for_me_alone_whatever_the_umask(cache: Path, monkey
     monkeypatch.setattr(grader.files, "UMASK", 0o002)
     entry = _yaml_entry(cache, b"h: 1\n")
     assert entry.stat().st_mode & 0o777 == 0o644
+
+
+@pytest.mark.parametrize("data", [{"h": float("nan")}, {"h": [1, float("inf")]}, {"h": -float("inf")}],
+                         ids=["NaN", "Infinity", "-Infinity"])
+def test_an_entry_holding_what_no_yaml_file_reads_as_is_a_miss(cache: Path, data: Any) -> None:
+    """JSON's NaN and Infinity tokens were read back as numbers no YAML file gives (the loader refuses them): a
+    template's `version: NaN` was refused, naming the user's file."""
+    entry = _yaml_entry(cache, b"h: 1\n")
+    caching.write_entry(entry, {"data": data})
+    assert parse_yaml(b"h: 1\n", Path("a.yaml")) == {"h": 1}

@@ -74,6 +74,14 @@ INVALID = [
     ("fixed-after", set_in("stages/1/after", {"ball": "v_after", "floor": "w"}),
      "stages[1].after.floor: expected no velocity after the impact for a fixed body (it keeps the velocity given"),
     ("tolerance", set_in("answers/e/tolerance", {"rtol": -1}), "answers.e.tolerance.rtol: expected a number from 0"),
+    ("title-escape", set_in("title", "\x1b[2J\x1b[31mBall"),
+     "title: expected one line of text without control characters, got '\\x1b[2J\\x1b[31mBall'"),
+    ("title-return", set_in("title", "Ball\rdropped"), r"title: expected one line of text without control"),
+    ("title-line-separator", set_in("title", "Ball\u2028dropped"), r"got 'Ball\u2028dropped'"),
+    ("answer-key", lambda raw: raw["answers"].update({"e\x1b[31m\r": raw["answers"].pop("e")}),
+     r"answers: expected names of letters, digits and _, got 'e\x1b[31m\r'"),
+    ("answer-key-newline", lambda raw: raw["answers"].update({"e\n": raw["answers"].pop("e")}),
+     r"answers: expected names of letters, digits and _, got 'e\n'"),
 ]
 
 

@@ -242,6 +242,18 @@ def _own_bank(tmp_path: Path, name: str, template_id: str, old: str = "", new: s
     return folder
 
 
+@pytest.mark.parametrize("title", ["Ball\\rdropped", "Ball\\u2028dropped", "\\e[2J\\e[31mBall"],
+                         ids=["return", "line separator", "escape sequence"])
+def test_list_refuses_a_title_a_terminal_would_act_on(tmp_path: Path, capsys: pytest.CaptureFixture[str],
+                                                      title: str) -> None:
+    """A title with a line break of any kind stopped `grader list` with a traceback (its table had more lines than
+    templates); an escape sequence was printed for the terminal to act on."""
+    mine = _own_bank(tmp_path, "mine", "my-drop", "title: Ball dropped onto a rigid floor", f'title: "{title}"')
+    code, out, err = run(capsys, "--bank", str(mine), "--no-shipped-bank", "list")
+    assert code == 2 and not out
+    assert "my-drop.yaml: title: expected one line of text without control characters" in err
+
+
 @pytest.mark.parametrize("command", [
     ["list"], ["show", "my-drop"], ["solve", "my-drop", "--set", "h_drop=2100", "--set", "h_rebound=1100"],
     ["simulate", "my-drop", "--set", "h_drop=2100", "--set", "h_rebound=1100"], ["check-bank", "--no-shipped-bank"],

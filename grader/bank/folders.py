@@ -1,12 +1,16 @@
-"""Where a bank's templates are (the shipped folder and the ones given, each template file of each), and
-the topics ``grader list`` groups them by: what a listing needs before any template is read.
+r"""Where a bank's templates are (the shipped folder and the ones given, each template file of each), the
+topics ``grader list`` groups them by, and what a template's id, title and names may be: what a listing
+needs before any template is read, and to check one read back from the cache.
 
 >>> [path.name for path in template_files(bank_folders()[0])][:2]
 ['ball-plate.yaml', 'ballistic-pendulum.yaml']
+>>> bool(TEMPLATE_ID.match("pile-driver")), bool(NAME.match("h_drop")), bool(NAME.match("h_drop\n"))
+(True, True, False)
 """
 
 from __future__ import annotations
 
+import re
 from collections.abc import Sequence
 from pathlib import Path
 
@@ -20,6 +24,25 @@ its scene decides: a scene with a slide is impact and sliding, one with a projec
 with flight; else an impact with t components (or a velocity from its components) is oblique; else
 a scene with a swing is an impact and a swing; else a scene with a fall, a rise or bounces is drops and
 rebounds; else it is a direct impact."""
+
+
+TEMPLATE_ID = re.compile(r"[a-z0-9][a-z0-9-]*\Z")
+"""A template's id (its file's name without ``.yaml``): lower-case letters, digits and ``-``."""
+
+NAME = re.compile(r"[A-Za-z][A-Za-z0-9_]*\Z")
+"""A parameter's, a symbol's, an answer's or a body's name: letters, digits and ``_``, a letter first."""
+
+_NOT_IN_A_LINE = re.compile(r"[\x00-\x1f\x7f-\x9f\u2028\u2029\u202a-\u202e\u2066-\u2069]")
+
+
+def one_line(text: str) -> bool:
+    r"""Whether ``text`` is one line a terminal shows as it is: no control character (an escape sequence, a
+    line break of any kind) and no bidirectional override (which reorders what follows it).
+
+    >>> one_line("Ball dropped onto a rigid floor"), one_line("Ball\rdropped"), one_line("\x1b[31mBall")
+    (True, False, False)
+    """
+    return not _NOT_IN_A_LINE.search(text)
 
 
 def template_files(folder: Path) -> list[Path]:

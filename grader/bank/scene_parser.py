@@ -9,16 +9,14 @@
 
 from __future__ import annotations
 
-import re
 from collections.abc import Mapping
 from typing import Any
 
+from grader.bank.folders import NAME
 from grader.errors import ExpressionError, TemplateError, shown
 from grader.model.expr import Node, names, parse
 from grader.model.scene import Body, Gravity, Scene, Stage, Velocity
 from grader.physics.effects import CATALOGUE, Effect, Field
-
-IDENTIFIER = re.compile(r"^[A-Za-z][A-Za-z0-9_]*$")
 
 
 def parse_scene(raw: Mapping[str, Any], where: str, gravity: Gravity | None) -> Scene:
@@ -37,7 +35,7 @@ def _parse_bodies(raw: Any, where: str) -> dict[str, Body]:
     bodies = {}
     for name, spec in raw.items():
         key = f"bodies.{name}"
-        if not IDENTIFIER.match(str(name)):
+        if not NAME.match(str(name)):
             raise TemplateError(where, key, "a name of letters, digits and _", shown(name))
         if not isinstance(spec, Mapping) or set(spec) - {"mass", "fixed", "radius"}:
             raise TemplateError(where, key, "{mass: EXPR} or {fixed: true}, and optionally radius: EXPR", shown(spec))
@@ -100,7 +98,7 @@ def _parse_field(spec: Field, value: Any, where: str, key: str, bodies: Mapping[
             raise TemplateError(where, key, "{n: EXPR, t: EXPR}", shown(value))
         return Velocity(_expr(value["n"], where, f"{key}.n"), _expr(value["t"], where, f"{key}.t"))
     if spec.kind == "name":
-        if not (isinstance(value, str) and IDENTIFIER.match(value)):
+        if not (isinstance(value, str) and NAME.match(value)):
             raise TemplateError(where, key, "a quantity name of letters, digits and _", shown(value))
         return value
     if spec.kind.startswith("choice:"):

@@ -17,8 +17,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from grader.bank.folders import TOPICS, bank_folders, template_files
-from grader.bank.scene_parser import IDENTIFIER, parse_scene
+from grader.bank.folders import NAME, TEMPLATE_ID, TOPICS, bank_folders, one_line, template_files
+from grader.bank.scene_parser import parse_scene
 from grader.errors import ExpressionError, GraderError, TemplateError, shown
 from grader.inputs import YAML_BYTES, parse_yaml, read_bytes
 from grader.model.expr import Node, Num, Op, Sym, names, parse, to_text
@@ -31,7 +31,6 @@ from grader.resources import bank_dir
 RESERVED = {"g", "pi"}
 _BOUND = r"(-?inf|[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)"
 _INTERVAL = re.compile(rf"^\s*([\[(])\s*{_BOUND}\s*,\s*{_BOUND}\s*([\])])\s*$")
-_ID = re.compile(r"[a-z0-9][a-z0-9-]*\Z")
 _TOP_KEYS = {"id", "title", "topic", "version", "gravity", "bodies", "stages", "symbols", "parameters",
              "constraints", "answers", "tolerance", "statement", "example"}
 
@@ -217,7 +216,7 @@ def load_one(template_id: str, directory: Path | None = None) -> Template | None
     ('Ball dropped onto a rigid floor', None, None)
     """
     path = (directory or bank_dir()) / f"{template_id}.yaml"
-    if not _ID.match(template_id) or not path.is_file():
+    if not TEMPLATE_ID.match(template_id) or not path.is_file():
         return None
     return load_template(path)
 
@@ -270,7 +269,7 @@ def parse_template(raw: Mapping[str, Any], where: str, source_hash: str, stem: s
         raise TemplateError(where, ", ".join(sorted(map(str, unknown))),
                             f"only the keys {', '.join(sorted(_TOP_KEYS))}", "unknown key(s)")
     template_id = _text(raw, "id", where)
-    if not _ID.match(template_id):
+    if not TEMPLATE_ID.match(template_id):
         raise TemplateError(where, "id", "lower-case letters, digits and -", shown(template_id))
     if stem is not None and stem != template_id:
         raise TemplateError(where, "id", f"the file name's stem '{stem}'", shown(template_id))
@@ -284,16 +283,20 @@ def parse_template(raw: Mapping[str, Any], where: str, source_hash: str, stem: s
         raise TemplateError(where, "symbols", "a mapping of names to {unit: ..., description: ...}", shown(symbols_raw))
     symbols = {name: _symbol(name, spec, where) for name, spec in symbols_raw.items()}
     for name in list(parameters) + list(symbols):
-        if not IDENTIFIER.match(name) or name in RESERVED:
+        if not NAME.match(name) or name in RESERVED:
             raise TemplateError(where, name, "a name of letters, digits and _, not g or pi", shown(name))
     both = set(parameters) & set(symbols)
     if both:
         raise TemplateError(where, "symbols", "names not also parameters", ", ".join(sorted(both)))
     scene = parse_scene(raw, where, gravity)
     default = tolerance_in(raw.get("tolerance", {}), where, "tolerance")
-    answers = {name: _answer(name, spec, where, default) for name, spec in _mapping(raw, "answers", where).items()}
+    answers_raw = _mapping(raw, "answers", where)
+    for name in answers_raw:
+        if not NAME.match(name):
+            raise TemplateError(where, "answers", "names of letters, digits and _", shown(name))
+    answers = {name: _answer(name, spec, where, default) for name, spec in answers_raw.items()}
     template = Template(
-        id=template_id, title=_text(raw, "title", where), topic=_topic(raw.get("topic"), scene, where),
+        id=template_id, title=_title(raw, where), topic=_topic(raw.get("topic"), scene, where),
         version=version, where=where,
         source_hash=source_hash, scene=scene, parameters=parameters, symbols=symbols,
         constraints=tuple(_constraint(i, c, where) for i, c in enumerate(_list(raw, "constraints", where))),
@@ -451,6 +454,13 @@ def _text(raw: Mapping[str, Any], key: str, where: str) -> str:
     if not isinstance(value, str) or not value.strip():
         raise TemplateError(where, key, "non-empty text", shown(value))
     return value.strip()
+
+
+def _title(raw: Mapping[str, Any], where: str) -> str:
+    title = _text(raw, "title", where)
+    if not one_line(title):  # grader list and show print it to a terminal
+        raise TemplateError(where, "title", "one line of text without control characters", shown(title))
+    return title
 
 
 def _list(raw: Mapping[str, Any], key: str, where: str) -> list[Any]:

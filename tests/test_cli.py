@@ -215,6 +215,22 @@ def test_list_groups_the_bank_by_topic(capsys: pytest.CaptureFixture[str]) -> No
     assert [r["topic"] for r in records] == sorted((r["topic"] for r in records), key=TOPICS.index)
 
 
+def test_list_shows_the_bank_whatever_its_cache_entry_says(capsys: pytest.CaptureFixture[str], tmp_path: Path,
+                                                          monkeypatch: pytest.MonkeyPatch) -> None:
+    """A listing entry (sealed as grader seals them) with a topic outside the list stopped `grader list` with a
+    traceback; one with a row no template file has listed it."""
+    from grader import caching
+
+    monkeypatch.setenv("GRADER_CACHE_DIR", str(tmp_path))
+    _, fresh, _ = run(capsys, "list")
+    (entry,) = tmp_path.glob("bank-*.json")
+    kept = caching.read_entry(entry)
+    kept["templates"][0]["topic"] = "no such topic"
+    kept["templates"].append({**kept["templates"][1], "id": "ghost", "title": "\x1b[31mghost"})
+    caching.write_entry(entry, kept)
+    assert run(capsys, "list") == (0, fresh, "")
+
+
 def test_show_prints_the_statement_with_the_example_numbers_and_their_answers(
         capsys: pytest.CaptureFixture[str]) -> None:
     code, out, _ = run(capsys, "show", "pile-driver")

@@ -204,3 +204,51 @@ def test_the_key_covers_everything_reading_a_template_runs() -> None:
 
     outside = sorted(module for module in needed if not is_covered(module))
     assert not outside, f"reading a template imports modules the listing's key does not read: {outside}"
+
+
+def _first_row(**changes: Any) -> Callable[[Any], Any]:
+    def change(entry: Any) -> Any:
+        entry["templates"][0].update(changes)
+        return entry
+    return change
+
+
+def _ghost(entry: Any) -> Any:
+    entry["templates"].append({**entry["templates"][0], "id": "ghost", "title": "Not a template"})
+    return entry
+
+
+def _swapped(entry: Any) -> Any:
+    entry["templates"].reverse()
+    return entry
+
+
+def _twice(entry: Any) -> Any:
+    entry["templates"][1] = dict(entry["templates"][0])
+    return entry
+
+
+HOSTILE = {
+    "a topic not in the list": _first_row(topic="no such topic"), "no topic": _first_row(topic=""),
+    "an escape sequence": _first_row(title="\x1b[2J\x1b[31mpwned"), "a line break": _first_row(title="a\rb"),
+    "an empty title": _first_row(title=""), "a title with spaces around": _first_row(title=" a "),
+    "a template no file holds": _ghost,
+    "a template missing": lambda entry: {**entry, "templates": entry["templates"][1:]},
+    "rows swapped": _swapped, "one template twice": _twice, "an id not the file's": _first_row(id="my-other"),
+    "an id with a slash": _first_row(id="../../etc/passwd"), "version 0": _first_row(version=0),
+    "a parameter that is no name": _first_row(parameters=["h\x1b[31m"]), "an answer that is no name": _first_row(
+        answers=["e\n"]), "a file elsewhere": _first_row(where="/etc/passwd"),
+}
+
+
+@pytest.mark.parametrize("hostile", HOSTILE.values(), ids=HOSTILE.keys())
+def test_an_entry_showing_what_no_template_file_says_is_a_miss(cache: Path, mine: Path, hostile: Callable[[Any], Any],
+                                                                monkeypatch: pytest.MonkeyPatch) -> None:
+    """Sealed as grader seals entries, for these very files: a topic outside the list stopped `grader list` with a
+    traceback, a title with a line break too, and a row no template file has was listed."""
+    good = listing([mine], False)
+    (entry,) = cache.glob("bank-*.json")
+    caching.write_entry(entry, hostile(caching.read_entry(entry)))
+    assert listing([mine], False) == good
+    no_reading(monkeypatch)
+    assert listing([mine], False) == good  # and written again

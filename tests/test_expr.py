@@ -101,3 +101,29 @@ def test_unknown_or_malformed_units_are_refused(unit: str) -> None:
     """A unit we cannot read is an error that quotes it."""
     with pytest.raises(GraderError, match=unit.replace("^", r"\^").replace("/", "/")):
         parse_unit(unit)
+
+
+@pytest.mark.parametrize("data", [
+    ["__import__", "x"], ["div", "x"], ["neg", "x", "y"], ["and", "x"], [], [1, "x"], {"q": [1, 0]}, {"q": [True, 1]},
+    {"q": [1.5, 2]}, {"q": [1]}, {"f": "1e5"}, {"f": float("nan")}, {"f": 1}, {"q": [1, 2], "f": 0.5}, {}, 1, None,
+    True, ("add", "x", "y"),
+], ids=repr)
+def test_a_tree_read_from_json_is_one_to_json_writes_or_refused(data: object) -> None:
+    """A compiled template's trees come from the cache: an unknown operation or a wrong number of arguments failed
+    only when the kernel was built (KeyError), a zero denominator was a ZeroDivisionError, a NaN an ExpressionError
+    (exit 2, naming no file); a number written as text was read as one."""
+    from grader.model.expr import from_json
+
+    with pytest.raises(ValueError, match="not an expression tree"):
+        from_json(data)
+
+
+@pytest.mark.parametrize("text", ["hypot(a, -2.5*b)", "h_r <= h and h > 0 or x < 1 and y > 2 and z >= 0",
+                                  "sind(x)**2 + Max(1/3, Min(x, 2))", "atan2(y, x) - pi"])
+def test_every_tree_reads_back_from_json(text: str) -> None:
+    import json
+
+    from grader.model.expr import from_json, to_json
+
+    tree = parse(text, allow_compare=True)
+    assert from_json(json.loads(json.dumps(to_json(tree)))) == tree

@@ -272,14 +272,41 @@ def to_json(node: Node) -> Any:
 
 
 def from_json(data: Any) -> Node:
-    """Inverse of :func:`to_json`.
+    """Inverse of :func:`to_json`; anything :func:`to_json` does not write (an unknown operation, a wrong number
+    of arguments, a zero denominator, a NaN, a number as text) is a ``ValueError``.
 
     >>> tree = parse("hypot(a, -2.5*b)")
     >>> from_json(to_json(tree)) == tree
     True
+    >>> from_json(["__import__", "os"])
+    Traceback (most recent call last):
+    ...
+    ValueError: not an expression tree: ['__import__', 'os']
     """
-    if isinstance(data, str):
+    if type(data) is str:
         return Sym(data)
-    if isinstance(data, dict):
-        return Num(Fraction(*data["q"])) if "q" in data else Num(float(data["f"]))
-    return Op(data[0], tuple(from_json(a) for a in data[1:]))
+    if type(data) is dict:
+        return _number_from_json(data)
+    if type(data) is list and data and _takes(data[0], len(data) - 1):
+        return Op(data[0], tuple(from_json(a) for a in data[1:]))
+    raise ValueError(f"not an expression tree: {data!r:.80}")
+
+
+_ARGUMENTS = {**FUNCTIONS, **dict.fromkeys(("add", "sub", "mul", "div", "pow", *_COMPARE.values()), 2), "neg": 1}
+
+
+def _takes(op: Any, count: int) -> bool:
+    """Whether the operation ``op`` takes ``count`` arguments (``and`` and ``or`` two or more)."""
+    if op in _BOOLEAN.values():
+        return count >= 2
+    return type(op) is str and _ARGUMENTS.get(op) == count
+
+
+def _number_from_json(data: dict[str, Any]) -> Num:
+    exact, inexact = data.get("q"), data.get("f")
+    if (len(data) == 1 and type(exact) is list and len(exact) == 2 and all(type(n) is int for n in exact)
+            and exact[1] != 0):
+        return Num(Fraction(exact[0], exact[1]))
+    if len(data) == 1 and type(inexact) is float and inexact == inexact:
+        return Num(inexact)
+    raise ValueError(f"not an expression tree: {data!r:.80}")

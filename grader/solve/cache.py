@@ -16,6 +16,7 @@ from typing import TYPE_CHECKING, Any, Protocol, TypeVar
 from grader import caching
 from grader.bank.template import Template
 from grader.caching import cache_dir
+from grader.errors import GraderError
 from grader.solve.compiled import FORMAT, Compiled
 
 if TYPE_CHECKING:  # each read where it is asked for: a warm `grader solve` needs neither
@@ -76,6 +77,10 @@ def routes_for(template: Template) -> Routes:
 
 
 class _Stored(Protocol):
+    @property
+    def template_id(self) -> str: ...
+    @property
+    def source_hash(self) -> str: ...
     def to_json(self) -> dict[str, Any]: ...
 
 
@@ -83,15 +88,19 @@ _T = TypeVar("_T", bound=_Stored)
 
 
 def _cached(template: Template, kind: str, read: Callable[[Any], _T], compile_now: Callable[[], _T]) -> _T:
-    """What ``compile_now`` makes for a template, kept as ``<id>-<hash><kind>.json`` (``read`` reads it back)."""
+    """What ``compile_now`` makes for a template, kept as ``<id>-<hash><kind>.json`` (``read`` reads it back); an
+    entry ``read`` cannot read, or made from another template, is made again."""
     key = hashlib.sha256(f"{template.source_hash}/{_fingerprint()}".encode()).hexdigest()[:20]
     path = caching.entry(f"{template.id}-{key}{kind}.json")
     stored = caching.read_entry(path)
     if stored is not None:
         try:
-            return read(stored)
-        except (ValueError, KeyError, TypeError, IndexError):
-            pass
+            kept = read(stored)
+        except (ValueError, KeyError, TypeError, IndexError, AttributeError, RecursionError, GraderError):
+            pass  # what grader writes reads back: anything else is not grader's, or not this grader's
+        else:
+            if kept.template_id == template.id and kept.source_hash == template.source_hash:
+                return kept
     made = compile_now()
     caching.write_entry(path, made.to_json())  # only a first run writes
     return made

@@ -129,9 +129,11 @@ class Compiled:
 
     @classmethod
     def from_json(cls, data: Mapping[str, Any]) -> Compiled:
-        """Inverse of :meth:`to_json`."""
+        """Inverse of :meth:`to_json`; another format is a ``ValueError``."""
         def tree(value: Any) -> Node | None:
             return None if value is None else from_json(value)
+        if data["format"] != FORMAT:
+            raise ValueError(f"compiled in format {data['format']!r}, not {FORMAT}")
         return cls(
             template_id=data["template"], source_hash=data["source_hash"],
             parameters=tuple(data["parameters"]), constants=dict(data["constants"]),

@@ -286,3 +286,83 @@ def test_an_entry_holding_what_no_yaml_file_reads_as_is_a_miss(cache: Path, data
     entry = _yaml_entry(cache, b"h: 1\n")
     caching.write_entry(entry, {"data": data})
     assert parse_yaml(b"h: 1\n", Path("a.yaml")) == {"h": 1}
+
+
+def _kept(cache: Path, count: int) -> list[Path]:
+    """``count`` entries written as grader writes them, each used a second later than the one before."""
+    import os
+
+    paths = []
+    cache.mkdir(exist_ok=True)
+    for index in range(count):
+        path = cache / f"yaml-{index:032x}.json"
+        path.write_bytes(caching.seal(path.name, json.dumps({"data": index}).encode()))
+        os.chmod(path, 0o644)
+        os.utime(path, (1_000_000 + index, 1_000_000 + index))
+        paths.append(path)
+    return paths
+
+
+@pytest.fixture
+def few(monkeypatch: pytest.MonkeyPatch) -> int:
+    """A cache of 10 entries at most, pruned by the next write of this test."""
+    monkeypatch.setattr(caching, "ENTRIES", 10)
+    monkeypatch.setattr(caching, "_PRUNED", set())
+    return 10
+
+
+def test_past_its_bound_the_cache_drops_the_entries_used_longest_ago(cache: Path, few: int) -> None:
+    """Editing a template 100 times left 219 entries, every upgrade of grader a whole new set: the folder grew
+    without bound."""
+    old = _kept(cache, few + 5)
+    caching.write_entry(cache / "yaml-new.json", {"data": "new"})
+    left = sorted(cache.iterdir())
+    assert len(left) == few * 3 // 4
+    assert left == sorted([*old[-(few * 3 // 4 - 1):], cache / "yaml-new.json"])
+
+
+def test_within_its_bound_the_cache_drops_nothing(cache: Path, few: int) -> None:
+    _kept(cache, few - 1)
+    caching.write_entry(cache / "yaml-new.json", {"data": "new"})
+    assert len(list(cache.iterdir())) == few
+
+
+def test_only_graders_own_entries_are_ever_dropped(cache: Path, few: int) -> None:
+    """Nothing a run did not write is deleted: a file of another name or format, one grader sealed under another
+    name, a link, a folder, a file another user owns all stay, however old, and count for nothing."""
+    import os
+
+    strangers = {"notes.txt": b"mine", "yaml-0.json": b'{"data": 1}', "yaml-1.json": caching.seal("yaml-2.json", b"1"),
+                 ".yaml-3.json.x.tmp": b"half"}
+    cache.mkdir()
+    for name, data in strangers.items():
+        (cache / name).write_bytes(data)
+    (cache / "link.json").symlink_to(cache / "notes.txt")
+    (cache / "folder.json").mkdir()
+    foreign = cache / f"yaml-{99:032x}.json"
+    foreign.write_bytes(caching.seal(foreign.name, b'{"data": 99}'))
+    os.chmod(foreign, 0o644)
+    if os.geteuid() == 0:
+        os.chown(foreign, 65534, 65534)
+    for path in cache.iterdir():
+        os.utime(path, (0, 0), follow_symlinks=False)
+    ours = _kept(cache, few + 1)
+    caching.write_entry(cache / "yaml-new.json", {"data": "new"})
+    left = {path.name for path in cache.iterdir()}
+    assert set(strangers) | {"link.json", "folder.json"} <= left
+    assert (foreign.name in left) == (os.geteuid() == 0)  # as another user's file, or as the oldest of mine
+    assert len(left & {path.name for path in ours}) < len(ours)
+
+
+def test_a_run_prunes_the_cache_once(cache: Path, few: int) -> None:
+    _kept(cache, few + 5)
+    caching.write_entry(cache / "yaml-new.json", {"data": "new"})
+    _kept(cache, few + 5)
+    caching.write_entry(cache / "yaml-newer.json", {"data": "newer"})
+    assert len(list(cache.iterdir())) == few + 5 + 2
+
+
+def test_a_run_that_only_reads_prunes_nothing(cache: Path, few: int) -> None:
+    paths = _kept(cache, few + 5)
+    assert [caching.read_entry(path) for path in paths] == [{"data": index} for index in range(few + 5)]
+    assert len(list(cache.iterdir())) == few + 5

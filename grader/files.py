@@ -52,9 +52,10 @@ UMASK = _umask()
 """The process umask, read once: temporary files are private until they take their final name."""
 
 
-def usual_mode(path: Path, folder: bool = False) -> None:
-    """Give a file or folder made by ``tempfile`` the permissions a normally created one has."""
-    os.chmod(path, (0o777 if folder else 0o666) & ~UMASK)
+def usual_mode(path: Path, mode: int = 0o666) -> None:
+    """Give a file made by ``tempfile`` the permissions ``mode`` less the umask, as ``open`` gives a new one
+    (by default, those of any new file)."""
+    os.chmod(path, mode & ~UMASK)
 
 
 def write_atomic(path: Path, text: str | bytes | Iterable[str], mode: int = 0o666) -> None:
@@ -73,7 +74,7 @@ def write_atomic(path: Path, text: str | bytes | Iterable[str], mode: int = 0o66
             else:
                 for piece in text:
                     stream.write(piece.encode("utf-8"))
-        os.chmod(temporary, mode & ~UMASK)
+        usual_mode(Path(temporary), mode)
         os.replace(temporary, path)
     except BaseException as error:
         Path(temporary).unlink(missing_ok=True)

@@ -135,49 +135,6 @@ def write_entry(path: Path | None, data: Any) -> None:
 
     with contextlib.suppress(OSError):
         write_atomic(path, sealed, mode=0o644)
-    prune(path.parent)
-
-
-ENTRIES = 10_000
-"""How many entries a cache folder keeps (the shipped bank's are 60, 0.5 MB; editing a template adds about 4, a
-new version of grader a whole set): past that, :func:`prune` drops the ones used longest ago."""
-
-_PRUNED: set[Path] = set()
-
-
-def prune(folder: Path) -> None:
-    """When ``folder`` holds more than :data:`ENTRIES` of grader's entries, drop those used longest ago (last read
-    or written, as far as the file system tells) until three quarters are left; once a run, and only by a run
-    that writes one. Only grader's own entries are ever deleted: regular files (not links) of this user, whose
-    contents are sealed (:func:`seal`) under their name. A dropped entry is only a miss for the next run."""
-    if folder in _PRUNED:
-        return
-    _PRUNED.add(folder)
-    try:
-        with os.scandir(folder) as found:
-            names = [item.name for item in found if item.name.endswith(".json") and not item.name.startswith(".")]
-    except OSError:
-        return
-    if len(names) <= ENTRIES:
-        return
-    ours = sorted((used, path) for path in map(folder.joinpath, names) if (used := _used(path)) is not None)
-    if len(ours) > ENTRIES:
-        for _, path in ours[:len(ours) - ENTRIES * 3 // 4]:
-            with contextlib.suppress(OSError):
-                path.unlink()
-
-
-def _used(path: Path) -> int | None:
-    """When grader's entry ``path`` was last used (nanoseconds), or None when it is not grader's entry."""
-    try:
-        status = path.lstat()
-        user = _user()
-        if not _mine(status) or (user is not None and status.st_uid != user):  # root's are not this run's to drop
-            return None
-        sealed = path.read_bytes()
-    except OSError:
-        return None
-    return max(status.st_atime_ns, status.st_mtime_ns) if unsealed(path.name, sealed) is not None else None
 
 
 _HEAD = b'{"grader cache entry": 1, "sha256": "'
@@ -214,10 +171,6 @@ def _mine(status: os.stat_result) -> bool:
     have written: theirs, and writable by no one else. Where files have no owner (Windows), any."""
     if not stat.S_ISREG(status.st_mode) or status.st_size > ENTRY_BYTES:
         return False
-    user = _user()
-    return user is None or (status.st_uid in (user, 0) and not status.st_mode & 0o022)
-
-
-def _user() -> int | None:
-    """The id of the user this run is, or None where files have no owner (Windows)."""
-    return os.geteuid() if hasattr(os, "geteuid") else None
+    if not hasattr(os, "geteuid"):
+        return True
+    return status.st_uid in (os.geteuid(), 0) and not status.st_mode & 0o022

@@ -97,8 +97,9 @@ def share(students: int, work: Path) -> list[str]:
     from grader.assign.variants import generate
     from grader.bank.template import load_bank
     from grader.grade.compare import is_correct
+    from grader.model.tolerance import ANSWER_SIG_FIGS
     from grader.solve.cache import routes_for
-    from grader.solve.routes import ANSWER_FIGURES, round_figures, walk_route
+    from grader.solve.routes import round_figures, walk_route
 
     bank = load_bank()
     generation = generate(load_assignment(ASSIGNMENT), load_roster(roster(work / "share.csv", students)), bank)
@@ -121,7 +122,7 @@ def share(students: int, work: Path) -> list[str]:
                 total[label] += int(defined.sum())
                 for figures in (3, 4):
                     given = round_figures(walk_route(routes, route, params,
-                                                     lambda _, v, f=figures: round_figures(v, f)), ANSWER_FIGURES)
+                                                     lambda _, v, f=figures: round_figures(v, f)), ANSWER_SIG_FIGS)
                     for tolerance in set(tolerances):
                         rows = defined & np.array([t == tolerance for t in tolerances])
                         right = is_correct(given[rows], expected[rows], tolerance,

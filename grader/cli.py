@@ -372,9 +372,9 @@ def _show(arguments: argparse.Namespace) -> int:
     scene = template.scene
     lines = [f"{template.id} (version {template.version}): {template.title}",
              f"topic: {template.topic}; file: {template.where}", "", "Statement, with example numbers:"]
-    for paragraph in example_statement(template).split("\n\n"):
-        lines += [*textwrap.wrap(paragraph, 100, initial_indent="  ", subsequent_indent="  "), ""]
-    print("\n".join(lines))
+    for paragraph in example_statement(template).split("\n\n"):  # a paragraph's line breaks are spaces here
+        lines += [*textwrap.wrap(" ".join(paragraph.split()), 100, initial_indent="  ", subsequent_indent="  "), ""]
+    print("\n".join(map(visible, lines)))  # the template's text shown, an escape sequence in it never acted on
     print("Answers for these numbers:")
     _print_solution(template, example.params, example.answers, example.error, False, None)
     lines = ["", "Bodies:"]
@@ -392,7 +392,7 @@ def _show(arguments: argparse.Namespace) -> int:
     for number, step in enumerate(compiled.steps, 1):
         lhs, rhs, solved = (to_text(readable(side, names)) for side in (*step.equation, step.solved))
         lines += [f"  {number}. {step.relation}", f"       {lhs} = {rhs}", f"       => {step.unknown} = {solved}"]
-    print("\n".join(lines))
+    print("\n".join(map(visible, lines)))
     return EXIT_OK
 
 

@@ -246,6 +246,16 @@ def test_show_prints_the_statement_with_the_example_numbers_and_their_answers(
     assert record["example_answers"]["e"]["value"] == pytest.approx(0.63148, rel=1e-5)
 
 
+def test_show_shows_escape_sequences_in_a_template_as_text(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
+    """A template's descriptions reach the terminal as text: an escape sequence in one (YAML has them in
+    double quotes) is shown as its escape, never acted on (a colour, a cleared screen)."""
+    folder = _own_bank(tmp_path, "bank", "escapes", "description: height the ball bounces back up to",
+                       'description: "height the ball bounces back up to\\e[2J"')
+    code, out, _ = run(capsys, "show", "escapes", "--bank", str(folder))
+    assert code == 0 and "\x1b" not in out
+    assert "height the ball bounces back up to\\x1b[2J" in out
+
+
 def _own_bank(tmp_path: Path, name: str, template_id: str, old: str = "", new: str = "") -> Path:
     """A folder with drop-rebound copied as ``template_id`` (``old`` replaced by ``new``)."""
     from grader.resources import bank_dir

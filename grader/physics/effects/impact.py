@@ -114,7 +114,7 @@ class _Impact:
             ))
         # Against a fixed body (a floor, a wall, a plate moving on regardless) a textbook writes the rebound
         # from e first (v' = -e v): the impulse is then a step only where it is asked for.
-        relations.insert(0, restitution) if w2 == 0 else relations.append(restitution)
+        relations.insert(0 if w2 == 0 else len(relations), restitution)
         for index in self.tangents:
             (_, before), (_, after) = self.before[index], self.after[index]
             relations.append(Relation(f"smooth surfaces: no impulse along t, so {self.bodies[index]}'s t-velocity is "

@@ -402,8 +402,7 @@ def bench_startup(arguments: argparse.Namespace) -> tuple[list[StartupRow], floa
     """Each command's median over interleaved rounds (its caches filled and bytecode written by one untimed
     run first), and one cold solve."""
     with tempfile.TemporaryDirectory(prefix="grader-bench-cache-") as cache:
-        env = {name: value for name, value in os.environ.items() if name != "PYTHONDONTWRITEBYTECODE"}
-        env["GRADER_CACHE_DIR"] = cache
+        env = {**os.environ, "GRADER_CACHE_DIR": cache}  # PYTHONDONTWRITEBYTECODE is cleared at the top
         cold = run(grader_command(*SOLVE_ARGS), env=env)  # an empty cache: compiles with sympy
         for command in STARTUP.values():
             run(command, env=env)  # warm: what a user's second run finds

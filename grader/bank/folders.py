@@ -14,7 +14,7 @@ import re
 from collections.abc import Sequence
 from pathlib import Path
 
-from grader.errors import GraderError, UsageError
+from grader.errors import CONTROL, GraderError, UsageError
 from grader.resources import bank_dir
 
 TOPICS = ("direct impact", "oblique impact", "drops and rebounds", "impact and a swing", "impact and sliding",
@@ -32,8 +32,6 @@ TEMPLATE_ID = re.compile(r"[a-z0-9][a-z0-9-]*\Z")
 NAME = re.compile(r"[A-Za-z][A-Za-z0-9_]*\Z")
 """A parameter's, a symbol's, an answer's or a body's name: letters, digits and ``_``, a letter first."""
 
-_NOT_IN_A_LINE = re.compile(r"[\x00-\x1f\x7f-\x9f\u2028\u2029\u202a-\u202e\u2066-\u2069]")
-
 
 def one_line(text: str) -> bool:
     r"""Whether ``text`` is one line a terminal shows as it is: no control character (an escape sequence, a
@@ -42,7 +40,7 @@ def one_line(text: str) -> bool:
     >>> one_line("Ball dropped onto a rigid floor"), one_line("Ball\rdropped"), one_line("\x1b[31mBall")
     (True, False, False)
     """
-    return not _NOT_IN_A_LINE.search(text)
+    return not CONTROL.search(text) and "\u2028" not in text and "\u2029" not in text  # the two line breaks
 
 
 def template_files(folder: Path) -> list[Path]:

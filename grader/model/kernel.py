@@ -378,9 +378,8 @@ class Kernel:
             for step in steps:
                 called = functions.setdefault(step.function, f"f{len(functions)}")
                 namespace[called] = step.function
-                out = outs.get(step.target) or (value(step.out) if step.out >= 0 else None)
-                if step.scratch >= 0:
-                    out = f"s{step.scratch}"
+                out = outs.get(step.target) or (value(step.out) if step.out >= 0 else
+                                                f"s{step.scratch}" if step.scratch >= 0 else None)
                 args = [value(arg) for arg in step.args] + ([f"out={out}"] if out else [])
                 lines.append(f"    v{step.target} = {called}({', '.join(args)})")
             return lines

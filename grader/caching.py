@@ -97,18 +97,19 @@ def entry(name: str) -> Path | None:
         return None
 
 
-def read_entry(path: Path | None) -> Any:
+def read_entry(path: Path | None, *, shipped: bool = False) -> Any:
     """What :func:`write_entry` kept at ``path``, or None when there is nothing grader kept there for this user:
     a file missing or unreadable; not a regular file (a named pipe would block the read, a device never end
     it); larger than :data:`ENTRY_BYTES`; written by another user, or writable by one (only the user and root
     can have written what is read); kept under another name, or changed since (:func:`seal`); JSON nested
-    deeper than Python reads."""
+    deeper than Python reads. A ``shipped`` entry is one the package itself carries (installed with grader's
+    code, so whoever installed it is trusted as the code is): its owner is not asked, the rest is."""
     if path is None:
         return None
     try:
         handle = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0))  # a FIFO opens without a writer
         with os.fdopen(handle, "rb") as stream:
-            if not _mine(os.fstat(handle)):
+            if not _mine(os.fstat(handle), owner=not shipped):
                 return None
             sealed = stream.read(ENTRY_BYTES + 1)
     except OSError:
@@ -166,11 +167,44 @@ def _digest(name: str, text: bytes) -> bytes:
     return hashlib.sha256(name.encode() + b"\0" + text).hexdigest().encode()
 
 
-def _mine(status: os.stat_result) -> bool:
+def _mine(status: os.stat_result, owner: bool = True) -> bool:
     """Whether a file is a regular one of at most :data:`ENTRY_BYTES` that no one but this user (or root) can
-    have written: theirs, and writable by no one else. Where files have no owner (Windows), any."""
+    have written: theirs, and writable by no one else (without ``owner``: any regular file of that size).
+    Where files have no owner (Windows), any."""
     if not stat.S_ISREG(status.st_mode) or status.st_size > ENTRY_BYTES:
         return False
-    if not hasattr(os, "geteuid"):
+    if not owner or not hasattr(os, "geteuid"):
         return True
     return status.st_uid in (os.geteuid(), 0) and not status.st_mode & 0o022
+
+
+def grader_entries(folder: Path) -> list[Path]:
+    """The entries grader wrote in ``folder`` for this user: regular files sealed under their own name (the
+    check :func:`read_entry` makes), in name order; nothing else there is grader's to count or remove.
+
+    >>> import tempfile, pathlib
+    >>> folder = pathlib.Path(tempfile.mkdtemp())
+    >>> write_entry(folder / "yaml-1.json", [1])
+    >>> _ = (folder / "notes.txt").write_text("mine")
+    >>> [path.name for path in grader_entries(folder)]
+    ['yaml-1.json']
+    """
+    try:
+        candidates = sorted(folder.iterdir())
+    except OSError:
+        return []
+    return [path for path in candidates if path.name.endswith(".json") and read_entry(path) is not None]
+
+
+def clear(folder: Path) -> tuple[int, int]:
+    """Remove grader's entries from ``folder`` (:func:`grader_entries`); the number removed and their bytes.
+    Other files, folders and the folder itself stay."""
+    removed = size = 0
+    for path in grader_entries(folder):
+        try:
+            bytes_ = path.stat().st_size
+            path.unlink()
+        except FileNotFoundError:  # another run removed it first
+            continue
+        removed, size = removed + 1, size + bytes_
+    return removed, size

@@ -177,6 +177,15 @@ def build_parser() -> argparse.ArgumentParser:
                     "per template; exit code 2 when any fails.")
     _bank_options(checking_bank)
     checking_bank.add_argument("--json", action="store_true", help="one JSON object per template")
+
+    cache = commands.add_parser(
+        "cache", help="where compiled templates are kept, and how much; 'clear' removes grader's entries",
+        description="Compiled templates and what YAML files read as are kept in $GRADER_CACHE_DIR, else "
+                    "$XDG_CACHE_HOME/grader, else ~/.cache/grader. 'grader cache' says where and how much; "
+                    "'grader cache clear' removes grader's own entries there (nothing else in the folder).")
+    cache.add_argument("action", nargs="?", choices=("info", "clear"), default="info",
+                       help="info (default): where and how much; clear: remove grader's entries")
+    cache.add_argument("--json", action="store_true", help="print one JSON object")
     return parser
 
 
@@ -787,5 +796,33 @@ def _check_bank(arguments: argparse.Namespace) -> int:
     return EXIT_USAGE if failed else EXIT_OK
 
 
+def _cache(arguments: argparse.Namespace) -> int:
+    from grader import caching
+
+    folder = caching.cache_dir()
+    entries = caching.grader_entries(folder)
+    size = sum(path.stat().st_size for path in entries if path.exists())
+    if arguments.action == "clear":
+        removed, freed = caching.clear(folder)
+        summary = {"folder": str(folder), "removed": removed, "bytes": freed}
+        said = f"removed {removed} entries ({_size(freed)}) from {folder}"
+    else:
+        summary = {"folder": str(folder), "entries": len(entries), "bytes": size}
+        said = f"{folder}: {len(entries)} entries, {_size(size)}"
+    print(json.dumps(summary) if arguments.json else visible(said))
+    return EXIT_OK
+
+
+def _size(size: int) -> str:
+    """A number of bytes as a person reads it.
+
+    >>> _size(512), _size(20_480), _size(3_500_000)
+    ('512 bytes', '20 KiB', '3.3 MiB')
+    """
+    if size < 1024:
+        return f"{size} bytes"
+    return f"{size / 1024:.0f} KiB" if size < 1024 * 1024 else f"{size / (1024 * 1024):.1f} MiB"
+
+
 _COMMANDS = {"list": _list, "show": _show, "solve": _solve, "simulate": _simulate, "generate": _generate,
-             "demo": _demo, "grade": _grade, "check": _check, "check-bank": _check_bank}
+             "demo": _demo, "grade": _grade, "check": _check, "check-bank": _check_bank, "cache": _cache}

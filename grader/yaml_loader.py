@@ -181,24 +181,26 @@ def _children(node: Any) -> list[Any]:
 def load_yaml(text: str, path: Path) -> Any:
     """YAML text read from ``path`` (for messages), with the bounds above."""
     try:
-        return yaml.load(text, Loader=_Loader)  # noqa: S506  (_Loader is a bounded SafeLoader)
+        try:
+            return yaml.load(text, Loader=_Loader)  # noqa: S506  (_Loader is a bounded SafeLoader)
+        except yaml.YAMLError as error:
+            problem = _in_python(text, error)
     except GraderError as error:
         raise GraderError(f"{path}: {error}") from None
-    except yaml.YAMLError as error:
-        raise GraderError(f"{path}: expected valid YAML, got {_yaml_problem(_in_python(text, error))}") from None
+    raise GraderError(f"{path}: expected valid YAML, got {_yaml_problem(problem)}") from None
 
 
 def _in_python(text: str, error: yaml.YAMLError) -> yaml.YAMLError:
     """What PyYAML's own parser says of text libyaml refused (``expected ',' or ']', but got '<stream end>'``
-    where libyaml says ``did not find expected ',' or ']'``); ``error`` if it says nothing."""
+    where libyaml says ``did not find expected ',' or ']'``); ``error`` if it says nothing. Where one of our
+    bounds holds the text back, its :class:`GraderError` is raised: libyaml's scanner looks ahead, and its
+    own nesting limit (1,000 in libyaml 0.2.5) fires before our composer reaches :data:`YAML_DEPTH`."""
     if _Loader is _PyLoader:
         return error
     try:
         yaml.load(text, Loader=_PyLoader)  # noqa: S506  (_PyLoader is a bounded SafeLoader)
     except yaml.YAMLError as python_error:
         return python_error
-    except GraderError:
-        pass
     return error
 
 

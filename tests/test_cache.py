@@ -18,9 +18,10 @@ from grader.solve.evaluate import solve_one
 
 @pytest.fixture
 def cache(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
-    """An empty cache folder of this test's own."""
+    """An empty cache folder of this test's own, and no shipped entries: every template is compiled into it."""
     folder = tmp_path / "cache"
     monkeypatch.setenv("GRADER_CACHE_DIR", str(folder))
+    monkeypatch.setattr(solve_cache, "SHIPPED", tmp_path / "none shipped")
     return folder
 
 
@@ -119,3 +120,22 @@ def test_another_templates_alternatives_or_routes_are_compiled_again(cache: Path
     read(bank["pile-driver"])
     caching.write_entry(_entry(cache, "drop-rebound", kind), caching.read_entry(_entry(cache, "pile-driver", kind)))
     assert read(bank["drop-rebound"]) == right
+
+
+@pytest.mark.parametrize("damage", [BROKEN["an unknown operation"], BROKEN["a NaN"], BROKEN["another format"]],
+                         ids=["an unknown operation", "a NaN", "another format"])
+def test_a_damaged_shipped_entry_is_compiled_again(tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
+                                                  damage: Callable[[Any], Any]) -> None:
+    """The package's own entries are read as the cache's are: one that is no compiled template is not used."""
+    import shutil
+
+    shipped = tmp_path / "shipped"
+    shutil.copytree(solve_cache.SHIPPED, shipped)
+    monkeypatch.setattr(solve_cache, "SHIPPED", shipped)
+    monkeypatch.setenv("GRADER_CACHE_DIR", str(tmp_path / "cache"))
+    template = load_bank()["drop-rebound"]
+    right = _answers(template)
+    entry = shipped / solve_cache.entry_name(template, "")
+    _write(entry, damage(caching.read_entry(entry, shipped=True)))
+    assert _answers(template) == right
+    assert [path.name for path in (tmp_path / "cache").glob("drop-rebound-*.json")] == [entry.name]  # compiled

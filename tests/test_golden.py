@@ -1,4 +1,5 @@
-"""The textbook's printed answers (shared/golden-answers.yaml) reproduced to 3 significant figures."""
+"""The textbook's printed answers (tests/data/golden-answers.yaml, with its provenance) reproduced to 3 significant
+figures."""
 
 from __future__ import annotations
 
@@ -12,7 +13,7 @@ from grader.bank.template import Template
 from grader.solve.compiled import Compiled
 from grader.solve.evaluate import solve_one
 
-GOLDEN_FILE = Path(__file__).resolve().parents[2] / "shared" / "golden-answers.yaml"
+GOLDEN_FILE = Path(__file__).resolve().parent / "data" / "golden-answers.yaml"
 GOLDEN = yaml.safe_load(GOLDEN_FILE.read_text(encoding="utf-8"))
 CASES = [(template_id, name, value) for template_id, case in GOLDEN.items()
          for name, value in case["answers"].items()]

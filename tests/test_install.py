@@ -33,6 +33,8 @@ def test_wheel_installed_in_a_fresh_venv_runs_from_another_folder(tmp_path: Path
     shipped = set(zipfile.ZipFile(wheel).namelist())
     sources = {p.relative_to(ROOT).as_posix() for p in (ROOT / "grader").rglob("*.py")}
     assert sources <= shipped, f"modules missing from the wheel (pyproject packages?): {sorted(sources - shipped)}"
+    compiled = {p.relative_to(ROOT).as_posix() for p in (ROOT / "grader" / "solve" / "shipped").glob("*.json")}
+    assert compiled and compiled <= shipped, "the shipped bank's compiled forms must be in the wheel"
     environment = tmp_path / "venv"
     venv.create(environment, with_pip=True)
     python = environment / "bin" / "python"
@@ -61,3 +63,5 @@ def test_wheel_installed_in_a_fresh_venv_runs_from_another_folder(tmp_path: Path
     assert (elsewhere / "demo" / "grades" / "details.csv").read_text(encoding="utf-8").count("\n") == 30 * 15 + 1
     assert len(list((elsewhere / "demo" / "students").glob("*.pdf"))) == 30
     assert (elsewhere / "demo" / "assignment.yaml").is_file() and (elsewhere / "demo" / "roster.csv").is_file()
+    # Everything the demo compiles comes with the wheel: the cache holds no compiled template
+    assert not [p.name for p in (tmp_path / "cache").glob("*.json") if not p.name.startswith(("yaml-", "bank-"))]

@@ -3,11 +3,17 @@
 The key is the template file's hash, the package version and a fingerprint of the solver's
 source: editing either recompiles. The folder is :func:`grader.caching.cache_dir`; if it cannot be
 written, templates are compiled each run and nothing fails.
+
+The shipped bank's entries come with the package too (:data:`SHIPPED`, written by ``python -m
+grader.solve.ship``; a test checks that they are current), under the names the cache gives them: a first run
+on a new machine reads them and pays for sympy only for an instructor's own templates. An entry made from
+other source, or for another version of a template, has another name and is simply not found.
 """
 
 from __future__ import annotations
 
 import hashlib
+import sys
 from collections.abc import Callable
 from functools import lru_cache
 from pathlib import Path
@@ -26,8 +32,13 @@ if TYPE_CHECKING:  # each read where it is asked for: a warm `grader solve` need
 # Every stage folder whose source can change what the solver compiles: editing any file in them
 # recompiles (a test checks that everything the solver imports is inside).
 SOLVER_FOLDERS = ("model", "physics", "bank", "solve")
+SHIPPED = caching.PACKAGE / "solve" / "shipped"
+"""The compiled forms of the shipped bank, carried by the package."""
+KINDS = ("", "-alternatives", "-routes")
+"""What is kept of a template: its compiled form, its alternatives, its routes (the end of the entry's name)."""
 
-__all__ = ["SOLVER_FOLDERS", "alternatives_for", "cache_dir", "compiled_for", "routes_for", "source_fingerprint"]
+__all__ = ["KINDS", "SHIPPED", "SOLVER_FOLDERS", "alternatives_for", "cache_dir", "compiled_for", "entry_name",
+           "routes_for", "source_fingerprint"]
 
 
 def source_fingerprint(package: Path) -> str:
@@ -56,9 +67,18 @@ def alternatives_for(template: Template) -> Alternatives:
     from grader.solve.alternatives import Alternatives
 
     def compile_now() -> Alternatives:
+        import time
+
         from grader.solve.derived import compile_alternatives
 
-        return compile_alternatives(template)
+        # seconds of sympy for an instructor's own template, the first time grading needs it: say so
+        start = time.perf_counter()
+        print(f"grader: deriving the chains of errors carried forward and of mistakes for {template.id} "
+              "(once; kept in the cache)...", file=sys.stderr, flush=True)
+        found = compile_alternatives(template)
+        print(f"grader: {template.id}: {len(found.items)} chains in {time.perf_counter() - start:.1f} s",
+              file=sys.stderr, flush=True)
+        return found
 
     return _cached(template, "-alternatives", Alternatives.from_json, compile_now)
 
@@ -87,12 +107,32 @@ class _Stored(Protocol):
 _T = TypeVar("_T", bound=_Stored)
 
 
-def _cached(template: Template, kind: str, read: Callable[[Any], _T], compile_now: Callable[[], _T]) -> _T:
-    """What ``compile_now`` makes for a template, kept as ``<id>-<hash><kind>.json`` (``read`` reads it back); an
-    entry ``read`` cannot read, or made from another template, is made again."""
+def entry_name(template: Template, kind: str) -> str:
+    """The name a template's entry of ``kind`` (one of :data:`KINDS`) is kept under: ``<id>-<hash><kind>.json``,
+    the hash that of the template's file and of the solver's source."""
     key = hashlib.sha256(f"{template.source_hash}/{_fingerprint()}".encode()).hexdigest()[:20]
-    path = caching.entry(f"{template.id}-{key}{kind}.json")
-    stored = caching.read_entry(path)
+    return f"{template.id}-{key}{kind}.json"
+
+
+def _cached(template: Template, kind: str, read: Callable[[Any], _T], compile_now: Callable[[], _T]) -> _T:
+    """What ``compile_now`` makes for a template, kept as :func:`entry_name` says (``read`` reads it back): from the
+    package's shipped entries, else the cache; an entry ``read`` cannot read, or made from another template, is
+    made again."""
+    name = entry_name(template, kind)
+    kept = _kept(template, read, caching.read_entry(SHIPPED / name, shipped=True))
+    if kept is not None:
+        return kept
+    path = caching.entry(name)
+    kept = _kept(template, read, caching.read_entry(path))
+    if kept is not None:
+        return kept
+    made = compile_now()
+    caching.write_entry(path, made.to_json())  # only a first run writes
+    return made
+
+
+def _kept(template: Template, read: Callable[[Any], _T], stored: Any) -> _T | None:
+    """What an entry holds, if it is this template's."""
     if stored is not None:
         try:
             kept = read(stored)
@@ -101,6 +141,4 @@ def _cached(template: Template, kind: str, read: Callable[[Any], _T], compile_no
         else:
             if kept.template_id == template.id and kept.source_hash == template.source_hash:
                 return kept
-    made = compile_now()
-    caching.write_entry(path, made.to_json())  # only a first run writes
-    return made
+    return None

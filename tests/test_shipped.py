@@ -70,3 +70,31 @@ def test_shipped_entries_are_what_the_solver_compiles_today(bank: dict[str, Temp
     for template in bank.values():
         stored = caching.read_entry(SHIPPED / entry_name(template, kind), shipped=True)
         assert stored == json.loads(json.dumps(compile_now(template).to_json())), template.id
+
+
+def test_an_instructors_own_template_derives_its_diagnosis_chains_when_grading_first_needs_them(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch) -> None:
+    """Generating compiles what the key needs and no more; the first grading says, on stderr, that it derives the
+    chains of errors carried forward and of mistakes (seconds of sympy), and a second grading reads them kept."""
+    from grader.cli import main
+    from grader.resources import bank_dir
+
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setenv("GRADER_CACHE_DIR", str(tmp_path / "cache"))
+    mine = tmp_path / "mine"
+    mine.mkdir()
+    text = (bank_dir() / "drop-rebound.yaml").read_text(encoding="utf-8")
+    (mine / "my-drop.yaml").write_text(text.replace("id: drop-rebound", "id: my-drop"), encoding="utf-8")
+    Path("a.yaml").write_text("title: HW\ncourse: C\nseed: s\nproblems:\n  - template: my-drop\n", encoding="utf-8")
+    Path("r.csv").write_text("id,name,email,section\n1,Ann,a@x.org,A\n", encoding="utf-8")
+    assert main(["generate", "a.yaml", "--roster", "r.csv", "--out", "out", "--no-pdf", "--bank", str(mine)]) == 0
+    assert "deriving" not in capsys.readouterr().err
+    assert not list((tmp_path / "cache").glob("my-drop-*-alternatives.json"))
+    Path("s.csv").write_text("student_id,label,answer\n1,1a,0.5\n", encoding="utf-8")
+    for run, out in ((1, "g1"), (2, "g2")):
+        code = main(["grade", "s.csv", "--key", "out/key.json", "--out", out, "--bank", str(mine)])
+        err = capsys.readouterr().err
+        assert code in (0, 3), err
+        said = "grader: deriving the chains of errors carried forward and of mistakes for my-drop"
+        assert (said in err) == (run == 1), err
+    assert list((tmp_path / "cache").glob("my-drop-*-alternatives.json"))

@@ -799,7 +799,10 @@ def _check_bank(arguments: argparse.Namespace) -> int:
 def _cache(arguments: argparse.Namespace) -> int:
     from grader import caching
 
-    folder = caching.cache_dir()
+    try:
+        folder = caching.cache_dir()
+    except RuntimeError:  # Path.home() found none
+        raise UsageError("there is no home folder to keep a cache in; set GRADER_CACHE_DIR to a folder") from None
     entries = caching.grader_entries(folder)
     size = sum(path.stat().st_size for path in entries if path.exists())
     if arguments.action == "clear":

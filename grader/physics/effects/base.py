@@ -33,6 +33,10 @@ class Field:
     radius), ``expr`` (an expression), ``name`` (a new quantity's name), ``velocities`` (per body: an
     expression, or ``{n:, t:}``), ``vector`` (one ``{n:, t:}``), ``choice:a|b`` (one of the listed
     words), ``flag`` (true or false).
+
+    ``default`` says what an optional key means when it is left out, as the reference shows it: the
+    value taken (``t``, ``false``), the name the solver gives the quantity (``J``), or what the stage
+    then lacks.
     """
 
     name: str
@@ -40,6 +44,7 @@ class Field:
     required: bool = True
     doc: str = ""
     dimension: Dimension | None = None  # what an expression or velocity here must measure
+    default: str | None = None
 
 
 @dataclass(frozen=True)
@@ -121,7 +126,8 @@ class Effect:
     """An entry of the catalogue: its name, what it means, its fields, its relations (the
     closed form), how to simulate it (its force law in the time domain; None: it has none),
     the mistakes students make with it, first the most telling (None: none declared), and the
-    other correct routes through it (None: none)."""
+    other correct routes through it (None: none). ``force_law`` says in words what ``simulate``
+    integrates (for ``grader effects`` and docs/effects.md); every effect states it."""
 
     name: str
     summary: str
@@ -130,3 +136,11 @@ class Effect:
     simulate: Callable[[Stage, Run], None] | None = None
     mistakes: Callable[[Stage, Context], list[Mistake]] | None = None
     routes: Callable[[Stage, Context], list[Route]] | None = None
+    force_law: str = field(kw_only=True)
+
+    def __post_init__(self) -> None:
+        if not self.force_law.strip():
+            raise ValueError(f"effect {self.name}: force_law must say what its simulation integrates")
+        for spec in self.fields:
+            if spec.required and spec.default is not None:
+                raise ValueError(f"effect {self.name}: field {spec.name} is required, so it has no default")

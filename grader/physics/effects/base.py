@@ -25,14 +25,17 @@ if TYPE_CHECKING:
     from grader.physics.symbolic import Context
 
 
+KINDS = {"body": "a body's name", "bodies": "two bodies' names", "spheres": "two names of bodies with a radius",
+         "expr": "an expression", "name": "a new quantity's name", "velocities": "per body: an expression, or {n:, t:}",
+         "vector": "one {n:, t:}", "choice": "one of the listed words", "flag": "true or false"}
+"""What the YAML value of a field of each kind is, in words (the scene parser reads them)."""
+
+
 @dataclass(frozen=True)
 class Field:
     """One key of a stage: its kind says how the YAML value is read.
 
-    kinds: ``body`` (a body's name), ``bodies`` (two names), ``spheres`` (two names of bodies with a
-    radius), ``expr`` (an expression), ``name`` (a new quantity's name), ``velocities`` (per body: an
-    expression, or ``{n:, t:}``), ``vector`` (one ``{n:, t:}``), ``choice:a|b`` (one of the listed
-    words), ``flag`` (true or false).
+    kinds: see :data:`KINDS` (``choice:a|b``: one of the listed words).
 
     ``default`` says what an optional key means when it is left out, as the reference shows it: the
     value taken (``t``, ``false``), the name the solver gives the quantity (``J``), or what the stage
@@ -45,6 +48,16 @@ class Field:
     doc: str = ""
     dimension: Dimension | None = None  # what an expression or velocity here must measure
     default: str | None = None
+
+    @property
+    def kind_in_words(self) -> str:
+        """What the YAML value is, in words.
+
+        >>> Field("from", "choice:t|n").kind_in_words, Field("height", "expr").kind_in_words
+        ('one of t, n', 'an expression')
+        """
+        kind, _, options = self.kind.partition(":")
+        return f"one of {', '.join(options.split('|'))}" if options else KINDS[kind]
 
 
 @dataclass(frozen=True)

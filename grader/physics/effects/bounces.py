@@ -51,13 +51,13 @@ _FIELDS = (
     Field("restitution", "expr", doc="coefficient of restitution e between body and floor, 0 <= e < 1",
           dimension=PURE),
     Field("count", "expr", required=False, doc="the bounce n whose rebound height is asked (a whole number >= 1)",
-          dimension=PURE, default="none: needed with rebound"),
+          dimension=PURE, default="none; rebound needs it"),
     Field("rebound", "expr", required=False, doc="height the body rises to after bounce n", dimension=LENGTH,
-          default="none: no rebound height in the scene"),
+          default="the scene has no rebound height"),
     Field("distance", "expr", required=False, doc="total distance travelled until the body rests",
-          dimension=LENGTH, default="none: no total distance in the scene"),
+          dimension=LENGTH, default="the scene has no total distance"),
     Field("time", "expr", required=False, doc="total time until the body rests", dimension=dimension_from(time=1),
-          default="none: no total time in the scene"),
+          default="the scene has no total time"),
 )
 
 

@@ -121,7 +121,7 @@ SLIDE = Effect(
     (
         Field("body", "body", doc="the body that slides"),
         Field("with", "body", required=False, doc="a body locked to it that slides along (two cars after a "
-              "perfectly plastic impact)", default="none: the body slides alone"),
+              "perfectly plastic impact)", default="the body slides alone"),
         Field("speed", "expr", doc="speed at the start of the slide, >= 0", dimension=SPEED),
         Field("distance", "expr", doc="distance slid to rest", dimension=LENGTH),
         Field("friction", "expr", doc="coefficient of kinetic friction mu_k, > 0", dimension=PURE),

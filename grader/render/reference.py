@@ -48,12 +48,12 @@ _ON_A_FLOOR: Mapping[str, Mapping[str, Any]] = {"A": {"mass": "m"}, "floor": {"f
 EXAMPLES: Mapping[str, tuple[Example, ...]] = {
     "free_fall": (
         Example("a body falls from rest through h", _ONE, {"body": "A", "height": "h", "speed": "v"}),
-        Example("in a problem in feet, the height printed in mm", _ONE, {"body": "A", "height": "h", "speed": "v"},
+        Example("a problem in feet, the height printed in mm", _ONE, {"body": "A", "height": "h", "speed": "v"},
                 gravity="32.2 ft/s^2", units={"h": "mm"}),
     ),
     "rise": (
         Example("a body moving up at v rises through h", _ONE, {"body": "A", "height": "h", "speed": "v"}),
-        Example("in a problem in feet, the height printed in mm", _ONE, {"body": "A", "height": "h", "speed": "v"},
+        Example("a problem in feet, the height printed in mm", _ONE, {"body": "A", "height": "h", "speed": "v"},
                 gravity="32.2 ft/s^2", units={"h": "mm"}),
     ),
     "impact": (

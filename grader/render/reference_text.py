@@ -27,7 +27,7 @@ def text(sheet: Sheet) -> str:
         lines += _wrapped(f"{row.name:<{width}}  {_field_words(row)}", "  ", "  " + " " * (width + 2))
     shown: set[tuple[str, str]] = set()
     for example, equations in _new_relations(sheet.examples, shown):
-        lines += ["", f"Relations, as a student writes them, for {example.shows}:"]
+        lines += ["", f"Relations as a student writes them ({example.shows}):"]
         lines += ["    " + line for line in example.stage.splitlines()]
         for label, equation in equations:
             lines += [*_wrapped(label + ":", "  ", "    "), f"      {equation}"]
@@ -62,7 +62,8 @@ def markdown(sheets: Sequence[Sheet]) -> str:
                   f"{'yes' if row.required else 'no'} | {_escaped(row.default or '')} |" for row in sheet.fields]
         shown: set[tuple[str, str]] = set()
         for example, equations in _new_relations(sheet.examples, shown):
-            lines += ["", f"**Relations**, for {_escaped(example.shows)}:", "", "```yaml", example.stage, "```", ""]
+            lines += ["", f"**Relations** as a student writes them ({_escaped(example.shows)})", "", "```yaml",
+                      example.stage, "```", ""]
             lines += [f"- {_escaped(label)}: `{equation}`" for label, equation in equations]
         lines += ["", "**Stable forms in the kernels**", ""]
         lines += [f"- `{form}`" + (f" ({when})" if when else "") for form, when in _stable_forms(sheet.examples)] \

@@ -169,6 +169,19 @@ def build_parser() -> argparse.ArgumentParser:
                       help="output folder (default: ./grader-demo)")
     _output_options(demo)
 
+    effects = commands.add_parser(
+        "effects", help="the effects a scene is made of: fields, relations, stable forms, force law, mistakes, figure",
+        description="Without NAME: every effect with its summary. With NAME: that effect in full: its fields, its "
+                    "relations as a student writes them for representative stages, the stable forms the kernels "
+                    "use, the force law the simulation integrates, the mistakes the grader diagnoses, other "
+                    "routes, and how its figure is drawn today.")
+    effects.add_argument("name", nargs="?", metavar="NAME", help="an effect, e.g. impact")
+    effects_output = effects.add_mutually_exclusive_group()
+    effects_output.add_argument("--json", action="store_true",
+                                help="print JSON: one object for NAME, else a list of every effect's")
+    effects_output.add_argument("--markdown", action="store_true",
+                                help="print the Markdown page docs/effects.md is (NAME: that effect's section only)")
+
     checking_bank = commands.add_parser(
         "check-bank", help="check every template of a bank, for authors: loads, samples, solves, simulates, renders",
         description="Check every template: it loads; 200 sampled variants each solve or are refused by a "
@@ -313,12 +326,17 @@ def _template(arguments: argparse.Namespace) -> Template:
         return template
     bank = _bank(arguments)  # an unusable folder is refused as such; a missing template gets suggestions
     if arguments.template not in bank:
-        import difflib
-
-        close = difflib.get_close_matches(arguments.template, list(bank), n=3, cutoff=0.5)
+        close = _close_matches(arguments.template, bank)
         hint = f"; did you mean {' or '.join(close)}?" if close else f"; the bank has {', '.join(sorted(bank))}"
         raise UsageError(f"unknown template '{arguments.template}'{hint}")
     return bank[arguments.template]
+
+
+def _close_matches(name: str, choices: Iterable[str]) -> list[str]:
+    """Up to three of ``choices`` that look like ``name`` (a misspelt id), closest first."""
+    import difflib
+
+    return difflib.get_close_matches(name, list(choices), n=3, cutoff=0.5)
 
 
 def _list(arguments: argparse.Namespace) -> int:
@@ -773,6 +791,32 @@ def _print_check(result: dict[str, Any]) -> None:
             print(f"{name:<10} {_printable(text)}")
 
 
+def _effects(arguments: argparse.Namespace) -> int:
+    """The catalogue of effects; listing it needs no sympy, an effect in full does (its relations)."""
+    from grader.physics.effects import CATALOGUE
+
+    names = sorted(CATALOGUE)
+    if arguments.name is not None and arguments.name not in CATALOGUE:
+        close = _close_matches(arguments.name, names)
+        hint = f" (did you mean {' or '.join(close)}?)" if close else ""
+        raise UsageError(f"unknown effect '{arguments.name}'{hint}; the effects are {', '.join(names)}")
+    if arguments.name is None and not (arguments.json or arguments.markdown):
+        print(_table(("effect", "summary"), [(name, CATALOGUE[name].summary) for name in names]))
+        return EXIT_OK
+    from grader.render.reference import sheet
+    from grader.render.reference_text import markdown, text
+
+    sheets = [sheet(name) for name in ([arguments.name] if arguments.name is not None else names)]
+    if arguments.json:
+        found = [s.to_json() for s in sheets]
+        print(json.dumps(found[0] if arguments.name is not None else found, allow_nan=False))
+    elif arguments.markdown:
+        print(markdown(sheets), end="")
+    else:
+        print(text(sheets[0]))
+    return EXIT_OK
+
+
 def _check_bank(arguments: argparse.Namespace) -> int:
     from grader.bank.folders import bank_folders, template_files
     from grader.bankcheck import check_bank
@@ -828,4 +872,5 @@ def _size(size: int) -> str:
 
 
 _COMMANDS = {"list": _list, "show": _show, "solve": _solve, "simulate": _simulate, "generate": _generate,
-             "demo": _demo, "grade": _grade, "check": _check, "check-bank": _check_bank, "cache": _cache}
+             "demo": _demo, "grade": _grade, "check": _check, "check-bank": _check_bank, "effects": _effects,
+             "cache": _cache}

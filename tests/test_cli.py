@@ -146,7 +146,7 @@ HEAVY = ("scipy", "sympy", "matplotlib", "typst", "jinja2", "pint")
     ["--help"], ["list"], ["list", "--json"], ["solve", "pile-driver", *PILE], ["solve", "car-collision", "--set",
                                                                             "p=0.5", "--set", "e=0.1", "--json"],
     ["show", "drop-rebound"], ["solve", "--help"], ["check", "--help"], ["grade", "--help"], ["generate", "--help"],
-    ["simulate", "--help"], ["demo", "--help"],
+    ["simulate", "--help"], ["demo", "--help"], ["effects"], ["effects", "--help"],
 ], ids=lambda argv: " ".join(argv[:2]))
 def test_commands_import_no_heavy_library_they_do_not_need(argv: list[str], compiled: dict[str, Any]) -> None:
     """`grader --help`, `list`, a warm `solve` or `show` (the compiled template is cached) and every

@@ -141,7 +141,9 @@ def dimension_from(length: int = 0, mass: int = 0, time: int = 0, angle: int = 0
 
 LENGTH, MASS, SPEED = dimension_from(1), dimension_from(mass=1), dimension_from(1, time=-1)
 ANGLE, PURE = dimension_from(angle=1), dimension_from()
-_NAMES = {LENGTH: "a length", MASS: "a mass", SPEED: "a speed", ANGLE: "an angle", PURE: "a pure number"}
+_NAMES = {LENGTH: "a length", MASS: "a mass", SPEED: "a speed", ANGLE: "an angle", PURE: "a pure number",
+          dimension_from(time=1): "a time", dimension_from(1, time=-2): "an acceleration",
+          dimension_from(1, 1, -1): "an impulse (a momentum)", dimension_from(2, 1, -2): "an energy"}
 
 
 def dimension_name(dim: Dimension) -> str:

@@ -13,6 +13,7 @@ cosd(theta) + 1
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from fractions import Fraction
 from typing import Any
@@ -200,10 +201,6 @@ def _pow(expr: sp.Pow) -> Node:
     return Op("pow", (to_node(base), to_node(exponent)))
 
 
-_DEFAULT_NAMES = {"impulse": "J", "energy_before": "T", "energy_after": "T_after",
-                  "energy_lost": "E_lost", "loss_fraction": "f_loss"}
-
-
 @dataclass
 class Context:
     """What an effect sees while its relations are built: the scene's symbols and bodies."""
@@ -242,10 +239,11 @@ class Context:
             raise TemplateError(self.scene.where, f"bodies.{body}", "a radius (radius: EXPR)", "a point body")
         return self.sym(radius)
 
-    def quantity(self, stage: Stage, key: str) -> sp.Symbol:
-        """The symbol a stage names under ``key``, or a default name (``J``, ``T``, ...)."""
+    def quantity(self, stage: Stage, key: str, defaults: Mapping[str, str]) -> sp.Symbol:
+        """The symbol a stage names under ``key``, or its default name (``J``, ``T``, ...: the effect's
+        field defaults)."""
         name = stage.fields.get(key)
-        return self.symbol(name if isinstance(name, str) else self.unused_name(_DEFAULT_NAMES[key], stage))
+        return self.symbol(name if isinstance(name, str) else self.unused_name(defaults[key], stage))
 
     def unused_name(self, base: str, stage: Stage) -> str:
         """``base``, unless the template or another stage uses it: then ``base_<stage index>``."""

@@ -52,6 +52,37 @@ from grader.render.skid import skid
 from grader.render.trajectory import trajectory
 from grader.render.worked import Typ, string
 
+STAGE_FIGURES: Mapping[str, str] = {
+    "free_fall": "the body at its drop height above what it falls onto (the ground, a fixed floor, a driven plate "
+                 "with its velocity, or a pile drawn under it), the height dimensioned, to scale when given; onto a "
+                 "fixed surface it strikes obliquely, an incline at its angle; followed by two or more rises, the "
+                 "path as arcs",
+    "rise": "after a fall and an impact only: the body dashed at its rebound height, dimensioned (an asked height "
+            "drawn at 0.6 of the drop, not to scale); two or more rises after impacts on a fixed surface, the path as "
+            "arcs, each height dimensioned; in no other scene",
+    "impact": "direct: the bodies as blocks in a line, areas following the masses (a fixed one a hatched wall), each "
+              "with its velocity before as an arrow; oblique against a fixed body: the surface with the incoming "
+              "and rebound velocities at their angles; oblique between two bodies: two touching circles with n, t "
+              "and the incoming velocity (a scene with a fall, swing, slide, flight or bounces is drawn by that "
+              "figure instead)",
+    "velocity": "not drawn on its own: its speed and angle label the velocity arrows of the oblique impact figures "
+                "and a projectile's throw",
+    "angle_between": "not drawn: no figure reads it",
+    "impact_geometry": "with an oblique impact after it: the two spheres at contact, radii in their ratio, the "
+                       "offset dimensioned and n at its angle to the path",
+    "bounces": "the drop and the decaying arcs until the body rests, heights and time along the floor to scale, the "
+               "bounce whose height is asked marked by its name",
+    "swing": "the cord at rest and at its greatest angle, to scale, and the arc between; a body that strikes the "
+             "hanging one (an impact before the swing) comes in from the left with its velocity",
+    "slide": "after an impact: two rows on one scale, the bodies at the impact and at rest, the skid from the point "
+             "of impact dimensioned; without an impact, the bodies in a row",
+    "flight": "a flight to a wall before an impact: the path to scale, solid to the wall, dashed from the wall to "
+              "the ground (the flight after the impact); in no other scene",
+}
+"""How a stage of each effect is drawn today, one sentence each (``grader effects`` shows them): the figure
+is chosen for the whole scene by :func:`figure`, so a stage is drawn only in the scenes it lists. A scene
+no figure fits is drawn as its bodies in a row, labelled."""
+
 
 def figure(template: Template, variant: ProblemVariant, values: Mapping[str, float]) -> Typ:
     """The figure of one variant's scene, as a Typst expression (code mode)."""

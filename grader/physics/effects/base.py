@@ -25,14 +25,21 @@ if TYPE_CHECKING:
     from grader.physics.symbolic import Context
 
 
+KINDS = {"body": "a body's name", "bodies": "two bodies' names", "spheres": "two names of bodies with a radius",
+         "expr": "an expression", "name": "a new quantity's name", "velocities": "per body: an expression, or {n:, t:}",
+         "vector": "one {n:, t:}", "choice": "one of the listed words", "flag": "true or false"}
+"""What the YAML value of a field of each kind is, in words (the scene parser reads them)."""
+
+
 @dataclass(frozen=True)
 class Field:
     """One key of a stage: its kind says how the YAML value is read.
 
-    kinds: ``body`` (a body's name), ``bodies`` (two names), ``spheres`` (two names of bodies with a
-    radius), ``expr`` (an expression), ``name`` (a new quantity's name), ``velocities`` (per body: an
-    expression, or ``{n:, t:}``), ``vector`` (one ``{n:, t:}``), ``choice:a|b`` (one of the listed
-    words), ``flag`` (true or false).
+    kinds: see :data:`KINDS` (``choice:a|b``: one of the listed words).
+
+    ``default`` says what an optional key means when it is left out, as the reference shows it: the
+    value taken (``t``, ``false``), the name the solver gives the quantity (``J``), or what the stage
+    then lacks.
     """
 
     name: str
@@ -40,6 +47,17 @@ class Field:
     required: bool = True
     doc: str = ""
     dimension: Dimension | None = None  # what an expression or velocity here must measure
+    default: str | None = None
+
+    @property
+    def kind_in_words(self) -> str:
+        """What the YAML value is, in words.
+
+        >>> Field("from", "choice:t|n").kind_in_words, Field("height", "expr").kind_in_words
+        ('one of t, n', 'an expression')
+        """
+        kind, _, options = self.kind.partition(":")
+        return f"one of {', '.join(options.split('|'))}" if options else KINDS[kind]
 
 
 @dataclass(frozen=True)
@@ -121,7 +139,8 @@ class Effect:
     """An entry of the catalogue: its name, what it means, its fields, its relations (the
     closed form), how to simulate it (its force law in the time domain; None: it has none),
     the mistakes students make with it, first the most telling (None: none declared), and the
-    other correct routes through it (None: none)."""
+    other correct routes through it (None: none). ``force_law`` says in words what ``simulate``
+    integrates (for ``grader effects`` and docs/effects.md); every effect states it."""
 
     name: str
     summary: str
@@ -130,3 +149,11 @@ class Effect:
     simulate: Callable[[Stage, Run], None] | None = None
     mistakes: Callable[[Stage, Context], list[Mistake]] | None = None
     routes: Callable[[Stage, Context], list[Route]] | None = None
+    force_law: str = field(kw_only=True)
+
+    def __post_init__(self) -> None:
+        if not self.force_law.strip():
+            raise ValueError(f"effect {self.name}: force_law must say what its simulation integrates")
+        for spec in self.fields:
+            if spec.required and spec.default is not None:
+                raise ValueError(f"effect {self.name}: field {spec.name} is required, so it has no default")

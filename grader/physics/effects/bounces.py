@@ -51,11 +51,13 @@ _FIELDS = (
     Field("restitution", "expr", doc="coefficient of restitution e between body and floor, 0 <= e < 1",
           dimension=PURE),
     Field("count", "expr", required=False, doc="the bounce n whose rebound height is asked (a whole number >= 1)",
-          dimension=PURE),
-    Field("rebound", "expr", required=False, doc="height the body rises to after bounce n", dimension=LENGTH),
+          dimension=PURE, default="none; rebound needs it"),
+    Field("rebound", "expr", required=False, doc="height the body rises to after bounce n", dimension=LENGTH,
+          default="the scene has no rebound height"),
     Field("distance", "expr", required=False, doc="total distance travelled until the body rests",
-          dimension=LENGTH),
-    Field("time", "expr", required=False, doc="total time until the body rests", dimension=dimension_from(time=1)),
+          dimension=LENGTH, default="the scene has no total distance"),
+    Field("time", "expr", required=False, doc="total time until the body rests", dimension=dimension_from(time=1),
+          default="the scene has no total time"),
 )
 
 
@@ -230,4 +232,7 @@ BOUNCES = Effect(
     _bounces,
     _simulate_bounces,
     _mistakes,
+    force_law="gravity in flight and the impact's Kelvin-Voigt contact with the floor, calibrated to e (no weight "
+              "during the contact); the first max(n, 5) bounces run in time, the tail beyond them added from the "
+              "series and reported as the bound on what was not integrated",
 )

@@ -145,6 +145,10 @@ def _simulate_rise(stage: Stage, run: Run) -> None:
 
 
 FREE_FALL = Effect("free_fall", "a body falls from rest through a height: v = sqrt(2 g h)", _FIELDS, _free_fall,
-                   _simulate_fall, _fall_mistakes)
+                   _simulate_fall, _fall_mistakes,
+                   force_law="gravity alone, a = -g upward, from rest at the height until the located event of "
+                             "reaching the bottom")
 RISE = Effect("rise", "a body moving up at a speed rises to a height where it stops: h = v^2/(2 g)", _FIELDS, _rise,
-              _simulate_rise, _rise_mistakes)
+              _simulate_rise, _rise_mistakes,
+              force_law="gravity alone, a = -g upward, from the bottom at the speed until the located event of "
+                        "the apex (velocity 0)")

@@ -105,4 +105,6 @@ IMPACT_GEOMETRY = Effect(
     ),
     _line_of_centres,
     _simulate_line_of_centres,
+    force_law="none: the first sphere moves uniformly toward the second, at rest, until the located event where "
+              "the centres are r1 + r2 apart; the line of centres is measured from the positions there",
 )

@@ -39,6 +39,30 @@ if TYPE_CHECKING:
     from grader.physics.symbolic import Context
 
 
+ENERGY = dimension_from(2, 1, -2)
+
+_FIELDS = (
+    Field("bodies", "bodies", doc="[first, second]: n points from the first into the second"),
+    Field("restitution", "expr", doc="coefficient of restitution e, 0..1", dimension=PURE),
+    Field("before", "velocities", doc="per body: n-velocity, or {n: .., t: ..}; omitted = at rest; a fixed body "
+          "keeps it", dimension=SPEED),
+    Field("after", "velocities", required=False, doc="per body: names for the velocities after", dimension=SPEED,
+          default="v_<body>_n_after (and v_<body>_t_after when oblique)"),
+    Field("impulse", "name", required=False, doc="name for the normal impulse J", dimension=dimension_from(1, 1, -1),
+          default="J"),
+    Field("energy_before", "name", required=False, doc="name for the kinetic energy before", dimension=ENERGY,
+          default="T"),
+    Field("energy_after", "name", required=False, doc="name for the kinetic energy after", dimension=ENERGY,
+          default="T_after"),
+    Field("energy_lost", "name", required=False, doc="name for the energy lost", dimension=ENERGY, default="E_lost"),
+    Field("loss_fraction", "name", required=False, doc="name for the fraction of energy lost", dimension=PURE,
+          default="f_loss"),
+    Field("weight_during_contact", "flag", required=False,
+          doc="simulate the weight during contact (the closed form neglects it)", default="false"),
+)
+_DEFAULT_NAMES = {spec.name: spec.default for spec in _FIELDS if spec.kind == "name" and spec.default is not None}
+
+
 @dataclass(frozen=True)
 class _Impact:
     """One impact's quantities as its relations use them. A mistake is the same impact with a field
@@ -73,7 +97,7 @@ class _Impact:
 
         (first, second), (w1, w2), e = self.bodies, self.inverse, self.e
         used = {"e": e, "e**2": e**2, "1/e": 1 / e}[self.law]
-        impulse = ctx.quantity(self.stage, "impulse")
+        impulse = ctx.quantity(self.stage, "impulse", _DEFAULT_NAMES)
         (u1, u2), (a1, a2) = (self.before[0][0], self.before[1][0]), (self.after[0][0], self.after[1][0])
         approach, separation = u1 - u2, a2 - a1
         ratio = separation / approach
@@ -161,8 +185,8 @@ class _Impact:
         import sympy as sp
 
         stage, (w1, w2) = self.stage, self.inverse
-        before, after = ctx.quantity(stage, "energy_before"), ctx.quantity(stage, "energy_after")
-        lost, fraction = ctx.quantity(stage, "energy_lost"), ctx.quantity(stage, "loss_fraction")
+        before, after = (ctx.quantity(stage, key, _DEFAULT_NAMES) for key in ("energy_before", "energy_after"))
+        lost, fraction = (ctx.quantity(stage, key, _DEFAULT_NAMES) for key in ("energy_lost", "loss_fraction"))
         totals = {when: self._kinetic(when) for when in ("before", "after")}
         lost_form = (1 - used) * (1 + used) * approach**2 / (2 * (w1 + w2))
         # With e derived, (v_rel - v_sep) is a difference of measured quantities; once e <= 1 is
@@ -394,30 +418,15 @@ def _output_energies(stage: Stage, run: Run, inverse: tuple[float, float], befor
             run.output(Sym(stage.fields[key]), value)
 
 
-ENERGY = dimension_from(2, 1, -2)
-
 IMPACT = Effect(
     "impact",
     "direct or oblique central impact with restitution e; smooth surfaces; a body may be fixed",
-    (
-        Field("bodies", "bodies", doc="[first, second]: n points from the first into the second"),
-        Field("restitution", "expr", doc="coefficient of restitution e, 0..1", dimension=PURE),
-        Field("before", "velocities", doc="per body: n-velocity, or {n: .., t: ..}; omitted = at rest; a fixed body "
-              "keeps it", dimension=SPEED),
-        Field("after", "velocities", required=False, doc="per body: names for the velocities after",
-              dimension=SPEED),
-        Field("impulse", "name", required=False, doc="name for the normal impulse J",
-              dimension=dimension_from(1, 1, -1)),
-        Field("energy_before", "name", required=False, doc="name for the kinetic energy before", dimension=ENERGY),
-        Field("energy_after", "name", required=False, doc="name for the kinetic energy after", dimension=ENERGY),
-        Field("energy_lost", "name", required=False, doc="name for the energy lost", dimension=ENERGY),
-        Field("loss_fraction", "name", required=False, doc="name for the fraction of energy lost",
-              dimension=PURE),
-        Field("weight_during_contact", "flag", required=False,
-              doc="simulate the weight during contact (the closed form neglects it); default false"),
-    ),
+    _FIELDS,
     _impact,
     _simulate_impact,
     _mistakes,
     _routes,
+    force_law="a Kelvin-Voigt contact along n (a linear spring and dashpot per unit reduced mass) calibrated so "
+              "that it reproduces e exactly; no force along t (smooth surfaces); the weight acts during the contact "
+              "only where asked for (weight_during_contact, or grader simulate --weight-during-contact)",
 )

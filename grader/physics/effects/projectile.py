@@ -44,14 +44,15 @@ _FIELDS = (
     Field("distance", "expr", doc="horizontal distance from the start to the end", dimension=LENGTH),
     Field("end_height", "expr", doc="height above the ground at the end (0 at the ground)", dimension=LENGTH),
     Field("end_vertical", "expr", doc="vertical velocity at the end, up positive", dimension=SPEED),
-    Field("time", "name", required=False, doc="name for the time of flight (default t_flight)",
-          dimension=dimension_from(time=1)),
+    Field("time", "name", required=False, doc="name for the time of flight", dimension=dimension_from(time=1),
+          default="t_flight"),
 )
+_DEFAULT_TIME = next(str(spec.default) for spec in _FIELDS if spec.name == "time")
 
 
 def _time(stage: Stage, ctx: Context) -> Any:
     name = stage.fields.get("time")
-    return ctx.symbol(name if isinstance(name, str) else ctx.unused_name("t_flight", stage))
+    return ctx.symbol(name if isinstance(name, str) else ctx.unused_name(_DEFAULT_TIME, stage))
 
 
 def _flight(stage: Stage, ctx: Context, law: str = "y0 + vy t - g t^2/2", root: str = "+") -> list[Relation]:
@@ -206,4 +207,6 @@ FLIGHT = Effect(
     _projectile,
     _simulate_flight,
     _mistakes,
+    force_law="gravity alone, a = (0, -g), until the located event x = D (the wall) or y = y1 while descending "
+              "(the ground)",
 )

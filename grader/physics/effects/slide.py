@@ -121,7 +121,7 @@ SLIDE = Effect(
     (
         Field("body", "body", doc="the body that slides"),
         Field("with", "body", required=False, doc="a body locked to it that slides along (two cars after a "
-              "perfectly plastic impact)"),
+              "perfectly plastic impact)", default="the body slides alone"),
         Field("speed", "expr", doc="speed at the start of the slide, >= 0", dimension=SPEED),
         Field("distance", "expr", doc="distance slid to rest", dimension=LENGTH),
         Field("friction", "expr", doc="coefficient of kinetic friction mu_k, > 0", dimension=PURE),
@@ -129,4 +129,6 @@ SLIDE = Effect(
     _slide,
     _simulate_slide,
     _mistakes,
+    force_law="Coulomb kinetic friction, a = -mu_k g against the motion while the body slides, until the located "
+              "event v = 0 (static friction then holds it); gravity enters only as the normal force",
 )

@@ -171,4 +171,7 @@ SWING = Effect(
     _swing,
     _simulate_swing,
     _mistakes,
+    force_law="a pendulum, phi'' = -(g/L) sin phi: gravity along the path, the cord's tension the constraint that "
+              "keeps the body on the circle; from the lowest point until it stops (phi' = 0) or the cord would go "
+              "slack (refused); with the speed unknown, released at rest at the angle and swung down",
 )

@@ -22,6 +22,8 @@ if TYPE_CHECKING:
     from grader.physics.run import Run
     from grader.physics.symbolic import Context
 
+_FROM = "t"  # the axis an angle is measured from when a stage does not say
+
 
 def _components(stage: Stage, ctx: Context, other_axis: bool = False) -> list[Relation]:
     """The stage's relations; ``other_axis``: its angle reported from the other axis (``90° - θ``)."""
@@ -31,8 +33,8 @@ def _components(stage: Stage, ctx: Context, other_axis: bool = False) -> list[Re
 
     speed, angle = ctx.sym(stage.fields["speed"]), ctx.sym(stage.fields["angle"])
     n, t = ctx.sym(stage.fields["n"]), ctx.sym(stage.fields["t"])
-    along, across = (t, n) if stage.fields.get("from", "t") == "t" else (n, t)
-    along_name, across_name = ("t", "n") if stage.fields.get("from", "t") == "t" else ("n", "t")
+    along, across = (t, n) if stage.fields.get("from", _FROM) == "t" else (n, t)
+    along_name, across_name = ("t", "n") if stage.fields.get("from", _FROM) == "t" else ("n", "t")
     what = stage.text("speed")
     relations = [
         Relation(f"{what}: component along {along_name}", along, speed * sp.cos(angle),
@@ -77,7 +79,7 @@ def _mistakes(stage: Stage, ctx: Context) -> list[Mistake]:
 def _simulate_components(stage: Stage, run: Run) -> None:
     """Kinematics, not a force: split a known velocity into components, or combine them."""
     fields = stage.fields
-    along_key, across_key = ("t", "n") if fields.get("from", "t") == "t" else ("n", "t")
+    along_key, across_key = ("t", "n") if fields.get("from", _FROM) == "t" else ("n", "t")
     if run.known(fields["speed"]) and run.known(fields["angle"]):
         # In degrees, reduced exactly (as the closed form does): cos 90 deg is 0, not 6e-17, so a
         # head-on impact has no tangential motion to give a stopped ball a direction.
@@ -104,13 +106,15 @@ VELOCITY = Effect(
     (
         Field("speed", "expr", doc="magnitude", dimension=SPEED),
         Field("angle", "expr", doc="direction, measured from the `from` axis toward the other", dimension=ANGLE),
-        Field("from", "choice:t|n", required=False, doc="axis the angle is measured from (default t)"),
+        Field("from", "choice:t|n", required=False, doc="axis the angle is measured from", default=_FROM),
         Field("n", "expr", doc="component along the line of impact", dimension=SPEED),
         Field("t", "expr", doc="component along the tangent", dimension=SPEED),
     ),
     _components,
     _simulate_components,
     _mistakes,
+    force_law="none: kinematics; a known velocity is split into components (cosine and sine in degrees, exact at "
+              "multiples of 90), or components combined with hypot and atan2",
 )
 
 
@@ -165,4 +169,5 @@ ANGLE_BETWEEN = Effect(
     ),
     _between,
     _simulate_between,
+    force_law="none: kinematics; the angle is atan2(|a x b|, a . b) of the two velocities' directions",
 )

@@ -157,3 +157,11 @@ def test_the_cli_reference_describes_the_global_options() -> None:
     reference = text(ROOT / "docs" / "cli.md")
     options = {o for a in build_parser()._actions for o in a.option_strings if o.startswith("--") and o != "--help"}
     assert options and not sorted(o for o in options if f"`{o}" not in reference)
+
+
+def test_every_page_the_code_cites_exists() -> None:
+    """A comment or docstring that cites a page of docs/ (the design notes, say) cites a page that exists."""
+    cited = {match for folder in ("grader", "tests", "benchmarks") for path in (ROOT / folder).rglob("*.py")
+             for match in re.findall(r"docs/[\w-]+\.md", path.read_text(encoding="utf-8"))}
+    assert "docs/design.md" in cited
+    assert not sorted(page for page in cited if not (ROOT / page).is_file())

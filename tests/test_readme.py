@@ -32,8 +32,9 @@ def _console_examples() -> list[tuple[str, str, str]]:
     return examples
 
 
-@pytest.mark.parametrize(("page", "command", "expected"), _console_examples(),
-                         ids=lambda value: value if value.endswith(".md") else value[:50])
+@pytest.mark.parametrize(("page", "command", "expected"),
+                         [pytest.param(*example, id=f"{example[0]}: {example[1][:60]}")
+                          for example in _console_examples()])
 def test_console_example_prints_what_the_page_shows(page: str, command: str, expected: str) -> None:
     """Running the command from the repository's folder gives the page's output, line for line: what it
     prints on standard output, then on standard error (an error message is an example too)."""

@@ -1,5 +1,6 @@
 """`grader demo` end to end: it generates, plays a class (`submissions.csv` in the forms students type),
-grades it into `grades/`, reruns byte for byte, and the README's grading excerpts are its real output."""
+grades it into `grades/`, reruns byte for byte, and the grading excerpts of the README and docs/ are its real
+output."""
 
 from __future__ import annotations
 
@@ -26,9 +27,10 @@ from grader.cli import main
 from grader.files import MANIFEST
 from grader.render.generate import Job
 from grader.resources import sample_dir
-from tests.demo_output import ROOT, DemoRun
+from tests.demo_output import DemoRun
+from tests.documents import all_text
 
-README = (ROOT / "README.md").read_text(encoding="utf-8")
+DOCS = all_text()  # README.md and docs/*.md
 REGRADE = "grader grade --key grader-demo/key.json grader-demo/submissions.csv --out grader-demo/grades --force"
 
 
@@ -153,7 +155,7 @@ def test_the_absent_student_scores_0_and_the_superseded_row_is_the_only_problem(
     assert len(absent) == 1
     student = grades[absent.pop()]
     assert student["total"] == "0"
-    assert f"{student['student_id']}, who submitted nothing, has 0 of {student['possible']} points" in README
+    assert f"{student['student_id']}, who submitted nothing, has 0 of {student['possible']} points" in DOCS
     late = answers[-1]
     line = len(answers) + 1  # the header is line 1
     superseded = next(i for i, a in enumerate(answers) if (a.student_id, a.label) == (late.student_id, late.label))
@@ -172,21 +174,21 @@ def test_the_grades_are_in_the_demo_folder_manifest_and_have_their_own(demo_run:
     assert "submissions.csv" in outer["files"]
 
 
-def test_demo_force_then_the_readme_regrade_then_demo_force_again_change_nothing(
+def test_demo_force_then_the_documented_regrade_then_demo_force_again_change_nothing(
         demo_run: DemoRun, tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
         capsys: pytest.CaptureFixture[str]) -> None:
-    """A second `grader demo --force` rewrites the folder byte for byte; the README's `grader grade ... --force`
-    regrades it to the same files and prints what the README shows; `grader demo --force` still works after."""
+    """A second `grader demo --force` rewrites the folder byte for byte; the docs' `grader grade ... --force`
+    regrades it to the same files and prints what the docs show; `grader demo --force` still works after."""
     shutil.copytree(demo_run.out, tmp_path / "grader-demo")
     monkeypatch.chdir(tmp_path)
     before = tree(demo_run.out)
     assert main(["demo", "--out", "grader-demo", "--force"]) == 0
     assert tree(tmp_path / "grader-demo") == before
     capsys.readouterr()
-    command = _readme_regrade()
+    command = _documented_regrade()
     assert command == REGRADE
     assert main(shlex.split(command)[1:]) == 0  # a superseded row is set aside by rule: nothing for anyone to do
-    assert capsys.readouterr().err.splitlines() == _readme_block_after(command)
+    assert capsys.readouterr().err.splitlines() == _documented_block_after(command)
     assert tree(tmp_path / "grader-demo") == before
     assert main(["demo", "--out", "grader-demo", "--force"]) == 0
     assert tree(tmp_path / "grader-demo") == before
@@ -212,9 +214,9 @@ def test_a_failure_while_grading_leaves_nothing_behind(tmp_path: Path, monkeypat
 
 @pytest.mark.parametrize("header", ["student_id,label,submitted,verdict,expected,feedback,diagnosis",
                                     "file,line,student_id,label,reason"])
-def test_the_readme_excerpts_are_rows_of_the_demo_output(demo_run: DemoRun, header: str) -> None:
+def test_the_documented_excerpts_are_rows_of_the_demo_output(demo_run: DemoRun, header: str) -> None:
     """Each excerpt row is a real row of details.csv (or problems.csv), in the excerpt's columns."""
-    block = next(b for b in re.findall(r"```text\n(.*?)```", README, flags=re.S) if b.startswith(header + "\n"))
+    block = next(b for b in re.findall(r"```text\n(.*?)```", DOCS, flags=re.S) if b.startswith(header + "\n"))
     excerpt = block.splitlines()
     real = rows(demo_run.out / "grades" / ("details.csv" if "verdict" in header else "problems.csv"))
     columns = header.split(",")
@@ -225,20 +227,20 @@ def test_the_readme_excerpts_are_rows_of_the_demo_output(demo_run: DemoRun, head
 
 @pytest.mark.parametrize("typed", ["2.75 m/s", "7.60°", "283 cm/s", "17.0 mph", "7.18 km/h", "2,95", "5.72×10^1",
                                    "2.06 m", "about 48", "v(1-0.07p)/(p+1)"])
-def test_the_readme_examples_of_forms_are_in_the_demo_file(answers: list[SampleAnswer], typed: str) -> None:
-    assert f"`{typed}`" in README or f'`"{typed}"`' in README
+def test_the_documented_examples_of_forms_are_in_the_demo_file(answers: list[SampleAnswer], typed: str) -> None:
+    assert f"`{typed}`" in DOCS or f'`"{typed}"`' in DOCS
     assert typed in {a.text for a in answers}
 
 
-def _readme_regrade() -> str:
-    found = re.search(r"```sh\n(grader grade --key grader-demo/[^\n]*)\n```", README)
-    assert found is not None, "the README shows how to grade the demo's submissions again"
+def _documented_regrade() -> str:
+    found = re.search(r"```sh\n(grader grade --key grader-demo/[^\n]*)\n```", DOCS)
+    assert found is not None, "the docs show how to grade the demo's submissions again"
     return found.group(1)
 
 
-def _readme_block_after(command: str) -> list[str]:
+def _documented_block_after(command: str) -> list[str]:
     """The lines of the first ```text block after the command's."""
-    after = README[README.index(command):]
+    after = DOCS[DOCS.index(command):]
     found = re.search(r"```text\n(.*?)```", after, flags=re.S)
     assert found is not None
     return found.group(1).splitlines()

@@ -1,4 +1,4 @@
-"""Float64 answers against 400-digit mpmath references on hard cases (DESIGN.md, Numerics).
+"""Float64 answers against 400-digit mpmath references on hard cases (docs/design.md, Numerics).
 
 The references are written here from first principles (momentum and restitution per particle,
 energies as sums of 1/2 m v^2) and take the float64 inputs as exact. Angles use mpmath's

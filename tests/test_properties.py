@@ -82,8 +82,8 @@ statement: A smooth body strikes a fixed wall with e = {{ e }}.
 RESTITUTION = {"unit": "", "domain": "[0, 1]", "sample": {"uniform": [0.3, 0.9]}, "decimals": 2}
 
 masses = st.floats(min_value=1e-6, max_value=1e6)
-# Magnitudes from DESIGN's envelope (down to 1e-150): near 1e-308 the kernels' u/m goes subnormal
-# (the inverse-mass form divides it by the mass) and loses digits: outside what DESIGN promises.
+# Magnitudes from docs/design.md's envelope (down to 1e-150): near 1e-308 the kernels' u/m goes subnormal
+# (the inverse-mass form divides it by the mass) and loses digits: outside what docs/design.md promises.
 speeds = st.one_of(st.just(0.0), st.builds(math.copysign, st.floats(min_value=1e-150, max_value=1e3),
                                            st.sampled_from([1.0, -1.0])))
 restitutions = st.floats(min_value=0.0, max_value=1.0)
@@ -154,7 +154,7 @@ def test_tangential_velocities_are_unchanged_by_a_smooth_impact(params: dict[str
 
 @PROPERTY
 @given(two_body_impacts())
-# Mass ratio 1e12 and speed 1e-150, both inside DESIGN's envelope: u1'**2 ~ 4e-324 underflows.
+# Mass ratio 1e12 and speed 1e-150, both inside docs/design.md's envelope: u1'**2 ~ 4e-324 underflows.
 @example({"m1": 1e6, "m2": 1e-6, "u1": 0.0, "u2": -1e-150, "s1": 0.0, "s2": 0.0, "e": 1.0})
 def test_kinetic_energy_never_increases_and_the_loss_is_before_minus_after(params: dict[str, float]) -> None:
     """T' <= T; the energy lost is >= 0 and equals T - T' to rounding of T."""
@@ -220,7 +220,7 @@ def test_pile_driver_forward_then_inverse_returns_e(m_pile: float, k: float, h_d
 
 def _widened(template: Template, name: str) -> st.SearchStrategy[float]:
     """Any value of the parameter's domain within [-1e3, 1e3], kept 1e-3 off an open zero bound; a
-    value of either sign (a signed velocity) is 0 or at least 1e-150 in size, DESIGN's envelope (a
+    value of either sign (a signed velocity) is 0 or at least 1e-150 in size, docs/design.md's envelope (a
     speed of 1e-287 squares to 0 in float64, and such a row is refused, not answered)."""
     domain = template.parameters[name].domain
     low, high = max(domain.low, -1e3), min(domain.high, 1e3)

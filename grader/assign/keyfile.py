@@ -51,7 +51,7 @@ _GUARDED_START = frozenset("=+-@\t\r\n'")  # a formula's first characters, and t
 
 
 def safe_cell(text: str) -> str:
-    """A CSV text cell a spreadsheet will not run as a formula (DESIGN: formula injection): a cell
+    """A CSV text cell a spreadsheet will not run as a formula (docs/design.md: formula injection): a cell
     starting with ``= + - @``, tab, CR or LF gets a leading ``'``, and so does one that already
     starts with ``'``, so the original is always recovered by :func:`original_cell`.
 

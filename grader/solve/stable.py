@@ -1,4 +1,4 @@
-"""Rewrites that keep a composed expression accurate in float64 (DESIGN.md, Numerics).
+"""Rewrites that keep a composed expression accurate in float64 (docs/design.md, Numerics).
 
 Each rewrite is an identity; together they make sure differences of nearly equal inputs are
 formed first and that no intermediate product overflows where the answer does not. Most work on

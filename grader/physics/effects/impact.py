@@ -4,7 +4,7 @@ A fixed surface has infinite mass: it is at rest, or moves at the constant veloc
 under ``before`` (a plate driven up and down), which the impact does not change.
 
 Axes: n along the line of impact, pointing from the first body into the second; t along the
-common tangent. Surfaces are smooth: no impulse along t. Numbers follow DESIGN.md: impulse form
+common tangent. Surfaces are smooth: no impulse along t. Numbers follow docs/design.md: impulse form
 with inverse masses ``w = 1/m`` (``w = 0`` for a fixed surface); after-impact velocities in the
 mass-centre form ``v1' = v_c - e w1 (v1 - v2)/(w1 + w2)``, which equals ``v1 - J w1`` but keeps its
 accuracy when ``e`` is small or the masses are very unequal; energy lost as

@@ -1,3 +1,3 @@
 """grader: problem generator and auto-grader for engineering dynamics (impact problems)."""
 
-__version__ = "0.1.0"
+__version__ = "0.2.0"

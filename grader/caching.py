@@ -179,8 +179,9 @@ def _mine(status: os.stat_result, owner: bool = True) -> bool:
 
 
 def grader_entries(folder: Path) -> list[Path]:
-    """The entries grader wrote in ``folder`` for this user: regular files sealed under their own name (the
-    check :func:`read_entry` makes), in name order; nothing else there is grader's to count or remove.
+    """The entries grader wrote in ``folder`` for this user: regular files (not links to one) sealed under their
+    own name (the check :func:`read_entry` makes), in name order; nothing else there is grader's to count or
+    remove.
 
     >>> import tempfile, pathlib
     >>> folder = pathlib.Path(tempfile.mkdtemp())
@@ -193,7 +194,8 @@ def grader_entries(folder: Path) -> list[Path]:
         candidates = sorted(folder.iterdir())
     except OSError:
         return []
-    return [path for path in candidates if path.name.endswith(".json") and read_entry(path) is not None]
+    return [path for path in candidates
+            if path.name.endswith(".json") and not path.is_symlink() and read_entry(path) is not None]
 
 
 def clear(folder: Path) -> tuple[int, int]:

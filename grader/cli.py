@@ -847,6 +847,8 @@ def _cache(arguments: argparse.Namespace) -> int:
         folder = caching.cache_dir()
     except RuntimeError:  # Path.home() found none
         raise UsageError("there is no home folder to keep a cache in; set GRADER_CACHE_DIR to a folder") from None
+    if folder.exists() and not folder.is_dir():
+        raise UsageError(f"the cache folder {folder} is a file, not a folder; set GRADER_CACHE_DIR to a folder")
     entries = caching.grader_entries(folder)
     size = sum(path.stat().st_size for path in entries if path.exists())
     if arguments.action == "clear":

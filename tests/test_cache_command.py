@@ -25,6 +25,8 @@ def folder(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
     caching.write_entry(folder / "sub" / "yaml-2.json", {"data": [2]})  # not where grader keeps entries
     sealed_elsewhere = caching.seal("yaml-9.json", b"[9]")
     (folder / "renamed.json").write_bytes(sealed_elsewhere)  # sealed under another name: not grader's here
+    caching.write_entry(tmp_path / "elsewhere" / "yaml-3.json", {"data": [3]})
+    (folder / "yaml-3.json").symlink_to(tmp_path / "elsewhere" / "yaml-3.json")  # the user's link to one
     return folder
 
 
@@ -46,7 +48,8 @@ def test_cache_says_where_and_how_much(folder: Path, capsys: pytest.CaptureFixtu
 def test_clear_removes_graders_entries_and_nothing_else(folder: Path, capsys: pytest.CaptureFixture[str]) -> None:
     code, out = _run(capsys, "clear")
     assert code == 0 and out.startswith("removed 2 entries (") and str(folder) in out
-    assert sorted(p.name for p in folder.iterdir()) == ["README", "notes.json", "renamed.json", "sub"]
+    assert sorted(p.name for p in folder.iterdir()) == ["README", "notes.json", "renamed.json", "sub",
+                                                              "yaml-3.json"]
     assert (folder / "sub" / "yaml-2.json").exists()
     assert _run(capsys, "clear", "--json")[1].strip() == json.dumps({"folder": str(folder), "removed": 0, "bytes": 0})
 
@@ -75,3 +78,12 @@ def test_entries_a_run_writes_are_what_clear_removes(tmp_path: Path, monkeypatch
     capsys.readouterr()
     assert _run(capsys, "clear")[1].startswith(f"removed {len(written)} entries")
     assert not list((tmp_path / "cache").iterdir())
+
+
+def test_a_cache_folder_that_is_a_file_is_a_usage_error(tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
+                                                        capsys: pytest.CaptureFixture[str]) -> None:
+    (tmp_path / "a file").write_text("mine", encoding="utf-8")
+    monkeypatch.setenv("GRADER_CACHE_DIR", str(tmp_path / "a file"))
+    assert main(["cache", "clear"]) == 2
+    assert f"the cache folder {tmp_path / 'a file'} is a file, not a folder" in capsys.readouterr().err
+    assert (tmp_path / "a file").read_text(encoding="utf-8") == "mine"

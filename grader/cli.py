@@ -849,13 +849,13 @@ def _cache(arguments: argparse.Namespace) -> int:
         raise UsageError("there is no home folder to keep a cache in; set GRADER_CACHE_DIR to a folder") from None
     if folder.exists() and not folder.is_dir():
         raise UsageError(f"the cache folder {folder} is a file, not a folder; set GRADER_CACHE_DIR to a folder")
-    entries = caching.grader_entries(folder)
-    size = sum(path.stat().st_size for path in entries if path.exists())
     if arguments.action == "clear":
         removed, freed = caching.clear(folder)
         summary = {"folder": str(folder), "removed": removed, "bytes": freed}
         said = f"removed {removed} entries ({_size(freed)}) from {folder}"
     else:
+        entries = caching.grader_entries(folder)
+        size = sum(path.stat().st_size for path in entries)
         summary = {"folder": str(folder), "entries": len(entries), "bytes": size}
         said = f"{folder}: {len(entries)} entries, {_size(size)}"
     print(json.dumps(summary) if arguments.json else visible(said))

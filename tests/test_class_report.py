@@ -174,6 +174,28 @@ def test_an_even_class_has_no_hard_corner() -> None:
     assert "No range of any parameter scored clearly below its problem." in page
 
 
+@pytest.mark.parametrize("values", [
+    [2.0 + 0.1 * i for i in range(19)] + [1.6e308],  # one student's parameter at 1.6e308 (issue 22)
+    [2.0 + 0.1 * i for i in range(18)] + [-1.6e308, 1.6e308],  # a span beyond float64: the bins overflowed too
+    [1e307 * i for i in range(1, 18)],  # all of them huge: matplotlib's ticks overflow from about 1e308
+], ids=["one-at-1.6e308", "span-beyond-float64", "all-near-the-limit"])
+def test_a_parameter_too_large_to_draw_is_left_out_with_a_note_not_a_traceback(values: list[float]) -> None:
+    """A key with a parameter near float64's limit crashed drawing the report (matplotlib's ``arange:
+    cannot compute length``); the panel is left out, the page says so, and the others are still drawn."""
+    kinds = ["correct" if i % 3 else "incorrect" for i in range(len(values))]
+    params = [{"h": value, "e": 0.1 * (index % 7)} for index, value in enumerate(values)]
+    page = class_report(make_class({"1a": kinds}, params=params))
+    assert "not drawn, with values beyond ±1e+300 (too large for a figure&#x27;s axis; check the key): h (" in page
+    assert page.count("<svg") == 3  # the histogram, the verdicts and e's panel
+
+
+def test_parameters_up_to_the_drawing_limit_are_drawn() -> None:
+    """The limit is not drawn too narrowly: ±1e300 and subnormal values still make a figure."""
+    values = [-1e300, 1e300, 5e-324, 1e-300] * 3
+    page = class_report(make_class({"1a": ["correct", "incorrect"] * 6}, params=[{"h": v} for v in values]))
+    assert "not drawn" not in page and page.count("<svg") == 3
+
+
 def test_a_key_without_parameters_still_reports() -> None:
     page = class_report(make_class({"1a": ["correct", "incorrect"]}))
     assert "the key holds no parameters for this problem" in page

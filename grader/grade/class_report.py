@@ -25,6 +25,7 @@ import html
 import numpy as np
 
 from grader.grade.class_summary import (
+    DRAWN_UP_TO,
     HARD_DROP,
     INVALID_STUDENTS,
     ClassSummary,
@@ -179,14 +180,19 @@ def _problem(problem: ProblemSummary, name: str) -> str:
     head = (f"<h3>Problem {_e(problem.key)}: {_e(problem.title)}</h3>\n<p class=\"muted\">parts "
             f"{_e(', '.join(problem.labels))}; {_students(attempted)} answered, mean score "
             f"{_percent(100 * problem.mean)}</p>")
-    varied = [p for p in problem.parameters if len(p.bins) > 1]
+    varied = problem.drawn
     fixed = [f"{p.name} = {_range(p.bins[0].low, p.bins[0].high)}" for p in problem.parameters if len(p.bins) == 1]
+    beyond = [f"{p.name} ({_range(p.bins[0].low, p.bins[-1].high)})" for p in problem.parameters
+              if len(p.bins) > 1 and not p.drawable]
     notes = []
     if fixed:
         notes.append("the same for everyone: " + ", ".join(fixed))
+    if beyond:
+        notes.append(f"not drawn, with values beyond ±{DRAWN_UP_TO:.0e} (too large for a figure's axis; check the "
+                     "key): " + ", ".join(beyond))
     if not problem.parameters:
         notes.append("the key holds no parameters for this problem")
-    elif not varied and attempted:
+    elif not varied and not beyond and attempted:
         notes.append("no parameter varies among the students who answered")
     figure = difficulty(problem, name) if varied and attempted else ""
     return "\n".join([head, figure, *(f"<p class=\"note\">{_e(note)}</p>" for note in notes)])

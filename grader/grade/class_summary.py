@@ -49,6 +49,7 @@ SHOWN_ORDER = ("correct", "ecf", "mistake", "incorrect", "invalid", "missing")
 HARD_DROP = 0.10  # a parameter's bin is hard when its mean is this far below the problem's (and clearly so)
 HARD_STUDENTS = 5  # ... and it holds at least this many students
 MAX_BINS = 12  # a parameter with at most this many values gets a bin per value
+DRAWN_UP_TO = 1e300  # a parameter reaching beyond ±this is not drawn: a figure's axis overflows near float64's limit
 TOP_MISTAKES = 5  # diagnosed mistakes listed per part
 INVALID_STUDENTS = 50  # students listed with the answers that could not be read; the rest are counted
 
@@ -114,6 +115,15 @@ class Parameter:
     values: Floats  # per student of the key (NaN: none in the key)
     bins: tuple[ParameterBin, ...]  # over the students who attempted the problem
 
+    @property
+    def drawable(self) -> bool:
+        """Whether a figure can scale to its values: every bin within ±:data:`DRAWN_UP_TO`.
+
+        >>> Parameter("h", np.array([2.0, 1.6e308]), binned(np.array([2.0, 1.6e308]), np.ones(2))).drawable
+        False
+        """
+        return all(part.low >= -DRAWN_UP_TO and part.high <= DRAWN_UP_TO for part in self.bins)
+
 
 @dataclass(frozen=True)
 class ProblemSummary:
@@ -130,6 +140,11 @@ class ProblemSummary:
     def mean(self) -> float:
         """The mean share of the points of the students who attempted the problem (0 when nobody did)."""
         return float(self.score[self.attempted].mean()) if self.attempted.any() else 0.0
+
+    @property
+    def drawn(self) -> tuple[Parameter, ...]:
+        """The parameters its figure shows: those that vary and that a figure can scale to."""
+        return tuple(p for p in self.parameters if len(p.bins) > 1 and p.drawable)
 
     def hard_corners(self) -> list[tuple[Parameter, ParameterBin]]:
         """Where a parameter's bin scored clearly below the problem (:func:`is_hard`), lowest first."""
@@ -283,7 +298,7 @@ def binned(values: Floats, score: Floats) -> tuple[ParameterBin, ...]:
         which = np.searchsorted(distinct, values)
     else:
         count = int(np.clip(np.sqrt(len(values)) / 2, 3, MAX_BINS))
-        cuts = np.linspace(distinct[0], distinct[-1], count + 1)
+        cuts = _cuts(float(distinct[0]), float(distinct[-1]), count)
         which = np.clip(np.searchsorted(cuts, values, side="right") - 1, 0, count - 1)
     students = np.bincount(which, minlength=count)
     sums = np.bincount(which, weights=score, minlength=count)
@@ -299,6 +314,17 @@ def binned(values: Floats, score: Floats) -> tuple[ParameterBin, ...]:
             variance = max(square - size * mean * mean, 0.0) / (size - 1) if size > 1 else 0.0
             found.append(ParameterBin(low, high, size, mean, (variance / size) ** 0.5))
     return tuple(found)
+
+
+def _cuts(low: float, high: float, count: int) -> Floats:
+    """``count`` equal widths from ``low`` to ``high``, whose span may be beyond float64 (-1e308 to 1e308).
+
+    >>> _cuts(-1.5e308, 1.5e308, 2).tolist()
+    [-1.5e+308, 0.0, 1.5e+308]
+    """
+    if np.isfinite(high - low):
+        return np.linspace(low, high, count + 1)
+    return np.linspace(low / 2, high / 2, count + 1) * 2
 
 
 def is_hard(part: ParameterBin, mean: float) -> bool:

@@ -84,7 +84,7 @@ def difficulty(problem: ProblemSummary, name: str) -> str:
     """A panel per parameter that varies: the problem's score against it (bins' means with their
     standard errors, hard bins in red, the problem's mean dashed, each student a point in a small class).
     ``name`` (letters, digits, ``-``) prefixes the figure's ids."""
-    shown = [p for p in problem.parameters if len(p.bins) > 1]
+    shown = problem.drawn
     rows = -(-len(shown) // PANELS_PER_ROW)
     with _figure((_WIDTH, 0.1 + 2.25 * rows), (0.6, 0.15, 0.5, 0.1),
                  (rows, PANELS_PER_ROW), (0.45, 0.5)) as figure:

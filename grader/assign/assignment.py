@@ -10,6 +10,7 @@
 
 from __future__ import annotations
 
+import difflib
 import re
 import unicodedata
 from collections.abc import Mapping
@@ -115,34 +116,57 @@ def load_assignment(path: Path) -> Assignment:
         raise TemplateError(where, "seed", "a number or text (the assignment seed)", shown(seed))
     return Assignment(where, _text(raw, "title", where), _text(raw, "course", where), str(seed).strip(),
                       _text(raw, "due", where, required=False), _text(raw, "instructions", where, required=False),
-                      problems, _grading(raw.get("grading"), where))
+                      problems, grading_from(raw.get("grading"), where))
 
 
-def _grading(raw: Any, where: str) -> Grading:
+GRADING_FIELDS = {"numeric_expressions": "true or false", "ecf_credit": "0 to 1", "mistake_credit": "0 to 1",
+                  "intermediate_sig_figs": "2 to 10", "max_tolerance": "0.001 to 0.5"}
+"""The fields of ``grading`` (in an assignment, and in the key that copies it) and their ranges."""
+
+
+def grading_from(raw: Any, where: str, field: str = "grading") -> Grading:
+    """The ``grading`` mapping of an assignment (or, as ``field``, of a key), checked: an unknown field
+    is refused with the nearest known one, a value out of range with its range.
+
+    >>> grading_from({"max_tolerance": 0.1}, "a.yaml").max_tolerance
+    0.1
+    >>> grading_from({"max_tolerence": 0.1}, "a.yaml")
+    Traceback (most recent call last):
+    ...
+    grader.errors.TemplateError: a.yaml: grading.max_tolerence: expected one of ... (did you mean max_tolerance?), ...
+    >>> grading_from({"max_tolerance": -1}, "a.yaml")
+    Traceback (most recent call last):
+    ...
+    grader.errors.TemplateError: a.yaml: grading.max_tolerance: expected a relative tolerance from 0.001 ..., got -1
+    """
     if raw is None:
         return Grading()
-    if not isinstance(raw, Mapping) or set(raw) - {"numeric_expressions", "ecf_credit", "mistake_credit",
-                                                   "intermediate_sig_figs", "max_tolerance"}:
-        raise TemplateError(where, "grading", "{numeric_expressions: true or false, ecf_credit: 0 to 1, "
-                            "mistake_credit: 0 to 1, intermediate_sig_figs: 2 to 10, max_tolerance: 0.001 to 0.5}",
-                            shown(raw))
+    if not isinstance(raw, Mapping):
+        raise TemplateError(where, field, "a mapping {" + ", ".join(f"{name}: {values}" for name, values
+                                                                      in GRADING_FIELDS.items()) + "}", shown(raw))
+    for name in raw:
+        if name not in GRADING_FIELDS:
+            close = difflib.get_close_matches(str(name), list(GRADING_FIELDS), n=1, cutoff=0.6)
+            hint = f" (did you mean {close[0]}?)" if close else ""
+            raise TemplateError(where, f"{field}.{shown(name, 40) if not isinstance(name, str) else name}",
+                                f"one of {', '.join(sorted(GRADING_FIELDS))}{hint}", "an unknown field")
     value = raw.get("numeric_expressions", True)
     if not isinstance(value, bool):
-        raise TemplateError(where, "grading.numeric_expressions", "true or false", shown(value))
+        raise TemplateError(where, f"{field}.numeric_expressions", "true or false", shown(value))
     credits = {}
     for name, default in (("ecf_credit", Grading.ecf_credit), ("mistake_credit", Grading.mistake_credit)):
         credit = raw.get(name, default)
         if not (_number(credit) and 0 <= credit <= 1):
-            raise TemplateError(where, f"grading.{name}", "a credit from 0 to 1 (a fraction of the part's points)",
+            raise TemplateError(where, f"{field}.{name}", "a credit from 0 to 1 (a fraction of the part's points)",
                                 shown(credit))
         credits[name] = float(credit)
     figures = raw.get("intermediate_sig_figs", Grading.intermediate_sig_figs)
     if isinstance(figures, bool) or not isinstance(figures, int) or not 2 <= figures <= 10:
-        raise TemplateError(where, "grading.intermediate_sig_figs",
+        raise TemplateError(where, f"{field}.intermediate_sig_figs",
                             "a whole number of significant figures from 2 to 10", shown(figures))
     widest = raw.get("max_tolerance", Grading.max_tolerance)
     if not (_number(widest) and 0.001 <= widest <= 0.5):
-        raise TemplateError(where, "grading.max_tolerance",
+        raise TemplateError(where, f"{field}.max_tolerance",
                             "a relative tolerance from 0.001 to 0.5 (0.05 is ±5 %)", shown(widest))
     return Grading(numeric_expressions=value, **credits, intermediate_sig_figs=figures,
                    max_tolerance=float(widest))

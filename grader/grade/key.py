@@ -29,7 +29,6 @@ import itertools
 import json
 import math
 import re
-from collections import Counter
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -37,14 +36,15 @@ from typing import Any, TypeVar
 
 import numpy as np
 
-from grader.assign.assignment import MAX_POINTS
-from grader.errors import GraderError, shown
+from grader.assign.assignment import MAX_POINTS, Grading, grading_from
+from grader.errors import GraderError, TemplateError, shown
 from grader.grade.notation import ReadError, check_powers
 from grader.inputs import CELL_CHARS, decode_text, read_bytes
 from grader.model.expr import names, parse
 from grader.model.tolerance import Tolerance
 from grader.model.units import parse_unit
 
+VERSIONS = (1, 2)  # the key schema versions grading reads
 KEY_BYTES = 1 << 30  # 1 GiB: a key holds every student's numbers; 2,000 students take about 2 MB
 SYMBOL_RANGE = (1.0, 10.0)  # version 1 keys give no ranges: a symbolic answer's names are drawn here
 
@@ -162,9 +162,9 @@ def load_key(path: Path) -> Key:
         raise GraderError(f"{where}: expected a grader answer key (schema grader-key, written by grader generate), "
                           f"got {shown(raw.get('schema') if isinstance(raw, dict) else type(raw).__name__)}")
     version = raw.get("version")
-    if version not in (1, 2):
-        raise GraderError(f"{where}: expected key schema version 1 or 2, got {shown(version)} (a newer grader "
-                          "wrote it? update grader)")
+    if type(version) is not int or version not in VERSIONS:  # not True, nor 2.0: no grader writes those
+        why = " (a newer grader wrote it? update grader)" if type(version) is int else " (not the whole number 1 or 2)"
+        raise GraderError(f"{where}: expected key schema version 1 or 2, got {shown(version)}{why}")
     try:
         return _key(raw, where, version)
     except _EntryError as error:
@@ -265,7 +265,8 @@ def _reader(header: Mapping[str, Any]) -> Callable[[Any], Any]:
     the students make a usable key; otherwise, or when a student does not read, the student's JSON,
     for :func:`_key` to read and refuse in order, as it would without this shortcut."""
     try:
-        usable = header.get("schema") == "grader-key" and header.get("version") in (1, 2)
+        usable = header.get("schema") == "grader-key" and type(header.get("version")) is int \
+            and header.get("version") in VERSIONS
         symbols = _symbols(header["problems"]) if usable else None
     except Exception:  # refused later, in order, by _key
         symbols = None
@@ -285,40 +286,70 @@ def _reader(header: Mapping[str, Any]) -> Callable[[Any], Any]:
 # --- the key's objects ----------------------------------------------------------------------------
 
 def _key(raw: Mapping[str, Any], where: str, version: int) -> Key:
-    problems = tuple(KeyProblem(str(p["key"]), _text(p.get("title", ""), "a problem's title"),
-                                tuple(_text(a["label"], "a problem's label") for a in p["answers"]),
-                                _text(p.get("template", ""), "a problem's template"))
-                     for p in raw["problems"])
+    problems = _problems(raw["problems"])
     symbols = _symbols(raw["problems"])
     shared: dict[Any, Any] = {}
     students = tuple(s if isinstance(s, KeyStudent) else _student(s, symbols, shared) for s in raw["students"])
     if not students or not problems:
         raise _EntryError(f"expected at least one {'student' if not students else 'problem'}, got none (grader "
                           "generate writes a key for a roster of students and an assignment of problems)")
-    ids = [s.id for s in students]
-    if len(set(ids)) != len(ids):
-        twice = next(student_id for student_id, n in Counter(ids).items() if n > 1)
-        raise _EntryError(f"the student id {shown(twice)} appears twice; expected each student once")
+    _once([s.id for s in students], lambda index: f"students[{index}].id", "the student id", "each student once")
     labels = {label for problem in problems for label in problem.labels}
     for student in students:
         if set(student.parts) != labels:
             raise ValueError(f"student {student.id} has parts {sorted(student.parts)}, the problems {sorted(labels)}")
-    grading = raw["assignment"].get("grading", {})
-    numeric_expressions = grading.get("numeric_expressions", True)
-    if not isinstance(numeric_expressions, bool):
-        raise _EntryError(f"assignment.grading.numeric_expressions: expected true or false, got "
-                          f"{shown(numeric_expressions)}")
+    grading = _grading(raw["assignment"].get("grading"), where)
     templates = {str(name): str(entry.get("sha256", "")) for name, entry in raw.get("templates", {}).items()}
-    return Key(where, version, _text(raw["assignment"]["title"], "assignment.title"), numeric_expressions,
-               problems, students, templates, _credit(grading, "ecf_credit", 1.0),
-               _credit(grading, "mistake_credit", 0.0))
+    return Key(where, version, _text(raw["assignment"]["title"], "assignment.title"), grading.numeric_expressions,
+               problems, students, templates, grading.ecf_credit, grading.mistake_credit)
 
 
-def _credit(grading: Mapping[str, Any], name: str, default: float) -> float:
-    value = grading.get(name, default)
-    if isinstance(value, bool) or not isinstance(value, int | float) or not 0 <= value <= 1:
-        raise _EntryError(f"assignment.grading.{name}: expected a credit from 0 to 1, got {shown(value)}")
-    return float(value)
+def _problems(raw: Any) -> tuple[KeyProblem, ...]:
+    """The key's problems, each key and each part's label given once (two problems with one key would
+    be graded, and totalled, twice; two parts with one label would share one column of answers)."""
+    problems = tuple(KeyProblem(str(p["key"]), _text(p.get("title", ""), "a problem's title"),
+                                tuple(_label(a["label"], f"problems[{index}].answers[{number}].label")
+                                      for number, a in enumerate(p["answers"])),
+                                _text(p.get("template", ""), "a problem's template"))
+                     for index, p in enumerate(raw))
+    _once([p.key for p in problems], lambda index: f"problems[{index}].key", "the problem key", "each problem once")
+    places = [f"problems[{index}].answers[{number}].label" for index, p in enumerate(problems)
+              for number in range(len(p.labels))]
+    _once([label for p in problems for label in p.labels], places.__getitem__, "the label",
+          "each part's label once")
+    return problems
+
+
+def _once(values: list[str], place: Callable[[int], str], what: str, expected: str) -> None:
+    """Refuse the second of two equal ``values``, naming both places.
+
+    >>> _once(["1", "2", "1"], lambda index: f"problems[{index}].key", "the problem key", "each problem once")
+    Traceback (most recent call last):
+    ...
+    grader.grade.key._EntryError: problems[2].key: the problem key '1' appears twice (also problems[0].key); ...
+    """
+    first: dict[str, int] = {}
+    for index, value in enumerate(values):
+        earlier = first.setdefault(value, index)
+        if earlier != index:
+            raise _EntryError(f"{place(index)}: {what} {shown(value)} appears twice (also {place(earlier)}); "
+                              f"expected {expected}")
+
+
+def _label(value: Any, where: str) -> str:
+    """A part's label: text with something to type (submissions name parts by it)."""
+    label = _text(value, where)
+    if not label.strip():
+        raise _EntryError(f"{where}: expected a label such as 1a, got {shown(label)}")
+    return label
+
+
+def _grading(raw: Any, where: str) -> Grading:
+    """The key's copy of the assignment's ``grading``, checked as an assignment's is."""
+    try:
+        return grading_from(raw, where, "assignment.grading")
+    except TemplateError as error:
+        raise _EntryError(f"{error.key}: expected {error.expected}, got {error.got}") from None
 
 
 def _symbols(problems: Any) -> dict[str, dict[str, tuple[float, float]]]:
@@ -355,16 +386,24 @@ def _student(raw: Mapping[str, Any], symbols: Mapping[str, Mapping[str, tuple[fl
     student_id = _text(raw["id"], "a student's id")
     if not student_id.strip():
         raise _EntryError(f"a student's id: expected an id, got {shown(student_id)}")
-    parts = {}
+    parts: dict[str, KeyPart] = {}
     parameters: list[tuple[str, str]] = []
     values: list[float] = []
+    keys: set[str] = set()
     for problem in raw["problems"]:
         key = _one(shared, str(problem["key"]))
+        if key in keys:
+            raise _EntryError(f"student {student_id}: the problem key {shown(key)} appears twice; expected each "
+                              "problem once")
+        keys.add(key)
         for name, answer in problem["answers"].items():
             try:
                 part = _part(key, _one(shared, str(name)), answer, symbols, shared)
             except _EntryError as error:
                 raise _EntryError(f"student {student_id}: {error}") from None
+            if part.label in parts:
+                raise _EntryError(f"student {student_id}: answer {name}: the label {shown(part.label)} appears twice "
+                                  f"(also answer {parts[part.label].name}); expected each part's label once")
             parts[part.label] = part
         printed = problem.get("params")
         for name, value in printed.items() if isinstance(printed, dict) else ():

@@ -133,7 +133,8 @@ def build_parser() -> argparse.ArgumentParser:
                          help="a Canvas gradebook export (Grades > Export): canvas.csv then has its students, names "
                               "and ids, and its 'Title (id)' column of the assignment")
     grading.add_argument("--force", action="store_true",
-                         help="replace an output folder an earlier run wrote (as its .grader-manifest.json says)")
+                         help="replace an output folder an earlier run of this command wrote (as its "
+                              ".grader-manifest.json says)")
     grading.add_argument("--json", action="store_true", help="print a summary object on stdout")
 
     checking = commands.add_parser(
@@ -214,7 +215,8 @@ def _bank_options(command: argparse.ArgumentParser, where: str = "") -> None:
 def _output_options(command: argparse.ArgumentParser) -> None:
     command.add_argument("--jobs", type=int, default=1, metavar="N", help="render PDFs in N parallel jobs")
     command.add_argument("--force", action="store_true",
-                         help="replace an output folder an earlier run wrote (as its .grader-manifest.json says)")
+                         help="replace an output folder an earlier run of this command wrote (as its "
+                              ".grader-manifest.json says)")
     command.add_argument("--font-dir", type=Path, action="append", default=[], metavar="DIR", dest="font_dirs",
                          help="also use the fonts in DIR (repeatable), e.g. for names in scripts the embedded "
                               "fonts and any installed Noto CJK / emoji fonts lack")

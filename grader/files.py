@@ -39,7 +39,7 @@ from contextlib import contextmanager, suppress
 from pathlib import Path
 from typing import Any
 
-from grader.errors import GraderError
+from grader.errors import GraderError, shown
 
 
 def _umask() -> int:
@@ -144,7 +144,7 @@ def output_folder(out: Path, *, command: str, inputs: Sequence[Path] = (), force
         raise
     finished = False
     try:
-        before = _state_before(out, target, force)
+        before = _state_before(out, target, force, command)
         staging = work / "new"
         staging.mkdir()
         try:
@@ -186,11 +186,11 @@ def write_manifest(folder: Path, command: str) -> None:
     write_atomic(folder / MANIFEST, json.dumps(document, indent=1) + "\n")
 
 
-def manifest_mismatches(folder: Path, shown: Path | None = None) -> list[str]:
+def manifest_mismatches(folder: Path, named: Path | None = None) -> list[str]:
     """What in ``folder`` disagrees with its manifest: files and folders it does not list, and files
     changed since (a listed file that is gone is no mismatch: replacing the folder loses nothing).
-    Messages name the folder as ``shown`` (default ``folder``)."""
-    manifest = _read_manifest(folder, shown)
+    Messages name the folder as ``named`` (default ``folder``)."""
+    manifest = _read_manifest(folder, named)
     files, folders, others = _listing(folder)
     found = [f"{name} (a link or special file, not written by grader)" for name in others]
     found += [f"{name}/ (a folder not made by grader)" for name in sorted(folders - set(manifest["folders"]))]
@@ -202,19 +202,19 @@ def manifest_mismatches(folder: Path, shown: Path | None = None) -> list[str]:
     return found
 
 
-def _read_manifest(folder: Path, shown: Path | None = None) -> dict[str, Any]:
-    shown = shown or folder
+def _read_manifest(folder: Path, named: Path | None = None) -> dict[str, Any]:
+    named = named or folder
     try:
         document = json.loads((folder / MANIFEST).read_text(encoding="utf-8"))
     except FileNotFoundError:
-        raise GraderError(f"{shown}: exists and is not empty, and no grader run wrote it (there is no {MANIFEST}); "
+        raise GraderError(f"{named}: exists and is not empty, and no grader run wrote it (there is no {MANIFEST}); "
                           "choose a new or empty --out: --force replaces only a folder a grader run wrote") from None
     except (OSError, ValueError, RecursionError) as error:
-        raise GraderError(f"{shown / MANIFEST}: expected a manifest grader wrote, got an unreadable file ({error}); "
+        raise GraderError(f"{named / MANIFEST}: expected a manifest grader wrote, got an unreadable file ({error}); "
                           "choose another --out") from None
     if not (isinstance(document, dict) and document.get("schema") == "grader-manifest"
             and isinstance(document.get("files"), dict) and isinstance(document.get("folders"), list)):
-        raise GraderError(f"{shown / MANIFEST}: expected a manifest grader wrote (schema grader-manifest), got "
+        raise GraderError(f"{named / MANIFEST}: expected a manifest grader wrote (schema grader-manifest), got "
                           "something else; choose another --out")
     return document
 
@@ -275,11 +275,30 @@ def _checked_target(out: Path, inputs: Sequence[Path]) -> Path:
             raise GraderError(f"{out}: is {what} or holds it, and --out is replaced whole; give a new folder "
                               "of its own, such as hw7")
     for source in inputs:
-        for candidate in {Path(os.path.abspath(source)), source.resolve()}:
-            if any(folder == candidate or folder in candidate.parents for folder in (absolute, target)):
-                raise GraderError(f"{out}: is or holds the input {source}, and --out is replaced whole; choose an "
-                                  "--out that holds none of the inputs")
+        if _holds(absolute, target, source):
+            raise GraderError(f"{out}: is or holds the input {source}, and --out is replaced whole; choose an "
+                              "--out that holds none of the inputs")
     return target
+
+
+def _holds(absolute: Path, target: Path, source: Path) -> bool:
+    """Whether the folder (``absolute``, whose real path is ``target``) is or holds ``source``: by its
+    path, or, where paths are spelt differently (a case-insensitive disk's ``HW/key.json`` in ``hw``, a
+    folder mounted twice), by being the same folder as one of the source's."""
+    candidates = {Path(os.path.abspath(source)), source.resolve()}
+    if any(folder == candidate or folder in candidate.parents for folder in (absolute, target)
+           for candidate in candidates):
+        return True
+    try:
+        folder = os.stat(target)
+    except OSError:  # nothing there yet: nothing to replace
+        return False
+    for candidate in candidates:
+        for place in (candidate, *candidate.parents):
+            with suppress(OSError):
+                if os.path.samestat(os.stat(place), folder):
+                    return True
+    return False
 
 
 def _name_max(folder: Path) -> int:
@@ -334,8 +353,10 @@ def _claim(out: Path, target: Path) -> Path:
     return work
 
 
-def _state_before(out: Path, target: Path, force: bool) -> object:
-    """What ``target`` holds now: nothing (None), an empty folder ("empty"), or a run's output (its manifest)."""
+def _state_before(out: Path, target: Path, force: bool, command: str) -> object:
+    """What ``target`` holds now: nothing (None), an empty folder ("empty"), or the output of an earlier run of
+    ``command`` (its manifest). Another command's output is never replaced: ``grader grade --force`` on the
+    folder ``grader demo`` wrote would delete its key, sheets and submissions."""
     if not os.path.lexists(target):
         return None
     if target.is_symlink() or not target.is_dir():
@@ -345,12 +366,18 @@ def _state_before(out: Path, target: Path, force: bool) -> object:
     if not force:
         raise GraderError(f"{out}: the output folder exists and is not empty; choose another --out, or --force to "
                           f"replace it (only if a grader run wrote it, as its {MANIFEST} says)")
+    manifest = _read_manifest(target, out)
+    writer = manifest.get("command")
+    if writer != command:
+        name = writer if isinstance(writer, str) and writer.isprintable() and len(writer) <= 60 else shown(writer)
+        raise GraderError(f"{out}: written by {name} (as its {MANIFEST} says); {command} --force replaces only "
+                          f"a folder {command} wrote, never another command's files; choose another --out")
     mismatches = manifest_mismatches(target, out)
     if mismatches:
-        shown = ", ".join(mismatches[:5]) + (f" and {len(mismatches) - 5} more" if len(mismatches) > 5 else "")
+        listed = ", ".join(mismatches[:5]) + (f" and {len(mismatches) - 5} more" if len(mismatches) > 5 else "")
         raise GraderError(f"{out}: --force replaces only a folder that holds exactly what its {MANIFEST} lists, "
-                          f"got {shown}; move those out of it, or choose another --out")
-    return _read_manifest(target, out)
+                          f"got {listed}; move those out of it, or choose another --out")
+    return manifest
 
 
 def _move_into_place(out: Path, target: Path, work: Path, before: object) -> None:

@@ -3,7 +3,7 @@
 
 Everything is written into a work folder beside the output and moved into place at the end, with a
 manifest of what was written (:func:`grader.files.output_folder`): a failed run leaves nothing behind,
-a previous output stays untouched, and ``--force`` replaces only what an earlier run wrote.
+a previous output stays untouched, and ``--force`` replaces only what an earlier run of ``grader generate`` wrote.
 """
 
 from __future__ import annotations

@@ -206,6 +206,21 @@ def test_text_cells_in_the_reports_cannot_run_as_formulas(tmp_path: Path, capsys
     assert row["submitted"].startswith("'=") and row["verdict"] == "invalid"
 
 
+@pytest.mark.parametrize("starter", ["\uff1d", "\uff0b", "\uff0d", "\uff20"], ids=["equals", "plus", "minus", "at"])
+def test_a_full_width_formula_starter_is_guarded_in_details_csv(tmp_path: Path, capsys: pytest.CaptureFixture[str],
+                                                                key_path: Path, starter: str) -> None:
+    """A cell starting with a full-width ``＝`` (U+FF1D), ``＋``, ``－`` or ``＠`` reached details.csv unguarded
+    (issue 22): a spreadsheet with an East Asian locale may read it as a formula."""
+    rows = key_answers(key_path)
+    student, label, _ = rows[0]
+    rows[0] = (student, label, f'{starter}HYPERLINK("http://x")')
+    (tmp_path / "a.csv").write_text(long_csv(rows), encoding="utf-8")
+    run(capsys, "grade", "--key", key_path, tmp_path / "a.csv", "--out", tmp_path / "g")
+    row = next(row for row in read(tmp_path / "g" / "details.csv") if (row["student_id"], row["label"]) == (student,
+                                                                                                          label))
+    assert row["submitted"] == f"'{starter}HYPERLINK(\"http://x\")"
+
+
 def test_control_characters_a_student_typed_are_shown_as_escapes_in_the_reports(
         tmp_path: Path, capsys: pytest.CaptureFixture[str], key_path: Path) -> None:
     """An escape sequence or a right-to-left override typed into an answer (or a stray label) reaches

@@ -353,7 +353,7 @@ def test_points_beyond_a_million_or_negative_are_refused(tmp_path: Path, capsys:
 def test_a_guarded_key_csv_cell_gives_back_the_original(text: str) -> None:
     cell = safe_cell(text)
     assert original_cell(cell) == text
-    assert not cell.startswith(("=", "+", "-", "@", "\t", "\r", "\n"))
+    assert not cell.startswith(("=", "+", "-", "@", "\t", "\r", "\n", "\uff1d", "\uff0b", "\uff0d", "\uff20"))
 
 
 def test_a_formula_like_id_is_guarded_in_key_csv_and_kept_in_key_json(tmp_path: Path,

@@ -47,16 +47,19 @@ from grader.model.tolerance import Tolerance
 
 SCHEMA, VERSION = "grader-key", 2
 SYMBOL_RANGE = (1.0, 10.0)  # where a symbol with no sampled range (a speed v) is drawn to compare expressions
-_GUARDED_START = frozenset("=+-@\t\r\n'")  # a formula's first characters, and the guard's own
+# A formula's first characters, their full-width forms (an East Asian keyboard's ＝, which a spreadsheet may
+# read as =) and small forms, and the guard's own.
+_GUARDED_START = frozenset("=+-@\t\r\n'" "\uff1d\uff0b\uff0d\uff20" "\ufe66\ufe62\ufe63\ufe6b")
 
 
 def safe_cell(text: str) -> str:
     """A CSV text cell a spreadsheet will not run as a formula (docs/design.md: formula injection): a cell
-    starting with ``= + - @``, tab, CR or LF gets a leading ``'``, and so does one that already
-    starts with ``'``, so the original is always recovered by :func:`original_cell`.
+    starting with ``= + - @`` (or their full-width forms ``＝ ＋ － ＠``, or small forms), tab, CR or LF gets a
+    leading ``'``, and so does one that already starts with ``'``, so the original is always recovered by
+    :func:`original_cell`.
 
-    >>> safe_cell("=HYPERLINK(1)"), safe_cell("Ana"), safe_cell("'quoted")
-    ("'=HYPERLINK(1)", 'Ana', "''quoted")
+    >>> safe_cell("=HYPERLINK(1)"), safe_cell("Ana"), safe_cell("'quoted"), safe_cell("＝HYPERLINK(1)")
+    ("'=HYPERLINK(1)", 'Ana', "''quoted", "'＝HYPERLINK(1)")
     """
     return "'" + text if text[:1] in _GUARDED_START else text
 

@@ -691,7 +691,7 @@ def _check(arguments: argparse.Namespace) -> int:
         expected, unit = _expected_quantity(arguments.expected, arguments.unit)
         against = check.expectation(expected, unit=unit,
                                     tolerance=tolerance, symbols=symbols,
-                                    domains=dict(check.domain(text) for text in arguments.domains))
+                                    domains=check.domains(arguments.domains))
     result = check.check(arguments.answer, against)
     if arguments.json:
         print(_json_line(result))

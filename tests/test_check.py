@@ -191,6 +191,24 @@ def test_batch_lines_beyond_float64_are_error_lines_and_every_line_is_strict_jso
     assert results[3]["error"] == "unit: cannot read unit '\ud800' (write units like m, m/s, m/s^2, kg, deg, %)"
 
 
+def test_a_batch_line_with_a_field_given_twice_is_an_error_line_naming_it(tmp_path: Path,
+                                                                         capsys: pytest.CaptureFixture[str]) -> None:
+    """JSON's rule, the last of two equal names wins, checked the line against the second "expected" and
+    said nothing (issue 22); at any depth, the line and the field are named and the other lines go on."""
+    lines = ['{"submitted": "1", "expected": 1, "expected": 2}',
+             '{"submitted": "1", "expected": 1, "tolerance": {"rtol": 0.5, "rtol": 0.01}}',
+             '{"submitted": "v", "expected": "v", "domains": {"v": [1, 2], "v": [3, 4]}}',
+             '{"submitted": "1", "expected": 1}']
+    batch = tmp_path / "answers.jsonl"
+    batch.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    code, out, _ = run(capsys, "--batch", batch)
+    assert code == 3
+    assert [json.loads(line) for line in out.splitlines()][:3] == [
+        {"line": number, "error": f"the field '{name}' appears twice; expected each field once (the last would win)"}
+        for number, name in ((1, "expected"), (2, "rtol"), (3, "v"))]
+    assert json.loads(out.splitlines()[3])["verdict"] == "correct"
+
+
 @pytest.mark.parametrize(("argv", "feedback"), [
     (["1e308", "--expected=-1e308"], "1e308 is more than 1.8e308 % above -1e308; only ±1 % is accepted"),
     (["1e308", "--expected=1"], "1e308 is more than 1.8e308 % above 1; only ±1 % is accepted"),
@@ -240,6 +258,9 @@ def test_student_and_label_are_read_as_grade_reads_their_cells(capsys: pytest.Ca
     (["6.3", "--expected", "inf", "--unit", "m"], "expected 'inf': inf is not a finite number"),
     (["6.3", "--expected", "v", "--symbols", ""], "symbols: expected names like p, v, got ['']"),  # "use ,  and"
     (["6.3", "--expected", "v", "--symbols", "p,,v"], "symbols: expected names like p, v"),
+    # the last --domain won silently (issue 22)
+    (["6.3", "--expected", "v", "--domain", "v=1:2", "--domain", "v=3:4"],
+     "--domain v=3:4: v's domain is already given (--domain v=1:2); give each name once"),
 ])
 def test_requests_that_cannot_be_carried_out_exit_2(capsys: pytest.CaptureFixture[str], key_path: Path,
                                                     argv: list[str], message: str) -> None:

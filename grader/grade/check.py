@@ -212,7 +212,9 @@ def batch(lines: Sequence[str], key: Key | None, physics: Physics | None = None)
 
 def _line(line: str, key: Key | None, physics: Physics | None) -> dict[str, Any]:
     try:
-        item = json.loads(line, parse_constant=_refuse_constant)
+        item = json.loads(line, parse_constant=_refuse_constant, object_pairs_hook=_once_each)
+    except _TwiceError as error:
+        raise UsageError(str(error)) from None
     except ValueError as error:
         raise UsageError(f"expected a JSON object, got invalid JSON ({error})") from None
     if not isinstance(item, dict):
@@ -251,6 +253,46 @@ def _text(item: Mapping[str, Any], name: str) -> str:
     if not isinstance(value, str):
         raise UsageError(f"{name}: expected text, got {shown(value)}")
     return value
+
+
+class _TwiceError(ValueError):
+    """A JSON object with a name given twice (JSON's rule, the last one wins, would drop the first)."""
+
+
+def _once_each(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
+    """A JSON object's pairs as a dict, each name given once.
+
+    >>> _once_each([("expected", 1), ("expected", 2)])
+    Traceback (most recent call last):
+    ...
+    grader.grade.check._TwiceError: the field 'expected' appears twice; expected each field once (the last would win)
+    """
+    item = dict(pairs)
+    if len(item) != len(pairs):
+        twice = next(name for index, (name, _) in enumerate(pairs) if any(name == n for n, _ in pairs[:index]))
+        raise _TwiceError(f"the field {shown(twice)} appears twice; expected each field once (the last would win)")
+    return item
+
+
+def domains(texts: Sequence[str]) -> dict[str, tuple[float, float]]:
+    """Command-line ``--domain``s by name, each name given once (the last would silently win).
+
+    >>> domains(["p=0.1:10", "v=1:5"])
+    {'p': (0.1, 10.0), 'v': (1.0, 5.0)}
+    >>> domains(["p=0.1:10", "p=1:2"])
+    Traceback (most recent call last):
+    ...
+    grader.errors.UsageError: --domain p=1:2: p's domain is already given (--domain p=0.1:10); give each name once
+    """
+    found: dict[str, tuple[float, float]] = {}
+    given: dict[str, str] = {}
+    for text in texts:
+        name, bounds = domain(text)
+        if name in found:
+            raise UsageError(f"--domain {text}: {name}'s domain is already given (--domain {given[name]}); give each "
+                             "name once")
+        found[name], given[name] = bounds, text
+    return found
 
 
 def _refuse_constant(name: str) -> float:

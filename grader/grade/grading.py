@@ -27,11 +27,12 @@ from grader.grade.cells import (
     read_number,
     undefined_word,
 )
-from grader.grade.compare import equivalent, errors, feedbacks, is_correct, number_text
+from grader.grade.compare import errors, feedbacks, is_correct, number_text
 from grader.grade.diagnosis import Earlier, Physics, ProblemPhysics, physics_for, reconsider
 from grader.grade.key import Key, KeyPart
 from grader.grade.notation import cut
 from grader.grade.submissions import Answer, RowProblem, Submissions
+from grader.grade.symbolic import equivalent, refused
 from grader.model.expr import Node, parse
 from grader.model.tolerance import Tolerance
 
@@ -268,7 +269,11 @@ def _symbolic(part: KeyPart, text: str, delimiter: str, key: Key) -> Outcome:
         return "missing", 0.0, "the answer was blank", ""
     if isinstance(cell, CellInvalid):
         return "invalid", 0.0, f"could not read this answer: {cell.reason}", ""
-    same = equivalent(cell.tree, _key_tree(str(part.value)), part.symbols, seed=f"{key.title}/{part.label}")
+    expected = _key_tree(str(part.value))
+    refusal = refused(cell.tree, expected)
+    if refusal is not None:
+        return "invalid", 0.0, f"could not read this answer: {refusal}", cell.text
+    same = equivalent(cell.tree, expected, part.symbols, seed=f"{key.title}/{part.label}")
     if isinstance(same, str):
         return "invalid", 0.0, f"could not compare this expression: {same}", cell.text
     names = " and ".join(symbols)

@@ -10,11 +10,12 @@ those points: ``... + 100*Max(0, p - 2.99)``, a bump ``50*exp(-1e6*(p - 1.7)^2)`
    through it, and at *probes*: for each sub-term that can change fast, where it does. A denominator or the
    argument of ``sqrt``, ``log``, ``abs``, ``hypot``, ``atan2`` changes fast where it is smallest in size
    (a pole, a kink, a step); the argument of ``exp`` where it is largest (a narrow bump). Each is found by a
-   scan along every variable, refined by golden sections and coordinate ascent; the expressions are compared
+   scan along every variable, refined by zoomed-in grids and coordinate ascent; the expressions are compared
    there and just either side.
 3. An expression that agrees everywhere there but uses a function the key does not, or has a sub-term that
    comes within a rounding of zero inside the domain, is checked exactly: sympy, on a tree built from ours
-   (never from the student's text), within :data:`EXACT_SECONDS`. Not shown identical, it is not equivalent.
+   (never from the student's text), within :data:`grader.grade.identity.EXACT_SECONDS`. Not shown identical,
+   it is not equivalent.
 
 >>> from grader.model.expr import parse
 >>> domains = {"v": (1.0, 10.0), "p": (0.3, 3.0)}
@@ -31,32 +32,28 @@ from __future__ import annotations
 
 import hashlib
 import math
-import signal
-import threading
 from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass, field
 from functools import lru_cache
-from typing import Any
 
 import numpy as np
 
 from grader.errors import shown
-from grader.model.expr import Node, Num, Op, Sym, names, to_text
+from grader.grade.identity import identical
+from grader.model.expr import CONSTANTS, Node, Num, Op, Sym, names, to_text
 from grader.model.kernel import evaluate
 
 REFUSED = {"Max": "piecewise", "Min": "piecewise", "sign": "a step", "abs": "piecewise",
            "atan2": "a step across its branch cut"}
 """Functions refused in a student's expression unless the key's uses them, and why."""
 
-EXACT_SECONDS = 2.0
-"""The time the exact check may take (in the main thread; elsewhere only its quick steps run)."""
-
 _TRANSCENDENTAL = {"sqrt", "sin", "cos", "tan", "sind", "cosd", "exp", "log", "hypot", "atan2", "abs", "sign",
                    "Max", "Min"}
 _SMALLEST = {"sqrt", "log", "abs", "sign", "hypot", "atan2"}  # whose arguments matter where they are near 0
 _GRID = 65  # points of a line scan
 _BASES = 4  # lines scanned along each variable
-_GOLDEN = 34  # golden-section steps: a bracket of 2/64 of the domain narrowed to about 1e-9 of it
+_ZOOM = 33  # points of a zoomed-in grid
+_LEVELS = 7  # zoomed-in grids: a bracket of 2/64 of the domain narrowed to about 1e-10 of it
 _NEAR_ZERO = 1e-7  # a sub-term this small relative to its largest size is "at zero"
 
 
@@ -101,7 +98,8 @@ def equivalent(student: Node, expected: Node, domains: Mapping[str, tuple[float,
     ``points`` random points are drawn, uniformly in each name's domain. Points where the key is undefined
     are skipped; a student expression undefined at a random point where the key is defined is not
     equivalent. Returns a reason instead of a verdict when no comparison is possible: the caller marks the
-    cell invalid. Results are cached per (texts, domains, seed, rtol, points).
+    cell invalid. Results are cached per (expressions, domains, seed, rtol, points); the points depend on the
+    key and the seed only, and are worked out once per key.
 
     >>> from grader.model.expr import parse
     >>> equivalent(parse("v/(p - p)"), parse("v*(1 - 0.1*p)/(p + 1)"), {"v": (1, 10), "p": (0.1, 5)}, seed="s1")
@@ -113,25 +111,27 @@ def equivalent(student: Node, expected: Node, domains: Mapping[str, tuple[float,
         if not (math.isfinite(low) and math.isfinite(high) and low <= high):
             raise ValueError(f"equivalent: domain of {name}: expected finite low <= high, got {shown((low, high))}")
     key = tuple(sorted((name, (float(low), float(high))) for name, (low, high) in domains.items()))
-    return _equivalent(_Form(to_text(student), student), _Form(to_text(expected), expected), key, seed, rtol, points)
+    return _equivalent(student, _key_form(expected), key, seed, rtol, points)
+
+
+@lru_cache(maxsize=1024)
+def _key_form(expected: Node) -> _Form:
+    return _Form(to_text(expected), expected)
 
 
 @lru_cache(maxsize=4096)
-def _equivalent(student: _Form, expected: _Form, domains: Domains, seed: str, rtol: float,
+def _equivalent(student: Node, expected: _Form, domains: Domains, seed: str, rtol: float,
                 points: int) -> bool | str:
-    known = dict(domains)
-    missing = sorted((names(student.tree) | names(expected.tree)) - set(known))
+    missing = sorted((names(student) | names(expected.tree)) - {name for name, _ in domains})
     if missing:
         return f"the expression uses {', '.join(missing)}, which this answer does not know"
-    digest = hashlib.sha256("\n".join((seed, student.text, expected.text)).encode()).digest()
-    generator = np.random.default_rng(np.random.SeedSequence(int.from_bytes(digest, "big")))
-    sampled = _sampled(domains, generator, 4 * points)
-    key_values, student_values = _values(expected.tree, sampled), _values(student.tree, sampled)
-    usable = np.flatnonzero(np.isfinite(key_values))
-    if usable.size == 0:
+    fixed, b = _fixed(expected, domains, seed, points)
+    if b.size == 0:
         return "the key's expression cannot be evaluated at any test point; please ask your instructor to check it"
-    usable = np.concatenate([usable[:points], usable[usable >= 4 * points]])  # the random ones, then scans
-    b, a = key_values[usable], student_values[usable]
+    found = [_structure(node, domains) for node in _watched(student) | _watched_in_key(expected)]
+    probes = _stack([probe for probe, _ in found])
+    values = _values(student, fixed if probes is None else _joined([fixed, probes]))
+    a = values[:b.size]
     if not np.isfinite(a).any():
         return "the expression cannot be evaluated at any test point (division by zero?)"
     if not np.isfinite(a).all():
@@ -139,16 +139,14 @@ def _equivalent(student: _Form, expected: _Form, domains: Domains, seed: str, rt
     floor = 1e-3 * rtol * float(np.max(np.abs(b)))
     if not _agree(a, b, rtol, floor):
         return False
-    found = [_structure(node, domains) for node in _watched(student.tree) | _watched(expected.tree)]
-    probes = _stack([probe for probe, _ in found], domains)
     if probes is not None:
-        b, a = _values(expected.tree, probes), _values(student.tree, probes)
+        a, b = values[b.size:], _values(expected.tree, probes)
         both = np.isfinite(a) & np.isfinite(b)  # a probe may sit on a pole: compare beside it
         if not _agree(a[both], b[both], rtol, floor):
             return False
     touches_zero = any(near for _, near in found)
-    if touches_zero or not _functions(student.tree) <= _functions(expected.tree):
-        return _identical(student.tree, expected.tree, domains)
+    if touches_zero or not _functions(student) <= _functions(expected.tree):
+        return identical(student, expected.tree, domains)
     return True
 
 
@@ -158,12 +156,23 @@ def _agree(a: np.ndarray, b: np.ndarray, rtol: float, floor: float) -> bool:
 
 
 Points = dict[str, np.ndarray]
+Score = Callable[[Points], tuple[np.ndarray, np.ndarray]]
+"""A sub-term's score at points (higher: nearer what is looked for), and its signs."""
 
 
-def _sampled(domains: Domains, generator: np.random.Generator, drawn: int) -> Points:
-    """``drawn`` random points, then the domain's corners and the line scans' points."""
-    random = {name: generator.uniform(low, high, drawn) for name, (low, high) in domains}
-    return _joined([random, _corners(domains), _scans(domains, generator)])
+@lru_cache(maxsize=256)
+def _fixed(expected: _Form, domains: Domains, seed: str, points: int) -> tuple[Points, np.ndarray]:
+    """The points every answer to a key is compared at, where the key is defined: ``points`` seeded random
+    ones, the domain's corners and the line scans; and the key's values there. Worked out once per key."""
+    digest = hashlib.sha256("\n".join((seed, expected.text)).encode()).digest()
+    generator = np.random.default_rng(np.random.SeedSequence(int.from_bytes(digest, "big")))
+    random = {name: generator.uniform(low, high, 4 * points) for name, (low, high) in domains}
+    chosen = np.flatnonzero(np.isfinite(_values(expected.tree, random)))[:points]
+    everywhere = _joined([{name: column[chosen] for name, column in random.items()}, _corners(domains),
+                          _scans(domains, generator)])
+    values = _values(expected.tree, everywhere)
+    defined = np.isfinite(values)
+    return {name: column[defined] for name, column in everywhere.items()}, values[defined]
 
 
 def _corners(domains: Domains) -> Points:
@@ -196,7 +205,7 @@ def _joined(parts: list[Points]) -> Points:
     return {name: np.concatenate([part[name] for part in parts]) for name in parts[0]}
 
 
-def _stack(probes: list[Points | None], domains: Domains) -> Points | None:
+def _stack(probes: list[Points | None]) -> Points | None:
     found = [probe for probe in probes if probe is not None]
     return _joined(found) if found else None
 
@@ -216,23 +225,36 @@ def _values(tree: Node, env: Points) -> np.ndarray:
 
 def _watched(tree: Node) -> set[tuple[str, Node]]:
     """The sub-terms that can change fast, each with what to look for: ``"small"`` (where it is nearest 0)
-    or ``"large"`` (where it is largest)."""
+    or ``"large"`` (where it is largest). Sub-terms without names are constants, never watched."""
     found: set[tuple[str, Node]] = set()
-    for node in _nodes(tree):
-        if not isinstance(node, Op) or not names(node):
-            continue
-        if node.op == "div":
+
+    def visit(node: Node) -> bool:  # whether the node uses a name; depth is bounded by the parser
+        if isinstance(node, Sym):
+            return node.name not in CONSTANTS
+        if isinstance(node, Num):
+            return False
+        uses = [visit(arg) for arg in node.args]
+        watched = [arg for arg, used in zip(node.args, uses, strict=True) if used]
+        if node.op == "div" and uses[1]:
             found.add(("small", node.args[1]))
         elif node.op in _SMALLEST:
-            found.update(("small", arg) for arg in node.args)
-        elif node.op in ("Max", "Min"):
+            found.update(("small", arg) for arg in watched)
+        elif node.op in ("Max", "Min") and watched:
             found.add(("small", Op("sub", node.args)))
-        elif node.op == "exp":
+        elif node.op == "exp" and watched:
             found.add(("large", node.args[0]))
-        elif node.op == "pow" and not (isinstance(node.args[1], Num) and float(node.args[1].value).is_integer()
-                                         and float(node.args[1].value) >= 0):
+        elif node.op == "pow" and uses[0] and not (isinstance(node.args[1], Num) and node.args[1].value >= 0
+                                                    and float(node.args[1].value).is_integer()):
             found.add(("small", node.args[0]))  # a root or a negative power: a kink or a pole at 0
-    return {(kind, node) for kind, node in found if names(node)}
+        return any(uses)
+
+    visit(tree)
+    return found
+
+
+@lru_cache(maxsize=1024)
+def _watched_in_key(expected: _Form) -> set[tuple[str, Node]]:
+    return _watched(expected.tree)
 
 
 @lru_cache(maxsize=4096)
@@ -240,14 +262,16 @@ def _structure(watched: tuple[str, Node], domains: Domains) -> tuple[Points | No
     """Probe points where a watched sub-term is most extreme (and just either side), and whether it comes
     within a rounding of zero inside the domain. Cached: the same denominators recur across a class."""
     kind, node = watched
+    if _tame(kind, node, domains):
+        return None, False
     sign = -1.0 if kind == "small" else 1.0
 
-    def score(env: Points) -> np.ndarray:
+    def score(env: Points) -> tuple[np.ndarray, np.ndarray]:
         values = _values(node, env)
         scored = sign * (np.abs(values) if kind == "small" else values)
-        return np.where(np.isnan(scored), -np.inf if kind == "large" else 0.0, scored)
+        return np.where(np.isnan(scored), -np.inf if kind == "large" else 0.0, scored), np.sign(values)
 
-    best = _ascend(score, domains)
+    best = _ascend(score, domains, names(node))
     if best is None:
         return None, False
     side = {name: np.array([value]) for name, value in best.items()}
@@ -267,105 +291,60 @@ def _structure(watched: tuple[str, Node], domains: Domains) -> tuple[Points | No
     return _joined(probes), near
 
 
-def _ascend(score: Callable[[Points], np.ndarray], domains: Domains) -> dict[str, float] | None:
-    """Coordinate ascent of ``score`` over the box: a grid along each name, a golden section around the grid's
-    best, two sweeps."""
-    spans = dict(domains)
+def _tame(kind: str, node: Node, domains: Domains) -> bool:
+    """Whether a sub-term of one name is seen well enough by the line scans: a denominator or a root's argument
+    of one sign that stays above 1e-3 of its largest size (a pole or a peak is then wider than the scans'
+    spacing), an exponent that changes by at most 20 over the domain."""
+    used = names(node)
+    if len(used) != 1:
+        return False  # in two names or more the scans may pass beside the place: search it
+    name = next(iter(used))
+    low, high = dict(domains)[name]
+    values = _values(node, {name: np.linspace(low, high, _GRID)})
+    if not np.isfinite(values).all():
+        return False
+    if kind == "large":
+        return bool(values.max() - values.min() <= 20)
+    size = np.abs(values)
+    return bool((np.all(values > 0) or np.all(values < 0)) and size.min() > 1e-3 * size.max())
+
+
+def _ascend(score: Score, domains: Domains, used: set[str]) -> dict[str, float] | None:
+    """Coordinate ascent of ``score`` over the box, along the names it ``used``: a grid along each name, zoomed
+    in around the grid's best where that is inside the domain or beside a change of sign, two sweeps."""
     point = {name: (low + high) / 2 for name, (low, high) in domains}
-    if not spans:
+    if not used:
         return None
-    for _ in range(2):
+    for _ in range(2 if len(used) > 1 else 1):
         for name, (low, high) in domains:
-            if high <= low:
+            if name not in used or high <= low:
                 continue
             along = np.linspace(low, high, _GRID)
-            env = {other: np.full(_GRID, value) for other, value in point.items()} | {name: along}
-            scores = score(env)
+            scores, signs = score(_line(point, name, along))
             index = int(np.argmax(scores))
-            left, right = along[max(index - 1, 0)], along[min(index + 1, _GRID - 1)]
-            point[name] = _golden(score, point, name, left, right, float(along[index]), float(scores[index]))
+            point[name] = float(along[index])
+            inside = 0 < index < _GRID - 1
+            crossing = bool(np.any(signs[max(index - 1, 0):index + 2] != signs[index]))
+            if inside or crossing:
+                left, right = along[max(index - 1, 0)], along[min(index + 1, _GRID - 1)]
+                point[name] = _zoom(score, point, name, float(left), float(right), float(scores[index]))
     return point
 
 
-def _golden(score: Callable[[Points], np.ndarray], point: dict[str, float], name: str, left: float,
-            right: float, best: float, best_score: float) -> float:
-    """The best of ``best`` and a golden-section search for the maximum of ``score`` in [left, right]."""
-    ratio = (math.sqrt(5) - 1) / 2
-    for _ in range(_GOLDEN):
-        inner = np.array([right - ratio * (right - left), left + ratio * (right - left)])
-        env = {other: np.full(2, value) for other, value in point.items()} | {name: inner}
-        low_score, high_score = score(env)
-        if low_score >= high_score:
-            right = float(inner[1])
-        else:
-            left = float(inner[0])
-        for value, at in ((low_score, inner[0]), (high_score, inner[1])):
-            if value > best_score:
-                best, best_score = float(at), float(value)
+def _line(point: Mapping[str, float], name: str, along: np.ndarray) -> Points:
+    return {other: np.full(along.size, value) for other, value in point.items()} | {name: along}
+
+
+def _zoom(score: Score, point: dict[str, float], name: str,
+          left: float, right: float, best_score: float) -> float:
+    """The best place for ``score`` in [left, right]: grids of :data:`_ZOOM` points, each around the last's
+    best, :data:`_LEVELS` times (the bracket narrows 16 times a level)."""
+    best = point[name]
+    for _ in range(_LEVELS):
+        along = np.linspace(left, right, _ZOOM)
+        scores, _ = score(_line(point, name, along))
+        index = int(np.argmax(scores))
+        if scores[index] >= best_score:
+            best, best_score = float(along[index]), float(scores[index])
+        left, right = float(along[max(index - 1, 0)]), float(along[min(index + 1, _ZOOM - 1)])
     return best
-
-
-# ---- the exact check ----------------------------------------------------------------------------
-
-def _identical(student: Node, expected: Node, domains: Domains) -> bool:
-    """Whether sympy shows ``student - expected`` to be 0, within :data:`EXACT_SECONDS`."""
-    import sympy
-
-    symbols = {name: sympy.Symbol(name, positive=True) if low > 0 else sympy.Symbol(name, real=True)
-               for name, (low, high) in domains}
-    difference = _sympy(student, symbols) - _sympy(expected, symbols)
-    try:
-        with _deadline(EXACT_SECONDS) as bounded:
-            if sympy.cancel(difference) == 0:
-                return True
-            return bounded and bool(sympy.simplify(difference) == 0)
-    except (_OutOfTimeError, RecursionError, ValueError, TypeError, ZeroDivisionError):
-        return False
-
-
-class _OutOfTimeError(Exception):
-    pass
-
-
-class _deadline:  # noqa: N801 - used as a context manager, like contextlib's
-    """Raise :class:`_OutOfTimeError` after ``seconds`` (an interval timer: only in the main thread; elsewhere the
-    context's value is False and only bounded steps should run)."""
-
-    def __init__(self, seconds: float) -> None:
-        self.seconds = seconds
-        self.armed = threading.current_thread() is threading.main_thread() and hasattr(signal, "setitimer")
-
-    def __enter__(self) -> bool:
-        if self.armed:
-            self.previous = signal.signal(signal.SIGALRM, self._expire)
-            signal.setitimer(signal.ITIMER_REAL, self.seconds)
-        return self.armed
-
-    def __exit__(self, *exc: object) -> None:
-        if self.armed:
-            signal.setitimer(signal.ITIMER_REAL, 0)
-            signal.signal(signal.SIGALRM, self.previous)
-
-    @staticmethod
-    def _expire(signum: int, frame: Any) -> None:
-        raise _OutOfTimeError
-
-
-def _sympy(node: Node, symbols: Mapping[str, Any]) -> Any:
-    """A sympy expression built from our tree, node by node (no text is parsed)."""
-    import sympy
-
-    if isinstance(node, Num):
-        value = node.value
-        return sympy.Float(value) if isinstance(value, float) else sympy.Rational(value.numerator, value.denominator)
-    if isinstance(node, Sym):
-        return sympy.pi if node.name == "pi" else symbols[node.name]
-    args = [_sympy(arg, symbols) for arg in node.args]
-    builders: dict[str, Callable[..., Any]] = {
-        "add": lambda a, b: a + b, "sub": lambda a, b: a - b, "mul": lambda a, b: a * b,
-        "div": lambda a, b: a / b, "pow": lambda a, b: a ** b, "neg": lambda a: -a,
-        "sqrt": sympy.sqrt, "sin": sympy.sin, "cos": sympy.cos, "tan": sympy.tan, "exp": sympy.exp,
-        "log": sympy.log, "abs": sympy.Abs, "sign": sympy.sign, "Max": sympy.Max, "Min": sympy.Min,
-        "atan2": sympy.atan2, "hypot": lambda a, b: sympy.sqrt(a**2 + b**2),
-        "sind": lambda a: sympy.sin(sympy.pi * a / 180), "cosd": lambda a: sympy.cos(sympy.pi * a / 180)}
-    return builders[node.op](*args)

@@ -245,3 +245,24 @@ def test_requests_that_cannot_be_carried_out_exit_2(capsys: pytest.CaptureFixtur
                                                     argv: list[str], message: str) -> None:
     code, out, err = run(capsys, *(str(key_path) if a == "KEY" else a for a in argv))
     assert code == 2 and out == "" and message in err
+
+
+def test_an_id_that_fits_two_students_once_zeros_are_restored_names_both(capsys: pytest.CaptureFixture[str],
+                                                                         tmp_path: Path) -> None:
+    """Issue 22: it said only "no student '123'"."""
+    key = json.loads(json.dumps(KEY))
+    key["students"].append({**key["students"][0], "id": "0123", "email": "bo@example.edu"})
+    path = tmp_path / "key.json"
+    path.write_text(json.dumps(key), encoding="utf-8")
+    code, _out, err = run(capsys, "6.3", "--key", path, "--student", "123", "--label", "1a")
+    assert code == 2 and "with leading zeros it could be 00123 or 0123: give the id in full" in err
+
+
+@pytest.mark.parametrize(("answer", "feedback"), [
+    ("6.26" + " +0" * 400, "could not read this answer: 1,204 characters; an answer has at most 1,000"),
+    ("1.66 m^99999", "the power 99999 of the unit m is beyond the limit"),
+    ("1e-400", "1e-400 is too small for a number"),
+])
+def test_issue_22_cells_say_what_is_wrong(capsys: pytest.CaptureFixture[str], answer: str, feedback: str) -> None:
+    result = checked(capsys, answer, "--expected", "6.26", "--unit", "m")
+    assert result["verdict"] == "invalid" and feedback in result["feedback"]

@@ -66,6 +66,8 @@ def from_key(key: Key, student: str, label: str, physics: Physics | None = None)
     if not found:
         unpadded = [s.id for s in key.students if s.id.lstrip("0") == student.lstrip("0")]
         hint = f"; did you mean {unpadded[0]}?" if len(unpadded) == 1 else ""
+        if len(unpadded) > 1:
+            hint = f"; with leading zeros it could be {' or '.join(sorted(unpadded))}: give the id in full"
         raise UsageError(f"{key.where}: no student {shown(student)} (by id or email){hint}")
     parts = found[0].parts
     named = find_label(label, key.labels)  # as grade reads a label cell: " 1A " is 1a

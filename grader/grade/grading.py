@@ -18,6 +18,7 @@ from functools import lru_cache
 import numpy as np
 
 from grader.grade.cells import (
+    MAX_CELL,
     CellBlank,
     CellExpression,
     CellInvalid,
@@ -258,7 +259,8 @@ def _row(part: KeyPart, answer: Answer | None, expected: str, words: str, kind: 
     """The verdict's fields; ``expected``: what the key holds, in words; ``words``: the tolerance that decided it."""
     if answer is None:
         return None, kind, credit, part.points, expected, parsed, part.unit, absolute, relative, words, said, "", ""
-    return (answer.text, kind, credit, part.points, expected, parsed, part.unit, absolute, relative, words, said, "",
+    shown_text = cut(answer.text, MAX_CELL)  # a longer answer is invalid: its first characters say which
+    return (shown_text, kind, credit, part.points, expected, parsed, part.unit, absolute, relative, words, said, "",
             f"{answer.file}:{answer.line}")
 
 

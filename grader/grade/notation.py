@@ -70,6 +70,7 @@ def _with_products(text: str, symbols: tuple[str, ...]) -> str:
         if match["num"] is not None:
             if previous == "num":
                 raise ReadError(f"two numbers side by side ({cut(text, 40)}); give one answer")
+            _check_underflow(match["num"])
             kind, parts = "num", [match["num"]]
         elif match["name"] is not None:
             kind, parts = _name(match["name"], symbols, text[position:].lstrip()[:1] == "(")
@@ -86,6 +87,13 @@ def _with_products(text: str, symbols: tuple[str, ...]) -> str:
         out += parts
         previous = kind
     return "".join(out)
+
+
+def _check_underflow(number: str) -> None:
+    """Refuse a number float64 would read as 0 though its digits are not (``1e-400``)."""
+    if float(number) == 0 and any(digit in "123456789" for digit in number.lower().partition("e")[0]):
+        raise ReadError(f"{cut(number, 40)} is too small for a number (below about 5e-324 it would be read as 0); "
+                        "write 0 if you mean 0")
 
 
 def _name(word: str, symbols: tuple[str, ...], called: bool) -> tuple[str, list[str]]:

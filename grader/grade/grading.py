@@ -14,6 +14,7 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from functools import lru_cache
+from typing import NamedTuple
 
 import numpy as np
 
@@ -115,9 +116,34 @@ def grade_part(part: KeyPart, student_id: str, answer: Answer | None, key: Key,
                physics: Physics | None = None) -> Verdict:
     """One part: the key's expectation against the answer (None: nothing submitted). With ``physics``, a
     wrong number may be a diagnosed mistake (an earlier answer to carry forward is not known here)."""
-    student = next((index for index, s in enumerate(key.students) if s.id == student_id), None)
-    found = None if physics is None or student is None else physics.problems.get(part.problem)
-    return Verdict(student_id, part.label, *_grade_label([(part, answer)], key, np.array([student or 0]), found, [])[0])
+    return grade_parts([Request(part, student_id, answer)], key, physics)[0]
+
+
+class Request(NamedTuple):
+    """A part to grade on its own (``grader check``): the key's expectation, whose it is, the answer."""
+
+    part: KeyPart
+    student_id: str
+    answer: Answer | None
+
+
+def grade_parts(requests: Sequence[Request], key: Key, physics: Physics | None = None) -> list[Verdict]:
+    """:func:`grade_part` for each request, in order: the requests of one label (and of students the key
+    has, or not) are graded together, as ``grader grade`` grades a column, each on its own (no error is
+    carried forward from another request)."""
+    positions = key.positions
+    groups: dict[tuple[str, bool], list[int]] = {}
+    for index, request in enumerate(requests):
+        groups.setdefault((request.part.label, request.student_id in positions), []).append(index)
+    verdicts: list[Verdict | None] = [None] * len(requests)
+    for (_, known), members in groups.items():
+        first = requests[members[0]].part
+        found = physics.problems.get(first.problem) if physics is not None and known else None
+        students = np.array([positions.get(requests[index].student_id, 0) for index in members])
+        cells = [(requests[index].part, requests[index].answer) for index in members]
+        for index, row in zip(members, _grade_label(cells, key, students, found, []), strict=True):
+            verdicts[index] = Verdict(requests[index].student_id, requests[index].part.label, *row)
+    return verdicts  # type: ignore[return-value]  # every request is in one group
 
 
 def _grade_label(cells: Sequence[tuple[KeyPart, Answer | None]], key: Key, students: np.ndarray,

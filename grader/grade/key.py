@@ -131,6 +131,12 @@ class Key:
         return max((student.possible for student in self.students), default=0.0)
 
     @functools.cached_property
+    def positions(self) -> dict[str, int]:
+        """Each student's place in :attr:`students`, by id; worked out once (``grader check --batch`` looks
+        a student up a line)."""
+        return {student.id: index for index, student in enumerate(self.students)}
+
+    @functools.cached_property
     def parameter_columns(self) -> dict[tuple[str, str], np.ndarray]:
         """Each (problem key, name) of a parameter any student has, with its value per student (NaN where
         a student has none); worked out once (the diagnosis and the class report both read it). Students

@@ -165,8 +165,21 @@ def _number(value: Any) -> Num:
     if isinstance(value, float):
         if value != value or value in (float("inf"), float("-inf")):
             raise ExpressionError(f"{value!r} is not a finite number")
-        return Num(Fraction(repr(value)))
+        return Num(_decimal_fraction(repr(value)))
     return Num(Fraction(value))
+
+
+def _decimal_fraction(text: str) -> Fraction:
+    """The exact value of a float's ``repr`` (``Fraction(text)`` does the same, four times slower).
+
+    >>> _decimal_fraction("0.1"), _decimal_fraction("-2.5e-07"), _decimal_fraction("1e+300") == 10**300
+    (Fraction(1, 10), Fraction(-1, 4000000), True)
+    """
+    mantissa, _, exponent = text.partition("e")
+    whole, _, decimals = mantissa.partition(".")
+    power = int(exponent or 0) - len(decimals)
+    digits = int(whole + decimals)
+    return Fraction(digits * 10**power) if power >= 0 else Fraction(digits, 10**-power)
 
 
 def _call(node: ast.Call, allow_compare: bool, depth: int) -> Node:

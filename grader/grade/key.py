@@ -120,9 +120,9 @@ class Key:
     ecf_credit: float = 1.0  # of a part right for the student's own earlier answer (0: no error carried forward)
     mistake_credit: float = 0.0  # of a part that matches a diagnosed mistake
 
-    @property
+    @functools.cached_property
     def labels(self) -> tuple[str, ...]:
-        """Every part's label, in the order of the sheet."""
+        """Every part's label, in the order of the sheet (worked out once: ``check --batch`` reads it a line)."""
         return tuple(label for problem in self.problems for label in problem.labels)
 
     @property

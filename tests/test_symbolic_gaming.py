@@ -5,6 +5,8 @@ rewritings of the key stay ``correct``. The keys are car-collision's (``problem_
 from __future__ import annotations
 
 import pytest
+from hypothesis import assume, given, settings
+from hypothesis import strategies as st
 
 from grader.grade.check import check, expectation
 
@@ -91,3 +93,34 @@ def test_a_refused_function_is_accepted_when_the_key_uses_it() -> None:
     result = check("Max(p, v)", expectation("Max(v, p)", symbols=["p", "v"], domains=DOMAINS))
     assert result["verdict"] == "correct"
 
+
+
+_TERMS = st.sampled_from(["v", "p", "p*v", "v/(p + 1)", "v^2/(2*p + 3)", "sqrt(p*v)", "exp(-p/4)*v", "sin(p)*v",
+                          "(1 - 0.1*p)*v/(p + 1)", "v*p^3", "1/(v + 0.5)"])
+
+
+@settings(max_examples=60, deadline=None)
+@given(terms=st.lists(_TERMS, min_size=1, max_size=3), scale=st.integers(2, 999),
+       rewrite=st.sampled_from(["({key})*{c}/{c}", "{c}*({key})/{c}", "({key}) + p - p", "1/(1/({key}))",
+                                "({key})*(p + {c})/(p + {c})"]))
+def test_an_honest_rewriting_of_any_key_is_correct(terms: list[str], scale: int, rewrite: str) -> None:
+    """What refuses the crafted answers never refuses an honest one: a key made of a few terms (rational,
+    roots, exponentials, sines), rewritten without changing its value, stays correct."""
+    key = " + ".join(terms)
+    answer = rewrite.format(key=key, c=scale)
+    assume("1/(1/" not in answer or "sin" not in key)  # a sine's zeros make 1/(1/x) undefined there, as it is
+    result = _verdict(key, answer)
+    assert result["verdict"] == "correct", (answer, result["feedback"])
+
+
+@settings(max_examples=60, deadline=None)
+@given(centre=st.floats(0.31, 2.99), width=st.integers(3, 12), height=st.sampled_from([0.01, 1.0, 100.0]),
+       shape=st.sampled_from(["{h}*exp(-((p - {c})*10^{w})^2)", "{h}/(1 + ((p - {c})*10^{w})^2)",
+                              "{h}*(1 + (p - {c})/sqrt((p - {c})^2))", "{h}/(1 + exp(-(p - {c})*10^{w}))",
+                              "{h}*exp(-((p - {c})^2 + (v - 5.5)^2)*10^{w})", "{h}*v/(1 + ((v - 1 - 3*{c})*10^{w})^2)",
+                              "{h}*exp(-((p*v - 3*{c})*10^{w})^2)"]))
+def test_a_bump_or_a_step_anywhere_in_the_domain_is_found(centre: float, width: int, height: float,
+                                                            shape: str) -> None:
+    """A narrow bump or a step hidden between the sampled points, wherever it is, however narrow."""
+    answer = f"{VA} + " + shape.format(h=height, c=round(centre, 4), w=width)
+    assert _verdict(VA, answer)["verdict"] == "incorrect", answer

@@ -156,8 +156,8 @@ def _agree(a: np.ndarray, b: np.ndarray, rtol: float, floor: float) -> bool:
 
 
 Points = dict[str, np.ndarray]
-Score = Callable[[Points], tuple[np.ndarray, np.ndarray]]
-"""A sub-term's score at points (higher: nearer what is looked for), and its signs."""
+Score = Callable[[Points], np.ndarray]
+"""A sub-term's score at points (higher: nearer what is looked for)."""
 
 
 @lru_cache(maxsize=256)
@@ -266,10 +266,10 @@ def _structure(watched: tuple[str, Node], domains: Domains) -> tuple[Points | No
         return None, False
     sign = -1.0 if kind == "small" else 1.0
 
-    def score(env: Points) -> tuple[np.ndarray, np.ndarray]:
+    def score(env: Points) -> np.ndarray:
         values = _values(node, env)
         scored = sign * (np.abs(values) if kind == "small" else values)
-        return np.where(np.isnan(scored), -np.inf if kind == "large" else 0.0, scored), np.sign(values)
+        return np.where(np.isnan(scored), -np.inf if kind == "large" else 0.0, scored)
 
     best = _ascend(score, domains, names(node))
     if best is None:
@@ -311,7 +311,7 @@ def _tame(kind: str, node: Node, domains: Domains) -> bool:
 
 def _ascend(score: Score, domains: Domains, used: set[str]) -> dict[str, float] | None:
     """Coordinate ascent of ``score`` over the box, along the names it ``used``: a grid along each name, zoomed
-    in around the grid's best where that is inside the domain or beside a change of sign, two sweeps."""
+    in around the grid's best, two sweeps."""
     point = {name: (low + high) / 2 for name, (low, high) in domains}
     if not used:
         return None
@@ -320,14 +320,13 @@ def _ascend(score: Score, domains: Domains, used: set[str]) -> dict[str, float] 
             if name not in used or high <= low:
                 continue
             along = np.linspace(low, high, _GRID)
-            scores, signs = score(_line(point, name, along))
+            scores = score(_line(point, name, along))
             index = int(np.argmax(scores))
             point[name] = float(along[index])
-            inside = 0 < index < _GRID - 1
-            crossing = bool(np.any(signs[max(index - 1, 0):index + 2] != signs[index]))
-            if inside or crossing:
-                left, right = along[max(index - 1, 0)], along[min(index + 1, _GRID - 1)]
-                point[name] = _zoom(score, point, name, float(left), float(right), float(scores[index]))
+            # Zoomed in even at an end of the grid: the place may lie within its last spacing (a sub-term
+            # that only tame ones, skipped before, never need).
+            left, right = along[max(index - 1, 0)], along[min(index + 1, _GRID - 1)]
+            point[name] = _zoom(score, point, name, float(left), float(right), float(scores[index]))
     return point
 
 
@@ -342,7 +341,7 @@ def _zoom(score: Score, point: dict[str, float], name: str,
     best = point[name]
     for _ in range(_LEVELS):
         along = np.linspace(left, right, _ZOOM)
-        scores, _ = score(_line(point, name, along))
+        scores = score(_line(point, name, along))
         index = int(np.argmax(scores))
         if scores[index] >= best_score:
             best, best_score = float(along[index]), float(scores[index])

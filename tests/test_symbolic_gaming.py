@@ -64,6 +64,7 @@ HONEST = [
     (VA, "v/(p+1) - 0.1 p v/(p+1)"), (VA, "(1-0.1*p)*v/(1+p)"), (VA, "v*(1 - 11/10 * p/(p+1))"),
     (VB, "1.1*v/(p + 1)"), (VB, "11/10*v/(1+p)"), (VB, "11v/(10p+10)"), (VB, "1.1 v (p+1)^-1"),
     (VB, "v*exp(log(1.1))/(p+1)"), (VB, "1.1*v*sqrt(1/(p+1)^2)"),
+    (VA, "sqrt(v^2*(1-0.1p)^2/(p+1)^2)"),  # 1 - 0.1p > 0 on the domain: the exact check knows where p lies
 ]
 
 

@@ -674,10 +674,15 @@ def _check(arguments: argparse.Namespace) -> int:
     key = load_key(arguments.key) if arguments.key is not None else None
     physics = physics_for(key, _lazy_bank(arguments)) if key is not None else None
     if arguments.batch is not None:
-        failed = 0
+        failed, printed = 0, []
         for result in check.batch(_batch_lines(arguments.batch), key, physics):
             failed += "error" in result
-            print(_json_line(result))
+            printed.append(_json_line(result))
+            if len(printed) == check.BATCH_CHUNK:  # written a chunk at a time, not a line at a time
+                print("\n".join(printed))
+                printed.clear()
+        if printed:
+            print("\n".join(printed))
         return EXIT_REFUSED if failed else EXIT_OK
     if key is not None:
         against = check.from_key(key, arguments.student, arguments.label, physics)

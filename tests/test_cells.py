@@ -41,13 +41,16 @@ NUMBERS = [
     ("V_PILE=6.26", "", 6.26), ("v_pile ≈ 6.26 m/s", "m/s", 6.26), ("  6.26  ", "", 6.26),
     ("sqrt(2*9.81*2)", "m/s", math.sqrt(2 * 9.81 * 2)), ("2.55 + 1.401", "", 2.55 + 1.401),
     ("2*pi", "rad", 2 * math.pi), ("hypot(3, 4)", "", 5.0), ("(1+0.4)(2)", "", 2.8),
-    ("1e308", "", 1e308), ("-1e308", "", -1e308), ("1e-400", "", 0.0), ("-0", "", 0.0),
+    ("1e308", "", 1e308), ("-1e308", "", -1e308), ("-0", "", 0.0),
     ("6.26 m/s", "m/s", 6.26), ("6.26m/s", "m/s", 6.26), ("6.26 m/sec", "m/s", 6.26),
     ("10 ft/sec", "m/s", 3.048), ("10 fps", "m/s", 3.048), ("10 ft/s", "m/s", 3.048),
     ("36 km/h", "m/s", 10.0), ("10 mph", "m/s", 4.4704), ("6.26 meters per second", "m/s", 6.26),
     ("3.048 m/s", "ft/s", 10.0), ("10 m/s", "km/h", 36.0),
     ("30°", "deg", 30.0), ("30 °", "deg", 30.0), ("30 deg", "deg", 30.0), ("30 degrees", "deg", 30.0),
     ("30°", "rad", math.pi / 6), ("pi/6 rad", "deg", 30.0), ("0.5 rad", "rad", 0.5),
+    # issue 22: degrees and minutes (and seconds) were "unexpected character '°'"
+    ("55°30'", "deg", 55.5), ("55° 30′", "deg", 55.5), ("-55°30'", "deg", -55.5), ("55°30'36\"", "deg", 55.51),
+    ("55°30'", "rad", math.radians(55.5)),
     ("5000 J", "kJ", 5.0), ("5 kJ", "J", 5000.0), ("5 N·s", "N*s", 5.0), ("5 N*s", "N*s", 5.0),
     ("5 kg m/s", "N*s", 5.0), ("9.81 m/s^2", "m/s^2", 9.81), ("9.81 m/s²", "m/s^2", 9.81),
     ("2.5 Mg", "kg", 2500.0), ("250 mm", "m", 0.25), ("2.5 in", "mm", 63.5),
@@ -78,6 +81,14 @@ REFUSED_NUMBERS = [
     ("abc", "", "cannot read"), ("2 +", "", "not a valid expression"), ("6.26 $", "", "unexpected character '$'"),
     ("10 ft -lb", "J", "cannot read"), ("10 ft- lb", "J", "cannot read"),
     ("x" * (MAX_CELL + 1), "", "at most 1,000"),
+    # issue 22: these were "cannot read 'm' as a number", read as 0 without a note, and "nested more than 40
+    # levels deep"
+    ("1.66 m^99999", "m", "the power 99999 of the unit m is beyond the limit: units are read with powers up to 9"),
+    ("1.66 m**12", "m", "the power 12 of the unit m is beyond the limit"),
+    ("1e-400", "m", "1e-400 is too small for a number (below about 5e-324 it would be read as 0)"),
+    ("6.26×10^-400", "m", "too small for a number"), ("2*1e-400", "", "1e-400 is too small for a number"),
+    ("+".join(["1"] * 42), "", "a sum or product of 42 terms; at most 41 terms are allowed in a row"),
+    ("55°75'", "deg", "minutes and seconds of an angle are below 60"),
 ]
 
 WRONG_UNITS = [
@@ -239,3 +250,14 @@ def test_importing_cells_does_not_import_pint() -> None:
     result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True,
                             cwd=Path(__file__).resolve().parent.parent)
     assert result.stdout.strip() == "False"
+
+
+def test_a_flat_sum_of_41_terms_is_read_and_deep_nesting_is_still_said_as_such() -> None:
+    """Issue 22: the limit is on terms in a row, and its message says so; nesting keeps its own message."""
+    assert isinstance(read_expression("+".join(["p"] * 41), ["p"]), CellExpression)
+    assert read_number("-" * 45 + "1", "") == CellInvalid("expression is nested more than 40 levels deep")
+
+
+def test_a_number_that_underflows_is_refused_but_zero_and_subnormals_are_read() -> None:
+    assert read_number("0.0e-400", "") == CellNumber(0.0, None)
+    assert read_number("1e-320", "") == CellNumber(1e-320, None)

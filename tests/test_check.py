@@ -266,3 +266,51 @@ def test_requests_that_cannot_be_carried_out_exit_2(capsys: pytest.CaptureFixtur
                                                     argv: list[str], message: str) -> None:
     code, out, err = run(capsys, *(str(key_path) if a == "KEY" else a for a in argv))
     assert code == 2 and out == "" and message in err
+
+
+def test_an_id_that_fits_two_students_once_zeros_are_restored_names_both(capsys: pytest.CaptureFixture[str],
+                                                                         tmp_path: Path) -> None:
+    """Issue 22: it said only "no student '123'"."""
+    key = json.loads(json.dumps(KEY))
+    key["students"].append({**key["students"][0], "id": "0123", "email": "bo@example.edu"})
+    path = tmp_path / "key.json"
+    path.write_text(json.dumps(key), encoding="utf-8")
+    code, _out, err = run(capsys, "6.3", "--key", path, "--student", "123", "--label", "1a")
+    assert code == 2 and "with leading zeros it could be 00123 or 0123: give the id in full" in err
+
+
+@pytest.mark.parametrize(("answer", "feedback"), [
+    ("6.26" + " +0" * 400, "could not read this answer: 1,204 characters; an answer has at most 1,000"),
+    ("1.66 m^99999", "the power 99999 of the unit m is beyond the limit"),
+    ("1e-400", "1e-400 is too small for a number"),
+])
+def test_issue_22_cells_say_what_is_wrong(capsys: pytest.CaptureFixture[str], answer: str, feedback: str) -> None:
+    result = checked(capsys, answer, "--expected", "6.26", "--unit", "m")
+    assert result["verdict"] == "invalid" and feedback in result["feedback"]
+
+
+def test_a_batch_is_graded_a_chunk_at_a_time_not_a_line_at_a_time(monkeypatch: pytest.MonkeyPatch,
+                                                                   key_path: Path) -> None:
+    """Issue 22: 100,000 lines took 47 s, 145 s with --key: the work of a grading call was done a line at a
+    time, and the key's students were searched a line at a time. The results are the same, in order."""
+    from grader.grade import check as check_module
+    from grader.grade.key import load_key
+
+    calls = []
+    real = check_module.grade_parts
+
+    def counted(*args: Any, **kwargs: Any) -> Any:
+        calls.append(len(args[0]))
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(check_module, "grade_parts", counted)
+    key = load_key(key_path)
+    lines = [json.dumps({"submitted": f"{6 + i / 1000}", "student": "00123", "label": "1a"}) for i in range(5000)]
+    lines[7] = "not json"
+    lines[9] = json.dumps({"submitted": "6.26 m/s", "expected": 6.26, "unit": "m/s"})
+    results = list(check_module.batch(lines, key))
+    assert len(results) == 5000 and results[7] == {"line": 8, "error": results[7]["error"]}
+    verdicts = (results[9]["verdict"], results[0]["verdict"], results[300]["verdict"])
+    assert verdicts == ("correct", "incorrect", "correct")
+    assert [r["parsed"] for r in results[10:13]] == [6.01, 6.011, 6.012]
+    assert sorted(calls) == [1, 904, 4094]  # two chunks; the line of a given value graded apart, one refused

@@ -19,13 +19,12 @@ from hypothesis import strategies as st
 from grader.errors import GraderError
 from grader.grade.compare import (
     LARGEST,
-    _equivalent,
-    equivalent,
     errors,
     feedback,
     feedbacks,
     is_correct,
 )
+from grader.grade.symbolic import _equivalent, equivalent
 from grader.model.expr import parse
 from grader.model.tolerance import Tolerance, ToleranceError
 

@@ -123,7 +123,17 @@ def test_ids_are_text(tmp_path: Path) -> None:
     assert read_submissions([path], [StudentRef("00123", ""), StudentRef("123", "")], ["1a"]).answers[0].student_id \
         == "00123"
     result = read_submissions([path], [StudentRef("123", ""), StudentRef("0123", "")], ["1a"])
-    assert [p.reason for p in result.problems] == ["unknown student '00123' (not in the answer key)"]  # two fit
+    assert [p.reason for p in result.problems] == [
+        "student '00123' is ambiguous: with its leading zeros restored it could be 0123 or 123; write the id in full"]
+
+
+def test_an_answer_over_the_cell_limit_is_kept_to_be_found_too_long_not_missing(tmp_path: Path) -> None:
+    """Issue 22: a 1,204-character answer was dropped with the row, and the part said "no answer was submitted"."""
+    long_answer = "6.26" + " +0" * 400
+    path = write(tmp_path, "a.csv", f"id,label,answer\n456,1a,{long_answer}\n456,1b,2\n{'9' * 1001},1a,1\n")
+    result = read(path)
+    assert summary(result)[0] == [(2, "456", "1a", long_answer), (3, "456", "1b", "2")]
+    assert [(p.line, p.reason) for p in result.problems] == [(4, "a cell of 1,001 characters; expected at most 1000")]
 
 
 def test_duplicates_with_timestamps_across_two_files_the_latest_wins(tmp_path: Path) -> None:
@@ -263,21 +273,22 @@ def test_unknown_students_and_labels_are_row_problems(tmp_path: Path) -> None:
         (3, "3c", "unknown label '3c' (expected one of 1a, 1b, 2)"), (4, "1a", "no student given")])
 
 
-def test_a_row_with_too_many_cells_or_a_huge_cell_is_a_row_problem_not_a_refused_file(tmp_path: Path) -> None:
+def test_a_row_with_too_many_cells_is_a_row_problem_and_a_huge_answer_is_kept_to_be_graded(tmp_path: Path) -> None:
     path = write(tmp_path, "r.csv", f"id,1a\n456,1,extra\n789,{'9' * 1001}\n00123,5\n")
     result = read(path)
-    assert summary(result)[0] == [(4, "00123", "1a", "5")]
-    assert [(p.line, p.reason[:20]) for p in result.problems if not p.caveat] == [
-        (2, "3 cells, but the hea"), (3, "a cell of 1,001 char")]
+    assert summary(result)[0] == [(3, "789", "1a", "9" * 1001), (4, "00123", "1a", "5")]
+    assert [(p.line, p.reason[:20]) for p in result.problems if not p.caveat] == [(2, "3 cells, but the hea")]
 
 
-def test_a_cell_beyond_the_csv_modules_limit_is_a_row_problem_too(tmp_path: Path) -> None:
+def test_a_cell_beyond_the_csv_modules_limit_is_not_a_refused_file(tmp_path: Path) -> None:
     """A 10 MB cell (an essay pasted in a form) refused the whole file, saying "a cell longer than 1000
-    characters" although cells of 1,001 to 131,072 characters were row problems."""
-    path = write(tmp_path, "r.csv", f'id,1a\n789,"{"9" * (10 << 20)}"\n00123,5\n')
+    characters" although cells of 1,001 to 131,072 characters were row problems. An answer that long is
+    now graded (invalid, too long: issue 22); an id that long is a row problem."""
+    path = write(tmp_path, "r.csv", f'id,1a\n789,"{"9" * (10 << 20)}"\n00123,5\n"{"9" * (10 << 20)}",1\n')
     result = read(path)
-    assert summary(result) == ([(3, "00123", "1a", "5")], [(2, "", "a cell of 10,485,760 characters; expected at "
-                                                               "most 1000")])
+    assert [(a.line, a.student_id, len(a.text)) for a in result.answers] == [(2, "789", 10 << 20), (3, "00123", 1)]
+    assert [(p.line, p.reason) for p in result.problems] == [(4, "a cell of 10,485,760 characters; expected at most "
+                                                                 "1000")]
 
 
 def test_a_quote_left_open_is_refused_at_the_line_it_opens(tmp_path: Path) -> None:

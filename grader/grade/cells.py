@@ -27,10 +27,11 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 from grader.grade.notation import ReadError, check_powers, cut, listed, tree_of, value_of
-from grader.grade.quantities import UnitMismatchError, UnknownUnitError, unit_factor, unit_factors
+from grader.grade.quantities import MAX_POWER, UnitMismatchError, UnknownUnitError, unit_factor, unit_factors
+from grader.inputs import CELL_CHARS
 from grader.model.expr import Node, names, to_text
 
-MAX_CELL = 1000
+MAX_CELL = CELL_CHARS
 
 
 @dataclass(frozen=True)
@@ -68,6 +69,7 @@ class CellExpression:
     text: str
 
 
+_NONZERO_DIGIT = re.compile("[1-9]")
 _SPACES = str.maketrans({"\u00a0": " ", "\u2009": " ", "\u202f": " ", "\u2007": " ", "\t": " ", "\n": " ",
                          "\r": " ", "\u2212": "-", "\u200b": None, "\ufeff": None})
 _SUPERSCRIPTS = str.maketrans("⁰¹²³⁴⁵⁶⁷⁸⁹⁻⁺", "0123456789-+")
@@ -83,6 +85,9 @@ _TWO_NUMBERS = re.compile(rf"{_NUM}(?:\s*(?:[,;–]|\bor\b|\band\b|\bto\b)\s*|\s
 _GROUPED = re.compile(r"(?<![\d.,])\d{1,3}(?: \d{3})+(?!\d)")
 _COMMA_NUMBER = re.compile(r"(?<![\w.,])(?P<groups>\d+(?:,\d+)+)(?P<fraction>\.\d*)?(?![\d,])")
 _CALL = re.compile(r"[A-Za-z_]\w*\s*\(")
+_DEGREES_MINUTES = re.compile(rf"(?P<sign>[-+]?)\s*(?P<degrees>{_NUM})\s*°\s*(?P<minutes>{_NUM})\s*['′’]"
+                              rf"(?:\s*(?P<seconds>{_NUM})\s*(?:\"|″|''|′′|”))?")
+_POWERED_WORD = re.compile(r"(?<=[\d.)\s])(?P<word>[A-Za-zµμ]+)\s*(?:\^|\*\*)\s*(?P<power>[-+]?\d+)$")
 _ASSIGNMENT = re.compile(r"(?P<word>[A-Za-z_][\w']*)\s*=")
 
 
@@ -107,6 +112,8 @@ def read_number(text: str, unit: str, *, delimiter: str = ",", numeric_expressio
     cleaned = _without_prefix(cleaned, names)
     try:
         _refuse_formula(cleaned, names)
+        if angle := _DEGREES_MINUTES.fullmatch(cleaned):
+            return CellNumber(_degrees(angle) * unit_factor("deg", unit) + 0.0, "°")
         number_text, unit_text = _split_unit(cleaned)
         value = _readvalue_of(number_text, delimiter, numeric_expressions)
         if unit_text:
@@ -199,6 +206,7 @@ def _refuse_formula(text: str, names: Sequence[str]) -> None:
 
 def _split_unit(text: str) -> tuple[str, str]:
     """The number and the unit after it: the first word from which the rest is a unit, after a number."""
+    _powered_unit(text[-60:])
     for start in range(max(1, len(text) - 40), len(text)):
         char, before = text[start], text[start - 1]
         if not (char.isalpha() or char in "°%") or before.isalpha() or before == "_":
@@ -207,6 +215,23 @@ def _split_unit(text: str) -> tuple[str, str]:
         if head and (head[-1].isdigit() or head[-1] in ".)") and unit_factors(text[start:]) is not None:
             return head, text[start:].strip()
     return text, ""
+
+
+def _degrees(angle: re.Match[str]) -> float:
+    """``55°30'`` (and ``55°30'15"``) in degrees; minutes and seconds below 60."""
+    minutes, seconds = float(angle["minutes"]), float(angle["seconds"] or 0)
+    if minutes >= 60 or seconds >= 60:
+        raise ReadError(f"{angle.group()}: minutes and seconds of an angle are below 60")
+    degrees = float(angle["degrees"]) + minutes / 60 + seconds / 3600
+    return -degrees if angle["sign"] == "-" else degrees
+
+
+def _powered_unit(text: str) -> None:
+    """Refuse, saying why, a unit with a power beyond :data:`MAX_POWER` (``1.66 m^99999``)."""
+    powered = _POWERED_WORD.search(text)
+    if powered and abs(int(powered["power"])) > MAX_POWER and unit_factors(powered["word"]) is not None:
+        raise ReadError(f"the power {cut(powered['power'], 12)} of the unit {powered['word']} is beyond the limit: "
+                        f"units are read with powers up to {MAX_POWER}")
 
 
 def _readvalue_of(text: str, delimiter: str, numeric_expressions: bool) -> float:
@@ -254,4 +279,7 @@ def _decimal_commas(text: str, delimiter: str) -> str:
 def _finite(value: float, text: str) -> float:
     if not math.isfinite(value):
         raise ReadError(f"{cut(text, 40)} is too large for a number (beyond about 1.8e308)")
+    if value == 0 and _NONZERO_DIGIT.search(text.lower().partition("e")[0].partition("×")[0].partition("x")[0]):
+        raise ReadError(f"{cut(text, 40)} is too small for a number (below about 5e-324 it would be read as 0); "
+                        "write 0 if you mean 0")
     return value

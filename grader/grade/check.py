@@ -25,7 +25,7 @@ from typing import Any
 from grader.errors import GraderError, UsageError, shown
 from grader.grade.cells import MAX_CELL
 from grader.grade.diagnosis import Physics
-from grader.grade.grading import Verdict, grade_part
+from grader.grade.grading import Request, Verdict, grade_part, grade_parts
 from grader.grade.key import SYMBOL_RANGE, Key, KeyPart
 from grader.grade.notation import ReadError, tree_of, value_of
 from grader.grade.submissions import Answer, find_label
@@ -61,11 +61,14 @@ def from_key(key: Key, student: str, label: str, physics: Physics | None = None)
     """The part ``label`` of the key's student ``student`` (an id, or an email as in the roster); with
     ``physics``, a wrong number is diagnosed as ``grader grade`` diagnoses it."""
     student = student.strip()
-    found = [s for s in key.students if s.id == student] or \
-            [s for s in key.students if s.email and s.email.lower() == student.lower()]
+    at = key.positions.get(student)
+    found = [key.students[at]] if at is not None else \
+        [s for s in key.students if s.email and s.email.lower() == student.lower()]
     if not found:
         unpadded = [s.id for s in key.students if s.id.lstrip("0") == student.lstrip("0")]
         hint = f"; did you mean {unpadded[0]}?" if len(unpadded) == 1 else ""
+        if len(unpadded) > 1:
+            hint = f"; with leading zeros it could be {' or '.join(sorted(unpadded))}: give the id in full"
         raise UsageError(f"{key.where}: no student {shown(student)} (by id or email){hint}")
     parts = found[0].parts
     named = find_label(label, key.labels)  # as grade reads a label cell: " 1A " is 1a
@@ -200,17 +203,46 @@ def result(verdict: Verdict, part: KeyPart) -> dict[str, Any]:
 
 def batch(lines: Sequence[str], key: Key | None, physics: Physics | None = None) -> Iterator[dict[str, Any]]:
     """One result per line that is not blank, in order; a line that cannot be checked gives
-    ``{"line": n, "error": reason}`` and the others go on. ``physics`` diagnoses the key's parts."""
-    for number, line in enumerate(lines, start=1):
+    ``{"line": n, "error": reason}`` and the others go on. ``physics`` diagnoses the key's parts. Lines are
+    read one by one and graded :data:`BATCH_CHUNK` at a time, a part's answers together, as ``grader grade``
+    grades a column."""
+    for start in range(0, len(lines), BATCH_CHUNK):
+        yield from _chunk(lines[start:start + BATCH_CHUNK], start, key, physics)
+
+
+BATCH_CHUNK = 4096
+"""Lines of ``--batch`` graded together: enough that the per-call work of grading is spread thin."""
+
+
+def _chunk(lines: Sequence[str], start: int, key: Key | None, physics: Physics | None) -> Iterator[dict[str, Any]]:
+    results: list[dict[str, Any] | None] = [None] * len(lines)
+    asked: list[tuple[int, Expectation]] = []
+    requests: list[Request] = []
+    for offset, line in enumerate(lines):
         if not line.strip():
             continue
         try:
-            yield _line(line, key, physics)
+            submitted, against = _line(line, key, physics)
         except (GraderError, ValueError, RecursionError) as error:
-            yield {"line": number, "error": str(error)}
+            results[offset] = {"line": start + offset + 1, "error": str(error)}
+            continue
+        asked.append((offset, against))
+        requests.append(Request(against.part, against.student,
+                                Answer("the command line", 0, "", against.part.label, submitted, ",", None)))
+    given = [index for index, (_, against) in enumerate(asked) if against.key is _GIVEN]
+    mine = [index for index, (_, against) in enumerate(asked) if against.key is not _GIVEN]
+    for indices, context, found in ((given, _GIVEN, None), (mine, key, physics)):
+        if not indices or context is None:
+            continue
+        verdicts = grade_parts([requests[index] for index in indices], context, found)
+        for index, verdict in zip(indices, verdicts, strict=True):
+            offset, against = asked[index]
+            results[offset] = result(verdict, against.part)
+    yield from (found_result for found_result in results if found_result is not None)
 
 
-def _line(line: str, key: Key | None, physics: Physics | None) -> dict[str, Any]:
+def _line(line: str, key: Key | None, physics: Physics | None) -> tuple[str, Expectation]:
+    """What a line of ``--batch`` asks: the answer, and what it is checked against."""
     try:
         item = json.loads(line, parse_constant=_refuse_constant, object_pairs_hook=_once_each)
     except _TwiceError as error:
@@ -230,7 +262,7 @@ def _line(line: str, key: Key | None, physics: Physics | None) -> dict[str, Any]
     if "student" in item or "label" in item:
         if key is None:
             raise UsageError("student and label need --key")
-        return check(submitted, from_key(key, _text(item, "student"), _text(item, "label"), physics))
+        return submitted, from_key(key, _text(item, "student"), _text(item, "label"), physics)
     if "expected" not in item:
         raise UsageError("expected: missing (a number, an expression or null)" +
                          ("; or give student and label" if key is not None else ""))
@@ -245,7 +277,7 @@ def _line(line: str, key: Key | None, physics: Physics | None) -> dict[str, Any]
         raise UsageError(f"unit: expected text like \"m/s\", got {shown(unit)}")
     against = expectation(item["expected"], unit=unit, tolerance=item.get("tolerance"), symbols=symbols,
                           domains={str(name): _range(str(name), bounds) for name, bounds in ranges.items()})
-    return check(submitted, against)
+    return submitted, against
 
 
 def _text(item: Mapping[str, Any], name: str) -> str:

@@ -24,20 +24,15 @@ True
 
 from __future__ import annotations
 
-import hashlib
 import math
-from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field
+from collections.abc import Sequence
 from decimal import Decimal
 from fractions import Fraction
-from functools import lru_cache
 
 import numpy as np
 from numpy.typing import ArrayLike
 
 from grader.errors import shown
-from grader.model.expr import Node, names, to_text
-from grader.model.kernel import evaluate
 from grader.model.tolerance import Tolerance, with_unit
 
 LARGEST = float(np.finfo(np.float64).max)
@@ -299,73 +294,3 @@ def _percent(ratio: float) -> str:
         return f"{percent:.0f}"
     text = f"{percent:.2g}"
     return text if "e" not in text else _shown(float(text))  # two figures print alike in _shown
-
-
-# ---- symbolic answers ----------------------------------------------------------------------------
-
-@dataclass(frozen=True)
-class _Form:
-    """An expression keyed by its normalised text (the tree rides along, outside the key)."""
-
-    text: str
-    tree: Node = field(compare=False, hash=False)
-
-
-def equivalent(student: Node, expected: Node, domains: Mapping[str, tuple[float, float]], *, seed: str,
-               rtol: float = 1e-6, points: int = 8) -> bool | str:
-    """Whether two expressions agree at ``points`` seeded random points (WeBWorK's method).
-
-    Each name is drawn uniformly from its domain. Points where the key is undefined are skipped
-    (more are drawn than needed); a student expression undefined where the key is defined is not
-    equivalent. Returns a reason instead of a verdict when no comparison is possible: the caller
-    marks the cell invalid. Results are cached per (texts, domains, seed, rtol, points).
-
-    >>> from grader.model.expr import parse
-    >>> domains = {"v": (1.0, 10.0), "p": (0.1, 5.0)}
-    >>> equivalent(parse("(v - 0.1*p*v)/(1 + p)"), parse("v*(1 - 0.1*p)/(p + 1)"), domains, seed="s1")
-    True
-    >>> equivalent(parse("v/(p - p)"), parse("v*(1 - 0.1*p)/(p + 1)"), domains, seed="s1")
-    'the expression cannot be evaluated at any test point (division by zero?)'
-    """
-    if not 0 < rtol < 1 or isinstance(points, bool) or not isinstance(points, int) or not 1 <= points <= 1000:
-        raise ValueError(f"equivalent: expected 0 < rtol < 1 and 1 <= points <= 1000, got {rtol!r}, {points!r}")
-    for name, (low, high) in domains.items():
-        if not (math.isfinite(low) and math.isfinite(high) and low <= high):
-            raise ValueError(f"equivalent: domain of {name}: expected finite low <= high, got {shown((low, high))}")
-    key = tuple(sorted((name, (float(low), float(high))) for name, (low, high) in domains.items()))
-    return _equivalent(_Form(to_text(student), student), _Form(to_text(expected), expected), key, seed, rtol, points)
-
-
-@lru_cache(maxsize=4096)
-def _equivalent(student: _Form, expected: _Form, domains: tuple[tuple[str, tuple[float, float]], ...],
-                seed: str, rtol: float, points: int) -> bool | str:
-    known = dict(domains)
-    missing = sorted((names(student.tree) | names(expected.tree)) - set(known))
-    if missing:
-        return f"the expression uses {', '.join(missing)}, which this answer does not know"
-    digest = hashlib.sha256("\n".join((seed, student.text, expected.text)).encode()).digest()
-    generator = np.random.default_rng(np.random.SeedSequence(int.from_bytes(digest, "big")))
-    drawn = 4 * points
-    env = {name: generator.uniform(low, high, drawn) for name, (low, high) in domains}
-    key_values, student_values = _values(expected.tree, env, drawn), _values(student.tree, env, drawn)
-    usable = np.flatnonzero(np.isfinite(key_values))[:points]
-    if usable.size == 0:
-        return "the key's expression cannot be evaluated at any test point; please ask your instructor to check it"
-    b, a = key_values[usable], student_values[usable]
-    if not np.isfinite(a).any():
-        return "the expression cannot be evaluated at any test point (division by zero?)"
-    if not np.isfinite(a).all():
-        return False
-    # The floor lets a value that cancels to near zero at one point agree to the size of the others.
-    floor = 1e-3 * rtol * float(np.max(np.abs(b)))
-    return bool(np.all(np.abs(a - b) <= rtol * np.maximum(np.abs(a), np.abs(b)) + floor))
-
-
-def _values(tree: Node, env: Mapping[str, np.ndarray], size: int) -> np.ndarray:
-    """The tree at every point; NaN wherever it is undefined, and everywhere if it cannot be evaluated."""
-    try:
-        with np.errstate(all="ignore"):
-            values = np.asarray(evaluate(tree, env), dtype=float)
-        return np.broadcast_to(values, (size,)).copy()
-    except (ArithmeticError, ValueError, TypeError, KeyError):
-        return np.full(size, np.nan)

@@ -14,10 +14,12 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from functools import lru_cache
+from typing import NamedTuple
 
 import numpy as np
 
 from grader.grade.cells import (
+    MAX_CELL,
     CellBlank,
     CellExpression,
     CellInvalid,
@@ -27,11 +29,12 @@ from grader.grade.cells import (
     read_number,
     undefined_word,
 )
-from grader.grade.compare import equivalent, errors, feedbacks, is_correct, number_text
+from grader.grade.compare import errors, feedbacks, is_correct, number_text
 from grader.grade.diagnosis import Earlier, Physics, ProblemPhysics, physics_for, reconsider
 from grader.grade.key import Key, KeyPart
 from grader.grade.notation import cut
 from grader.grade.submissions import Answer, RowProblem, Submissions
+from grader.grade.symbolic import equivalent, refused
 from grader.model.expr import Node, parse
 from grader.model.tolerance import Tolerance
 
@@ -113,9 +116,34 @@ def grade_part(part: KeyPart, student_id: str, answer: Answer | None, key: Key,
                physics: Physics | None = None) -> Verdict:
     """One part: the key's expectation against the answer (None: nothing submitted). With ``physics``, a
     wrong number may be a diagnosed mistake (an earlier answer to carry forward is not known here)."""
-    student = next((index for index, s in enumerate(key.students) if s.id == student_id), None)
-    found = None if physics is None or student is None else physics.problems.get(part.problem)
-    return Verdict(student_id, part.label, *_grade_label([(part, answer)], key, np.array([student or 0]), found, [])[0])
+    return grade_parts([Request(part, student_id, answer)], key, physics)[0]
+
+
+class Request(NamedTuple):
+    """A part to grade on its own (``grader check``): the key's expectation, whose it is, the answer."""
+
+    part: KeyPart
+    student_id: str
+    answer: Answer | None
+
+
+def grade_parts(requests: Sequence[Request], key: Key, physics: Physics | None = None) -> list[Verdict]:
+    """:func:`grade_part` for each request, in order: the requests of one label (and of students the key
+    has, or not) are graded together, as ``grader grade`` grades a column, each on its own (no error is
+    carried forward from another request)."""
+    positions = key.positions
+    groups: dict[tuple[str, bool], list[int]] = {}
+    for index, request in enumerate(requests):
+        groups.setdefault((request.part.label, request.student_id in positions), []).append(index)
+    verdicts: list[Verdict | None] = [None] * len(requests)
+    for (_, known), members in groups.items():
+        first = requests[members[0]].part
+        found = physics.problems.get(first.problem) if physics is not None and known else None
+        students = np.array([positions.get(requests[index].student_id, 0) for index in members])
+        cells = [(requests[index].part, requests[index].answer) for index in members]
+        for index, row in zip(members, _grade_label(cells, key, students, found, []), strict=True):
+            verdicts[index] = Verdict(requests[index].student_id, requests[index].part.label, *row)
+    return verdicts  # type: ignore[return-value]  # every request is in one group
 
 
 def _grade_label(cells: Sequence[tuple[KeyPart, Answer | None]], key: Key, students: np.ndarray,
@@ -257,7 +285,8 @@ def _row(part: KeyPart, answer: Answer | None, expected: str, words: str, kind: 
     """The verdict's fields; ``expected``: what the key holds, in words; ``words``: the tolerance that decided it."""
     if answer is None:
         return None, kind, credit, part.points, expected, parsed, part.unit, absolute, relative, words, said, "", ""
-    return (answer.text, kind, credit, part.points, expected, parsed, part.unit, absolute, relative, words, said, "",
+    shown_text = cut(answer.text, MAX_CELL)  # a longer answer is invalid: its first characters say which
+    return (shown_text, kind, credit, part.points, expected, parsed, part.unit, absolute, relative, words, said, "",
             f"{answer.file}:{answer.line}")
 
 
@@ -268,7 +297,11 @@ def _symbolic(part: KeyPart, text: str, delimiter: str, key: Key) -> Outcome:
         return "missing", 0.0, "the answer was blank", ""
     if isinstance(cell, CellInvalid):
         return "invalid", 0.0, f"could not read this answer: {cell.reason}", ""
-    same = equivalent(cell.tree, _key_tree(str(part.value)), part.symbols, seed=f"{key.title}/{part.label}")
+    expected = _key_tree(str(part.value))
+    refusal = refused(cell.tree, expected)
+    if refusal is not None:
+        return "invalid", 0.0, f"could not read this answer: {refusal}", cell.text
+    same = equivalent(cell.tree, expected, part.symbols, seed=f"{key.title}/{part.label}")
     if isinstance(same, str):
         return "invalid", 0.0, f"could not compare this expression: {same}", cell.text
     names = " and ".join(symbols)

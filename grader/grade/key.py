@@ -120,15 +120,21 @@ class Key:
     ecf_credit: float = 1.0  # of a part right for the student's own earlier answer (0: no error carried forward)
     mistake_credit: float = 0.0  # of a part that matches a diagnosed mistake
 
-    @property
+    @functools.cached_property
     def labels(self) -> tuple[str, ...]:
-        """Every part's label, in the order of the sheet."""
+        """Every part's label, in the order of the sheet (worked out once: ``check --batch`` reads it a line)."""
         return tuple(label for problem in self.problems for label in problem.labels)
 
     @property
     def possible(self) -> float:
         """The most points a student can earn (Canvas' "points possible" of the assignment)."""
         return max((student.possible for student in self.students), default=0.0)
+
+    @functools.cached_property
+    def positions(self) -> dict[str, int]:
+        """Each student's place in :attr:`students`, by id; worked out once (``grader check --batch`` looks
+        a student up a line)."""
+        return {student.id: index for index, student in enumerate(self.students)}
 
     @functools.cached_property
     def parameter_columns(self) -> dict[tuple[str, str], np.ndarray]:

@@ -14,8 +14,9 @@ grader.grade.notation.ReadError: the power 3.8742e+08 is larger than 64
 from __future__ import annotations
 
 import math
+import operator
 import re
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 
 import numpy as np
 
@@ -70,6 +71,7 @@ def _with_products(text: str, symbols: tuple[str, ...]) -> str:
         if match["num"] is not None:
             if previous == "num":
                 raise ReadError(f"two numbers side by side ({cut(text, 40)}); give one answer")
+            _check_underflow(match["num"])
             kind, parts = "num", [match["num"]]
         elif match["name"] is not None:
             kind, parts = _name(match["name"], symbols, text[position:].lstrip()[:1] == "(")
@@ -85,7 +87,16 @@ def _with_products(text: str, symbols: tuple[str, ...]) -> str:
             out.append("*")
         out += parts
         previous = kind
+        if len(out) > 3 * MAX_NODES:  # bounded work a cell: refused before it is parsed (parentheses counted)
+            raise ReadError(f"more than {MAX_NODES} numbers, names and operations; simplify the answer")
     return "".join(out)
+
+
+def _check_underflow(number: str) -> None:
+    """Refuse a number float64 would read as 0 though its digits are not (``1e-400``)."""
+    if float(number) == 0 and any(digit in "123456789" for digit in number.lower().partition("e")[0]):
+        raise ReadError(f"{cut(number, 40)} is too small for a number (below about 5e-324 it would be read as 0); "
+                        "write 0 if you mean 0")
 
 
 def _name(word: str, symbols: tuple[str, ...], called: bool) -> tuple[str, list[str]]:
@@ -165,6 +176,10 @@ def value_of(tree: Node) -> float:
         return _step(tree)
 
 
+_PLAIN_ARITHMETIC: dict[str, Callable[..., float]] = {
+    "add": operator.add, "sub": operator.sub, "mul": operator.mul, "div": operator.truediv, "neg": operator.neg}
+
+
 def _step(node: Node) -> float:
     if isinstance(node, Num):
         try:
@@ -178,7 +193,14 @@ def _step(node: Node) -> float:
     args = [_step(arg) for arg in node.args]
     if node.op == "pow" and abs(args[1]) > MAX_EXPONENT:
         raise ReadError(f"the power {args[1]:g} is larger than {MAX_EXPONENT}")
-    result = float(OPERATIONS[node.op](*args))
+    plain = _PLAIN_ARITHMETIC.get(node.op)
+    try:
+        # Python's own arithmetic on floats where it agrees with numpy's (a division by zero, an overflow
+        # below end up as the non-finite numbers numpy would give): a numpy call on two floats costs 20 times
+        # as much, and a 480-character cell has a hundred steps.
+        result = float(plain(*args) if plain is not None else OPERATIONS[node.op](*args))
+    except ZeroDivisionError:
+        result = math.inf
     if math.isfinite(result):
         return result
     step = cut(to_text(node), 60)

@@ -43,7 +43,7 @@ from typing import Literal
 from grader.errors import GraderError, shown
 from grader.files import shown_path
 from grader.grade.columns import Layout, find_layout
-from grader.inputs import CsvRow, CsvTable, read_csv
+from grader.inputs import CELL_CHARS, CsvRow, CsvTable, read_csv
 
 
 @dataclass(frozen=True)
@@ -202,6 +202,9 @@ class Roster:
         found = self.stripped.get(text.lstrip("0"), []) if text.strip("0") else []
         if len(found) == 1:
             return found[0], f"leading zeros restored: {text} -> {found[0]}"
+        if found:
+            return None, (f"student {shown(text)} is ambiguous: with its leading zeros restored it could be "
+                          f"{' or '.join(sorted(found))}; write the id in full")
         return None, f"unknown student {shown(text)} (not in the answer key)"
 
     def known(self, text: str, by_email: bool) -> bool:
@@ -219,7 +222,7 @@ def _read_row(file: str, index: int, row: CsvRow, table: CsvTable, layout: Layou
     label = ""
     if not layout.wide:
         label = find_label(row.cells[layout.label or ""], labels) or row.cells[layout.label or ""]
-    if row.problem is not None:
+    if row.problem is not None and not _only_long_answers(row, layout):
         problems.append(RowProblem(file, row.line, who, label, row.problem.split(": ", 1)[-1]))
         return
     student_id, why = roster.find(who, layout.by_email) if who else (None, "no student given")
@@ -245,6 +248,15 @@ def _read_row(file: str, index: int, row: CsvRow, table: CsvTable, layout: Layou
         problems.append(RowProblem(file, row.line, student_id, "", stamp, caveat=True))
         stamp = None
     rows.append(_Row(file, index, row.line, student_id, answers, stamp, table.delimiter, layout.wide))
+
+
+def _only_long_answers(row: CsvRow, layout: Layout) -> bool:
+    """Whether a row's only fault is an answer longer than ``CELL_CHARS``: the answer is then graded, and
+    found too long with the limit said, where the student's other answers are."""
+    if row.problem is None or not row.problem.startswith(f"line {row.line}: a cell of "):
+        return False
+    answers = set(layout.labels) if layout.wide else {layout.answer}
+    return all(column in answers for column, text in row.cells.items() if len(text) > CELL_CHARS)
 
 
 def find_label(text: str, labels: Sequence[str]) -> str | None:

@@ -97,12 +97,41 @@ def parse(text: str, *, allow_compare: bool = False) -> Node:
         raise ExpressionError(f"'{text}' is not a valid expression ({error.msg})") from None
     except (RecursionError, MemoryError):
         raise ExpressionError(f"expression is nested more than {MAX_DEPTH} levels deep") from None
-    return _convert(tree.body, allow_compare, 0)
+    try:
+        return _convert(tree.body, allow_compare, 0)
+    except _TooDeepError:
+        terms = _longest_chain(tree.body)
+        if terms > MAX_DEPTH:  # a flat sum or product nests one level a term
+            raise ExpressionError(f"a sum or product of {terms} terms; at most {MAX_DEPTH + 1} terms are allowed "
+                                  "in a row (group some in parentheses, or simplify)") from None
+        raise ExpressionError(f"expression is nested more than {MAX_DEPTH} levels deep") from None
+
+
+class _TooDeepError(ExpressionError):
+    """A tree deeper than :data:`MAX_DEPTH` (said to the user by :func:`parse`)."""
+
+
+def _longest_chain(tree: ast.AST) -> int:
+    """The most terms joined by one kind of operator (``+ -`` or ``* /``) in a row: ``a + b - c`` is 3.
+
+    >>> _longest_chain(ast.parse("a + b*c*d - e", mode="eval").body)
+    3
+    """
+    kinds = {ast.Add: 0, ast.Sub: 0, ast.Mult: 1, ast.Div: 1}
+    longest = 1
+    for node in ast.walk(tree):
+        if not isinstance(node, ast.BinOp) or type(node.op) not in kinds:
+            continue
+        terms, left = 2, node.left
+        while isinstance(left, ast.BinOp) and kinds.get(type(left.op)) == kinds[type(node.op)]:
+            terms, left = terms + 1, left.left
+        longest = max(longest, terms)
+    return longest
 
 
 def _convert(node: ast.AST, allow_compare: bool, depth: int) -> Node:
     if depth > MAX_DEPTH:
-        raise ExpressionError(f"expression is nested more than {MAX_DEPTH} levels deep")
+        raise _TooDeepError(f"expression is nested more than {MAX_DEPTH} levels deep")
     deeper = depth + 1
     if isinstance(node, ast.Constant):
         return _number(node.value)
@@ -136,8 +165,21 @@ def _number(value: Any) -> Num:
     if isinstance(value, float):
         if value != value or value in (float("inf"), float("-inf")):
             raise ExpressionError(f"{value!r} is not a finite number")
-        return Num(Fraction(repr(value)))
+        return Num(_decimal_fraction(repr(value)))
     return Num(Fraction(value))
+
+
+def _decimal_fraction(text: str) -> Fraction:
+    """The exact value of a float's ``repr`` (``Fraction(text)`` does the same, four times slower).
+
+    >>> _decimal_fraction("0.1"), _decimal_fraction("-2.5e-07"), _decimal_fraction("1e+300") == 10**300
+    (Fraction(1, 10), Fraction(-1, 4000000), True)
+    """
+    mantissa, _, exponent = text.partition("e")
+    whole, _, decimals = mantissa.partition(".")
+    power = int(exponent or 0) - len(decimals)
+    digits = int(whole + decimals)
+    return Fraction(digits * 10**power) if power >= 0 else Fraction(digits, 10**-power)
 
 
 def _call(node: ast.Call, allow_compare: bool, depth: int) -> Node:

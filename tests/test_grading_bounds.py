@@ -7,6 +7,9 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+import pytest
+
+from grader.cli import main
 from grader.grade.key import Key, KeyStudent, load_key
 
 
@@ -46,3 +49,24 @@ def test_a_key_with_20000_parameter_names_loads_and_reads_its_columns(tmp_path: 
                       "problems": [{"key": "1", "answers": {"x": answer}, "params": params}]}]}))
     columns = load_key(path).parameter_columns
     assert len(columns) == 20_000 and columns["1", "p19999"][0] == 19_999.0
+
+
+def test_an_out_folder_that_will_be_refused_is_refused_before_anything_is_read_or_graded(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]) -> None:
+    """``--out`` was checked only when the reports were written, after the whole grading run: a folder of
+    someone else's files was refused after a minute of grading a big file. Now nothing is read first."""
+    import grader.grade.run
+
+    def must_not_run(*_: object, **__: object) -> None:
+        raise AssertionError("read or graded before --out was checked")
+
+    for name in ("load_key", "read_submissions", "grade", "read_export"):
+        monkeypatch.setattr(grader.grade.run, name, must_not_run)
+    out = tmp_path / "theirs"
+    out.mkdir()
+    (out / "thesis.tex").write_text("not grader's")
+    submissions = tmp_path / "big.csv"
+    submissions.write_text("student_id,label,answer\n" + "x,1a,1\n" * 100_000)
+    code = main(["grade", "--key", str(tmp_path / "key.json"), str(submissions), "--out", str(out)])
+    assert code == 2 and "theirs" in capsys.readouterr().err
+    assert [p.name for p in out.iterdir()] == ["thesis.tex"]

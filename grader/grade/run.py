@@ -1,8 +1,9 @@
 """``grader grade``: a key and submission files become grades, details, problems and a Canvas import.
 
-Inputs are read and checked first; the outputs are written into a work folder beside ``--out`` and
-moved into place at the end (:func:`grader.files.output_folder`), so an unusable input or a failure
-leaves nothing behind and a previous output untouched.
+``--out`` is checked first (a folder that would be refused is refused before a minute of grading), then
+the inputs are read and checked; the outputs are written into a work folder beside ``--out`` and moved
+into place at the end (:func:`grader.files.output_folder`), so an unusable input or a failure leaves
+nothing behind and a previous output untouched.
 """
 
 from __future__ import annotations
@@ -61,13 +62,14 @@ def run(key_path: Path, paths: Sequence[Path], out: Path, fmt: Literal["auto", "
     :mod:`grader.grade.canvas`).
     """
     started = time.perf_counter()
-    with collector_paused():
+    inputs = (key_path, *paths, *([canvas] if canvas is not None else []))
+    # The output folder is claimed first: a folder that will be refused is refused before the inputs are
+    # read and graded (which may take a minute), and a failure still leaves it as it was.
+    with collector_paused(), output_folder(out, command=COMMAND, inputs=inputs, force=force) as staging:
         key = load_key(key_path)
         export = read_export(canvas, key) if canvas is not None else None
         graded = _graded(key, paths, fmt, (), bank)
-        inputs = (key_path, *paths, *([canvas] if canvas is not None else []))
-        with output_folder(out, command=COMMAND, inputs=inputs, force=force) as staging:
-            write_reports(graded, staging, export)
+        write_reports(graded, staging, export)
     return _summary(graded, out, started, export)
 
 

@@ -11,6 +11,7 @@ from __future__ import annotations
 import time
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
+from datetime import datetime
 from pathlib import Path
 from typing import Literal
 
@@ -74,22 +75,23 @@ def run(key_path: Path, paths: Sequence[Path], out: Path, fmt: Literal["auto", "
 
 
 def grade_into(folder: Path, key_path: Path, paths: Sequence[Path], out: Path, names: Sequence[str],
-               bank: Path | Mapping[str, Template] | None = None) -> GradeSummary:
+               bank: Path | Mapping[str, Template] | None = None, now: datetime | None = None) -> GradeSummary:
     """Grade into ``folder``, a part of an output folder still being written (the demo's ``grades/``), as
     ``grader grade --out out`` would, with the files named as in ``names`` (where they will be) and the
-    manifest ``grader grade`` writes, so that ``grader grade --out out --force`` may replace it later."""
+    manifest ``grader grade`` writes, so that ``grader grade --out out --force`` may replace it later;
+    ``now``: the time the grading is as at (a timestamp after it is a caveat), by default the clock's."""
     started = time.perf_counter()
     with collector_paused():
-        graded = _graded(load_key(key_path), paths, "auto", names, bank)
+        graded = _graded(load_key(key_path), paths, "auto", names, bank, now)
         write_reports(graded, folder)
         write_manifest(folder, COMMAND)
     return _summary(graded, out, started, None)
 
 
 def _graded(key: Key, paths: Sequence[Path], fmt: Literal["auto", "long", "wide"], names: Sequence[str],
-            bank: Path | Mapping[str, Template] | None) -> Graded:
+            bank: Path | Mapping[str, Template] | None, now: datetime | None = None) -> Graded:
     submissions = read_submissions(paths, [StudentRef(s.id, s.email) for s in key.students], key.labels, fmt,
-                                   names)
+                                   names, now=now)
     return grade(key, submissions, physics_for(key, bank))
 
 
@@ -97,7 +99,7 @@ def _summary(graded: Graded, out: Path, started: float, export: CanvasExport | N
     students, columns = range(len(graded.key.students)), graded.columns.values()
     answered = sum(any(rows[index][0] is not None for rows in columns) for index in students)
     return GradeSummary(out, len(students), answered, len(students) * len(graded.columns),
-                        sum(problem.not_graded for problem in graded.problems),
-                        sum(problem.routine for problem in graded.problems), counts(graded),
+                        sum(problem.rows for problem in graded.problems if problem.not_graded),
+                        sum(problem.rows for problem in graded.problems if problem.routine), counts(graded),
                         graded.ignored_columns, (*graded.notes, *(export.notes if export else ())),
                         time.perf_counter() - started)

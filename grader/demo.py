@@ -16,7 +16,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
-from grader.assign.sample_answers import sample_answers, submissions_csv
+from grader.assign.sample_answers import due_time, sample_answers, submissions_csv
 from grader.bank.template import Template
 from grader.files import output_folder, write_atomic
 from grader.grade.run import GradeSummary, grade_into
@@ -46,8 +46,9 @@ def demo(out: Path, bank: Mapping[str, Template], jobs: int = 1, force: bool = F
             shutil.copyfile(source, staging / source.name)
         generation, _ = write_outputs(job, assignment, roster, bank, staging)
         write_atomic(staging / SUBMISSIONS, submissions_csv(sample_answers(assignment, generation, bank)))
+        # Graded as at the due date, by which the simulated class submitted (not a caveat for each row).
         graded = grade_into(staging / GRADES, staging / KEY, [staging / SUBMISSIONS], out / GRADES,
-                            [str(out / SUBMISSIONS)], bank)
+                            [str(out / SUBMISSIONS)], bank, now=due_time(assignment.due))
         files = sum(path.is_file() for path in staging.rglob("*"))
     generated = Summary(out, len(roster), len(assignment.problems), generation.collisions, files,
                         time.perf_counter() - started)

@@ -32,10 +32,10 @@ import re
 import stat
 from collections import Counter
 from collections.abc import Iterator
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from functools import lru_cache
 from pathlib import Path
-from typing import Any
+from typing import Any, NamedTuple
 
 from grader import caching
 from grader.errors import GraderError
@@ -227,10 +227,10 @@ def _yaml_reader() -> str:
 
 # --- CSV ----------------------------------------------------------------------------------------
 
-@dataclass(frozen=True, slots=True)
-class CsvRow:
+class CsvRow(NamedTuple):
     """One data row: the line it starts on, its cells by header name (stripped), and what is wrong
-    with the row as a whole (more cells than columns), for the caller to refuse the row or the file."""
+    with the row as a whole (more cells than columns), for the caller to refuse the row or the file.
+    (A named tuple: made ten million times for a big file, a frozen dataclass took a second a million.)"""
 
     line: int
     cells: dict[str, str]
@@ -248,6 +248,38 @@ class CsvTable:
     header_line: int
     delimiter: str = ","
     encoding: str = "UTF-8"
+
+
+@dataclass(frozen=True)
+class CsvStream:
+    """A CSV file whose header is read and whose data rows are read as :meth:`rows` is iterated (from the
+    start on each call): a file of ten million short rows costs its text, not an object per row."""
+
+    path: Path
+    header: tuple[str, ...]
+    header_line: int
+    delimiter: str
+    encoding: str
+    exports: bool
+    text: str = field(repr=False)  # from the header's line on
+    skipped: int = 0  # blank lines before the header's
+
+    def rows(self) -> Iterator[CsvRow]:
+        """The non-blank data rows, as :func:`read_csv` describes them."""
+        records = _records(_lines(self.text), self.path, self.delimiter, self.skipped)
+        next(records)  # the header
+        header, width = self.header, len(self.header)
+        for line, cells in records:
+            problem = None
+            longest = max(map(len, cells))
+            if longest > CELL_CHARS:
+                if not self.exports:
+                    _check_cell_lengths(cells, self.path, line)
+                problem = f"line {line}: a cell of {longest:,} characters; expected at most {CELL_CHARS}"
+            problem = _width_problem(cells, width, line) or problem
+            if len(cells) != width:  # cells beyond the header's are dropped, missing ones are empty
+                cells = (cells + [""] * width)[:width]
+            yield CsvRow(line, dict(zip(header, map(str.strip, cells), strict=True)), problem)
 
 
 def read_csv(path: Path, *, exports: bool = False) -> CsvTable:
@@ -269,21 +301,15 @@ def read_csv(path: Path, *, exports: bool = False) -> CsvTable:
     >>> table.header, [(row.line, row.cells) for row in table.rows]
     (('h_drop', 'h_rebound'), [(3, {'h_drop': '2100', 'h_rebound': '1100'}), (5, {'h_drop': '2,0', 'h_rebound': '1'})])
     """
-    head, records = _open_csv(path, exports)
-    header, width = head.header, len(head.header)
-    rows = []
-    for line, cells in records:
-        problem = None
-        longest = max(map(len, cells))
-        if longest > CELL_CHARS:
-            if not exports:
-                _check_cell_lengths(cells, path, line)
-            problem = f"line {line}: a cell of {longest:,} characters; expected at most {CELL_CHARS}"
-        problem = _width_problem(cells, width, line) or problem
-        if len(cells) != width:  # cells beyond the header's are dropped, missing ones are empty
-            cells = (cells + [""] * width)[:width]
-        rows.append(CsvRow(line, dict(zip(header, map(str.strip, cells), strict=True)), problem))
-    return CsvTable(path, header, tuple(rows), head.header_line, head.delimiter, head.encoding)
+    stream = open_csv(path, exports=exports)
+    return CsvTable(path, stream.header, tuple(stream.rows()), stream.header_line, stream.delimiter,
+                    stream.encoding)
+
+
+def open_csv(path: Path, *, exports: bool = False) -> CsvStream:
+    """A CSV file as :func:`read_csv` reads it, its header read and its rows to come (:meth:`CsvStream.rows`)."""
+    head, _ = _open_csv(path, exports)
+    return head
 
 
 @dataclass(frozen=True)
@@ -339,18 +365,11 @@ def _check_every_cell_length(grid: list[list[str]], lines: list[int], path: Path
             _check_cell_lengths(cells, path, line)
 
 
-@dataclass(frozen=True)
-class _CsvHead:
-    header: tuple[str, ...]
-    header_line: int
-    delimiter: str
-    encoding: str
-
-
-def _open_csv(path: Path, exports: bool) -> tuple[_CsvHead, Iterator[tuple[int, list[str]]]]:
-    """The header of a CSV file, and its non-blank data rows to come: ``(line, cells)``."""
+def _open_csv(path: Path, exports: bool) -> tuple[CsvStream, Iterator[tuple[int, list[str]]]]:
+    """The file, its header read, and its non-blank data rows to come: ``(line, cells)``."""
     data = read_bytes(path, CSV_BYTES)
     text, encoding = decode_export(data, path) if exports else (decode_text(data, path), "UTF-8")
+    del data  # a file's bytes beside its text would double what it costs
     text = _unified(text)
     text_starts = len(text) - len(text.lstrip())  # on the first line that is not blank
     if text_starts == len(text):
@@ -360,13 +379,32 @@ def _open_csv(path: Path, exports: bool) -> tuple[_CsvHead, Iterator[tuple[int, 
     end = text.find("\n", text_starts)
     header_text = text[start:] if end < 0 else text[start:end]
     delimiter = max(",;\t", key=lambda candidate: _count_outside_quotes(header_text, candidate))
-    records = _records(io.StringIO(text[start:]), path, delimiter, first)
+    if start:
+        text = text[start:]
+    records = _records(_lines(text), path, delimiter, first)
     first_record = next(records, None)
     if first_record is None:  # only quotes or delimiters: no cell has text
         raise GraderError(f"{path}: no header line with text; expected a header line")
     header_line, header_cells = first_record
     _check_cell_lengths(header_cells, path, header_line)
-    return _CsvHead(_header(header_cells, path, header_line), header_line, delimiter, encoding), records
+    return CsvStream(path, _header(header_cells, path, header_line), header_line, delimiter, encoding, exports, text,
+                     first), records
+
+
+def _lines(text: str, piece: int = 1 << 20) -> Iterator[str]:
+    """The lines of ``text`` (split at ``\\n`` only, as ``io.StringIO`` splits them), read through a
+    ``StringIO`` of about ``piece`` characters at a time: one of the whole text would take four bytes a
+    character beside it."""
+    return itertools.chain.from_iterable(map(io.StringIO, _pieces(text, piece)))
+
+
+def _pieces(text: str, piece: int) -> Iterator[str]:
+    start = 0
+    while start < len(text):
+        end = text.find("\n", start + piece)
+        end = len(text) if end < 0 else end + 1
+        yield text[start:end]
+        start = end
 
 
 def _width_problem(cells: list[str], width: int, line: int) -> str | None:
@@ -405,7 +443,7 @@ def _check_cell_lengths(cells: list[str], path: Path, line: int) -> None:
         raise GraderError(f"{path}: line {line}: a cell of {len(long):,} characters; expected at most {CELL_CHARS}")
 
 
-def _records(stream: io.StringIO, path: Path, delimiter: str, offset: int) -> Iterator[tuple[int, list[str]]]:
+def _records(stream: Iterator[str], path: Path, delimiter: str, offset: int) -> Iterator[tuple[int, list[str]]]:
     """The non-blank records of the text and the line each starts on; an error names the line of the
     record it is in (where a quote left open begins, not the end of the file it ran to)."""
     import csv  # here: `grader solve --set` and `grader list` read no CSV

@@ -202,7 +202,7 @@ def test_a_failure_while_grading_leaves_nothing_behind(tmp_path: Path, monkeypat
     def without_pdfs(job: Job, *args: Any) -> int:
         return write_outputs(replace(job, pdf=False), *args)
 
-    def broken(*args: object) -> None:
+    def broken(*args: object, **keywords: object) -> None:
         raise RuntimeError("disk full")
 
     monkeypatch.setattr(grader.demo, "write_outputs", without_pdfs)

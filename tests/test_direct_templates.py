@@ -206,7 +206,7 @@ def test_two_rebounds(bank, compiled, h1, h2):
     ("coupling", {"m_A": 60, "m_B": 40, "v_A": 3, "v_B": 3}, "the cars never meet"),
     ("moving-plate", {"h": 1.2, "u": -5, "e": 0.6}, "ball and plate are not approaching"),
     ("moving-plate", {"h": 1.2, "u": -2, "e": 0.3}, "ball must move up (v_out >= 0)"),
-    ("three-balls", {"m1": 1, "m2": 1, "m3": 1, "v": 4, "e": 0}, "e = 0 is outside its domain (0, 1]"),
+    ("three-balls", {"m1": 1, "m2": 1, "m3": 1, "v": 4, "e": 0}, "with e = 0 balls 1 and 2 move on together"),
     ("two-rebounds", {"h1": 1.2, "h2": 1.3}, "cannot rise higher after the second impact"),
     ("two-rebounds", {"h1": 1.2, "h2": 0}, "h2 = 0 m is outside its domain (0, inf)"),
 ])

@@ -14,9 +14,11 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from grader.errors import GraderError
-from grader.grade.submissions import Answer, RowProblem, StudentRef, Submissions, _timestamp, read_submissions
+from grader.grade.submissions import Answer, RowProblem, StudentRef, Submissions, read_submissions
+from grader.grade.timestamps import read_timestamp
 from grader.inputs import read_csv
 
+NOW = datetime(2030, 1, 1, tzinfo=UTC)  # the run's time: the files' timestamps, in 2026, are before it
 STUDENTS = [StudentRef("00123", "Ann.Lee@uni.edu"), StudentRef("456", "bob@uni.edu"), StudentRef("789", "cy@uni.edu")]
 LABELS = ["1a", "1b", "2"]
 
@@ -31,7 +33,7 @@ def write(folder: Path, name: str, content: str | bytes) -> Path:
 
 
 def read(*paths: Path, fmt: str = "auto") -> Submissions:
-    result = read_submissions(list(paths), STUDENTS, LABELS, fmt)  # type: ignore[arg-type]
+    result = read_submissions(list(paths), STUDENTS, LABELS, fmt, now=NOW)  # type: ignore[arg-type]
     assert_accounted(result, {str(p): {row.line for row in read_csv(p, exports=True).rows} for p in paths})
     return result
 
@@ -187,12 +189,12 @@ def test_an_unreadable_timestamp_is_a_caveat_and_the_row_has_none(tmp_path: Path
     ("", None),
 ])
 def test_timestamp_formats(text: str, when: datetime | None) -> None:
-    assert _timestamp(text) == when
+    assert read_timestamp(text) == when
 
 
 @pytest.mark.parametrize("text", ["yesterday", "13/45/2026 10:00", "2026-02-30", "12/4/26 10:00"])
 def test_timestamps_that_do_not_read_say_so(text: str) -> None:
-    assert "not understood" in str(_timestamp(text))
+    assert "not understood" in str(read_timestamp(text))
 
 
 def test_utf16_with_bom_tab_delimited_as_excel_saves_unicode_text(tmp_path: Path) -> None:
@@ -383,7 +385,7 @@ def test_every_data_line_is_accounted_for_exactly_once(
             path = write(Path(folder), f"f{index}.csv", text)
             paths.append(path)
             lines[str(path)] = data_lines
-        result = read_submissions(paths, STUDENTS, LABELS)
+        result = read_submissions(paths, STUDENTS, LABELS, now=NOW)
         assert_accounted(result, lines)
         if not any(wide or stamped for _, wide, _, stamped in files):  # long, no timestamps: the last row wins
             last = {}

@@ -82,7 +82,7 @@ class _Typed:
 def sample_answers(assignment: Assignment, generation: Generation,
                    bank: Mapping[str, Template]) -> list[SampleAnswer]:
     """Every student's answers, in roster and sheet order; the late resubmission comes last."""
-    deadline = _deadline(assignment.due)
+    deadline = due_time(assignment.due)
     roles = variant_generator(assignment.seed, _KEY, "")[0].permutation(len(generation.students))
     absent, late, vague = (int(i) for i in roles[:3]) if len(roles) >= 3 else (-1, -1, -1)
     rows, resubmitted = [], []
@@ -272,7 +272,9 @@ def _three(value: float) -> str:
     return printed_text(value, None, 3)
 
 
-def _deadline(due: str) -> datetime:
+def due_time(due: str) -> datetime:
+    """The time an assignment is due, by which the simulated class submits (a date that is not ISO 8601:
+    the sample's)."""
     try:
         return datetime.fromisoformat(due.strip())
     except ValueError:

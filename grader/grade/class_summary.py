@@ -206,7 +206,8 @@ def summarize(graded: Graded) -> ClassSummary:
     percent = np.divide(100.0 * earned, possible, out=np.zeros(count), where=possible > 0)
     return ClassSummary(key, kinds, percent, int(answered.sum()), tuple(parts),
                         _problems(key, scores, points, missing), _invalid(graded, sorted(invalid)[:INVALID_STUDENTS]),
-                        len(invalid), sum(problem.not_graded for problem in graded.problems), graded.notes)
+                        len(invalid), sum(problem.rows for problem in graded.problems if problem.not_graded),
+                        graded.notes)
 
 
 def _is(verdicts: list[str], kind: str) -> npt.NDArray[np.bool_]:

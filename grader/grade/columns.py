@@ -16,7 +16,7 @@ from dataclasses import dataclass
 from typing import Literal
 
 from grader.errors import GraderError, shown
-from grader.inputs import CsvTable
+from grader.inputs import CsvStream
 
 STUDENT = ("student id", "id", "sid", "sis user id", "username")  # "student_id" reads as "student id"
 EMAIL = ("email", "email address")
@@ -57,7 +57,7 @@ def label_of(header: str, labels: Sequence[str]) -> str | None:
     return max(fits, key=len) if fits else None
 
 
-def find_layout(table: CsvTable, labels: Sequence[str], fmt: Literal["auto", "long", "wide"],
+def find_layout(table: CsvStream, labels: Sequence[str], fmt: Literal["auto", "long", "wide"],
                 known: Callable[[str, bool], bool]) -> Layout:
     """The layout of ``table``; ``known(text, by_email)`` says whether a cell names a key's student
     (used to choose between several id columns: Canvas has both ``ID`` and ``SIS User ID``)."""
@@ -74,8 +74,7 @@ def find_layout(table: CsvTable, labels: Sequence[str], fmt: Literal["auto", "lo
                           f"{_EXPECTED.format(labels=', '.join(labels[:4]))}; got the columns "
                           f"{shown(list(table.header), 160)}")
     by_email = not named["student"]
-    student = student_columns[0] if len(student_columns) == 1 else max(student_columns, key=lambda column: (
-        sum(known(row.cells[column], by_email) for row in table.rows), -student_columns.index(column)))
+    student = student_columns[0] if len(student_columns) == 1 else _most_known(table, student_columns, by_email, known)
     used = {student, *(named[kind][0] for kind in ("timestamp",) + (() if wide else ("label", "answer"))
                        if named[kind])}
     if wide:
@@ -86,11 +85,21 @@ def find_layout(table: CsvTable, labels: Sequence[str], fmt: Literal["auto", "lo
                   named["timestamp"][0] if named["timestamp"] else None, wide_columns if wide else {}, ignored)
 
 
+def _most_known(table: CsvStream, columns: list[str], by_email: bool, known: Callable[[str, bool], bool]) -> str:
+    """The column of ``columns`` whose cells name the most students of the key (the first, of equals), in one
+    reading of the rows."""
+    found = dict.fromkeys(columns, 0)
+    for row in table.rows():
+        for column in columns:
+            found[column] += known(row.cells[column], by_email)
+    return max(columns, key=lambda column: (found[column], -columns.index(column)))
+
+
 def _claimed(header: str, named: dict[str, list[str]]) -> bool:
     return any(header in columns for columns in named.values())
 
 
-def _check_one_column_per_label(table: CsvTable, columns: dict[str, str]) -> None:
+def _check_one_column_per_label(table: CsvStream, columns: dict[str, str]) -> None:
     seen: dict[str, str] = {}
     for column, label in columns.items():
         if label in seen:

@@ -1,8 +1,9 @@
 """``grader grade``: a key and submission files become grades, details, problems and a Canvas import.
 
-Inputs are read and checked first; the outputs are written into a work folder beside ``--out`` and
-moved into place at the end (:func:`grader.files.output_folder`), so an unusable input or a failure
-leaves nothing behind and a previous output untouched.
+``--out`` is checked first (a folder that would be refused is refused before a minute of grading), then
+the inputs are read and checked; the outputs are written into a work folder beside ``--out`` and moved
+into place at the end (:func:`grader.files.output_folder`), so an unusable input or a failure leaves
+nothing behind and a previous output untouched.
 """
 
 from __future__ import annotations
@@ -10,6 +11,7 @@ from __future__ import annotations
 import time
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
+from datetime import datetime
 from pathlib import Path
 from typing import Literal
 
@@ -61,33 +63,35 @@ def run(key_path: Path, paths: Sequence[Path], out: Path, fmt: Literal["auto", "
     :mod:`grader.grade.canvas`).
     """
     started = time.perf_counter()
-    with collector_paused():
+    inputs = (key_path, *paths, *([canvas] if canvas is not None else []))
+    # The output folder is claimed first: a folder that will be refused is refused before the inputs are
+    # read and graded (which may take a minute), and a failure still leaves it as it was.
+    with collector_paused(), output_folder(out, command=COMMAND, inputs=inputs, force=force) as staging:
         key = load_key(key_path)
         export = read_export(canvas, key) if canvas is not None else None
         graded = _graded(key, paths, fmt, (), bank)
-        inputs = (key_path, *paths, *([canvas] if canvas is not None else []))
-        with output_folder(out, command=COMMAND, inputs=inputs, force=force) as staging:
-            write_reports(graded, staging, export)
+        write_reports(graded, staging, export)
     return _summary(graded, out, started, export)
 
 
 def grade_into(folder: Path, key_path: Path, paths: Sequence[Path], out: Path, names: Sequence[str],
-               bank: Path | Mapping[str, Template] | None = None) -> GradeSummary:
+               bank: Path | Mapping[str, Template] | None = None, now: datetime | None = None) -> GradeSummary:
     """Grade into ``folder``, a part of an output folder still being written (the demo's ``grades/``), as
     ``grader grade --out out`` would, with the files named as in ``names`` (where they will be) and the
-    manifest ``grader grade`` writes, so that ``grader grade --out out --force`` may replace it later."""
+    manifest ``grader grade`` writes, so that ``grader grade --out out --force`` may replace it later;
+    ``now``: the time the grading is as at (a timestamp after it is a caveat), by default the clock's."""
     started = time.perf_counter()
     with collector_paused():
-        graded = _graded(load_key(key_path), paths, "auto", names, bank)
+        graded = _graded(load_key(key_path), paths, "auto", names, bank, now)
         write_reports(graded, folder)
         write_manifest(folder, COMMAND)
     return _summary(graded, out, started, None)
 
 
 def _graded(key: Key, paths: Sequence[Path], fmt: Literal["auto", "long", "wide"], names: Sequence[str],
-            bank: Path | Mapping[str, Template] | None) -> Graded:
+            bank: Path | Mapping[str, Template] | None, now: datetime | None = None) -> Graded:
     submissions = read_submissions(paths, [StudentRef(s.id, s.email) for s in key.students], key.labels, fmt,
-                                   names)
+                                   names, now=now)
     return grade(key, submissions, physics_for(key, bank))
 
 
@@ -95,7 +99,7 @@ def _summary(graded: Graded, out: Path, started: float, export: CanvasExport | N
     students, columns = range(len(graded.key.students)), graded.columns.values()
     answered = sum(any(rows[index][0] is not None for rows in columns) for index in students)
     return GradeSummary(out, len(students), answered, len(students) * len(graded.columns),
-                        sum(problem.not_graded for problem in graded.problems),
-                        sum(problem.routine for problem in graded.problems), counts(graded),
+                        sum(problem.rows for problem in graded.problems if problem.not_graded),
+                        sum(problem.rows for problem in graded.problems if problem.routine), counts(graded),
                         graded.ignored_columns, (*graded.notes, *(export.notes if export else ())),
                         time.perf_counter() - started)

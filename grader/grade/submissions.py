@@ -19,31 +19,59 @@ the latest submission wins: in a wide file the whole row, in a long file the row
 
 Rules of accounting (a test checks them on every file): each data line is either the line of one or
 more answers, or of exactly one problem whose ``caveat`` is false. Caveats (``caveat=True``: leading
-zeros restored, an unreadable timestamp, one answer of a wide row superseded by a later long row) may
-accompany either.
+zeros restored, an unreadable timestamp, a timestamp after the run's time, one answer of a wide row
+superseded by a later long row) may accompany either. Of each kind of problem the first
+:data:`~grader.grade.row_problems.LISTED` are listed and the rest counted, in one problem per file and
+kind (:mod:`grader.grade.row_problems`).
 
-Timestamps: ISO 8601 (``2026-12-04 23:59:07``, ``2026-12-04T23:59:07Z``, ``... UTC``) and Google Forms'
-``12/4/2026 23:59:07`` (month first, optional ``AM``/``PM``), each with or without a zone. Times
-without a zone are taken as UTC when compared with times that have one (a note says so). When every
-competing row has a timestamp, the latest wins (ties: the later row); when any of them has none
-(or one that does not read: a caveat), the last row wins, in file order, then argument order.
+Files are read row by row and nothing is kept per row but the rows that may still win
+(:mod:`grader.grade.latest`) and the problems listed: memory is bounded by the file's text and the key,
+whatever the number of rows.
+
+Timestamps (:mod:`grader.grade.timestamps`) without a zone are taken as UTC when compared with times that
+have one (a note says so). When every competing row has a timestamp, the latest wins (ties: the later
+row); when any of them has none (or one that does not read: a caveat), the last row wins, in file order,
+then argument order. A timestamp more than a day after the run's own time (beyond any time zone) wins all
+the same, with a caveat and a note: a clock was wrong, or the time was typed.
 """
 
 from __future__ import annotations
 
 import os
-import re
 from collections import defaultdict
-from collections.abc import Iterable, Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from datetime import UTC, datetime, timedelta, timezone
+from datetime import datetime, timedelta
+from functools import lru_cache
 from pathlib import Path
 from typing import Literal
 
 from grader.errors import GraderError, shown
 from grader.files import shown_path
+from grader.grade import timestamps
 from grader.grade.columns import Layout, find_layout
-from grader.inputs import CELL_CHARS, CsvRow, CsvTable, read_csv
+from grader.grade.latest import Answer, Contests, SubmittedRow
+from grader.grade.row_problems import (
+    ASIDE,
+    EMPTY,
+    FUTURE,
+    LABEL,
+    LISTED,
+    MALFORMED,
+    UNKNOWN,
+    UNREADABLE_TIME,
+    ZEROS,
+    Kind,
+    ProblemLog,
+    RowProblem,
+)
+from grader.grade.timestamps import instant, read_timestamp
+from grader.inputs import CELL_CHARS, CsvRow, CsvStream, open_csv
+
+__all__ = ["Answer", "RowProblem", "StudentRef", "Submissions", "find_label", "read_submissions"]
+
+FUTURE_MARGIN = timedelta(days=1)
+"""A timestamp later than the run's own time by more than this (more than any time zone's offset) is a caveat."""
 
 
 @dataclass(frozen=True)
@@ -52,42 +80,6 @@ class StudentRef:
 
     id: str
     email: str
-
-
-@dataclass(frozen=True, slots=True)
-class Answer:
-    """One answer a student gave: where it came from (``line``: the line its row starts on, the
-    header being line 1, blank lines counted), and the file's ``delimiter`` (with ``;`` or a tab,
-    ``6,26`` may be a decimal comma)."""
-
-    file: str
-    line: int
-    student_id: str
-    label: str
-    text: str
-    delimiter: str
-    timestamp: datetime | None
-
-
-@dataclass(frozen=True)
-class RowProblem:
-    """Why a row (``label == ""``) or one answer of it was not used; ``caveat``: the row's answers
-    were used all the same, and this is said so that nobody is surprised; ``routine``: not used by rule,
-    with nothing for anyone to do (superseded by the same student's later answer, or one of Canvas' rows
-    that are no student's), so it does not make a run end with "rows not graded"."""
-
-    file: str
-    line: int
-    student_id: str
-    label: str
-    reason: str
-    caveat: bool = False
-    routine: bool = False
-
-    @property
-    def not_graded(self) -> bool:
-        """Whether a submitted answer went ungraded for a reason someone should look at."""
-        return not self.caveat and not self.routine
 
 
 @dataclass(frozen=True)
@@ -101,68 +93,39 @@ class Submissions:
     notes: tuple[str, ...]
 
 
-@dataclass(slots=True)
-class _Row:
-    """One data row that names a known student, with its non-empty answers as (label, text) pairs (a
-    long row's one answer may be empty: a blank submitted). A class of 100,000 has a million rows:
-    they hold no more than they need."""
-
-    file: str
-    index: int  # of the file, in argument order
-    line: int
-    student_id: str
-    answers: tuple[tuple[str, str], ...]
-    timestamp: datetime | None
-    delimiter: str
-    wide: bool
-    lost: list[tuple[str, str]] | None = None  # (label, why) taken by a later long row
-
-    @property
-    def order(self) -> tuple[int, int]:
-        """Where the row is: argument order, then file order."""
-        return self.index, self.line
-
-    def text(self, label: str) -> str:
-        """The row's answer to ``label``."""
-        return dict(self.answers)[label]
-
-
 def read_submissions(paths: Sequence[Path], students: Sequence[StudentRef], labels: Sequence[str],
-                     fmt: Literal["auto", "long", "wide"] = "auto", names: Sequence[str] = ()) -> Submissions:
+                     fmt: Literal["auto", "long", "wide"] = "auto", names: Sequence[str] = (), *,
+                     listed: int = LISTED, now: datetime | None = None) -> Submissions:
     """Every answer of ``paths`` to one of ``labels`` by one of ``students``, the latest of each.
     Answers and problems name their file as in ``names`` when given (one per path), else by its path.
+    Of each kind of problem the first ``listed`` are listed, the rest counted; ``now``: the run's time (a
+    timestamp after it is a caveat), by default the clock's.
 
     Raises :class:`GraderError` for a file that cannot be used as a whole (unreadable, neither UTF-8
     nor UTF-16 nor clean Windows-1252, no recognisable header); a bad row is a :class:`RowProblem`.
     """
     _refuse_repeated(paths)
-    roster = Roster(students)
-    rows: list[_Row] = []
-    problems: list[RowProblem] = []
+    reader = _Reader(Roster(students), labels, ProblemLog(listed), instant(now or timestamps.clock()))
     ignored: dict[str, None] = {}
     notes: list[str] = []
     shown_as = [shown_path(name) for name in names or paths]
     for index, (path, name) in enumerate(zip(paths, shown_as, strict=True)):
-        table = read_csv(path, exports=True)
-        layout = find_layout(table, labels, fmt, roster.known)
+        table = open_csv(path, exports=True)
+        layout = find_layout(table, labels, fmt, reader.roster.known)
         ignored.update(dict.fromkeys(layout.ignored))
         if table.encoding == "Windows-1252":
             notes.append(f"{name}: not UTF-8; read as Windows-1252 (Latin-1): check accented text, or save the "
                          'file as "CSV UTF-8"')
-        for row in table.rows:
-            _read_row(name, index, row, table, layout, labels, roster, rows, problems)
-        del table  # its rows are read: the next file's need not wait beside them
-    stamps = [row.timestamp for row in rows if row.timestamp is not None]
-    if any(s.tzinfo is None for s in stamps) and any(s.tzinfo is not None for s in stamps):
-        notes.append("some timestamps have a time zone and some do not: those without were taken as UTC "
-                     "to compare them")
-    answers = _latest(rows, problems, labels)
-    del rows
+        for row in table.rows():
+            reader.read(name, index, row, table, layout)
+        del table  # its rows are read: the next file's text need not wait beside it
+    answers = reader.contests.answers(labels)
+    problems = reader.log.problems()
     order = {name: index for index, name in enumerate(shown_as)}
     position = {label: index for index, label in enumerate(labels)}
     return Submissions(tuple(sorted(answers, key=lambda a: (order[a.file], a.line, position[a.label]))),
-                       tuple(sorted(problems, key=lambda p: (order[p.file], p.line, p.caveat, p.label))),
-                       tuple(ignored), tuple(notes))
+                       tuple(sorted(problems, key=lambda p: (order[p.file], p.rows > 1, p.line, p.caveat, p.label))),
+                       tuple(ignored), (*notes, *reader.notes()))
 
 
 def _refuse_repeated(paths: Sequence[Path]) -> None:
@@ -215,39 +178,96 @@ _CANVAS_ROWS = ("points possible", "manual posting", "muted")
 TEST_STUDENTS = ("student, test", "test student")  # Canvas' test student, as its name is exported
 
 
-def _read_row(file: str, index: int, row: CsvRow, table: CsvTable, layout: Layout, labels: Sequence[str],
-              roster: Roster, rows: list[_Row], problems: list[RowProblem]) -> None:
-    """Append ``row`` to ``rows`` (with its caveats to ``problems``), or its problem to ``problems``."""
-    who = row.cells[layout.student]
-    label = ""
-    if not layout.wide:
-        label = find_label(row.cells[layout.label or ""], labels) or row.cells[layout.label or ""]
-    if row.problem is not None and not _only_long_answers(row, layout):
-        problems.append(RowProblem(file, row.line, who, label, row.problem.split(": ", 1)[-1]))
-        return
-    student_id, why = roster.find(who, layout.by_email) if who else (None, "no student given")
-    if student_id is None:
-        nobody = _not_a_student(row, layout)
-        problems.append(RowProblem(file, row.line, who, label, nobody or why, routine=bool(nobody)))
-        return
-    if why:
-        problems.append(RowProblem(file, row.line, student_id, "", why, caveat=True))
-    if layout.wide:
-        answers = tuple((label, row.cells[column]) for column, label in layout.labels.items() if row.cells[column])
-        if not answers:
-            problems.append(RowProblem(file, row.line, student_id, "", "no answers in this row"))
+class _Reader:
+    """What reading the rows keeps: the contests of the rows that may still win, the problems, and what the
+    notes need (time zones seen, timestamps after the run's time)."""
+
+    def __init__(self, roster: Roster, labels: Sequence[str], log: ProblemLog, now: datetime) -> None:
+        self.roster, self.labels, self.log = roster, labels, log
+        self.find = lru_cache(maxsize=65536)(roster.find)  # a file of a million rows names a few thousand students
+        self.contests = Contests(log)
+        self.now, self.zoned, self.unzoned = now, False, False
+        self.future: list[tuple[str, int]] = []  # the first row with a timestamp after now, and how many
+        self.futures = 0
+
+    def read(self, file: str, index: int, row: CsvRow, table: CsvStream, layout: Layout) -> None:
+        """Enter ``row`` in its contest (with its caveats to the log), or its problem to the log."""
+        who = row.cells[layout.student]
+        label = ""
+        if not layout.wide:
+            label = find_label(row.cells[layout.label or ""], self.labels) or row.cells[layout.label or ""]
+        order = (index, row.line)
+        if row.problem is not None and not _only_long_answers(row, layout):
+            problem = row.problem
+            self._problem(MALFORMED, order, file, who, label, lambda: problem.split(": ", 1)[-1])
             return
-    elif label not in labels:
-        problems.append(RowProblem(file, row.line, student_id, label,
-                                   f"unknown label {shown(label)} (expected one of {', '.join(labels)})"))
-        return
-    else:
-        answers = ((label, row.cells[layout.answer or ""]),)
-    stamp = _timestamp(row.cells[layout.timestamp]) if layout.timestamp else None
-    if isinstance(stamp, str):
-        problems.append(RowProblem(file, row.line, student_id, "", stamp, caveat=True))
-        stamp = None
-    rows.append(_Row(file, index, row.line, student_id, answers, stamp, table.delimiter, layout.wide))
+        student_id, why = self.find(who, layout.by_email) if who else (None, "no student given")
+        if student_id is None:
+            nobody = _not_a_student(row, layout)
+            self._problem(ASIDE if nobody else UNKNOWN, order, file, who, label, lambda: nobody or why)
+            return
+        if why:
+            self._problem(ZEROS, order, file, student_id, "", lambda: why)
+        if layout.wide:
+            answers = tuple((label, row.cells[column]) for column, label in layout.labels.items() if row.cells[column])
+            if not answers:
+                self._problem(EMPTY, order, file, student_id, "", lambda: "no answers in this row")
+                return
+        elif label not in self.labels:
+            self._problem(LABEL, order, file, student_id, label,
+                          lambda: f"unknown label {shown(label)} (expected one of {', '.join(self.labels)})")
+            return
+        else:
+            answers = ((label, row.cells[layout.answer or ""]),)
+        stamp = self._timestamp(row.cells[layout.timestamp], order, file, student_id) if layout.timestamp else None
+        self.contests.enter(SubmittedRow(file, index, row.line, student_id, answers, stamp, table.delimiter,
+                                         layout.wide))
+
+    def _timestamp(self, text: str, order: tuple[int, int], file: str, student_id: str) -> datetime | None:
+        stamp = read_timestamp(text)
+        if isinstance(stamp, str):
+            why = stamp
+            self._problem(UNREADABLE_TIME, order, file, student_id, "", lambda: why)
+            return None
+        if stamp is None:
+            return None
+        if stamp.tzinfo is None:
+            self.unzoned = True
+        else:
+            self.zoned = True
+        if instant(stamp) > self.now + FUTURE_MARGIN:
+            self.futures += 1
+            if not self.future:
+                self.future.append((file, order[1]))
+            self._problem(FUTURE, order, file, student_id, "", lambda: (
+                f"timestamp {shown(text.strip())} is after this run's time ({self.now:%Y-%m-%d %H:%M} UTC): it "
+                "wins over every submission of this answer before it, real or not; check the clock that wrote it"))
+        return stamp
+
+    def _problem(self, kind: Kind, order: tuple[int, int], file: str, student_id: str, label: str,
+                 reason: Callable[[], str]) -> None:
+        """A problem of ``kind``; its reason is worked out only if it is listed (millions may not be)."""
+        if self.log.wants(kind, order):
+            self.log.add(kind, order, file, RowProblem(file, order[1], student_id, label, reason(), kind.caveat,
+                                                       kind.routine))
+        else:
+            self.log.count(kind, file)
+
+    def notes(self) -> list[str]:
+        """Notes about the rows as a whole."""
+        notes = []
+        if self.zoned and self.unzoned:
+            notes.append("some timestamps have a time zone and some do not: those without were taken as UTC "
+                         "to compare them")
+        if self.futures:
+            file, line = self.future[0]
+            notes.append(f"{self.futures:,} row{'s have' if self.futures > 1 else ' has'} a timestamp after this "
+                         f"run's time ({self.now:%Y-%m-%d %H:%M} UTC), the first {file} line {line}: such a row "
+                         "wins over every submission before it; see problems.csv")
+        if self.log.unlisted():
+            notes.append(f"problems.csv lists the first {self.log.listed:,} rows of each kind of problem; "
+                         f"{self.log.unlisted():,} more are counted there, not listed")
+        return notes
 
 
 def _only_long_answers(row: CsvRow, layout: Layout) -> bool:
@@ -270,126 +290,20 @@ def find_label(text: str, labels: Sequence[str]) -> str | None:
 def _not_a_student(row: CsvRow, layout: Layout) -> str:
     """Why a row that names no known student is none (Canvas' extra rows, the header again where two
     files were pasted into one), or ""."""
-    if " ".join(row.cells.get(layout.student, "").split()).lower() == " ".join(layout.student.split()).lower():
+    return _nobody(layout.student, tuple(row.cells.get(column, "") for column in (layout.student, *layout.ignored)))
+
+
+@lru_cache(maxsize=4096)  # a file of a million rows of nobody repeats the same few cells
+def _nobody(student_column: str, cells: tuple[str, ...]) -> str:
+    """:func:`_not_a_student` of the cells of the student column and the ignored ones, in that order."""
+    if " ".join(cells[0].split()).lower() == " ".join(student_column.split()).lower():
         return "not a student row (the header repeated: were two files pasted into one?)"
-    for column in (layout.student, *layout.ignored):
-        value = " ".join(row.cells.get(column, "").split()).lower()
+    for cell in cells:
+        value = " ".join(cell.split()).lower()
         if value in _CANVAS_ROWS:
-            return f"not a student row (Canvas' {shown(row.cells[column].strip())} row)"
+            return f"not a student row (Canvas' {shown(cell.strip())} row)"
         if value in TEST_STUDENTS:
             return "not a student row (Canvas' test student)"
     return ""
 
 
-# --- timestamps ---------------------------------------------------------------------------------
-
-_ZONE = r"(?:\s*(?P<zone>Z|UTC|GMT|(?:UTC|GMT)?\s*(?P<sign>[+-])(?P<zh>\d{1,2})(?::?(?P<zm>\d{2}))?))?"
-_ISO = re.compile(r"(?P<base>\d{4}-\d{2}-\d{2}(?:[T ]\d{1,2}:\d{2}(?::\d{2}(?:[.,]\d+)?)?)?)" + _ZONE, re.I)
-_FORMS = re.compile(r"(?P<month>\d{1,2})/(?P<day>\d{1,2})/(?P<year>\d{4})(?:[T ]+(?P<hour>\d{1,2}):(?P<minute>\d{2})"
-                    r"(?::(?P<second>\d{2})(?:\.\d+)?)?(?:\s*(?P<half>AM|PM))?)?" + _ZONE, re.I)
-
-
-def _timestamp(text: str) -> datetime | str | None:
-    """A timestamp cell read: the time, ``None`` when empty, or why it does not read (a caveat).
-
-    >>> _timestamp("12/4/2026 11:59:07 PM"), _timestamp("2026-12-04T23:59:07Z")
-    (datetime.datetime(2026, 12, 4, 23, 59, 7), datetime.datetime(2026, 12, 4, 23, 59, 7, tzinfo=datetime.timezone.utc))
-    """
-    text = text.strip()
-    if not text:
-        return None
-    try:
-        iso, forms = _ISO.fullmatch(text), _FORMS.fullmatch(text)
-        if iso:
-            when = datetime.fromisoformat(iso["base"].replace(",", "."))
-        elif forms:
-            hour = int(forms["hour"] or 0)
-            if forms["half"]:
-                hour = hour % 12 + (12 if forms["half"].upper() == "PM" else 0)
-            when = datetime(int(forms["year"]), int(forms["month"]), int(forms["day"]), hour,
-                            int(forms["minute"] or 0), int(forms["second"] or 0))
-        else:
-            raise ValueError(text)
-        return _zoned(when, iso or forms)
-    except (ValueError, OverflowError):
-        return (f"timestamp {shown(text)} not understood (expected ISO 8601 like 2026-12-04 23:59:07 or "
-                "12/4/2026 23:59:07); the row is taken as having none")
-
-
-def _zoned(when: datetime, match: re.Match[str] | None) -> datetime:
-    if match is None or match["zone"] is None:
-        return when
-    if match["sign"] is None:
-        return when.replace(tzinfo=UTC)
-    offset = timedelta(hours=int(match["zh"]), minutes=int(match["zm"] or 0))
-    return when.replace(tzinfo=timezone(-offset if match["sign"] == "-" else offset))
-
-
-# --- the latest submission wins -------------------------------------------------------------------
-
-def _latest(rows: list[_Row], problems: list[RowProblem], labels: Sequence[str]) -> list[Answer]:
-    """The winning answers; every row or answer that lost goes to ``problems`` with its winner.
-
-    A wide row is one submission: per student, the latest wide row wins whole. Then, per (student,
-    label), the winning wide row's answer competes with the long rows of that label.
-    """
-    by_student: dict[str, list[_Row]] = defaultdict(list)
-    for row in rows:
-        if row.wide:
-            by_student[row.student_id].append(row)
-    contenders = [row for row in rows if not row.wide]
-    for group in by_student.values():
-        winner, losers, why = _pick(group)
-        contenders.append(winner)
-        problems.extend(RowProblem(row.file, row.line, row.student_id, "", why, routine=True) for row in losers)
-    first: dict[tuple[str, str], tuple[_Row, str]] = {}  # most answers have one row: no list for them
-    more: dict[tuple[str, str], list[_Row]] = {}
-    for row in contenders:
-        for label, text in row.answers:
-            found = first.setdefault((row.student_id, label), (row, text))[0]
-            if found is not row:
-                more.setdefault((row.student_id, label), [found]).append(row)
-    answers = []
-    for (student_id, label), (winner, text) in first.items():
-        if (student_id, label) in more:
-            winner, losers, why = _pick(more[student_id, label])
-            text = winner.text(label)
-            for row in losers:
-                if row.wide:
-                    row.lost = row.lost or []
-                    row.lost.append((label, why))
-                else:
-                    problems.append(RowProblem(row.file, row.line, student_id, label, why, routine=True))
-        answers.append(Answer(winner.file, winner.line, student_id, label, text, winner.delimiter, winner.timestamp))
-    for row in contenders:
-        if row.wide and row.lost:
-            problems.extend(_lost_answers(row, labels))
-    return answers
-
-
-def _pick(group: Iterable[_Row]) -> tuple[_Row, list[_Row], str]:
-    """The latest row of ``group``, the others, and the reason they lost."""
-    group = sorted(group, key=lambda row: row.order)
-    timed = all(row.timestamp is not None for row in group)
-    if timed:
-        group.sort(key=lambda row: (_instant(row.timestamp), row.order))
-    winner = group[-1]
-    rule = ("submitted later" if timed else "no timestamps: the last row wins" if all(
-        row.timestamp is None for row in group) else "not every row has a timestamp: the last row wins")
-    return winner, group[:-1], f"superseded by {winner.file} line {winner.line} ({rule})"
-
-
-def _instant(when: datetime | None) -> datetime:
-    """``when`` comparable with any other: without a zone, taken as UTC."""
-    when = when or datetime.min
-    return when if when.tzinfo is not None else when.replace(tzinfo=UTC)
-
-
-def _lost_answers(row: _Row, labels: Sequence[str]) -> list[RowProblem]:
-    """A winning wide row some of whose answers a later long row replaced: a caveat per answer, or,
-    when it kept none, one problem for the row."""
-    lost = sorted(row.lost or (), key=lambda pair: labels.index(pair[0]))
-    if len(lost) < len(row.answers):
-        return [RowProblem(row.file, row.line, row.student_id, label, why, caveat=True) for label, why in lost]
-    whys = "; ".join(f"{label}: {why}" for label, why in lost)
-    return [RowProblem(row.file, row.line, row.student_id, "", f"every answer superseded ({whys})", routine=True)]

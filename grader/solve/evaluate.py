@@ -84,10 +84,36 @@ def solve_columns(template: Template, compiled: Compiled, table: Mapping[str, An
     with np.errstate(all="ignore"):
         _check_domains(template, columns, refusals)
         _check_constraints(template, columns, refusals)
-        trees = compiled.kernel(columns)
+        trees = _overflows_again_in_extended_range(compiled, columns, compiled.kernel(columns), count)
         _check_physics(compiled, trees, refusals)
         values, undefined = _numeric_answers(compiled, trees, refusals, count)
     return Columns(columns, values, undefined, refusals)
+
+
+def _overflows_again_in_extended_range(compiled: Compiled, columns: Mapping[str, Any], trees: Mapping[Any, Any],
+                                       count: int) -> Mapping[Any, Any]:
+    """``trees``, with the rows where a step is not finite worked out again in numpy's ``longdouble``, whose
+    exponent reaches 10**4932 on x86: a subnormal ``p = 1e-309`` is a float64 whose ``1/p`` is not, although
+    the answer (``(1/p - e)/(1 + 1/p)``, 1) is ordinary. Where ``longdouble`` is float64 nothing changes; a row
+    still not finite in float64 is refused as before.
+    """
+    if np.finfo(np.longdouble).maxexp <= np.finfo(np.float64).maxexp or not count:
+        return trees
+    columnar = {key: value for key, value in trees.items() if np.shape(value) == (count,)}
+    failing = np.zeros(count, dtype=bool)
+    for value in columnar.values():
+        if np.asarray(value).dtype.kind == "f":
+            failing |= ~np.isfinite(value)
+    if not failing.any():
+        return trees
+    rows = np.flatnonzero(failing)
+    again = compiled.kernel({name: np.asarray(column, dtype=np.longdouble)[rows] for name, column in columns.items()})
+    redone = dict(trees)
+    for key, value in columnar.items():
+        if np.shape(again[key]) == rows.shape:
+            redone[key] = np.array(value)  # a copy: the kernel's arrays may be its own
+            redone[key][rows] = again[key]
+    return redone
 
 
 def solve_batch(template: Template, compiled: Compiled, table: Mapping[str, Any]) -> list[Solution]:

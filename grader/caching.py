@@ -109,9 +109,10 @@ def read_entry(path: Path | None, *, shipped: bool = False) -> Any:
     try:
         handle = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0))  # a FIFO opens without a writer
         with os.fdopen(handle, "rb") as stream:
-            if not _mine(os.fstat(handle), owner=not shipped):
+            status = os.fstat(handle)
+            if not _mine(status, owner=not shipped):
                 return None
-            sealed = stream.read(ENTRY_BYTES + 1)
+            sealed = read_at_most(stream, ENTRY_BYTES + 1, status.st_size + 1)
     except OSError:
         return None
     text = unsealed(path.name, sealed)
@@ -121,6 +122,24 @@ def read_entry(path: Path | None, *, shipped: bool = False) -> Any:
         return json.loads(text)
     except (ValueError, RecursionError):
         return None
+
+
+def read_at_most(stream: Any, most: int, chunk: int) -> bytes:
+    """At most ``most`` bytes of ``stream``, read ``chunk`` bytes at a time (a regular file's size and one more
+    byte, to see that it has not grown: one read).
+
+    >>> import io
+    >>> read_at_most(io.BytesIO(b"abcdef"), 4, 3), read_at_most(io.BytesIO(b"ab"), 4, 3)
+    (b'abcd', b'ab')
+    """
+    parts, size = [], 0
+    while size < most:
+        part = stream.read(min(max(chunk, 1), most - size))
+        if not part:
+            break
+        parts.append(part)
+        size += len(part)
+    return b"".join(parts)
 
 
 def write_entry(path: Path | None, data: Any) -> None:

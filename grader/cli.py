@@ -768,13 +768,14 @@ def _expected_quantity(text: str, unit: str | None) -> tuple[float | str, str]:
 
 
 def _batch_lines(path: Path) -> list[str]:
+    from grader.caching import read_at_most
     from grader.inputs import decode_text, read_bytes
 
     limit = 1 << 30
     if str(path) == "-":
         if sys.stdin is None:  # started with standard input closed (`grader check --batch - <&-`)
             raise UsageError("--batch -: standard input is closed; send the lines to it, or give --batch FILE.jsonl")
-        data = sys.stdin.buffer.read(limit + 1)
+        data = read_at_most(sys.stdin.buffer, limit + 1, 1 << 20)
         if len(data) > limit:
             raise UsageError(f"standard input: more than {limit:,} bytes; split the batch")
         return decode_text(data, Path("standard input")).splitlines()

@@ -47,12 +47,16 @@ CELL_CHARS = 1000  # no answer, id or parameter value is longer
 
 def read_bytes(path: Path, limit: int) -> bytes:
     """A file's bytes, refused beyond ``limit`` (read no further: ``/dev/zero`` is a file too; a
-    regular file's size is known, so a 2 GB file is refused before any of it is read)."""
+    regular file's size is known, so a 2 GB file is refused before any of it is read). Memory is taken for
+    what the file holds, not for ``limit``: ``read(n)`` asks for ``n`` bytes at once, 1 GiB for a key of a
+    few kB, which a memory limit (``ulimit -v``) refuses."""
     try:
         with open(path, "rb") as stream:
             status = os.fstat(stream.fileno())
-            too_large = stat.S_ISREG(status.st_mode) and status.st_size > limit
-            data = b"" if too_large else stream.read(limit + 1)
+            regular = stat.S_ISREG(status.st_mode)
+            too_large = regular and status.st_size > limit
+            chunk = status.st_size + 1 if regular else 1 << 20
+            data = b"" if too_large else caching.read_at_most(stream, limit + 1, chunk)
     except OSError as error:
         raise GraderError(f"{path}: cannot read ({error.strerror or error})") from None
     if too_large or len(data) > limit:

@@ -43,7 +43,7 @@ import math
 import re
 from collections import defaultdict
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 from grader.errors import GraderError, shown
@@ -51,7 +51,7 @@ from grader.files import shown_path
 from grader.grade.columns import EMAIL, normalized
 from grader.grade.key import Key
 from grader.grade.submissions import TEST_STUDENTS, Roster, RowProblem, StudentRef
-from grader.inputs import CsvRow, CsvTable, read_csv
+from grader.inputs import CsvRow, CsvStream, open_csv
 
 STUDENT_COLUMNS = ("Student", "LastName", "FirstName", "ID", "SIS User ID", "SIS Login ID", "Integration ID",
                    "Root Account", "Section")  # in the order Canvas' import reads them
@@ -62,9 +62,12 @@ _SCORE = re.compile(r"-?\d+(?:\.\d+)?")  # a score as Canvas exports it; "7,50" 
 _EXPECTED = ("a Canvas gradebook export (Grades > Export) with the columns Student (or LastName and FirstName), "
              "ID, SIS Login ID and Section")
 _KEPT = "no score written, the export's score kept"
+MAX_ROWS = 100_000
+"""Rows an export may have: more than any course has students (tens of thousands at most). The rows kept
+take a few hundred bytes a student; a 64 MiB file of short rows would be millions of them."""
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, slots=True)
 class CanvasRow:
     """A student row of the export: its student columns as exported, and the key student whose score
     it takes, or (``key_id`` None) the export's own score ``kept``: a number, text such as ``EX``, or
@@ -93,46 +96,69 @@ class CanvasExport:
 def read_export(path: Path, key: Key) -> CanvasExport:
     """Read a Canvas gradebook export and match its students to ``key``'s.
 
+    The export is read row by row, and of each student row only what ``canvas.csv`` writes is kept
+    (:class:`CanvasRow`): the memory it takes is its text and a few hundred bytes a student.
+
     Raises :class:`GraderError` for a file that is no usable export: unreadable, without Canvas'
-    student columns, with no student rows or none the key knows, or with two columns of the key's
-    assignment.
+    student columns, with no student rows or none the key knows, with more than :data:`MAX_ROWS` rows,
+    or with two columns of the key's assignment.
     """
-    table = read_csv(path, exports=True)
-    columns = _student_columns(table)
-    assignment = _assignment_column(table, key.title)
-    finder = _Finder(key, next((h for h in table.header if normalized(h) in EMAIL), None))
-    rows: list[CanvasRow] = []
-    problems: list[RowProblem] = []
-    taken: dict[str, int] = {}  # key student -> the line that took them
-    for row in table.rows:
+    stream = open_csv(path, exports=True)
+    columns = _student_columns(stream)
+    assignment = _assignment_column(stream, key.title)
+    finder = _Finder(key, next((h for h in stream.header if normalized(h) in EMAIL), None))
+    read = _read_rows(stream, columns, assignment, finder)
+    if not read.taken:
+        raise _unrelated(path, key, len(read.rows))
+    missing = [s.id for s in key.students if s.id not in read.taken]
+    problems = [*read.problems, *(RowProblem(shown_path(path), 0, student_id, "", "in the key but not in the Canvas "
+                                             "export: no score can be imported for them (dropped the course, or "
+                                             "enrolled under another id?)", caveat=True) for student_id in missing)]
+    notes = [*_assignment_notes(stream, assignment, key), *_points_notes(stream, assignment, read.points, key),
+             f"{path}: {len(read.rows)} Canvas students, {sum(r.key_id is not None for r in read.rows)} scored from "
+             f"the key; key students not in the export: {len(missing)} (see problems.csv)"]
+    return CanvasExport(path, tuple(columns), assignment or key.title, tuple(read.rows), tuple(problems), tuple(notes))
+
+
+@dataclass(slots=True)
+class _Read:
+    """What the rows of an export gave: its student rows and caveats, the key students taken (and the
+    line that took each), and the assignment's cell of Canvas' points-possible row (None without one)."""
+
+    rows: list[CanvasRow] = field(default_factory=list)
+    problems: list[RowProblem] = field(default_factory=list)
+    taken: dict[str, int] = field(default_factory=dict)
+    points: str | None = None
+
+
+def _read_rows(stream: CsvStream, columns: Mapping[str, str], assignment: str | None, finder: _Finder) -> _Read:
+    """The export's rows, read one at a time; refused beyond :data:`MAX_ROWS` (before the rest is read)."""
+    read, file, first = _Read(), shown_path(stream.path), stream.header[0]
+    for count, row in enumerate(stream.rows(), 1):
+        if count > MAX_ROWS:
+            raise GraderError(f"{stream.path}: line {row.line}: more than {MAX_ROWS:,} rows; expected a Canvas "
+                              "gradebook export, a row per student of one course (tens of thousands at most)")
+        if read.points is None and "points possible" in row.cells[first].lower():
+            read.points = row.cells[assignment] if assignment else ""
         who = {name: row.cells[header] for name, header in columns.items()}
         name = who.get("Student") or f"{who.get('LastName', '')}, {who.get('FirstName', '')}"
         if not _is_student(row, name):
             continue
         if row.problem is not None:
-            problems.append(RowProblem(shown_path(path), row.line, _canvas_id(who), "",
-                                       f"{row.problem.split(': ', 1)[-1]}: left out of canvas.csv", caveat=True))
+            read.problems.append(RowProblem(file, row.line, _canvas_id(who), "",
+                                            f"{row.problem.split(': ', 1)[-1]}: left out of canvas.csv", caveat=True))
             continue
         current = row.cells[assignment] if assignment else ""
         key_id, caveat = finder.find(who, row.cells)
-        reason = _not_scored(key_id, name, taken, current)
+        reason = _not_scored(key_id, name, read.taken, current)
         if key_id is not None:
-            taken.setdefault(key_id, row.line)
+            read.taken.setdefault(key_id, row.line)
         if reason or caveat:
-            problems.append(RowProblem(shown_path(path), row.line, key_id or _canvas_id(who), "", reason or caveat,
-                                       caveat=True))
-        rows.append(CanvasRow(row.line, tuple(who.values()), None if reason else key_id,
-                              _kept(current) if reason else None))
-    if not taken:
-        raise _unrelated(path, key, len(rows))
-    missing = [s.id for s in key.students if s.id not in taken]
-    problems += [RowProblem(shown_path(path), 0, student_id, "", "in the key but not in the Canvas export: no score "
-                            "can be imported for them (dropped the course, or enrolled under another id?)",
-                            caveat=True) for student_id in missing]
-    notes = [*_assignment_notes(table, assignment, key), *_points_notes(table, assignment, key),
-             f"{path}: {len(rows)} Canvas students, {sum(r.key_id is not None for r in rows)} scored from the key; "
-             f"key students not in the export: {len(missing)} (see problems.csv)"]
-    return CanvasExport(path, tuple(columns), assignment or key.title, tuple(rows), tuple(problems), tuple(notes))
+            read.problems.append(RowProblem(file, row.line, key_id or _canvas_id(who), "", reason or caveat,
+                                            caveat=True))
+        read.rows.append(CanvasRow(row.line, tuple(who.values()), None if reason else key_id,
+                                   _kept(current) if reason else None))
+    return read
 
 
 def _unrelated(path: Path, key: Key, students: int) -> GraderError:
@@ -143,27 +169,27 @@ def _unrelated(path: Path, key: Key, students: int) -> GraderError:
                        "Login ID or email); expected the Canvas gradebook export of this assignment's course")
 
 
-def _student_columns(table: CsvTable) -> dict[str, str]:
+def _student_columns(stream: CsvStream) -> dict[str, str]:
     """Canvas' student columns the export has, in Canvas' order: Canvas' name -> the header as written."""
-    written = {normalized(header): header for header in table.header}
+    written = {normalized(header): header for header in stream.header}
     found = {name: written[normalized(name)] for name in STUDENT_COLUMNS if normalized(name) in written}
     if "Student" in found:  # Canvas writes Student, or LastName and FirstName
         found = {name: header for name, header in found.items() if name not in ("LastName", "FirstName")}
     named = "Student" in found or {"LastName", "FirstName"} <= found.keys()
     if not named or any(name not in found for name in _REQUIRED):
-        raise GraderError(f"{table.path}: line {table.header_line}: expected {_EXPECTED}; got the columns "
-                          f"{shown(list(table.header), 160)}")
+        raise GraderError(f"{stream.path}: line {stream.header_line}: expected {_EXPECTED}; got the columns "
+                          f"{shown(list(stream.header), 160)}")
     return found
 
 
-def _assignment_column(table: CsvTable, title: str) -> str | None:
+def _assignment_column(stream: CsvStream, title: str) -> str | None:
     """The export's ``Title (id)`` column of the key's assignment: its title exactly, else ignoring
     case and spacing; None when there is none. Two are refused: the import would update one of them."""
-    titled = [(header, match["title"]) for header in table.header if (match := _TITLE_ID.fullmatch(header))]
+    titled = [(header, match["title"]) for header in stream.header if (match := _TITLE_ID.fullmatch(header))]
     found = ([header for header, text in titled if text == title]
              or [header for header, text in titled if _folded(text) == _folded(title)])
     if len(found) > 1:
-        raise GraderError(f"{table.path}: line {table.header_line}: the columns {shown(found[0])} and "
+        raise GraderError(f"{stream.path}: line {stream.header_line}: the columns {shown(found[0])} and "
                           f"{shown(found[1])} both have the key's assignment title {shown(title)}; expected one "
                           "(delete the other assignment's column from the export, or retitle it in Canvas)")
     return found[0] if found else None
@@ -238,26 +264,24 @@ def _score(text: str) -> float | None:
     return score if math.isfinite(score) else None
 
 
-def _assignment_notes(table: CsvTable, column: str | None, key: Key) -> list[str]:
+def _assignment_notes(stream: CsvStream, column: str | None, key: Key) -> list[str]:
     if column is None:
-        return [f"{table.path}: no column {shown(key.title + ' (id)')}; canvas.csv's column is titled "
+        return [f"{stream.path}: no column {shown(key.title + ' (id)')}; canvas.csv's column is titled "
                 f"{shown(key.title)}: Canvas updates the assignment of exactly that title, or creates one"]
     match = _TITLE_ID.fullmatch(column)
     if match and match["title"] != key.title:
-        return [f"{table.path}: the column {shown(column)} taken as the key's assignment {shown(key.title)} "
+        return [f"{stream.path}: the column {shown(column)} taken as the key's assignment {shown(key.title)} "
                 "(the titles differ in case or spacing)"]
     return []
 
 
-def _points_notes(table: CsvTable, column: str | None, key: Key) -> list[str]:
-    """A note when Canvas' points possible for the assignment are not what the key's students can earn
-    (the import does not change an existing assignment's points: scores would read as a fraction of
-    Canvas' points)."""
-    first = table.header[0]
-    row = next((row for row in table.rows if "points possible" in row.cells[first].lower()), None)
-    points = _score(row.cells[column].replace(",", ".")) if row and column else None
+def _points_notes(stream: CsvStream, column: str | None, points_cell: str | None, key: Key) -> list[str]:
+    """A note when Canvas' points possible for the assignment (``points_cell``: its cell of Canvas'
+    points-possible row) are not what the key's students can earn (the import does not change an existing
+    assignment's points: scores would read as a fraction of Canvas' points)."""
+    points = _score(points_cell.replace(",", ".")) if points_cell and column else None
     if points is None or math.isclose(points, key.possible):
         return []
-    return [f"{table.path}: Canvas gives {shown(column)} {points:g} points possible, the key's students can "
+    return [f"{stream.path}: Canvas gives {shown(column)} {points:g} points possible, the key's students can "
             f"earn {key.possible:g}: change the assignment's points in Canvas, or the scores read as a fraction of "
             f"{points:g}"]

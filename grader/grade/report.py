@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import csv
 import io
+import itertools
 import math
 from collections.abc import Iterable, Iterator, Sequence
 from pathlib import Path
@@ -81,37 +82,50 @@ def details_csv(graded: Graded, students_per_piece: int = 2000) -> Iterator[str]
     yield stream.getvalue()
 
 
-def problems_csv(graded: Graded, export: CanvasExport | None = None) -> str:
+def problems_csv(graded: Graded, export: CanvasExport | None = None) -> Iterator[str]:
     """Every input row not graded, or graded with a caveat, with the reason; then the Canvas
-    export's caveats (line empty: a key student the export lacks)."""
-    rows: list[list[object]] = [["file", "line", "student_id", "label", "reason"]]
-    rows += [[p.file, p.line or None, p.student_id, p.label, p.reason]
-             for p in (*graded.problems, *(export.problems if export else ()))]
-    return _csv(rows)
+    export's caveats (line empty: a key student the export lacks). In pieces, as :func:`_csv_pieces`."""
+    header = [["file", "line", "student_id", "label", "reason"]]
+    rows = ([p.file, p.line or None, p.student_id, p.label, p.reason]
+            for p in (*graded.problems, *(export.problems if export else ())))
+    return _csv_pieces(itertools.chain(header, rows))
 
 
-def canvas_csv(graded: Graded, export: CanvasExport | None = None) -> str:
+def canvas_csv(graded: Graded, export: CanvasExport | None = None) -> Iterator[str]:
     """A Canvas gradebook import: the student columns Canvas wants, one column of the assignment, and
     its ``Points Possible`` row. Without an ``export``, a row per student of the key, named as the key
-    names them; with one, its student rows and columns as exported, and its ``Title (id)`` header."""
+    names them; with one, its student rows and columns as exported, and its ``Title (id)`` header. In
+    pieces, as :func:`_csv_pieces` (an export may have 100,000 students)."""
     key = graded.key
     scores = {student_id: sum(by_problem.values()) for student_id, by_problem in totals(graded).items()}
     columns: tuple[str, ...]
+    body: Iterable[Sequence[object]]
     if export is None:
         columns, title = ("Student", "ID", "SIS User ID", "SIS Login ID", "Section"), key.title
-        body: list[list[object]] = [[s.name, "", s.id, s.email, s.section, scores[s.id]] for s in key.students]
+        body = ([s.name, "", s.id, s.email, s.section, scores[s.id]] for s in key.students)
     else:
         columns, title = export.columns, export.assignment
-        body = [[*row.identity, row.kept if row.key_id is None else scores[row.key_id]] for row in export.rows]
-    return _csv([[*columns, title], ["Points Possible", *[""] * (len(columns) - 1), key.possible], *body])
+        body = ([*row.identity, row.kept if row.key_id is None else scores[row.key_id]] for row in export.rows)
+    head = [[*columns, title], ["Points Possible", *[""] * (len(columns) - 1), key.possible]]
+    return _csv_pieces(itertools.chain(head, body))
 
 
 def _csv(rows: Iterable[Sequence[object]]) -> str:
+    return "".join(_csv_pieces(rows))
+
+
+def _csv_pieces(rows: Iterable[Sequence[object]], rows_per_piece: int = 2000) -> Iterator[str]:
+    """The CSV text of ``rows`` in pieces of ``rows_per_piece`` rows, to be written as they come: the
+    whole text of a big file would be held twice (its writer's buffer and the text)."""
     stream = io.StringIO()
     writer = csv.writer(stream, lineterminator="\n")
-    for row in rows:
+    for count, row in enumerate(rows, 1):
         writer.writerow([_cell(value) for value in row])
-    return stream.getvalue()
+        if count % rows_per_piece == 0:
+            yield stream.getvalue()
+            stream.seek(0)
+            stream.truncate()
+    yield stream.getvalue()
 
 
 def _cell(value: object) -> str:

@@ -106,7 +106,7 @@ def canvas_csv(graded: Graded, export: CanvasExport | None = None) -> Iterator[s
     else:
         columns, title = export.columns, export.assignment
         body = ([*row.identity, row.kept if row.key_id is None else scores[row.key_id]] for row in export.rows)
-    head = [[*columns, title], ["Points Possible", *[""] * (len(columns) - 1), key.possible]]
+    head: list[list[object]] = [[*columns, title], ["Points Possible", *[""] * (len(columns) - 1), key.possible]]
     return _csv_pieces(itertools.chain(head, body))
 
 

@@ -15,6 +15,7 @@ from pathlib import Path
 import pytest
 
 from grader.cli import main
+from grader.grade.canvas import MAX_ROWS
 from grader.grade.key import Key, KeyStudent, load_key
 from grader.grade.submissions import StudentRef, read_submissions
 
@@ -183,14 +184,14 @@ end. Not ``getrusage(RUSAGE_CHILDREN)``: a child's peak counts the memory of the
 from, here the test session's."""
 
 
-def _peak_of_grading(folder: Path, submissions: Path) -> int:
-    """Peak resident memory (bytes) of ``grader grade`` of ``submissions`` in a fresh process; its exit code
-    must be 0 or 3."""
+def _peak_of_grading(folder: Path, submissions: Path, *options: str) -> int:
+    """Peak resident memory (bytes) of ``grader grade`` of ``submissions`` (with ``options``) in a fresh
+    process; its exit code must be 0 or 3."""
     if not Path("/proc/self/status").exists():
         pytest.skip("peak memory is read from /proc (Linux)")
     report = folder / "peak.txt"
     done = subprocess.run([sys.executable, "-c", _MEASURED, str(report), "grade", "--key", str(_key(folder)),
-                           str(submissions), "--out", str(folder / "out")], capture_output=True, text=True,
+                           str(submissions), "--out", str(folder / "out"), *options], capture_output=True, text=True,
                           check=False)
     assert done.returncode in (0, 3), done.stderr
     return int(report.read_text()) * 1024
@@ -212,3 +213,49 @@ def test_a_63_mb_file_of_9_5_million_rows_is_graded_within_the_stated_bound(tmp_
     path = tmp_path / "long.csv"
     path.write_text("student_id,label,answer\n" + "x,1a,1\n" * 9_500_000)
     assert _peak_of_grading(tmp_path, path) < 1 << 30
+
+
+# --- a Canvas export ------------------------------------------------------------------------------------
+
+def _export(path: Path, students: int, assignments: int = 0) -> Path:
+    """A Canvas gradebook export of ``students`` students (the first two the key's 456 and 457), with
+    the key's assignment column and ``assignments`` others, as Canvas writes them."""
+    others = [f"Homework {n} ({1000 + n})" for n in range(assignments)]
+    scores = ",7.50" * assignments
+    with path.open("w") as out:
+        out.write(",".join(["Student", "ID", "SIS User ID", "SIS Login ID", "Section", "HW (12345)", *others,
+                            "Current Score"]) + "\n")
+        out.write("    Points Possible,,,,,1.00" + ",10.00" * assignments + ",(read only)\n")
+        for n in range(students):
+            out.write(f'"Student{n:06d}, Jane",{n},{456 + n},login{n:06d},Section {n % 7},{scores},75\n')
+    return path
+
+
+def test_a_canvas_export_of_100000_students_is_read_row_by_row(tmp_path: Path) -> None:
+    """``--canvas`` read the export whole, about 640 bytes a row beside what canvas.csv needs: a 64 MB
+    export of 100,000 students took 1.2 GB, and the 7 M short rows of another 64 MB file 8.1 GB (3.5
+    minutes). Now its rows are streamed, each student keeps only canvas.csv's cells, and canvas.csv is
+    written in pieces: this 26 MB export (the most rows accepted) took 600 MB before, now about 180 MB."""
+    submissions = tmp_path / "a.csv"
+    submissions.write_text("student_id,label,answer\n456,1a,1\n")
+    export = _export(tmp_path / "export.csv", MAX_ROWS - 1, assignments=40)
+    assert _peak_of_grading(tmp_path, submissions, "--canvas", str(export)) < 250 << 20
+    with (tmp_path / "out" / "canvas.csv").open() as written:
+        assert sum(1 for _ in written) == 2 + MAX_ROWS - 1
+
+
+def test_a_canvas_export_of_more_rows_than_any_course_has_is_refused_before_it_is_all_read(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """A 64 MB export of short rows is millions of them: refused at the first row past ``MAX_ROWS``
+    (exit 2, nothing written), stating the limit."""
+    submissions = tmp_path / "a.csv"
+    submissions.write_text("student_id,label,answer\n456,1a,1\n")
+    export = _export(tmp_path / "export.csv", MAX_ROWS)
+    with export.open("a") as out:
+        out.write("not,even,read,\"\n")  # an unclosed quote after the limit: never reached
+    code = main(["grade", "--key", str(_key(tmp_path)), str(submissions), "--canvas", str(export),
+                 "--out", str(tmp_path / "out")])
+    assert code == 2 and not (tmp_path / "out").exists()
+    assert capsys.readouterr().err.strip().endswith(
+        f"export.csv: line {MAX_ROWS + 2}: more than 100,000 rows; expected a Canvas gradebook export, a row "
+        "per student of one course (tens of thousands at most)")

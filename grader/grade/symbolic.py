@@ -32,7 +32,7 @@ from __future__ import annotations
 
 import hashlib
 import math
-from collections.abc import Callable, Iterator, Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from functools import lru_cache
 from typing import NamedTuple
@@ -69,16 +69,14 @@ def refused(student: Node, key: Node) -> str | None:
 
 
 def _functions(tree: Node) -> set[str]:
-    return {node.op for node in _nodes(tree) if isinstance(node, Op) and node.op in _TRANSCENDENTAL}
-
-
-def _nodes(tree: Node) -> Iterator[Node]:
-    stack = [tree]
+    found, stack = set(), [tree]
     while stack:
         node = stack.pop()
-        yield node
         if isinstance(node, Op):
+            if node.op in _TRANSCENDENTAL:
+                found.add(node.op)
             stack.extend(node.args)
+    return found
 
 
 @dataclass(frozen=True)
@@ -261,14 +259,14 @@ def _survey(tree: Node) -> _Survey:
 
     def visit(node: Node) -> frozenset[str]:  # the names the node uses; depth is bounded by the parser
         if isinstance(node, Sym):
-            return _NONE if node.name in CONSTANTS else frozenset((node.name,))
+            return _NONE if node.name in CONSTANTS else _named(node.name)
         if isinstance(node, Num):
             return _NONE
         uses = [visit(arg) for arg in node.args]
         op = node.op
         if op in _TRANSCENDENTAL:
             functions.add(op)
-        used = uses[0] if len(uses) == 1 else uses[0].union(*uses[1:])
+        used = uses[0] if len(uses) == 1 else _union(uses)
         if not used:
             return used
         if op == "div" and uses[1]:
@@ -286,6 +284,19 @@ def _survey(tree: Node) -> _Survey:
 
     used = visit(tree)
     return _Survey(used, frozenset(functions), tuple(found))
+
+
+@lru_cache(maxsize=1024)
+def _named(name: str) -> frozenset[str]:
+    return frozenset((name,))
+
+
+def _union(uses: list[frozenset[str]]) -> frozenset[str]:
+    first, *rest = uses
+    for other in rest:
+        if not other <= first:  # mostly a sub-term's names are its sibling's: no new set then
+            first = first | other
+    return first
 
 
 @lru_cache(maxsize=1024)
@@ -342,12 +353,13 @@ def _tame(kind: str, node: Node, used: frozenset[str], domains: Domains) -> bool
     name = next(iter(used))
     low, high = dict(domains)[name]
     values = _values(node, {name: _grid(low, high)})
-    if not np.isfinite(values).all():
+    least, most = float(values.min()), float(values.max())  # NaN if any value is
+    if not (math.isfinite(least) and math.isfinite(most)):
         return False
     if kind == "large":
-        return bool(values.max() - values.min() <= 20)
-    size = np.abs(values)
-    return bool((np.all(values > 0) or np.all(values < 0)) and size.min() > 1e-3 * size.max())
+        return most - least <= 20
+    # Of one sign, its size never below 1e-3 of its largest: |values| run from least to most, or -most to -least.
+    return (least > 0 and least > 1e-3 * most) or (most < 0 and -most > 1e-3 * -least)
 
 
 @lru_cache(maxsize=256)

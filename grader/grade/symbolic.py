@@ -125,7 +125,7 @@ def _equivalent(student: Node, expected: _Form, domains: Domains, seed: str, rto
     missing = sorted((survey.names | key_survey.names) - {name for name, _ in domains})
     if missing:
         return f"the expression uses {', '.join(missing)}, which this answer does not know"
-    fixed, b = _fixed(expected, domains, seed, points)
+    fixed, b, largest = _fixed(expected, domains, seed, points)
     if b.size == 0:
         return "the key's expression cannot be evaluated at any test point; please ask your instructor to check it"
     # A sub-term found twice is probed twice (the same points): cheaper than hashing every one to drop repeats.
@@ -133,11 +133,10 @@ def _equivalent(student: Node, expected: _Form, domains: Domains, seed: str, rto
     probes = _stack([probe for probe, _ in found])
     values = _values(student, fixed if probes is None else _joined([fixed, probes]))
     a = values[:b.size]
-    if not np.isfinite(a).any():
-        return "the expression cannot be evaluated at any test point (division by zero?)"
-    if not np.isfinite(a).all():
-        return False
-    floor = 1e-3 * rtol * float(np.max(np.abs(b)))
+    finite = np.isfinite(a)
+    if not finite.all():
+        return False if finite.any() else "the expression cannot be evaluated at any test point (division by zero?)"
+    floor = 1e-3 * rtol * largest
     if not _agree(a, b, rtol, floor):
         return False
     if probes is not None:
@@ -161,8 +160,16 @@ Score = Callable[[Points], np.ndarray]
 """A sub-term's score at points (higher: nearer what is looked for)."""
 
 
+class _Fixed(NamedTuple):
+    """The points every answer to a key is compared at, the key's values there and the largest of their sizes."""
+
+    points: Points
+    values: np.ndarray
+    largest: float
+
+
 @lru_cache(maxsize=256)
-def _fixed(expected: _Form, domains: Domains, seed: str, points: int) -> tuple[Points, np.ndarray]:
+def _fixed(expected: _Form, domains: Domains, seed: str, points: int) -> _Fixed:
     """The points every answer to a key is compared at, where the key is defined: ``points`` seeded random
     ones, the domain's corners and the line scans; and the key's values there. Worked out once per key."""
     digest = hashlib.sha256("\n".join((seed, expected.text)).encode()).digest()
@@ -173,7 +180,9 @@ def _fixed(expected: _Form, domains: Domains, seed: str, points: int) -> tuple[P
                           _scans(domains, generator)])
     values = _values(expected.tree, everywhere)
     defined = np.isfinite(values)
-    return {name: column[defined] for name, column in everywhere.items()}, values[defined]
+    values = values[defined]
+    largest = float(np.max(np.abs(values))) if values.size else 0.0
+    return _Fixed({name: column[defined] for name, column in everywhere.items()}, values, largest)
 
 
 def _corners(domains: Domains) -> Points:

@@ -24,8 +24,8 @@ from grader.grade.compare import (
     feedbacks,
     is_correct,
 )
-from grader.grade.symbolic import _equivalent, equivalent
-from grader.model.expr import parse
+from grader.grade.symbolic import _equivalent, _functions, _survey, equivalent
+from grader.model.expr import names, parse
 from grader.model.tolerance import Tolerance, ToleranceError
 
 
@@ -392,3 +392,18 @@ def test_a_widened_tolerance_keeps_its_reason_through_the_key_and_grades_like_it
     assert back == Tolerance(rtol=0.027)  # the reason does not change how answers are graded
     with pytest.raises(ToleranceError, match=r"tolerance\.reason: expected text of at most 300 characters"):
         Tolerance(rtol=0.02, reason="x" * 301)
+
+
+_PIECES = st.sampled_from(["v", "p", "pi", "2.5", "(p + 1)", "sqrt(p*v)", "exp(-p/4)", "Max(p, v)", "abs(p - 1)",
+                           "atan2(p, v)", "hypot(p, 3)", "log(v)", "p^-1.5", "sin(pi)"])
+
+
+@given(pieces=st.lists(_PIECES, min_size=1, max_size=5), joins=st.lists(st.sampled_from("+-*/^"),
+                                                                          min_size=4, max_size=4))
+def test_one_walk_of_a_symbolic_answer_finds_its_names_and_functions(pieces: list[str], joins: list[str]) -> None:
+    """The survey symbolic comparison makes of a tree in one walk finds the names and functions the separate
+    walks find, and watches only sub-terms that use a name (those it watches carry their own names)."""
+    tree = parse("".join(piece + join for piece, join in zip(pieces, [*joins[:len(pieces) - 1], ""], strict=True)))
+    found = _survey(tree)
+    assert found.names == names(tree) and found.functions == _functions(tree)
+    assert all(watched.names == names(watched.node) and watched.names for watched in found.watched)

@@ -26,10 +26,10 @@ import re
 from collections.abc import Sequence
 from dataclasses import dataclass
 
-from grader.grade.notation import ReadError, check_powers, cut, listed, tree_of, value_of
+from grader.grade.notation import ReadError, check_powers, cut, listed, tree_of, uses_a_name, value_of
 from grader.grade.quantities import MAX_POWER, UnitMismatchError, UnknownUnitError, unit_factor, unit_factors
 from grader.inputs import CELL_CHARS
-from grader.model.expr import Node, names, to_text
+from grader.model.expr import Node, to_text
 
 MAX_CELL = CELL_CHARS
 
@@ -144,7 +144,7 @@ def read_expression(text: str, symbols: Sequence[str], *,
     try:
         _refuse_formula(cleaned, ())
         tree = tree_of(cleaned, tuple(symbols))
-        if not names(tree):
+        if not uses_a_name(tree):
             raise ReadError(f"a number; expected an expression in {listed(symbols)}")
         check_powers(tree)
     except ReadError as problem:

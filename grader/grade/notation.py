@@ -52,12 +52,12 @@ def tree_of(text: str, symbols: tuple[str, ...]) -> Node:
 def _with_products(text: str, symbols: tuple[str, ...]) -> str:
     """Text :func:`parse` accepts: ``2v(1+p)`` becomes ``2*v*(1+p)``; names outside ``symbols``,
     the functions and ``pi`` are refused, and so are characters outside the allow-list."""
-    tokenizer = _TOKEN_NO_E if {"e", "E"} & set(symbols) else _TOKEN
+    tokenizer = _TOKEN_NO_E if "e" in symbols or "E" in symbols else _TOKEN
     out: list[str] = []
     previous = ""  # kind of the last token: num, name, func, ( , ) or op
     calls: list[bool] = []  # for each open parenthesis: does it hold a function's arguments?
-    position = 0
-    while position < len(text):
+    position, end = 0, len(text)
+    while position < end:
         match = tokenizer.match(text, position)
         if match is None:
             rest = text[position:].lstrip()
@@ -68,28 +68,36 @@ def _with_products(text: str, symbols: tuple[str, ...]) -> str:
             raise ReadError(f"unexpected character '{rest[0]}'" if rest[0].isprintable() else
                               f"unexpected character U+{ord(rest[0]):04X}")
         position = match.end()
-        if match["num"] is not None:
+        group = match.lastgroup or "op"  # the one of num, name, op that matched
+        token = match[group]
+        if group == "num":
             if previous == "num":
                 raise ReadError(f"two numbers side by side ({cut(text, 40)}); give one answer")
-            _check_underflow(match["num"])
-            kind, parts = "num", [match["num"]]
-        elif match["name"] is not None:
-            kind, parts = _name(match["name"], symbols, text[position:].lstrip()[:1] == "(")
+            _check_underflow(token)
+            kind, parts = "num", [token]
+        elif group == "name":
+            kind, parts = _name(token, symbols, text[position:position + 1] == "(" or
+                                text[position:].lstrip()[:1] == "(")
         else:
-            kind, parts = match["op"], [{"^": "**", "×": "*", "·": "*"}.get(match["op"], match["op"])]
+            kind, parts = token, [_WRITTEN.get(token, token)]
             if kind == "(":
                 calls.append(previous == "func")
             elif kind == ")" and calls:
                 calls.pop()
             elif kind == ",":
                 _check_comma(calls, previous, text[position:])
-        if previous in ("num", "name", ")") and kind in ("num", "name", "func", "("):
+        if previous in _BEFORE_PRODUCT and kind in _AFTER_PRODUCT:
             out.append("*")
         out += parts
         previous = kind
         if len(out) > 3 * MAX_NODES:  # bounded work a cell: refused before it is parsed (parentheses counted)
             raise ReadError(f"more than {MAX_NODES} numbers, names and operations; simplify the answer")
     return "".join(out)
+
+
+_WRITTEN = {"^": "**", "×": "*", "·": "*"}
+_BEFORE_PRODUCT = frozenset(("num", "name", ")"))  # a token after which ...
+_AFTER_PRODUCT = frozenset(("num", "name", "func", "("))  # ... one of these is multiplied: 2v, v(1 + p), (p)2
 
 
 def _check_underflow(number: str) -> None:
@@ -147,6 +155,22 @@ def listed(symbols: Sequence[str]) -> str:
     if not symbols:
         return "no names"
     return symbols[0] if len(symbols) == 1 else ", ".join(symbols[:-1]) + " and " + symbols[-1]
+
+
+def uses_a_name(tree: Node) -> bool:
+    """Whether the tree uses a name (``pi`` is not one); stops at the first (``names`` walks all of it).
+
+    >>> uses_a_name(tree_of("2*pi*(1 + 3)", ())), uses_a_name(tree_of("2*pi*v", ("v",)))
+    (False, True)
+    """
+    stack = [tree]
+    while stack:
+        node = stack.pop()
+        if isinstance(node, Op):
+            stack.extend(node.args)
+        elif isinstance(node, Sym) and node.name not in CONSTANTS:
+            return True
+    return False
 
 
 def _count(tree: Node) -> int:

@@ -32,15 +32,16 @@ from __future__ import annotations
 
 import hashlib
 import math
-from collections.abc import Callable, Iterator, Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from functools import lru_cache
+from typing import NamedTuple
 
 import numpy as np
 
 from grader.errors import shown
 from grader.grade.identity import identical
-from grader.model.expr import CONSTANTS, Node, Num, Op, Sym, names, to_text
+from grader.model.expr import CONSTANTS, Node, Num, Op, Sym, to_text
 from grader.model.kernel import evaluate
 
 REFUSED = {"Max": "piecewise", "Min": "piecewise", "sign": "a step", "abs": "piecewise",
@@ -68,16 +69,14 @@ def refused(student: Node, key: Node) -> str | None:
 
 
 def _functions(tree: Node) -> set[str]:
-    return {node.op for node in _nodes(tree) if isinstance(node, Op) and node.op in _TRANSCENDENTAL}
-
-
-def _nodes(tree: Node) -> Iterator[Node]:
-    stack = [tree]
+    found, stack = set(), [tree]
     while stack:
         node = stack.pop()
-        yield node
         if isinstance(node, Op):
+            if node.op in _TRANSCENDENTAL:
+                found.add(node.op)
             stack.extend(node.args)
+    return found
 
 
 @dataclass(frozen=True)
@@ -122,21 +121,22 @@ def _key_form(expected: Node) -> _Form:
 @lru_cache(maxsize=4096)
 def _equivalent(student: Node, expected: _Form, domains: Domains, seed: str, rtol: float,
                 points: int) -> bool | str:
-    missing = sorted((names(student) | names(expected.tree)) - {name for name, _ in domains})
+    survey, key_survey = _survey(student), _survey_of_key(expected)
+    missing = sorted((survey.names | key_survey.names) - {name for name, _ in domains})
     if missing:
         return f"the expression uses {', '.join(missing)}, which this answer does not know"
-    fixed, b = _fixed(expected, domains, seed, points)
+    fixed, b, largest = _fixed(expected, domains, seed, points)
     if b.size == 0:
         return "the key's expression cannot be evaluated at any test point; please ask your instructor to check it"
-    found = [_structure(node, domains) for node in _watched(student) | _watched_in_key(expected)]
+    # A sub-term found twice is probed twice (the same points): cheaper than hashing every one to drop repeats.
+    found = [*(_structure(watched, domains) for watched in survey.watched), *_key_structure(expected, domains)]
     probes = _stack([probe for probe, _ in found])
     values = _values(student, fixed if probes is None else _joined([fixed, probes]))
     a = values[:b.size]
-    if not np.isfinite(a).any():
-        return "the expression cannot be evaluated at any test point (division by zero?)"
-    if not np.isfinite(a).all():
-        return False
-    floor = 1e-3 * rtol * float(np.max(np.abs(b)))
+    finite = np.isfinite(a)
+    if not finite.all():
+        return False if finite.any() else "the expression cannot be evaluated at any test point (division by zero?)"
+    floor = 1e-3 * rtol * largest
     if not _agree(a, b, rtol, floor):
         return False
     if probes is not None:
@@ -145,7 +145,7 @@ def _equivalent(student: Node, expected: _Form, domains: Domains, seed: str, rto
         if not _agree(a[both], b[both], rtol, floor):
             return False
     touches_zero = any(near for _, near in found)
-    if touches_zero or not _functions(student) <= _functions(expected.tree):
+    if touches_zero or not survey.functions <= key_survey.functions:
         return identical(student, expected.tree, domains)
     return True
 
@@ -160,8 +160,16 @@ Score = Callable[[Points], np.ndarray]
 """A sub-term's score at points (higher: nearer what is looked for)."""
 
 
+class _Fixed(NamedTuple):
+    """The points every answer to a key is compared at, the key's values there and the largest of their sizes."""
+
+    points: Points
+    values: np.ndarray
+    largest: float
+
+
 @lru_cache(maxsize=256)
-def _fixed(expected: _Form, domains: Domains, seed: str, points: int) -> tuple[Points, np.ndarray]:
+def _fixed(expected: _Form, domains: Domains, seed: str, points: int) -> _Fixed:
     """The points every answer to a key is compared at, where the key is defined: ``points`` seeded random
     ones, the domain's corners and the line scans; and the key's values there. Worked out once per key."""
     digest = hashlib.sha256("\n".join((seed, expected.text)).encode()).digest()
@@ -172,7 +180,9 @@ def _fixed(expected: _Form, domains: Domains, seed: str, points: int) -> tuple[P
                           _scans(domains, generator)])
     values = _values(expected.tree, everywhere)
     defined = np.isfinite(values)
-    return {name: column[defined] for name, column in everywhere.items()}, values[defined]
+    values = values[defined]
+    largest = float(np.max(np.abs(values))) if values.size else 0.0
+    return _Fixed({name: column[defined] for name, column in everywhere.items()}, values, largest)
 
 
 def _corners(domains: Domains) -> Points:
@@ -216,53 +226,105 @@ def _values(tree: Node, env: Points) -> np.ndarray:
     try:
         with np.errstate(all="ignore"):
             values = np.asarray(evaluate(tree, env), dtype=float)
-        return np.broadcast_to(values, (size,)).copy()
+        return values.copy() if values.shape == (size,) else np.broadcast_to(values, (size,)).copy()
     except (ArithmeticError, ValueError, TypeError, KeyError):
         return np.full(size, np.nan)
 
 
 # ---- where the structure changes ----------------------------------------------------------------
 
-def _watched(tree: Node) -> set[tuple[str, Node]]:
-    """The sub-terms that can change fast, each with what to look for: ``"small"`` (where it is nearest 0)
-    or ``"large"`` (where it is largest). Sub-terms without names are constants, never watched."""
-    found: set[tuple[str, Node]] = set()
+class _Watched(NamedTuple):
+    """A sub-term that can change fast, what to look for in it (``"small"``: where it is nearest 0; ``"large"``:
+    where it is largest), and the names it uses."""
 
-    def visit(node: Node) -> bool:  # whether the node uses a name; depth is bounded by the parser
+    kind: str
+    node: Node
+    names: frozenset[str]
+
+
+class _Survey(NamedTuple):
+    """What one walk of a tree finds: the names it uses, its functions of :data:`_TRANSCENDENTAL`, the sub-terms
+    it has that can change fast."""
+
+    names: frozenset[str]
+    functions: frozenset[str]
+    watched: tuple[_Watched, ...]  # in the order found; not made a set, which would hash every sub-term
+
+
+_NONE: frozenset[str] = frozenset()
+
+
+def _survey(tree: Node) -> _Survey:
+    """The tree's names, functions and watched sub-terms, in one walk. Sub-terms without names are constants,
+    never watched.
+
+    >>> from grader.model.expr import parse
+    >>> found = _survey(parse("v/(p + 1) + exp(-p)"))
+    >>> sorted(found.names), sorted(found.functions), sorted((w.kind, to_text(w.node)) for w in found.watched)
+    (['p', 'v'], ['exp'], [('large', '-p'), ('small', 'p + 1')])
+    """
+    functions: set[str] = set()
+    found: list[_Watched] = []
+
+    def visit(node: Node) -> frozenset[str]:  # the names the node uses; depth is bounded by the parser
         if isinstance(node, Sym):
-            return node.name not in CONSTANTS
+            return _NONE if node.name in CONSTANTS else _named(node.name)
         if isinstance(node, Num):
-            return False
+            return _NONE
         uses = [visit(arg) for arg in node.args]
-        watched = [arg for arg, used in zip(node.args, uses, strict=True) if used]
-        if node.op == "div" and uses[1]:
-            found.add(("small", node.args[1]))
-        elif node.op in _SMALLEST:
-            found.update(("small", arg) for arg in watched)
-        elif node.op in ("Max", "Min") and watched:
-            found.add(("small", Op("sub", node.args)))
-        elif node.op == "exp" and watched:
-            found.add(("large", node.args[0]))
-        elif node.op == "pow" and uses[0] and not (isinstance(node.args[1], Num) and node.args[1].value >= 0
-                                                    and float(node.args[1].value).is_integer()):
-            found.add(("small", node.args[0]))  # a root or a negative power: a kink or a pole at 0
-        return any(uses)
+        op = node.op
+        if op in _TRANSCENDENTAL:
+            functions.add(op)
+        used = uses[0] if len(uses) == 1 else _union(uses)
+        if not used:
+            return used
+        if op == "div" and uses[1]:
+            found.append(_Watched("small", node.args[1], uses[1]))
+        elif op in _SMALLEST:
+            found.extend(_Watched("small", arg, its) for arg, its in zip(node.args, uses, strict=True) if its)
+        elif op in ("Max", "Min"):
+            found.append(_Watched("small", Op("sub", node.args), used))
+        elif op == "exp":
+            found.append(_Watched("large", node.args[0], used))
+        elif op == "pow" and uses[0] and not (isinstance(node.args[1], Num) and node.args[1].value >= 0
+                                               and float(node.args[1].value).is_integer()):
+            found.append(_Watched("small", node.args[0], uses[0]))  # a root or a negative power: a kink or a pole at 0
+        return used
 
-    visit(tree)
-    return found
+    used = visit(tree)
+    return _Survey(used, frozenset(functions), tuple(found))
 
 
 @lru_cache(maxsize=1024)
-def _watched_in_key(expected: _Form) -> set[tuple[str, Node]]:
-    return _watched(expected.tree)
+def _named(name: str) -> frozenset[str]:
+    return frozenset((name,))
+
+
+def _union(uses: list[frozenset[str]]) -> frozenset[str]:
+    first, *rest = uses
+    for other in rest:
+        if not other <= first:  # mostly a sub-term's names are its sibling's: no new set then
+            first = first | other
+    return first
+
+
+@lru_cache(maxsize=1024)
+def _survey_of_key(expected: _Form) -> _Survey:
+    return _survey(expected.tree)
+
+
+@lru_cache(maxsize=256)
+def _key_structure(expected: _Form, domains: Domains) -> tuple[tuple[Points | None, bool], ...]:
+    """The key's probes (see :func:`_structure`), worked out once per key."""
+    return tuple(_structure(watched, domains) for watched in _survey_of_key(expected).watched)
 
 
 @lru_cache(maxsize=4096)
-def _structure(watched: tuple[str, Node], domains: Domains) -> tuple[Points | None, bool]:
+def _structure(watched: _Watched, domains: Domains) -> tuple[Points | None, bool]:
     """Probe points where a watched sub-term is most extreme (and just either side), and whether it comes
     within a rounding of zero inside the domain. Cached: the same denominators recur across a class."""
-    kind, node = watched
-    if _tame(kind, node, domains):
+    kind, node, used = watched
+    if _tame(kind, node, used, domains):
         return None, False
     sign = -1.0 if kind == "small" else 1.0
 
@@ -271,7 +333,7 @@ def _structure(watched: tuple[str, Node], domains: Domains) -> tuple[Points | No
         scored = sign * (np.abs(values) if kind == "small" else values)
         return np.where(np.isnan(scored), -np.inf if kind == "large" else 0.0, scored)
 
-    best = _ascend(score, domains, names(node))
+    best = _ascend(score, domains, used)
     if best is None:
         return None, False
     side = {name: np.array([value]) for name, value in best.items()}
@@ -279,7 +341,7 @@ def _structure(watched: tuple[str, Node], domains: Domains) -> tuple[Points | No
     if kind == "small":
         size = float(np.max(np.abs(np.nan_to_num(_values(node, _corners(domains)), posinf=0, neginf=0))))
         at = abs(float(_values(node, side)[0]))
-        inside = any(low < best[name] < high for name, (low, high) in domains if name in names(node))
+        inside = any(low < best[name] < high for name, (low, high) in domains if name in used)
         near = inside and (not (at > _NEAR_ZERO * size) if size > 0 else True)
     probes = [side]
     for name, (low, high) in domains:
@@ -291,25 +353,33 @@ def _structure(watched: tuple[str, Node], domains: Domains) -> tuple[Points | No
     return _joined(probes), near
 
 
-def _tame(kind: str, node: Node, domains: Domains) -> bool:
+def _tame(kind: str, node: Node, used: frozenset[str], domains: Domains) -> bool:
     """Whether a sub-term of one name is seen well enough by the line scans: a denominator or a root's argument
     of one sign that stays above 1e-3 of its largest size (a pole or a peak is then wider than the scans'
     spacing), an exponent that changes by at most 20 over the domain."""
-    used = names(node)
     if len(used) != 1:
         return False  # in two names or more the scans may pass beside the place: search it
     name = next(iter(used))
     low, high = dict(domains)[name]
-    values = _values(node, {name: np.linspace(low, high, _GRID)})
-    if not np.isfinite(values).all():
+    values = _values(node, {name: _grid(low, high)})
+    least, most = float(values.min()), float(values.max())  # NaN if any value is
+    if not (math.isfinite(least) and math.isfinite(most)):
         return False
     if kind == "large":
-        return bool(values.max() - values.min() <= 20)
-    size = np.abs(values)
-    return bool((np.all(values > 0) or np.all(values < 0)) and size.min() > 1e-3 * size.max())
+        return most - least <= 20
+    # Of one sign, its size never below 1e-3 of its largest: |values| run from least to most, or -most to -least.
+    return (least > 0 and least > 1e-3 * most) or (most < 0 and -most > 1e-3 * -least)
 
 
-def _ascend(score: Score, domains: Domains, used: set[str]) -> dict[str, float] | None:
+@lru_cache(maxsize=256)
+def _grid(low: float, high: float) -> np.ndarray:
+    """:data:`_GRID` points from ``low`` to ``high`` (read only: shared between calls)."""
+    along = np.linspace(low, high, _GRID)
+    along.flags.writeable = False
+    return along
+
+
+def _ascend(score: Score, domains: Domains, used: frozenset[str]) -> dict[str, float] | None:
     """Coordinate ascent of ``score`` over the box, along the names it ``used``: a grid along each name, zoomed
     in around the grid's best, two sweeps."""
     point = {name: (low + high) / 2 for name, (low, high) in domains}

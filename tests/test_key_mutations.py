@@ -149,16 +149,23 @@ def test_grading_a_mutated_key_grades_or_refuses_it_and_never_crashes(sample: tu
     document, submissions = copy.deepcopy(sample[0]), sample[1]
     for _ in range(data.draw(st.integers(1, 3), label="changes")):
         _mutate(document, data)
+    grade_or_refuse(document, submissions.encode("utf-8"))
+
+
+def grade_or_refuse(document: dict[str, Any], submissions: bytes) -> int:
+    """Grade ``submissions`` against the key ``document`` in a folder of their own and check what any input must
+    give: exit 0, 2 or 3, never a traceback, the inputs unchanged; on 2 one line on stderr and nothing left
+    beside them (no --out, nor its work folder); else the grades and the report written. The exit code."""
     with tempfile.TemporaryDirectory() as name:
         folder = Path(name)
         key, answers, out = folder / "key.json", folder / "submissions.csv", folder / "grades"
         key.write_text(json.dumps(document), encoding="utf-8")  # NaN and 1e400 are written as JSON cannot hold
-        answers.write_text(submissions, encoding="utf-8")
+        answers.write_bytes(submissions)
         before = {path: _digest(path) for path in (key, answers)}
         err = io.StringIO()
         with contextlib.redirect_stderr(err), contextlib.redirect_stdout(io.StringIO()):
             code = main(["grade", "--key", str(key), str(answers), "--out", str(out)])  # a bug raises: test fails
-        event(f"exit {code}")  # --hypothesis-show-statistics: how many keys were graded, how many refused
+        event(f"exit {code}")  # --hypothesis-show-statistics: how many were graded, how many refused
         assert code in (0, 2, 3), err.getvalue()
         assert "Traceback" not in err.getvalue()
         assert {path: _digest(path) for path in (key, answers)} == before
@@ -167,3 +174,4 @@ def test_grading_a_mutated_key_grades_or_refuses_it_and_never_crashes(sample: tu
             assert sorted(p.name for p in folder.iterdir()) == ["key.json", "submissions.csv"]
         else:
             assert (out / "grades.csv").is_file() and (out / "report.html").is_file()
+        return code

@@ -278,15 +278,19 @@ HOSTILE_KEYS = [  # (what is changed in the key, what the refusal says): each wa
     (lambda d: d["problems"][1]["answers"][0].update(symbols={"p": [], "v": [1, 10]}),
      "answer 2a: symbols.p: expected [LOW, HIGH]"),  # an IndexError's traceback
     (lambda d: d.update(students=[]), "expected at least one student, got none"),  # 0 students, all rows refused
-    (lambda d: d["students"][0].update(section="\ud800"), "section: expected text, got '\\ud800', which holds a "
-                                                           "lone surrogate"),  # UnicodeEncodeError writing grades.csv
+    (lambda d: d["students"][0].update(section="\ud800"),  # a UnicodeEncodeError writing grades.csv
+     "students[0].section: expected text, got half of a character ('\\ud800')"),
+    (lambda d: d["assignment"].update(course="Dynamics \udc00"), "assignment.course: expected text, got half of a "
+                                                                 "character ('\\udc00')"),  # a field _text never saw
+    (lambda d: d["problems"][0].update(key="\ud800"), "problems[0].key: expected text, got half of a character"),
 ]
 
 
 @pytest.mark.parametrize(("change", "message"), HOSTILE_KEYS, ids=[
     "points-1e308", "points-negative", "value-10**400", "digits-99", "unit-kg^99", "expression-import",
     "expression-power", "expression-unknown-name", "range-overflows", "id-null", "id-twice", "name-1e6-chars",
-    "numeric-expressions-text", "undefined-not-text", "range-empty", "no-students", "section-lone-surrogate"])
+    "numeric-expressions-text", "undefined-not-text", "range-empty", "no-students", "section-lone-surrogate",
+    "course-lone-surrogate", "problem-key-lone-surrogate"])
 def test_a_hand_edited_key_that_cannot_be_graded_is_refused_naming_the_entry(
         tmp_path: Path, capsys: pytest.CaptureFixture[str], key_path: Path, change: Any, message: str) -> None:
     document = key_document(key_path)

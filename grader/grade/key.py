@@ -163,6 +163,8 @@ def load_key(path: Path) -> Key:
     where = str(path)
     text = decode_text(read_bytes(path, KEY_BYTES), path)
     try:
+        if _ESCAPED_SURROGATE.search(text):  # rare: JSON escapes a character beyond U+FFFF as two; one alone is none
+            _refuse_lone_surrogates(json.loads(text), where)
         raw = _decode(text)
     except (ValueError, RecursionError) as error:
         raise GraderError(f"{where}: expected a key.json that grader wrote, got invalid JSON ({error})") from None
@@ -181,6 +183,32 @@ def load_key(path: Path) -> Key:
     except (KeyError, IndexError, TypeError, ValueError, AttributeError, OverflowError) as error:
         raise GraderError(f"{where}: a grader key with a missing or malformed entry ({type(error).__name__}: "
                           f"{shown(str(error))}); regenerate it with grader generate") from None
+
+
+_ESCAPED_SURROGATE = re.compile(r"\\u[dD][89a-fA-F]")
+
+
+def _refuse_lone_surrogates(raw: Any, where: str) -> None:
+    r"""Refuse a text holding half of a character (``"\ud800"`` alone): no report could write it as UTF-8.
+
+    >>> _refuse_lone_surrogates({"students": [{"name": "Ana \U0001f600"}]}, "k.json")  # a whole pair: text
+    >>> _refuse_lone_surrogates({"students": [{"name": "Ana \ud800"}]}, "k.json")
+    Traceback (most recent call last):
+    ...
+    grader.errors.GraderError: k.json: students[0].name: expected text, got half of a character ('\ud800'); ...
+    """
+    stack: list[tuple[str, Any]] = [("", raw)]
+    while stack:
+        here, value = stack.pop()
+        if isinstance(value, dict):
+            stack.extend((f"{here}.{name}" if here else str(name), item) for name, item in value.items())
+            stack.extend((f"{here}: a key", name) for name in value)
+        elif isinstance(value, list):
+            stack.extend((f"{here}[{index}]", item) for index, item in enumerate(value))
+        elif isinstance(value, str) and any("\ud800" <= character <= "\udfff" for character in value):
+            half = next(character for character in value if "\ud800" <= character <= "\udfff")
+            raise GraderError(f"{where}: {here}: expected text, got half of a character ({half!a}); "
+                              "regenerate the key with grader generate")
 
 
 class _EntryError(ValueError):
@@ -379,15 +407,10 @@ def _range(label: str, name: str, bounds: Any) -> tuple[float, float]:
 
 def _text(value: Any, what: str) -> str:
     """A text entry (an id, name, label, unit, title): text of at most CELL_CHARS characters, as in a
-    roster, that UTF-8 can write (JSON's ``\\ud800`` is a lone surrogate: the reports could not hold it)."""
+    roster (half a character anywhere in the key is refused as it is read: :func:`_refuse_lone_surrogates`)."""
     if not isinstance(value, str) or len(value) > CELL_CHARS:
         raise _EntryError(f"{what}: expected text of at most {CELL_CHARS} characters, got {shown(value)}")
-    if not value.isascii() and _SURROGATE.search(value):
-        raise _EntryError(f"{what}: expected text, got {shown(value)}, which holds a lone surrogate (no character)")
     return value
-
-
-_SURROGATE = re.compile("[\ud800-\udfff]")
 
 
 def _student(raw: Mapping[str, Any], symbols: Mapping[str, Mapping[str, tuple[float, float]]],

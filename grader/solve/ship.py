@@ -49,8 +49,9 @@ def build(templates: Iterable[Template]) -> tuple[int, int]:
     made = compilers()
     for template in templates:
         for kind, compile_now in made.items():
-            caching.write_entry(SHIPPED / entry_name(template, kind), compile_now(template).to_json())
-            print(f"  {entry_name(template, kind)}", file=sys.stderr)
+            name = entry_name(template, kind)
+            caching.write_entry(SHIPPED / name, compile_now(template).to_json())
+            print(f"  {name}", file=sys.stderr)
     stale = present_names() - expected_names(templates)
     for name in stale:
         (SHIPPED / name).unlink()
@@ -63,8 +64,8 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     bank = load_bank()
     if args.check:
-        missing = expected_names(bank.values()) - present_names()
-        extra = present_names() - expected_names(bank.values())
+        expected, present = expected_names(bank.values()), present_names()
+        missing, extra = expected - present, present - expected
         for name in sorted(missing):
             print(f"missing: {name}")
         for name in sorted(extra):

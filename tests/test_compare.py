@@ -24,8 +24,9 @@ from grader.grade.compare import (
     feedbacks,
     is_correct,
 )
-from grader.grade.symbolic import _equivalent, _functions, _survey, equivalent
-from grader.model.expr import names, parse
+from grader.grade.grading import symbolic_outcome
+from grader.grade.symbolic import _functions, _survey, equivalent
+from grader.model.expr import names, parse, to_text
 from grader.model.tolerance import Tolerance, ToleranceError
 
 
@@ -302,14 +303,17 @@ def test_equivalent_skips_points_where_the_key_is_undefined() -> None:
         "the key's expression cannot be evaluated at any test point; please ask your instructor to check it")
 
 
-def test_equivalent_is_seeded_and_cached() -> None:
+def test_equivalent_is_seeded_and_graded_once_a_text() -> None:
     student, wrong = parse("(v - 0.1*p*v)/(1 + p)"), parse("v*(1 - 0.1*p)/(p + 1.0001)")
     first = [equivalent(wrong, KEY, DOMAINS, seed=f"seed{i}", rtol=1e-5) for i in range(5)]
     assert first == [equivalent(wrong, KEY, DOMAINS, seed=f"seed{i}", rtol=1e-5) for i in range(5)]
     assert all(equivalent(student, KEY, DOMAINS, seed=f"seed{i}") is True for i in range(5))
-    hits = _equivalent.cache_info().hits
-    equivalent(parse("(v - 0.1*p*v)/(1 + p)"), KEY, dict(DOMAINS), seed="seed0")
-    assert _equivalent.cache_info().hits == hits + 1
+    domains = tuple(sorted(DOMAINS.items()))
+    verdict = symbolic_outcome("(v - 0.1pv)/(1 + p)", ",", domains, to_text(KEY), "seed0")
+    hits = symbolic_outcome.cache_info().hits
+    assert symbolic_outcome("(v - 0.1pv)/(1 + p)", ",", domains, to_text(KEY), "seed0") == verdict
+    assert symbolic_outcome.cache_info().hits == hits + 1
+    assert verdict[:2] == ("correct", 1.0) and verdict[3] == "(v - 0.1*p*v)/(1 + p)"
 
 
 def test_equivalent_refuses_bad_settings() -> None:

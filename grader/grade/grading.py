@@ -21,7 +21,6 @@ import numpy as np
 from grader.grade.cells import (
     MAX_CELL,
     CellBlank,
-    CellExpression,
     CellInvalid,
     CellNumber,
     CellWrongUnit,
@@ -35,7 +34,6 @@ from grader.grade.key import Key, KeyPart
 from grader.grade.notation import cut
 from grader.grade.submissions import Answer, RowProblem, Submissions
 from grader.grade.symbolic import equivalent, refused
-from grader.model.expr import Node, parse
 from grader.model.tolerance import Tolerance
 
 VERDICTS = ("correct", "ecf", "mistake", "incorrect", "invalid", "missing")
@@ -291,17 +289,25 @@ def _row(part: KeyPart, answer: Answer | None, expected: str, words: str, kind: 
 
 
 def _symbolic(part: KeyPart, text: str, delimiter: str, key: Key) -> Outcome:
-    symbols = tuple(part.symbols)
-    cell = _expression(text, symbols, delimiter)
+    domains = tuple((name, (float(low), float(high))) for name, (low, high) in part.symbols.items())
+    return symbolic_outcome(text, delimiter, domains, str(part.value), f"{key.title}/{part.label}")
+
+
+@lru_cache(maxsize=65536)
+def symbolic_outcome(text: str, delimiter: str, domains: tuple[tuple[str, tuple[float, float]], ...],
+                     expected_text: str, seed: str) -> Outcome:
+    """A symbolic answer's verdict, credit, sentence and what it was read as; ``domains``: where each name is
+    drawn, in the key's order. Worked out once per distinct answer, keyed by text (a tree is slow to hash)."""
+    symbols = tuple(name for name, _ in domains)
+    cell = read_expression(text, symbols, delimiter=delimiter)
     if isinstance(cell, CellBlank):
         return "missing", 0.0, "the answer was blank", ""
     if isinstance(cell, CellInvalid):
         return "invalid", 0.0, f"could not read this answer: {cell.reason}", ""
-    expected = _key_tree(str(part.value))
-    refusal = refused(cell.tree, expected)
+    refusal = refused(cell.tree, expected_text)
     if refusal is not None:
         return "invalid", 0.0, f"could not read this answer: {refusal}", cell.text
-    same = equivalent(cell.tree, expected, part.symbols, seed=f"{key.title}/{part.label}")
+    same = equivalent(cell.tree, expected_text, dict(domains), seed=seed)
     if isinstance(same, str):
         return "invalid", 0.0, f"could not compare this expression: {same}", cell.text
     names = " and ".join(symbols)
@@ -314,17 +320,6 @@ def _symbolic(part: KeyPart, text: str, delimiter: str, key: Key) -> Outcome:
 def _number(text: str, unit: str, delimiter: str, numeric_expressions: bool,
             names: tuple[str, ...]) -> CellBlank | CellInvalid | CellWrongUnit | CellNumber:
     return read_number(text, unit, delimiter=delimiter, numeric_expressions=numeric_expressions, names=names)
-
-
-@lru_cache(maxsize=65536)
-def _expression(text: str, symbols: tuple[str, ...], delimiter: str) -> CellBlank | CellInvalid | CellExpression:
-    return read_expression(text, symbols, delimiter=delimiter)
-
-
-@lru_cache(maxsize=4096)
-def _key_tree(text: str) -> Node:
-    """The key's expression, parsed once per distinct text (comparisons are cached in compare)."""
-    return parse(text)
 
 
 def _expected(part: KeyPart) -> str:

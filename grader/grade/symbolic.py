@@ -41,7 +41,7 @@ import numpy as np
 
 from grader.errors import shown
 from grader.grade.identity import identical
-from grader.model.expr import CONSTANTS, Node, Num, Op, Sym, to_text
+from grader.model.expr import CONSTANTS, Node, Num, Op, Sym, parse, to_text
 from grader.model.kernel import evaluate
 
 REFUSED = {"Max": "piecewise", "Min": "piecewise", "sign": "a step", "abs": "piecewise",
@@ -58,9 +58,10 @@ _LEVELS = 7  # zoomed-in grids: a bracket of 2/64 of the domain narrowed to abou
 _NEAR_ZERO = 1e-7  # a sub-term this small relative to its largest size is "at zero"
 
 
-def refused(student: Node, key: Node) -> str | None:
-    """Why ``student`` is refused (a function of :data:`REFUSED` the key does not use), or None."""
-    allowed = _functions(key)
+def refused(student: Node, key: Node | str) -> str | None:
+    """Why ``student`` is refused (a function of :data:`REFUSED` the key does not use), or None. ``key``: the key's
+    expression, a tree or its text (read once per distinct text)."""
+    allowed = _survey_of_key(_key_form(key)).functions
     for name in sorted(_functions(student) - allowed):
         if name in REFUSED:
             return f"{name}() is not accepted in this answer (it is {REFUSED[name]}: a physical answer here does " \
@@ -90,15 +91,16 @@ class _Form:
 Domains = tuple[tuple[str, tuple[float, float]], ...]
 
 
-def equivalent(student: Node, expected: Node, domains: Mapping[str, tuple[float, float]], *, seed: str,
+def equivalent(student: Node, expected: Node | str, domains: Mapping[str, tuple[float, float]], *, seed: str,
                rtol: float = 1e-6, points: int = 64) -> bool | str:
     """Whether two expressions are equal on ``domains`` (see the module's steps), to ``rtol``.
 
     ``points`` random points are drawn, uniformly in each name's domain. Points where the key is undefined
     are skipped; a student expression undefined at a random point where the key is defined is not
     equivalent. Returns a reason instead of a verdict when no comparison is possible: the caller marks the
-    cell invalid. Results are cached per (expressions, domains, seed, rtol, points); the points depend on the
-    key and the seed only, and are worked out once per key.
+    cell invalid. ``expected``: the key's expression, a tree or its text (read once per distinct text, which is
+    faster to look up than a tree is to hash). Nothing is cached per student expression (grading keeps one
+    verdict per distinct text); the points depend on the key and the seed only, and are worked out once per key.
 
     >>> from grader.model.expr import parse
     >>> equivalent(parse("v/(p - p)"), parse("v*(1 - 0.1*p)/(p + 1)"), {"v": (1, 10), "p": (0.1, 5)}, seed="s1")
@@ -114,11 +116,11 @@ def equivalent(student: Node, expected: Node, domains: Mapping[str, tuple[float,
 
 
 @lru_cache(maxsize=1024)
-def _key_form(expected: Node) -> _Form:
-    return _Form(to_text(expected), expected)
+def _key_form(expected: Node | str) -> _Form:
+    tree = parse(expected) if isinstance(expected, str) else expected
+    return _Form(to_text(tree), tree)
 
 
-@lru_cache(maxsize=4096)
 def _equivalent(student: Node, expected: _Form, domains: Domains, seed: str, rtol: float,
                 points: int) -> bool | str:
     survey, key_survey = _survey(student), _survey_of_key(expected)

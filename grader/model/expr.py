@@ -296,9 +296,9 @@ def format_number(value: Fraction | float) -> str:
     if denominator != 1:
         return f"{value.numerator}/{value.denominator}"
     places = max(twos, fives)
-    scaled = value * 10**places
+    scaled = value.numerator * (10**places // value.denominator)  # exact: the denominator divides 10**places
     sign = "-" if scaled < 0 else ""
-    digits = str(abs(scaled.numerator)).rjust(places + 1, "0")
+    digits = str(abs(scaled)).rjust(places + 1, "0")
     return f"{sign}{digits[:-places]}.{digits[-places:]}"
 
 

@@ -39,12 +39,12 @@ import yaml
 from textbook import FORMS, skid_length, swing_angle
 
 from grader.bank.template import Template, load_bank, parse_template
+from grader.base.resources import bank_dir
 from grader.model.kernel import evaluate
 from grader.physics.effects.impact import ContactLaw
 from grader.physics.integrate import Settings, SimulationError
-from grader.physics.run import DEFAULT_CONTACT_DURATION, Options
+from grader.physics.record import DEFAULT_CONTACT_DURATION, Options
 from grader.render.preview import example_printed
-from grader.resources import bank_dir
 from grader.simulate.walker import simulate
 from grader.solve.cache import compiled_for
 from grader.solve.compiled import Compiled

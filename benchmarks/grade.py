@@ -18,7 +18,7 @@ Run: ``python benchmarks/grade.py [--students N] [--runs R]`` (defaults 100,000 
   process, whose peak a later child would report as its own). The machine's load average is printed
   with the figures (the machine is shared).
 - **Symbolic**: 20,000 answers to the car-collision expressions (5,000 distinct texts), compared by
-  ``grader.grade.symbolic.equivalent`` (random points, cached) beside per-answer
+  ``grader.grade.equivalence.equivalent`` (random points, cached) beside per-answer
   ``sympy.simplify(student - expected) == 0`` (timed on 200 answers and extrapolated: at tens of
   milliseconds each it would take minutes). Target: at least 100x faster than sympy.
 """
@@ -201,7 +201,7 @@ def symbolic(answers: int = 20_000, distinct: int = 5_000, sympy_sample: int = 2
     import sympy
 
     from grader.grade.cells import CellExpression, read_expression
-    from grader.grade.symbolic import equivalent
+    from grader.grade.equivalence import equivalent
     from grader.model.expr import parse
 
     rng = random.Random(11)

@@ -141,9 +141,9 @@ def main() -> None:
     distinct = honest(arguments.answers // 4, random.Random(23))
     repeated_seconds, _ = ours(distinct)
     repeated_each = repeated_seconds / arguments.answers
-    # grader grade pauses the cyclic collector while it grades (grader.heap): other distinct answers graded so
+    # grader grade pauses the cyclic collector while it grades (grader.base.heap): other distinct answers graded so
     # (the same ones would be found in the comparison's cache).
-    from grader.heap import collector_paused
+    from grader.base.heap import collector_paused
 
     with collector_paused():
         paused_seconds, _ = ours(honest(arguments.answers, random.Random(24)))
@@ -164,7 +164,7 @@ def main() -> None:
         + ", ".join(f"{ours_each * 1e3:.3f}" for ours_each, _, _ in rounds) + " ms; last round's verdicts: "
         + ", ".join(f"{n:,} {k}" for k, n in sorted(verdicts.items())) + ".",
         "",
-        f"With the cyclic collector paused, as `grader grade` grades (`grader.heap`), not counted against the "
+        f"With the cyclic collector paused, as `grader grade` grades (`grader.base.heap`), not counted against the "
         f"target below: {arguments.answers:,} other distinct honest answers in {paused_seconds:.2f} s, "
         f"{paused_seconds / arguments.answers * 1e3:.3f} ms each.",
         "",

@@ -33,9 +33,9 @@ from grader.assign.assignment import Assignment, ProblemSpec, Student
 from grader.assign.variants import MAX_DRAWS, ProblemDraws, generate, variant_generator
 from grader.bank.folders import bank_folders, template_files
 from grader.bank.template import Template, load_template, same_id
-from grader.errors import GraderError
+from grader.base.errors import GraderError
 from grader.physics.integrate import Settings
-from grader.physics.run import Options
+from grader.physics.record import Options
 from grader.render.documents import sources
 from grader.render.typeset import compile_typst, font_paths
 from grader.simulate.walker import simulate

@@ -18,7 +18,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from grader import __version__
-from grader.errors import GraderError, UsageError, some, visible
+from grader.base.errors import GraderError, UsageError, some, visible
 
 if TYPE_CHECKING:
     from grader.bank.listing import Listed
@@ -253,7 +253,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             _discard_stdout()
             return _error(f"cannot write to standard output ({error.strerror}); free some space, or send the "
                           "output to a file or program that takes it")
-        from grader.files import describe_os_error
+        from grader.base.files import describe_os_error
 
         return _error(describe_os_error(error))
     finally:
@@ -491,7 +491,7 @@ def _table(header: Sequence[str], rows: Sequence[Sequence[str]]) -> str:
 
 def _simulate(arguments: argparse.Namespace) -> int:
     from grader.physics.integrate import Settings
-    from grader.physics.run import Options
+    from grader.physics.record import Options
     from grader.simulate.walker import simulate
     from grader.solve.batch import read_assignments
     from grader.solve.cache import compiled_for
@@ -768,8 +768,8 @@ def _expected_quantity(text: str, unit: str | None) -> tuple[float | str, str]:
 
 
 def _batch_lines(path: Path) -> list[str]:
-    from grader.caching import read_at_most
-    from grader.inputs import decode_text, read_bytes
+    from grader.base.caching import read_at_most
+    from grader.base.inputs import decode_text, read_bytes
 
     limit = 1 << 30
     if str(path) == "-":
@@ -849,7 +849,7 @@ def _check_bank(arguments: argparse.Namespace) -> int:
 
 
 def _cache(arguments: argparse.Namespace) -> int:
-    from grader import caching
+    from grader.base import caching
 
     try:
         folder = caching.cache_dir()

@@ -3,7 +3,7 @@
 It generates the sample assignment for the sample roster (:mod:`grader.render.generate`), plays the
 class (``submissions.csv``: answers as students type them, :mod:`grader.assign.sample_answers`) and
 grades them into ``grades/`` as ``grader grade`` would (:func:`grader.grade.run.grade_into`). All of it
-is one output folder (:func:`grader.files.output_folder`): a failure leaves nothing behind, and
+is one output folder (:func:`grader.base.files.output_folder`): a failure leaves nothing behind, and
 ``--force`` replaces a previous demo whole. ``grades/`` has a manifest of its own, so that
 ``grader grade --key DIR/key.json DIR/submissions.csv --out DIR/grades --force`` can grade again.
 """
@@ -18,10 +18,10 @@ from pathlib import Path
 
 from grader.assign.sample_answers import due_time, sample_answers, submissions_csv
 from grader.bank.template import Template
-from grader.files import output_folder, write_atomic
+from grader.base.files import output_folder, write_atomic
+from grader.base.resources import sample_dir
 from grader.grade.run import GradeSummary, grade_into
 from grader.render.generate import Job, Summary, load_inputs, write_outputs
-from grader.resources import sample_dir
 
 SUBMISSIONS, GRADES, KEY = "submissions.csv", "grades", "key.json"
 

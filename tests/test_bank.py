@@ -11,8 +11,8 @@ import pytest
 import yaml
 
 from grader.bank.template import load_bank, load_template, parse_template
-from grader.errors import GraderError, TemplateError
-from grader.resources import bank_dir
+from grader.base.errors import GraderError, TemplateError
+from grader.base.resources import bank_dir
 from grader.solve.solver import compile_template
 
 BASE = yaml.safe_load((bank_dir() / "drop-rebound.yaml").read_text(encoding="utf-8"))
@@ -222,7 +222,7 @@ def test_two_templates_with_one_id_are_refused_naming_both_files(tmp_path: Path)
 
 def test_no_bank_at_all_is_a_usage_error() -> None:
     from grader.bank.template import load_banks
-    from grader.errors import UsageError
+    from grader.base.errors import UsageError
 
     with pytest.raises(UsageError, match=r"without the shipped bank .*give --bank DIR"):
         load_banks([], shipped=False)
@@ -233,7 +233,7 @@ def test_libyaml_and_pythons_parser_read_every_template_alike() -> None:
     PyYAML's own, all in Python, must give the same data (and gives the messages for broken files)."""
     import yaml
 
-    from grader.yaml_loader import _Loader, _PyLoader
+    from grader.base.yaml_loader import _Loader, _PyLoader
 
     if not yaml.__with_libyaml__:
         pytest.skip("PyYAML was built without libyaml here: both loaders are Python's")

@@ -12,12 +12,12 @@ import numpy as np
 import pytest
 
 from grader import bankcheck
+from grader.base.resources import bank_dir
 from grader.cli import main
 from grader.model.expr import parse
 from grader.model.kernel import evaluate
 from grader.physics.integrate import Settings
-from grader.physics.run import Options
-from grader.resources import bank_dir
+from grader.physics.record import Options
 
 
 def run(capsys: pytest.CaptureFixture[str], *argv: str) -> tuple[int, str, str]:

@@ -10,9 +10,9 @@ from typing import Any
 import pytest
 
 from grader.bank.template import Template
+from grader.base.errors import GraderError
+from grader.base.inputs import read_csv, read_csv_columns
 from grader.cli import main
-from grader.errors import GraderError
-from grader.inputs import read_csv, read_csv_columns
 from grader.solve.batch import read_value, record
 from grader.solve.compiled import Compiled
 from grader.solve.evaluate import solve_batch

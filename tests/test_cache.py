@@ -10,8 +10,8 @@ from typing import Any
 
 import pytest
 
-from grader import caching
 from grader.bank.template import Template, load_bank
+from grader.base import caching
 from grader.solve import cache as solve_cache
 from grader.solve.evaluate import solve_one
 

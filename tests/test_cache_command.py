@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from grader import caching
+from grader.base import caching
 from grader.cli import main
 
 

@@ -1,5 +1,5 @@
-"""What YAML files read as, kept on disk by grader.inputs.parse_yaml through grader.caching: the same bytes read
-back exactly, refusals made every time with their messages, damaged entries read as misses."""
+"""What YAML files read as, kept on disk by grader.base.inputs.parse_yaml through grader.base.caching: the same
+bytes read back exactly, refusals made every time with their messages, damaged entries read as misses."""
 
 from __future__ import annotations
 
@@ -12,12 +12,12 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-import grader.yaml_loader
-from grader import caching
-from grader.errors import GraderError
-from grader.inputs import parse_yaml, plain_data
-from grader.resources import bank_dir, sample_dir
-from grader.yaml_loader import load_yaml
+import grader.base.yaml_loader
+from grader.base import caching
+from grader.base.errors import GraderError
+from grader.base.inputs import YAML_SOURCES, parse_yaml, plain_data
+from grader.base.resources import bank_dir, sample_dir
+from grader.base.yaml_loader import load_yaml
 
 SHIPPED = sorted(bank_dir().glob("*.yaml")) + sorted(sample_dir().glob("*.yaml"))
 
@@ -48,7 +48,7 @@ def no_loading(monkeypatch: pytest.MonkeyPatch) -> None:
     def fail(*args: object) -> None:
         raise AssertionError("the YAML was read again")
 
-    monkeypatch.setattr(grader.yaml_loader, "load_yaml", fail)
+    monkeypatch.setattr(grader.base.yaml_loader, "load_yaml", fail)
 
 
 @pytest.mark.parametrize("path", SHIPPED, ids=lambda path: path.name)
@@ -119,9 +119,9 @@ def test_an_edit_of_the_yaml_reader_reads_files_again(tmp_path: Path) -> None:
 
     copy = tmp_path / "grader"
     shutil.copytree(caching.PACKAGE, copy, ignore=shutil.ignore_patterns("__pycache__"))
-    sources, salt = ("inputs.py", "yaml_loader.py"), "yaml 1"
+    sources, salt = YAML_SOURCES, "yaml 1"
     before = caching.source_fingerprint(copy, sources, salt, ("yaml",))
-    loader = copy / "yaml_loader.py"
+    loader = copy / "base" / "yaml_loader.py"
     loader.write_text(loader.read_text(encoding="utf-8") + "\n# reads differently\n", encoding="utf-8")
     assert caching.source_fingerprint(copy, sources, salt, ("yaml",)) != before
 
@@ -271,9 +271,9 @@ def test_an_entry_others_may_write_is_a_miss_and_written_again_for_me_alone(cach
 
 def test_entries_are_written_for_me_alone_whatever_the_umask(cache: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     """Under umask 002 (many distributions' default for users) entries were group-writable."""
-    import grader.files
+    import grader.base.files
 
-    monkeypatch.setattr(grader.files, "UMASK", 0o002)
+    monkeypatch.setattr(grader.base.files, "UMASK", 0o002)
     entry = _yaml_entry(cache, b"h: 1\n")
     assert entry.stat().st_mode & 0o777 == 0o644
 

@@ -219,7 +219,7 @@ def test_list_shows_the_bank_whatever_its_cache_entry_says(capsys: pytest.Captur
                                                           monkeypatch: pytest.MonkeyPatch) -> None:
     """A listing entry (sealed as grader seals them) with a topic outside the list stopped `grader list` with a
     traceback; one with a row no template file has listed it."""
-    from grader import caching
+    from grader.base import caching
 
     monkeypatch.setenv("GRADER_CACHE_DIR", str(tmp_path))
     _, fresh, _ = run(capsys, "list")
@@ -258,7 +258,7 @@ def test_show_shows_escape_sequences_in_a_template_as_text(capsys: pytest.Captur
 
 def _own_bank(tmp_path: Path, name: str, template_id: str, old: str = "", new: str = "") -> Path:
     """A folder with drop-rebound copied as ``template_id`` (``old`` replaced by ``new``)."""
-    from grader.resources import bank_dir
+    from grader.base.resources import bank_dir
 
     folder = tmp_path / name
     folder.mkdir()
@@ -300,7 +300,7 @@ def test_a_template_id_in_two_banks_is_refused_by_every_command(
         tmp_path: Path, capsys: pytest.CaptureFixture[str], command: list[str], workdir: str) -> None:
     """Exit 2 before any work, naming both files; nothing is written (check-bank reports it as one template's
     failure: tests/test_bankcheck.py)."""
-    from grader.resources import bank_dir
+    from grader.base.resources import bank_dir
 
     copy = _own_bank(tmp_path, "copy", "drop-rebound")
     code, out, err = run(capsys, command[0], "--bank", str(copy), *command[1:])

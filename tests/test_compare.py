@@ -16,7 +16,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from grader.errors import GraderError
+from grader.base.errors import GraderError
 from grader.grade.compare import (
     LARGEST,
     errors,
@@ -24,8 +24,8 @@ from grader.grade.compare import (
     feedbacks,
     is_correct,
 )
+from grader.grade.equivalence import _functions, _survey, equivalent
 from grader.grade.grading import symbolic_outcome
-from grader.grade.symbolic import _functions, _survey, equivalent
 from grader.model.expr import names, parse, to_text
 from grader.model.tolerance import Tolerance, ToleranceError
 

@@ -19,14 +19,14 @@ import pytest
 
 import grader.demo
 from grader.assign.assignment import load_assignment, load_roster
-from grader.assign.keyfile import original_cell
 from grader.assign.sample_answers import NUMERIC, SYMBOLIC, SampleAnswer, sample_answers, submissions_csv
 from grader.assign.variants import generate
 from grader.bank.template import Template
+from grader.base.files import MANIFEST
+from grader.base.resources import sample_dir
+from grader.base.spreadsheet import original_cell
 from grader.cli import main
-from grader.files import MANIFEST
 from grader.render.generate import Job
-from grader.resources import sample_dir
 from tests.demo_output import DemoRun
 from tests.documents import all_text
 

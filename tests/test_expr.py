@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 import sympy as sp
 
-from grader.errors import ExpressionError, GraderError
+from grader.base.errors import ExpressionError, GraderError
 from grader.model.expr import MAX_DEPTH, MAX_LENGTH, format_number, parse, to_text
 from grader.model.kernel import cosd, evaluate, sind
 from grader.model.units import parse_unit

@@ -14,8 +14,8 @@ from grader.assign.assignment import load_assignment, load_roster
 from grader.assign.fair import SAFETY, display_name, fair_tolerances
 from grader.assign.variants import Generation, generate
 from grader.bank.template import Template
+from grader.base.errors import GraderError
 from grader.cli import main
-from grader.errors import GraderError
 from grader.grade.compare import is_correct
 from grader.model.tolerance import ANSWER_SIG_FIGS, Tolerance
 from grader.solve.cache import routes_for

@@ -23,6 +23,7 @@ from grader.assign.assignment import Assignment, load_assignment, load_roster
 from grader.assign.keyfile import key_csv
 from grader.assign.variants import Generation, StudentVariants, generate, tolerance
 from grader.bank.template import Template
+from grader.base.resources import sample_dir
 from grader.cli import main
 from grader.grade.class_report import class_report
 from grader.grade.class_summary import summarize
@@ -33,7 +34,6 @@ from grader.grade.submissions import Answer, StudentRef, read_submissions
 from grader.model.tolerance import Tolerance
 from grader.render.documents import Documents, cover, key_source, student_source
 from grader.render.typeset import compile_typst
-from grader.resources import sample_dir
 from tests.demo_output import DemoRun
 
 REASON = "rounding T and T′ to 4 figures moves loss_pct by up to {:.2g} %"

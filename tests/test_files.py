@@ -1,4 +1,4 @@
-"""The output-folder mechanism of ``grader.files``: manifests, refusals, and errors that name their path."""
+"""The output-folder mechanism of ``grader.base.files``: manifests, refusals, and errors that name their path."""
 
 from __future__ import annotations
 
@@ -12,8 +12,8 @@ from pathlib import Path
 
 import pytest
 
-from grader.errors import GraderError
-from grader.files import MANIFEST, describe_os_error, manifest_mismatches, output_folder, write_atomic
+from grader.base.errors import GraderError
+from grader.base.files import MANIFEST, describe_os_error, manifest_mismatches, output_folder, write_atomic
 from tests.demo_output import DemoRun
 
 
@@ -57,7 +57,7 @@ def test_ctrl_c_between_the_two_renames_of_force_leaves_one_whole_output(tmp_pat
     """--force moves the previous output aside, then the new one in. A Ctrl-C between the two left no
     output at --out (the previous one stranded in the work folder, which then blocked every later run);
     now the signal waits for the second rename, and the run ends with the new output in place."""
-    import grader.files
+    import grader.base.files
 
     out = _written(tmp_path / "out")
     renames, rename = [], os.rename
@@ -68,7 +68,7 @@ def test_ctrl_c_between_the_two_renames_of_force_leaves_one_whole_output(tmp_pat
         if len(renames) == 1:  # the previous output just went aside
             signal.raise_signal(signal.SIGINT)
 
-    monkeypatch.setattr(grader.files.os, "rename", rename_then_interrupt)
+    monkeypatch.setattr(grader.base.files.os, "rename", rename_then_interrupt)
     with pytest.raises(KeyboardInterrupt), output_folder(out, command="test", force=True) as staging:
         write_atomic(staging / "grades.csv", "id,score\n")
     assert len(renames) == 2
@@ -98,13 +98,13 @@ def test_an_os_error_inside_names_the_output_path_not_the_work_folder(tmp_path: 
 def test_write_atomic_on_a_full_disk_names_the_file_and_leaves_no_temporary(tmp_path: Path,
                                                                            monkeypatch: pytest.MonkeyPatch) -> None:
     """A failed write() names no file; write_atomic's error names the one it was writing."""
-    import grader.files
+    import grader.base.files
 
     def full(handle: int, mode: str = "rb") -> object:
         os.close(handle)
         return open("/dev/full", mode)
 
-    monkeypatch.setattr(grader.files.os, "fdopen", full)
+    monkeypatch.setattr(grader.base.files.os, "fdopen", full)
     with pytest.raises(OSError) as caught:
         write_atomic(tmp_path / "key.json", "{}")
     monkeypatch.undo()
@@ -153,7 +153,7 @@ def _refused(capsys: pytest.CaptureFixture[str], *argv: object) -> str:
 
 def _other_commands(demo: Path, elsewhere: Path) -> dict[str, list[object]]:
     """Each command, with inputs outside the folders it is pointed at (copies of the demo's own)."""
-    from grader.resources import sample_dir
+    from grader.base.resources import sample_dir
 
     elsewhere.mkdir()
     key, submissions = elsewhere / "key.json", elsewhere / "submissions.csv"

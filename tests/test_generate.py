@@ -16,9 +16,9 @@ import yaml
 from grader.assign.assignment import load_assignment, load_roster
 from grader.assign.variants import generate
 from grader.bank.template import Template
+from grader.base.files import MANIFEST
+from grader.base.resources import sample_dir
 from grader.cli import main
-from grader.files import MANIFEST
-from grader.resources import sample_dir
 from grader.solve.compiled import Compiled
 from grader.solve.evaluate import solve_one
 from tests.demo_output import DemoRun
@@ -436,7 +436,7 @@ def test_an_output_that_appears_during_the_run_is_not_replaced(tmp_path: Path, m
 def test_a_failed_replace_leaves_the_previous_output_and_no_work_folder(
         tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str], failing: int) -> None:
     """os.rename fails (EBUSY, as for a mount point) at either step of --force: old output intact, no leftovers."""
-    import grader.files
+    import grader.base.files
 
     out = tmp_path / "out"
     assert run(capsys, "generate", ASSIGNMENT, "--roster", ROSTER, "--out", out, "--no-pdf")[0] == 0
@@ -450,7 +450,7 @@ def test_a_failed_replace_leaves_the_previous_output_and_no_work_folder(
             raise OSError(errno.EBUSY, os.strerror(errno.EBUSY), source)
         real(source, destination)
 
-    monkeypatch.setattr(grader.files.os, "rename", busy)
+    monkeypatch.setattr(grader.base.files.os, "rename", busy)
     err = _one_line_error(*run(capsys, "generate", ASSIGNMENT, "--roster", ROSTER, "--out", out, "--no-pdf",
                                "--force"))
     assert "Device or resource busy" in err and "the previous output is unchanged" in err
@@ -505,13 +505,13 @@ def test_a_read_only_parent_folder_is_one_line(tmp_path: Path, capsys: pytest.Ca
 def test_a_full_disk_while_writing_the_key_is_one_line_and_leaves_nothing(
         tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]) -> None:
     """Every atomic write goes to /dev/full (ENOSPC from the kernel): the path, the reason, nothing left."""
-    import grader.files
+    import grader.base.files
 
     def full(handle: int, mode: str = "rb") -> object:
         os.close(handle)
         return open("/dev/full", mode)
 
-    monkeypatch.setattr(grader.files.os, "fdopen", full)
+    monkeypatch.setattr(grader.base.files.os, "fdopen", full)
     err = _one_line_error(*run(capsys, "generate", ASSIGNMENT, "--roster", ROSTER, "--out", tmp_path / "out",
                                "--no-pdf"))
     monkeypatch.undo()

@@ -12,13 +12,13 @@ from typing import Any
 
 import pytest
 
+from grader.base.errors import GraderError
+from grader.base.resources import sample_dir
 from grader.cli import main
-from grader.errors import GraderError
 from grader.grade.diagnosis import physics_for
 from grader.grade.grading import grade, grade_part
 from grader.grade.key import load_key
 from grader.grade.submissions import StudentRef, read_submissions
-from grader.resources import sample_dir
 
 
 def run(capsys: pytest.CaptureFixture[str], *argv: object) -> tuple[int, str, str]:

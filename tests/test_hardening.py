@@ -16,9 +16,9 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from grader.assign.keyfile import original_cell, safe_cell
+from grader.base.resources import bank_dir, sample_dir
+from grader.base.spreadsheet import original_cell, safe_cell
 from grader.cli import main
-from grader.resources import bank_dir, sample_dir
 
 ROSTER = sample_dir() / "roster.csv"
 ONE_PROBLEM = "title: HW\ncourse: C\nseed: s\nproblems:\n  - template: drop-rebound\n"

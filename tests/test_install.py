@@ -48,7 +48,7 @@ def test_wheel_installed_in_a_fresh_venv_runs_from_another_folder(tmp_path: Path
                              capture_output=True, text=True, timeout=120)
     assert listing.returncode == 0, listing.stderr
     assert "pile-driver" in listing.stdout and "oblique-spheres" in listing.stdout
-    location = subprocess.run([str(python), "-c", "import grader.resources as r; print(r.bank_dir())"],
+    location = subprocess.run([str(python), "-c", "import grader.base.resources as r; print(r.bank_dir())"],
                               cwd=elsewhere, env=env, capture_output=True, text=True, timeout=60)
     assert str(environment) in location.stdout, "the bank must be found inside the installed package"
     solved = subprocess.run([str(python), "-m", "grader", "solve", "drop-rebound", "--set", "h_drop=2100",

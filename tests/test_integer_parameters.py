@@ -14,8 +14,8 @@ import pytest
 import yaml
 
 from grader.bank.template import parse_template
+from grader.base.errors import TemplateError
 from grader.cli import main
-from grader.errors import TemplateError
 from grader.simulate.walker import simulate
 
 BOUNCES = {
@@ -99,7 +99,7 @@ def test_simulate_refuses_a_count_that_is_not_a_whole_number(capsys: pytest.Capt
 
 
 def test_simulate_called_directly_refuses_it_too(bank: dict[str, object]) -> None:
-    from grader.errors import GraderError
+    from grader.base.errors import GraderError
 
     with pytest.raises(GraderError, match=r"n = 1.5 is not a whole number; n is an integer parameter"):
         simulate(bank["successive-bounces"], {"h0": 2.0, "e": 0.5, "n": 1.5})  # type: ignore[arg-type]

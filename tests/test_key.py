@@ -15,8 +15,8 @@ from typing import Any
 
 import pytest
 
+from grader.base.resources import sample_dir
 from grader.cli import main
-from grader.resources import sample_dir
 
 Document = dict[str, Any]
 

@@ -22,8 +22,8 @@ import pytest
 from hypothesis import HealthCheck, event, given, settings
 from hypothesis import strategies as st
 
+from grader.base.resources import sample_dir
 from grader.cli import main
-from grader.resources import sample_dir
 
 Path_ = tuple[str | int, ...]  # where a value sits in the key's JSON: keys and indexes
 

@@ -16,15 +16,15 @@ import pytest
 PACKAGE = Path(__file__).resolve().parent.parent / "grader"
 
 # The pipeline, bottom to top: a folder may import only folders of a lower rank. Stages of one rank
-# are peers and import neither each other. The top-level modules caching, errors, files, heap, inputs,
-# resources, yaml_loader and grader/__init__ sit below everything; cli, __main__, demo (which generates and
-# grades) and bankcheck (which samples, solves, simulates and typesets) above everything.
+# are peers and import neither each other. The folder base (errors, files, inputs, caching, heap, resources,
+# yaml_loader) and grader/__init__ sit below everything; cli, __main__, demo (which generates and grades) and
+# bankcheck (which samples, solves, simulates and typesets) above everything.
 RANKS = {"base": 0, "model": 1, "physics": 2, "bank": 3, "solve": 4, "simulate": 4, "assign": 5,
          "render": 6, "grade": 6, "cli": 7}
-TOP_LEVEL = {"grader": "base", "grader.errors": "base", "grader.files": "base", "grader.inputs": "base",
-             "grader.resources": "base", "grader.heap": "base", "grader.caching": "base",
-             "grader.yaml_loader": "base",
-             "grader.cli": "cli", "grader.__main__": "cli", "grader.demo": "cli", "grader.bankcheck": "cli"}
+TOP_LEVEL = {"grader": "base", "grader.cli": "cli", "grader.__main__": "cli", "grader.demo": "cli",
+             "grader.bankcheck": "cli"}
+MAX_TOP_LEVEL = 8
+"""Modules at the top of ``grader/`` (``__init__`` and ``__main__`` counted): the rest stand in their stage."""
 
 
 def module_files(package: Path) -> dict[str, Path]:
@@ -148,6 +148,24 @@ def test_every_module_has_a_place_in_the_pipeline() -> None:
     unplaced = sorted(m for m in GRAPH if stage_of(m) not in RANKS)
     assert not unplaced, f"modules outside the pipeline order: {unplaced}; add their folder to RANKS"
     assert {stage_of(m) for m in GRAPH} == set(RANKS), "RANKS names a stage that has no module"
+
+
+def test_the_top_level_holds_at_most_a_few_modules() -> None:
+    """The bottom layer stands in its own folder, each stage in its own: the top holds the commands' entry points."""
+    top = sorted(path.name for path in PACKAGE.glob("*.py"))
+    assert len(top) <= MAX_TOP_LEVEL, f"{len(top)} modules at the top of grader/: {top}"
+    assert {f"grader.{name.removesuffix('.py')}" for name in top} - {"grader.__init__"} <= set(TOP_LEVEL)
+
+
+def test_no_two_modules_share_a_name() -> None:
+    """A module's name says what it does: two files of one name in different stages (a drawing ``canvas`` and
+    the LMS's, a simulation's ``run`` and grading's) read as one thing."""
+    seen: dict[str, list[str]] = {}
+    for name, path in module_files(PACKAGE).items():
+        if path.name not in ("__init__.py", "__main__.py"):
+            seen.setdefault(path.stem, []).append(name)
+    shared = {stem: names for stem, names in seen.items() if len(names) > 1}
+    assert not shared, f"modules sharing a name: {shared}"
 
 
 def test_every_stage_package_says_what_it_does() -> None:

@@ -12,7 +12,7 @@ from hypothesis import assume, example, given, settings
 from hypothesis import strategies as st
 
 from grader.bank.template import Template, load_bank, parse_template
-from grader.resources import bank_dir
+from grader.base.resources import bank_dir
 from grader.solve.compiled import Compiled
 from grader.solve.evaluate import solve_one
 from grader.solve.solver import compile_template

@@ -16,7 +16,8 @@ from grader.model.expr import Node, Num, Op, Sym, parse, to_text
 from grader.model.kernel import evaluate
 from grader.render.preview import example_printed
 from grader.render.readable import Names, readable
-from grader.render.worked import math, worked
+from grader.render.typst_math import math
+from grader.render.worked import worked
 
 # Each step as the key prints it (Typst math): the relation's equation where it is not already the
 # solved form, then "unknown = solved form". Written by hand: numbers first, then masses, g, lengths,

@@ -15,14 +15,16 @@ from pypdf import PdfReader
 from grader.assign.assignment import Assignment, ProblemSpec, Student, load_assignment, load_roster
 from grader.assign.variants import AnswerPart, Generation, ProblemVariant, StudentVariants, generate
 from grader.bank.template import Template, parse_template
-from grader.errors import GraderError
+from grader.base.errors import GraderError
+from grader.base.resources import sample_dir
 from grader.model.expr import parse
 from grader.render.documents import file_names, render_page_png, safe_file_name, statement
 from grader.render.figures import figure
 from grader.render.pdfs import render_all
 from grader.render.typeset import compile_typst, font_paths, system_fonts, uncovered
-from grader.render.worked import Typ, dimension, math, unit_of, worked, worked_form
-from grader.resources import sample_dir
+from grader.render.typst_math import math
+from grader.render.typst_text import Typ
+from grader.render.worked import dimension, unit_of, worked, worked_form
 from grader.solve.cache import compiled_for
 from grader.solve.evaluate import solve_one
 

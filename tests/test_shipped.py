@@ -10,8 +10,8 @@ from pathlib import Path
 
 import pytest
 
-from grader import caching
 from grader.bank.template import Template
+from grader.base import caching
 from grader.solve import ship
 from grader.solve.alternatives import Alternatives
 from grader.solve.cache import KINDS, SHIPPED, entry_name
@@ -76,8 +76,8 @@ def test_an_instructors_own_template_derives_its_diagnosis_chains_when_grading_f
         tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch) -> None:
     """Generating compiles what the key needs and no more; the first grading says, on stderr, that it derives the
     chains of errors carried forward and of mistakes (seconds of sympy), and a second grading reads them kept."""
+    from grader.base.resources import bank_dir
     from grader.cli import main
-    from grader.resources import bank_dir
 
     monkeypatch.chdir(tmp_path)
     monkeypatch.setenv("GRADER_CACHE_DIR", str(tmp_path / "cache"))

@@ -17,7 +17,7 @@ from grader.bank.template import Template, parse_template
 from grader.cli import main
 from grader.physics.effects import CATALOGUE
 from grader.physics.integrate import Settings, SimulationError
-from grader.physics.run import Options
+from grader.physics.record import Options
 from grader.simulate.walker import simulate
 from grader.solve.compiled import Compiled
 from grader.solve.evaluate import solve_one

@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 from grader.physics.effects import CATALOGUE
-from grader.physics.run import Options
+from grader.physics.record import Options
 from grader.simulate.walker import simulate
 from grader.solve.evaluate import solve_one
 from tests import references

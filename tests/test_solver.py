@@ -8,7 +8,7 @@ import pytest
 import yaml
 
 from grader.bank.template import Template, parse_template
-from grader.errors import TemplateError
+from grader.base.errors import TemplateError
 from grader.model.expr import names
 from grader.solve.compiled import Compiled
 from grader.solve.evaluate import solve_one

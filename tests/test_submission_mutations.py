@@ -100,8 +100,8 @@ def _grade_mutated(sample: tuple[dict[str, Any], str], data: st.DataObject, not_
 def test_reading_a_small_key_takes_memory_for_what_it_holds_not_for_the_limit(tmp_path: Path) -> None:
     """A file was read with ``read(limit + 1)``: 1 GiB asked of the allocator for a key of a few kB (untouched,
     so not resident, but refused under a memory limit such as ``ulimit -v``)."""
+    from grader.base.inputs import read_bytes
     from grader.grade.key import KEY_BYTES
-    from grader.inputs import read_bytes
 
     small = tmp_path / "key.json"
     small.write_bytes(b"{}" * 1000)

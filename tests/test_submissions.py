@@ -13,10 +13,10 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from grader.errors import GraderError
+from grader.base.errors import GraderError
+from grader.base.inputs import read_csv
 from grader.grade.submissions import Answer, RowProblem, StudentRef, Submissions, read_submissions
 from grader.grade.timestamps import read_timestamp
-from grader.inputs import read_csv
 
 NOW = datetime(2030, 1, 1, tzinfo=UTC)  # the run's time: the files' timestamps, in 2026, are before it
 STUDENTS = [StudentRef("00123", "Ann.Lee@uni.edu"), StudentRef("456", "bob@uni.edu"), StudentRef("789", "cy@uni.edu")]

@@ -1,6 +1,6 @@
 """An assignment (YAML) and a class roster (CSV), parsed and validated into frozen objects.
 
->>> from grader.resources import sample_dir
+>>> from grader.base.resources import sample_dir
 >>> assignment = load_assignment(sample_dir() / "assignment.yaml")
 >>> [p.key for p in assignment.problems], assignment.problems[0].template
 (['1', '2', '3', '4', '5'], 'drop-rebound')
@@ -19,8 +19,8 @@ from pathlib import Path
 from typing import Any
 
 from grader.bank.template import Parameter, Template, tolerance_in
-from grader.errors import GraderError, TemplateError, shown
-from grader.inputs import read_csv, read_yaml
+from grader.base.errors import GraderError, TemplateError, shown
+from grader.base.inputs import read_csv, read_yaml
 from grader.model.tolerance import ANSWER_SIG_FIGS, FORMS
 
 _KEY = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_-]{0,15}$")
@@ -133,11 +133,11 @@ def grading_from(raw: Any, where: str, field: str = "grading") -> Grading:
     >>> grading_from({"max_tolerence": 0.1}, "a.yaml")
     Traceback (most recent call last):
     ...
-    grader.errors.TemplateError: a.yaml: grading.max_tolerence: expected one of ... (did you mean max_tolerance?), ...
+    grader.base.errors.TemplateError: a.yaml: grading.max_tolerence: ... (did you mean max_tolerance?)...
     >>> grading_from({"max_tolerance": -1}, "a.yaml")
     Traceback (most recent call last):
     ...
-    grader.errors.TemplateError: a.yaml: grading.max_tolerance: expected a relative tolerance from 0.001 ..., got -1
+    grader.base.errors.TemplateError: a.yaml: grading.max_tolerance: expected a relative tolerance ..., got -1
     """
     if raw is None:
         return Grading()

@@ -30,11 +30,9 @@ and the tolerance's ``mode``: its tolerances are ``{"rtol", "atol"}``; a version
 
 from __future__ import annotations
 
-import csv
 import hashlib
-import io
 import json
-from collections.abc import Mapping
+from collections.abc import Iterator, Mapping, Sequence
 from functools import lru_cache
 from pathlib import Path
 from typing import Any
@@ -43,36 +41,11 @@ from grader import __version__
 from grader.assign.assignment import Assignment, ProblemSpec
 from grader.assign.variants import AnswerPart, Generation
 from grader.bank.template import Template
+from grader.base.spreadsheet import csv_text, safe_cell
 from grader.model.tolerance import Tolerance
 
 SCHEMA, VERSION = "grader-key", 2
 SYMBOL_RANGE = (1.0, 10.0)  # where a symbol with no sampled range (a speed v) is drawn to compare expressions
-# A formula's first characters, their full-width forms (an East Asian keyboard's ＝, which a spreadsheet may
-# read as =) and small forms, and the guard's own.
-_GUARDED_START = frozenset("=+-@\t\r\n'" "\uff1d\uff0b\uff0d\uff20" "\ufe66\ufe62\ufe63\ufe6b")
-
-
-def safe_cell(text: str) -> str:
-    """A CSV text cell a spreadsheet will not run as a formula (docs/design.md: formula injection): a cell
-    starting with ``= + - @`` (or their full-width forms ``＝ ＋ － ＠``, or small forms), tab, CR or LF gets a
-    leading ``'``, and so does one that already starts with ``'``, so the original is always recovered by
-    :func:`original_cell`.
-
-    >>> safe_cell("=HYPERLINK(1)"), safe_cell("Ana"), safe_cell("'quoted"), safe_cell("＝HYPERLINK(1)")
-    ("'=HYPERLINK(1)", 'Ana', "''quoted", "'＝HYPERLINK(1)")
-    """
-    return "'" + text if text[:1] in _GUARDED_START else text
-
-
-def original_cell(cell: str) -> str:
-    """The text :func:`safe_cell` guarded: one leading ``'`` dropped.
-
-    >>> original_cell("'=1+1"), original_cell("''quoted"), original_cell("Ana")
-    ('=1+1', "'quoted", 'Ana')
-    """
-    return cell[1:] if cell.startswith("'") else cell
-
-
 def key_document(assignment: Assignment, generation: Generation, bank: Mapping[str, Template]) -> dict[str, Any]:
     """The key as a JSON-ready dictionary."""
     used = {p.template: bank[p.template] for p in assignment.problems}
@@ -157,19 +130,19 @@ def key_json(document: Mapping[str, Any]) -> str:
 
 def key_csv(generation: Generation) -> str:
     """``key.csv``: one row per student and answer part, for people and spreadsheets."""
-    stream = io.StringIO()
-    writer = csv.writer(stream, lineterminator="\n")
-    writer.writerow(["student_id", "name", "section", "problem", "template", "label", "answer", "value", "unit",
-                     "points", "tolerance", "parameters"])
-    for entry in generation.students:
-        student = entry.student
-        who = [safe_cell(student.id), safe_cell(student.name), safe_cell(student.section)]
-        for variant in entry.problems:
-            given = "; ".join(f"{name}={text}" for name, text in variant.printed.items())
-            writer.writerows([*who, variant.key, variant.template, part.label, part.name,
-                              _csv_value(part), part.unit, part.points, _tolerance_text(part.tolerance, part.unit),
-                              given] for part in variant.answers)
-    return stream.getvalue()
+    def rows() -> Iterator[Sequence[object]]:
+        yield ["student_id", "name", "section", "problem", "template", "label", "answer", "value", "unit", "points",
+               "tolerance", "parameters"]
+        for entry in generation.students:
+            student = entry.student
+            who = [safe_cell(student.id), safe_cell(student.name), safe_cell(student.section)]
+            for variant in entry.problems:
+                given = "; ".join(f"{name}={text}" for name, text in variant.printed.items())
+                yield from ([*who, variant.key, variant.template, part.label, part.name, _csv_value(part), part.unit,
+                             part.points, _tolerance_text(part.tolerance, part.unit), given]
+                            for part in variant.answers)
+
+    return csv_text(rows())
 
 
 def _csv_value(part: AnswerPart) -> float | str:

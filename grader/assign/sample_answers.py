@@ -21,8 +21,6 @@ answer deserves exactly one verdict.
 
 from __future__ import annotations
 
-import csv
-import io
 import math
 import re
 from collections.abc import Mapping, Sequence
@@ -34,6 +32,7 @@ import numpy as np
 from grader.assign.assignment import Assignment
 from grader.assign.variants import AnswerPart, Generation, printed_text, variant_generator
 from grader.bank.template import Template
+from grader.base.spreadsheet import csv_text
 from grader.solve.alternatives import carries_forward, values
 from grader.solve.cache import alternatives_for
 
@@ -118,11 +117,7 @@ def sample_answers(assignment: Assignment, generation: Generation,
 
 def submissions_csv(answers: Sequence[SampleAnswer]) -> str:
     """The long-format file ``grader grade`` reads: ``student_id,label,answer,timestamp``."""
-    stream = io.StringIO()
-    writer = csv.writer(stream, lineterminator="\n")
-    writer.writerow(HEADER)
-    writer.writerows((a.student_id, a.label, a.text, a.timestamp) for a in answers)
-    return stream.getvalue()
+    return csv_text([HEADER, *((a.student_id, a.label, a.text, a.timestamp) for a in answers)])
 
 
 def student_style(expression: str) -> str:

@@ -29,7 +29,7 @@ import numpy as np
 from grader.assign.assignment import Assignment, ProblemSpec, Student
 from grader.assign.fair import Fair, fair_tolerances
 from grader.bank.template import Parameter, Template
-from grader.errors import GraderError
+from grader.base.errors import GraderError
 from grader.model.expr import Sym
 from grader.model.tolerance import Tolerance
 from grader.solve.cache import compiled_for, routes_for

@@ -14,8 +14,8 @@ import re
 from collections.abc import Sequence
 from pathlib import Path
 
-from grader.errors import CONTROL, GraderError, UsageError
-from grader.resources import bank_dir
+from grader.base.errors import CONTROL, GraderError, UsageError
+from grader.base.resources import bank_dir
 
 TOPICS = ("direct impact", "oblique impact", "drops and rebounds", "impact and a swing", "impact and sliding",
           "impact with flight")

@@ -26,15 +26,15 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from grader.bank.folders import NAME, TEMPLATE_ID, TOPICS, bank_folders, one_line, template_files
-from grader.caching import PACKAGE, entry, read_entry, source_fingerprint, write_entry
-from grader.errors import GraderError
-from grader.inputs import YAML_BYTES, read_bytes
+from grader.base.caching import PACKAGE, entry, read_entry, source_fingerprint, write_entry
+from grader.base.errors import GraderError
+from grader.base.inputs import YAML_BYTES, read_bytes
 
 if TYPE_CHECKING:
     from grader.bank.template import Template
 
 FORMAT = 1
-SOURCES = ("model", "physics", "bank", "errors.py", "inputs.py", "resources.py", "yaml_loader.py")
+SOURCES = ("model", "physics", "bank", "base/errors.py", "base/inputs.py", "base/resources.py", "base/yaml_loader.py")
 """Everything reading and checking a template runs (a test walks the imports to see that it is all here)."""
 LIBRARIES = ("yaml", "jinja2")
 

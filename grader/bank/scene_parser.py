@@ -13,7 +13,7 @@ from collections.abc import Mapping
 from typing import Any
 
 from grader.bank.folders import NAME
-from grader.errors import ExpressionError, TemplateError, shown
+from grader.base.errors import ExpressionError, TemplateError, shown
 from grader.model.expr import Node, names, parse
 from grader.model.scene import Body, Gravity, Scene, Stage, Velocity
 from grader.physics.effects import CATALOGUE, Effect, Field

@@ -19,14 +19,14 @@ from typing import Any
 
 from grader.bank.folders import NAME, TEMPLATE_ID, TOPICS, bank_folders, one_line, template_files
 from grader.bank.scene_parser import parse_scene
-from grader.errors import ExpressionError, GraderError, TemplateError, shown
-from grader.inputs import YAML_BYTES, parse_yaml, read_bytes
+from grader.base.errors import ExpressionError, GraderError, TemplateError, shown
+from grader.base.inputs import YAML_BYTES, parse_yaml, read_bytes
+from grader.base.resources import bank_dir
 from grader.model.expr import Node, Num, Op, Sym, names, parse, to_text
 from grader.model.scene import Gravity, Scene
 from grader.model.tolerance import Tolerance, ToleranceError
 from grader.model.units import LENGTH, MASS, Dimension, Unit, dimension_from, dimension_name, dimension_of, parse_unit
 from grader.physics.effects import CATALOGUE
-from grader.resources import bank_dir
 
 RESERVED = {"g", "pi"}
 _BOUND = r"(-?inf|[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)"

@@ -46,12 +46,12 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from grader.errors import GraderError, shown
-from grader.files import shown_path
+from grader.base.errors import GraderError, shown
+from grader.base.files import shown_path
+from grader.base.inputs import CsvRow, CsvStream, open_csv
 from grader.grade.columns import EMAIL, normalized
 from grader.grade.key import Key
 from grader.grade.submissions import TEST_STUDENTS, Roster, RowProblem, StudentRef
-from grader.inputs import CsvRow, CsvStream, open_csv
 
 STUDENT_COLUMNS = ("Student", "LastName", "FirstName", "ID", "SIS User ID", "SIS Login ID", "Integration ID",
                    "Root Account", "Section")  # in the order Canvas' import reads them

@@ -26,9 +26,9 @@ import re
 from collections.abc import Sequence
 from dataclasses import dataclass
 
+from grader.base.inputs import CELL_CHARS
 from grader.grade.notation import ReadError, check_powers, cut, listed, tree_of, uses_a_name, value_of
 from grader.grade.quantities import MAX_POWER, UnitMismatchError, UnknownUnitError, unit_factor, unit_factors
-from grader.inputs import CELL_CHARS
 from grader.model.expr import Node, to_text
 
 MAX_CELL = CELL_CHARS

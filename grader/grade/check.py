@@ -22,7 +22,7 @@ from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
-from grader.errors import GraderError, UsageError, shown
+from grader.base.errors import GraderError, UsageError, shown
 from grader.grade.cells import MAX_CELL
 from grader.grade.diagnosis import Physics
 from grader.grade.grading import Request, Verdict, grade_part, grade_parts
@@ -314,7 +314,7 @@ def domains(texts: Sequence[str]) -> dict[str, tuple[float, float]]:
     >>> domains(["p=0.1:10", "p=1:2"])
     Traceback (most recent call last):
     ...
-    grader.errors.UsageError: --domain p=1:2: p's domain is already given (--domain p=0.1:10); give each name once
+    grader.base.errors.UsageError: --domain p=1:2: p's domain is already given (--domain p=0.1:10); give each name once
     """
     found: dict[str, tuple[float, float]] = {}
     given: dict[str, str] = {}

@@ -15,8 +15,8 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Literal
 
-from grader.errors import GraderError, shown
-from grader.inputs import CsvStream
+from grader.base.errors import GraderError, shown
+from grader.base.inputs import CsvStream
 
 STUDENT = ("student id", "id", "sid", "sis user id", "username")  # "student_id" reads as "student id"
 EMAIL = ("email", "email address")

@@ -32,7 +32,7 @@ from fractions import Fraction
 import numpy as np
 from numpy.typing import ArrayLike
 
-from grader.errors import shown
+from grader.base.errors import shown
 from grader.model.tolerance import Tolerance, with_unit
 
 LARGEST = float(np.finfo(np.float64).max)

@@ -25,11 +25,11 @@ from pathlib import Path
 import numpy as np
 
 from grader.bank.template import Template, load_template
-from grader.errors import GraderError
+from grader.base.errors import GraderError
+from grader.base.resources import bank_dir
 from grader.grade.compare import is_correct, number_text
 from grader.grade.key import Key, KeyProblem
 from grader.model.tolerance import Tolerance, with_unit
-from grader.resources import bank_dir
 from grader.solve.alternatives import Alternative, Alternatives, carries_forward, values
 from grader.solve.cache import alternatives_for
 

@@ -30,10 +30,10 @@ from grader.grade.cells import (
 )
 from grader.grade.compare import errors, feedbacks, is_correct, number_text
 from grader.grade.diagnosis import Earlier, Physics, ProblemPhysics, physics_for, reconsider
+from grader.grade.equivalence import equivalent, refused
 from grader.grade.key import Key, KeyPart
 from grader.grade.notation import cut
 from grader.grade.submissions import Answer, RowProblem, Submissions
-from grader.grade.symbolic import equivalent, refused
 from grader.model.tolerance import Tolerance
 
 VERDICTS = ("correct", "ecf", "mistake", "incorrect", "invalid", "missing")

@@ -1,5 +1,5 @@
 """Whether two expressions are identical, shown by sympy within a time bound: the exact check behind
-:func:`grader.grade.symbolic.equivalent`. The sympy expressions are built from our trees node by node; no
+:func:`grader.grade.equivalence.equivalent`. The sympy expressions are built from our trees node by node; no
 text, least of all a student's, is parsed.
 
 >>> from grader.model.expr import parse

@@ -37,9 +37,9 @@ from typing import Any, TypeVar
 import numpy as np
 
 from grader.assign.assignment import MAX_POINTS, Grading, grading_from
-from grader.errors import GraderError, TemplateError, shown
+from grader.base.errors import GraderError, TemplateError, shown
+from grader.base.inputs import CELL_CHARS, decode_text, read_bytes
 from grader.grade.notation import ReadError, check_powers
-from grader.inputs import CELL_CHARS, decode_text, read_bytes
 from grader.model.expr import names, parse
 from grader.model.tolerance import Tolerance
 from grader.model.units import parse_unit
@@ -195,7 +195,7 @@ def _refuse_lone_surrogates(raw: Any, where: str) -> None:
     >>> _refuse_lone_surrogates({"students": [{"name": "Ana \ud800"}]}, "k.json")
     Traceback (most recent call last):
     ...
-    grader.errors.GraderError: k.json: students[0].name: expected text, got half of a character ('\ud800'); ...
+    grader.base.errors.GraderError: k.json: students[0].name: expected text, got half of a character ('\ud800'); ...
     """
     stack: list[tuple[str, Any]] = [("", raw)]
     while stack:

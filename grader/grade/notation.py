@@ -20,7 +20,7 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 
-from grader.errors import ExpressionError
+from grader.base.errors import ExpressionError
 from grader.model.expr import CONSTANTS, FUNCTIONS, MAX_EXPONENT, Node, Num, Op, Sym, names, parse, to_text
 from grader.model.kernel import OPERATIONS
 

@@ -28,7 +28,7 @@ import functools
 import re
 from typing import Any
 
-from grader.errors import GraderError
+from grader.base.errors import GraderError
 from grader.model.expr import CONSTANTS, FUNCTIONS
 
 MAX_UNIT_TEXT = 40

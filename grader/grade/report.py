@@ -1,25 +1,23 @@
 """The files a grading run writes: ``grades.csv``, ``details.csv``, ``problems.csv``, ``canvas.csv``, and
 the class report ``report.html`` (:mod:`grader.grade.class_report`).
 
-Every text cell is guarded against formula injection (:func:`grader.assign.keyfile.safe_cell`), and
+Every text cell is guarded against formula injection (:func:`grader.base.spreadsheet.safe_cell`), and
 what came from a student or an input file shows its control characters as escapes
-(:func:`grader.errors.visible`: an escape sequence a student typed is not run by the terminal that
+(:func:`grader.base.errors.visible`: an escape sequence a student typed is not run by the terminal that
 prints the file); numbers stay numbers and are never NaN or infinite. Rows come in the key's order, so two runs on
 the same inputs give byte-identical files.
 """
 
 from __future__ import annotations
 
-import csv
-import io
 import itertools
 import math
 from collections.abc import Iterable, Iterator, Sequence
 from pathlib import Path
 
-from grader.assign.keyfile import safe_cell
-from grader.errors import visible
-from grader.files import write_atomic
+from grader.base.errors import visible
+from grader.base.files import write_atomic
+from grader.base.spreadsheet import csv_pieces, safe_cell
 from grader.grade.canvas import CanvasExport
 from grader.grade.class_report import REPORT, class_report
 from grader.grade.grading import Graded, totals
@@ -59,27 +57,24 @@ def details_csv(graded: Graded, students_per_piece: int = 2000) -> Iterator[str]
 
     Each cell is what :func:`_cell` makes of the verdict's field (the loop knows the field's type).
     """
-    stream = io.StringIO()
-    writer = csv.writer(stream, lineterminator="\n")
-    writer.writerow(DETAILS_HEADER)
     columns = [(safe_cell(label), graded.columns[label]) for label in graded.key.labels]
     numbers = _Cells()  # credits, points and scores: a few values
     words = _Cells()  # verdicts, units, tolerances: a few texts
-    for index, student in enumerate(graded.key.students):
-        who = safe_cell(student.id)
-        for label, rows in columns:
-            (submitted, verdict, credit, points, expected, parsed, unit, abs_error, rel_error, tolerance, feedback,
-             diagnosis, source) = rows[index]
-            writer.writerow((who, label, "" if submitted is None else safe_cell(visible(submitted)), words[verdict],
-                             numbers[credit], numbers[points], numbers[credit * points], safe_cell(expected),
-                             safe_cell(visible(parsed)), words[unit], "" if abs_error is None else _number(abs_error),
-                             "" if rel_error is None else _number(rel_error), words[tolerance],
-                             safe_cell(visible(feedback)), words[diagnosis], safe_cell(visible(source))))
-        if index % students_per_piece == students_per_piece - 1:
-            yield stream.getvalue()
-            stream.seek(0)
-            stream.truncate()
-    yield stream.getvalue()
+
+    def rows() -> Iterator[Sequence[object]]:
+        yield DETAILS_HEADER
+        for index, student in enumerate(graded.key.students):
+            who = safe_cell(student.id)
+            for label, verdicts in columns:
+                (submitted, verdict, credit, points, expected, parsed, unit, abs_error, rel_error, tolerance, feedback,
+                 diagnosis, source) = verdicts[index]
+                yield (who, label, "" if submitted is None else safe_cell(visible(submitted)), words[verdict],
+                       numbers[credit], numbers[points], numbers[credit * points], safe_cell(expected),
+                       safe_cell(visible(parsed)), words[unit], "" if abs_error is None else _number(abs_error),
+                       "" if rel_error is None else _number(rel_error), words[tolerance], safe_cell(visible(feedback)),
+                       words[diagnosis], safe_cell(visible(source)))
+
+    return csv_pieces(rows(), students_per_piece * max(1, len(columns)))
 
 
 def problems_csv(graded: Graded, export: CanvasExport | None = None) -> Iterator[str]:
@@ -114,18 +109,9 @@ def _csv(rows: Iterable[Sequence[object]]) -> str:
     return "".join(_csv_pieces(rows))
 
 
-def _csv_pieces(rows: Iterable[Sequence[object]], rows_per_piece: int = 2000) -> Iterator[str]:
-    """The CSV text of ``rows`` in pieces of ``rows_per_piece`` rows, to be written as they come: the
-    whole text of a big file would be held twice (its writer's buffer and the text)."""
-    stream = io.StringIO()
-    writer = csv.writer(stream, lineterminator="\n")
-    for count, row in enumerate(rows, 1):
-        writer.writerow([_cell(value) for value in row])
-        if count % rows_per_piece == 0:
-            yield stream.getvalue()
-            stream.seek(0)
-            stream.truncate()
-    yield stream.getvalue()
+def _csv_pieces(rows: Iterable[Sequence[object]]) -> Iterator[str]:
+    """The CSV text of ``rows``, each value a report's cell (:func:`_cell`), in pieces written as they come."""
+    return csv_pieces([_cell(value) for value in row] for row in rows)
 
 
 def _cell(value: object) -> str:

@@ -2,7 +2,7 @@
 
 ``--out`` is checked first (a folder that would be refused is refused before a minute of grading), then
 the inputs are read and checked; the outputs are written into a work folder beside ``--out`` and moved
-into place at the end (:func:`grader.files.output_folder`), so an unusable input or a failure leaves
+into place at the end (:func:`grader.base.files.output_folder`), so an unusable input or a failure leaves
 nothing behind and a previous output untouched.
 """
 
@@ -16,14 +16,14 @@ from pathlib import Path
 from typing import Literal
 
 from grader.bank.template import Template
-from grader.files import output_folder, write_manifest
+from grader.base.files import output_folder, write_manifest
+from grader.base.heap import collector_paused
 from grader.grade.canvas import CanvasExport, read_export
 from grader.grade.diagnosis import physics_for
 from grader.grade.grading import Graded, counts, grade
 from grader.grade.key import Key, load_key
 from grader.grade.report import write_reports
 from grader.grade.submissions import StudentRef, read_submissions
-from grader.heap import collector_paused
 
 COMMAND = "grader grade"
 

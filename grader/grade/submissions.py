@@ -46,8 +46,9 @@ from functools import lru_cache
 from pathlib import Path
 from typing import Literal
 
-from grader.errors import GraderError, shown
-from grader.files import shown_path
+from grader.base.errors import GraderError, shown
+from grader.base.files import shown_path
+from grader.base.inputs import CELL_CHARS, CsvRow, CsvStream, open_csv
 from grader.grade import timestamps
 from grader.grade.columns import Layout, find_layout
 from grader.grade.latest import Answer, Contests, SubmittedRow
@@ -66,7 +67,6 @@ from grader.grade.row_problems import (
     RowProblem,
 )
 from grader.grade.timestamps import instant, read_timestamp
-from grader.inputs import CELL_CHARS, CsvRow, CsvStream, open_csv
 
 __all__ = ["Answer", "RowProblem", "StudentRef", "Submissions", "find_label", "read_submissions"]
 

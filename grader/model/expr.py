@@ -14,7 +14,7 @@ parsed with Python's ``ast`` and an allow-list; nothing is ever passed to ``eval
 >>> parse("__import__('os')")  # doctest: +ELLIPSIS
 Traceback (most recent call last):
 ...
-grader.errors.ExpressionError: '__import__' is not an allowed function (allowed: Max, Min, abs, ...)
+grader.base.errors.ExpressionError: '__import__' is not an allowed function (allowed: Max, Min, abs, ...)
 """
 
 from __future__ import annotations
@@ -25,7 +25,7 @@ from dataclasses import dataclass
 from fractions import Fraction
 from typing import Any
 
-from grader.errors import ExpressionError
+from grader.base.errors import ExpressionError
 
 MAX_LENGTH = 500
 MAX_DEPTH = 40

@@ -18,7 +18,7 @@ from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
 from typing import Any, Literal
 
-from grader.errors import GraderError, shown
+from grader.base.errors import GraderError, shown
 
 Mode = Literal["rtol", "sigfigs", "decimals"]
 MODES: tuple[Mode, ...] = ("rtol", "sigfigs", "decimals")

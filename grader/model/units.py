@@ -12,7 +12,7 @@ True
 >>> parse_unit("furlong")  # doctest: +ELLIPSIS
 Traceback (most recent call last):
 ...
-grader.errors.GraderError: unknown unit 'furlong' in 'furlong' (known: %, cm, deg, ft, g, ...)
+grader.base.errors.GraderError: unknown unit 'furlong' in 'furlong' (known: %, cm, deg, ft, g, ...)
 """
 
 from __future__ import annotations
@@ -23,7 +23,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from fractions import Fraction
 
-from grader.errors import GraderError
+from grader.base.errors import GraderError
 from grader.model.expr import Node, Num, Op, Sym
 
 Dimension = tuple[Fraction, Fraction, Fraction, Fraction]
@@ -165,11 +165,11 @@ def dimension_of(node: Node, known: Mapping[str, Dimension]) -> Dimension | None
     >>> dimension_of(parse("h + m"), {"h": LENGTH, "m": MASS})
     Traceback (most recent call last):
     ...
-    grader.errors.GraderError: adds a length to a mass
+    grader.base.errors.GraderError: adds a length to a mass
     >>> dimension_of(parse("h**h"), {"h": LENGTH})
     Traceback (most recent call last):
     ...
-    grader.errors.GraderError: raises to a power that is a length
+    grader.base.errors.GraderError: raises to a power that is a length
     """
     if isinstance(node, Num):
         return PURE

@@ -29,7 +29,7 @@ from typing import Any
 
 import numpy as np
 
-from grader.errors import GraderError
+from grader.base.errors import GraderError
 
 METHODS = ("euler", "rk4", "adaptive")
 # rk4 reaches rounding (1e-16) at about 10,000 steps per contact, and Euler's first-order error

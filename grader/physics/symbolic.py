@@ -20,7 +20,7 @@ from typing import Any
 
 import sympy as sp
 
-from grader.errors import TemplateError
+from grader.base.errors import TemplateError
 from grader.model.expr import FUNCTIONS, Node, Num, Op, Sym, parse  # noqa: F401  (parse: doctest)
 from grader.model.scene import Scene, Stage
 from grader.model.units import Unit

@@ -34,24 +34,14 @@ from grader.assign.assignment import Assignment, Student
 from grader.assign.variants import AnswerPart, Generation, ProblemVariant, tolerance
 from grader.bank.markup import paragraphs
 from grader.bank.template import Template, filled_statement
-from grader.errors import GraderError
+from grader.base.errors import GraderError
+from grader.base.resources import templates_dir
 from grader.model.tolerance import Tolerance, widening
 from grader.render.figures import figure
 from grader.render.typeset import compile_typst, font_paths
-from grader.render.worked import (
-    Typ,
-    Worked,
-    WorkedForm,
-    WorkedStep,
-    answer_math,
-    math,
-    name,
-    string,
-    text,
-    worked,
-    worked_form,
-)
-from grader.resources import templates_dir
+from grader.render.typst_math import math, name
+from grader.render.typst_text import Typ, string, text
+from grader.render.worked import Worked, WorkedForm, WorkedStep, answer_math, worked, worked_form
 from grader.solve.cache import compiled_for
 from grader.solve.compiled import Compiled
 

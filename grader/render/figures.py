@@ -31,7 +31,7 @@ The kind of figure follows from the scene's structure, never from the template's
 * anything else: the bodies in a row, labelled.
 
 The oblique figures are :mod:`grader.render.oblique`'s, the drawing primitives
-:class:`grader.render.canvas.Canvas`'s.
+:class:`grader.render.drawing.Drawing`'s.
 """
 
 from __future__ import annotations
@@ -43,14 +43,14 @@ from grader.assign.variants import ProblemVariant
 from grader.bank.template import Template
 from grader.model.expr import Node, Op
 from grader.model.scene import Stage, Velocity
-from grader.render.canvas import Canvas, Point
+from grader.render.drawing import Drawing, Point
 from grader.render.oblique import incline, offset_spheres, spheres, surface
 from grader.render.pendulum import swing_figure
 from grader.render.scene_view import SceneView, find_stage
 from grader.render.series import bounce_series
 from grader.render.skid import skid
 from grader.render.trajectory import trajectory
-from grader.render.worked import Typ, string
+from grader.render.typst_text import Typ, string
 
 STAGE_FIGURES: Mapping[str, str] = {
     "free_fall": "the body at its drop height above what it falls onto (the ground, a fixed floor, a driven plate "
@@ -89,7 +89,7 @@ def figure(template: Template, variant: ProblemVariant, values: Mapping[str, flo
     scene = SceneView(template, variant, values)
     stages = template.scene.stages
     impact = find_stage(stages, "impact")
-    canvas = Canvas()
+    canvas = Drawing()
     bounces, swing = find_stage(stages, "bounces"), find_stage(stages, "swing")
     if bounces is not None and bounce_series(canvas, scene, bounces):
         return canvas.typst()
@@ -98,7 +98,7 @@ def figure(template: Template, variant: ProblemVariant, values: Mapping[str, flo
     if impact is None:
         fall = find_stage(stages, "free_fall")
         if fall is None or not _drop(canvas, scene, fall, None, None):
-            canvas = Canvas()
+            canvas = Drawing()
             _row(canvas, scene)
         return canvas.typst()
     flight = find_stage(stages, "flight", before=impact.index)
@@ -129,14 +129,14 @@ def figure(template: Template, variant: ProblemVariant, values: Mapping[str, flo
     else:
         drawn = _direct(canvas, scene, [s for s in stages if s.effect == "impact" and not s.is_oblique])
     if not drawn:
-        canvas = Canvas()
+        canvas = Drawing()
         _row(canvas, scene)
     return canvas.typst()
 
 
 # --- the figures --------------------------------------------------------------------------------
 
-def _drop(canvas: Canvas, scene: SceneView, fall: Stage, impact: Stage | None, rise: Stage | None) -> bool:
+def _drop(canvas: Drawing, scene: SceneView, fall: Stage, impact: Stage | None, rise: Stage | None) -> bool:
     """A body at its drop height above a floor or a pile (or the ground, without an impact), and
     dashed at its rebound height."""
     first = fall.fields["body"]
@@ -189,7 +189,7 @@ def _drop(canvas: Canvas, scene: SceneView, fall: Stage, impact: Stage | None, r
     return True
 
 
-def _vertical_velocity(canvas: Canvas, scene: SceneView, at: Point, upward: float, given: Node) -> None:
+def _vertical_velocity(canvas: Drawing, scene: SceneView, at: Point, upward: float, given: Node) -> None:
     """An arrow through ``at`` the way a surface moves (up or down), labelled with what gives its velocity."""
     if not _m.isfinite(upward) or upward == 0:
         canvas.label(at, "w", [*scene.given(_parameter_of(given)), "(at rest)"])
@@ -205,7 +205,7 @@ def _parameter_of(node: Node) -> Node:
     return node.args[0] if isinstance(node, Op) and node.op == "neg" else node
 
 
-def _bounces(canvas: Canvas, scene: SceneView, fall: Stage, rises: Sequence[Stage], surface: str) -> bool:
+def _bounces(canvas: Drawing, scene: SceneView, fall: Stage, rises: Sequence[Stage], surface: str) -> bool:
     """A body dropped onto a fixed surface and rebounding again and again: its path as arcs, the
     given heights to scale, an asked one drawn (not to scale) and labelled with its name only."""
     first = fall.fields["body"]
@@ -250,7 +250,7 @@ def _line_of_bodies(impacts: Sequence[Stage]) -> list[str]:
     return order
 
 
-def _direct(canvas: Canvas, scene: SceneView, impacts: Sequence[Stage]) -> bool:
+def _direct(canvas: Drawing, scene: SceneView, impacts: Sequence[Stage]) -> bool:
     """Bodies on a line in the order they are struck, blocks whose areas follow the masses (a fixed
     one a wall); above each its velocity before it is first struck, an arrow the way it moves with
     lengths in the ratio of the speeds, or ``v = 0``."""
@@ -286,7 +286,7 @@ def _direct(canvas: Canvas, scene: SceneView, impacts: Sequence[Stage]) -> bool:
     return True
 
 
-def _horizontal_velocity(canvas: Canvas, scene: SceneView, at: Point, velocity: Velocity | None,
+def _horizontal_velocity(canvas: Drawing, scene: SceneView, at: Point, velocity: Velocity | None,
                          fastest: float) -> None:
     """Above a body: an arrow centred on ``at`` the way it moves, 1.6 cm for the fastest body of the
     figure (at least 0.5 cm), labelled with its velocity as given; ``v = 0`` for a body at rest."""
@@ -300,7 +300,7 @@ def _horizontal_velocity(canvas: Canvas, scene: SceneView, at: Point, velocity: 
     canvas.label((at[0], at[1] + 0.2), "s", scene.given(given))
 
 
-def _row(canvas: Canvas, scene: SceneView) -> None:
+def _row(canvas: Drawing, scene: SceneView) -> None:
     """Bodies side by side, named, with their masses: the figure of a scene of no known kind."""
     x = 0.0
     for body in scene.template.scene.bodies:

@@ -2,7 +2,7 @@
 :mod:`grader.demo`).
 
 Everything is written into a work folder beside the output and moved into place at the end, with a
-manifest of what was written (:func:`grader.files.output_folder`): a failed run leaves nothing behind,
+manifest of what was written (:func:`grader.base.files.output_folder`): a failed run leaves nothing behind,
 a previous output stays untouched, and ``--force`` replaces only what an earlier run of ``grader generate`` wrote.
 """
 
@@ -20,8 +20,8 @@ from grader.assign.assignment import Assignment, Student, check_against_bank, lo
 from grader.assign.keyfile import key_csv, key_document, key_json
 from grader.assign.variants import Generation, generate
 from grader.bank.template import Template
-from grader.files import output_folder, write_atomic
-from grader.heap import collector_paused
+from grader.base.files import output_folder, write_atomic
+from grader.base.heap import collector_paused
 
 
 @dataclass(frozen=True)

@@ -8,12 +8,12 @@ import math as _m
 from collections.abc import Sequence
 
 from grader.model.scene import Stage, Velocity
-from grader.render.canvas import Canvas, Point
+from grader.render.drawing import Drawing, Point
 from grader.render.scene_view import SceneView, find_stage, velocity_stage
-from grader.render.worked import string
+from grader.render.typst_text import string
 
 
-def _axes(canvas: Canvas, origin: Point, n: Point, t: Point) -> None:
+def _axes(canvas: Drawing, origin: Point, n: Point, t: Point) -> None:
     """A small n-t axis glyph."""
     for direction, label in ((n, "n"), (t, "t")):
         tip = (origin[0] + 0.6 * direction[0], origin[1] + 0.6 * direction[1])
@@ -36,7 +36,7 @@ def _axis(stage: Stage, n: Point, t: Point) -> Point:
     return t if stage.fields.get("from", "t") == "t" else n
 
 
-def _angle_mark(canvas: Canvas, center: Point, ray: Point, axes: Sequence[Point], radius: float,
+def _angle_mark(canvas: Drawing, center: Point, ray: Point, axes: Sequence[Point], radius: float,
                 lines: Sequence[str]) -> None:
     """The arc between ``ray`` and the nearest of ``axes``, labelled outside it."""
     axis = _nearest_axis(ray, axes)
@@ -58,7 +58,7 @@ def _angle_mark(canvas: Canvas, center: Point, ray: Point, axes: Sequence[Point]
             return
 
 
-def _speed_mark(canvas: Canvas, tail: Point, tip: Point, away: Point, lines: Sequence[str],
+def _speed_mark(canvas: Drawing, tail: Point, tip: Point, away: Point, lines: Sequence[str],
                 along: float = 0.5) -> None:
     """An arrow's label beside it (``along``: where, from the tail), on the side of ``away``."""
     dx, dy = tip[0] - tail[0], tip[1] - tail[1]
@@ -88,7 +88,7 @@ def _angle_label(scene: SceneView, stage: Stage | None) -> list[str]:
     return scene.given(stage.fields["angle"]) if stage is not None else []
 
 
-def surface(canvas: Canvas, scene: SceneView, impact: Stage) -> bool:
+def surface(canvas: Drawing, scene: SceneView, impact: Stage) -> bool:
     """A body striking a fixed surface obliquely: incoming and rebound velocities to scale."""
     first = impact.fields["bodies"][0]
     before = impact.fields["before"].get(first)
@@ -128,7 +128,7 @@ def surface(canvas: Canvas, scene: SceneView, impact: Stage) -> bool:
     return True
 
 
-def spheres(canvas: Canvas, scene: SceneView, impact: Stage) -> bool:
+def spheres(canvas: Drawing, scene: SceneView, impact: Stage) -> bool:
     """Two touching spheres, the line of centres n and the tangent t, the incoming velocity."""
     first, second = impact.fields["bodies"]
     radius = 0.85
@@ -162,7 +162,7 @@ def spheres(canvas: Canvas, scene: SceneView, impact: Stage) -> bool:
     return True
 
 
-def incline(canvas: Canvas, scene: SceneView, impact: Stage) -> bool:
+def incline(canvas: Drawing, scene: SceneView, impact: Stage) -> bool:
     """A body dropped onto a fixed incline: the incline at its angle (the body arrives straight down, so
     the angle its velocity makes with n is the incline's), the body at the drop height above the point
     of impact, and its rebound velocity with the angle to the surface, drawn but not to scale (the
@@ -216,7 +216,7 @@ def incline(canvas: Canvas, scene: SceneView, impact: Stage) -> bool:
     return True
 
 
-def offset_spheres(canvas: Canvas, scene: SceneView, geometry: Stage, impact: Stage) -> bool:
+def offset_spheres(canvas: Drawing, scene: SceneView, geometry: Stage, impact: Stage) -> bool:
     """Two spheres at contact, the line of centres to scale: sphere 1 on its line of travel, sphere 2's
     centre the offset from it (dimensioned), the line of centres n at its angle to the velocity and the
     tangent t. Radii in their ratio, neither drawn below a fifth of their sum (the angle stays exact)."""

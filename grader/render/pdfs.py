@@ -25,7 +25,7 @@ from pathlib import Path
 from grader.assign.assignment import Assignment
 from grader.assign.variants import Generation
 from grader.bank.template import Template
-from grader.errors import GraderError
+from grader.base.errors import GraderError
 from grader.render.documents import (
     Documents,
     check_statements,
@@ -37,7 +37,7 @@ from grader.render.documents import (
 )
 from grader.render.joining import Part, join, read_part
 from grader.render.typeset import compile_typst, font_paths, one_pdf, release_memory
-from grader.render.worked import Typ
+from grader.render.typst_text import Typ
 
 STUDENTS_PER_PART = 4  # of the key: about 16 pages, some 25 MiB of Typst's memo while it compiles
 ROWS_PER_PART = 50  # of a table of answers at a glance: a page or two, some 15 MiB

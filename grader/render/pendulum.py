@@ -12,15 +12,16 @@ from __future__ import annotations
 import math as _m
 
 from grader.model.scene import Stage
-from grader.render.canvas import Canvas
+from grader.render.drawing import Drawing
 from grader.render.scene_view import SceneView
-from grader.render.worked import math, string
+from grader.render.typst_math import math
+from grader.render.typst_text import string
 
 CORD = 3.6  # cm: the cord's length on the page
 HALF_WIDTH, HALF_HEIGHT = 0.42, 0.3  # cm: the block hanging from it
 
 
-def swing_figure(canvas: Canvas, scene: SceneView, swing: Stage, impact: Stage | None) -> bool:
+def swing_figure(canvas: Drawing, scene: SceneView, swing: Stage, impact: Stage | None) -> bool:
     """The pivot, the cord at rest and at its greatest angle, the arc between, and the striking body;
     False when the angle cannot be drawn."""
     body = swing.fields["body"]
@@ -54,7 +55,7 @@ def swing_figure(canvas: Canvas, scene: SceneView, swing: Stage, impact: Stage |
     return True
 
 
-def _striker(canvas: Canvas, scene: SceneView, impact: Stage, target: tuple[float, float]) -> None:
+def _striker(canvas: Drawing, scene: SceneView, impact: Stage, target: tuple[float, float]) -> None:
     """The first body of the impact, small, coming in from the left at the block's height."""
     first = impact.fields["bodies"][0]
     x = target[0] - HALF_WIDTH - 1.9

@@ -14,7 +14,8 @@ from grader.bank.template import Template
 from grader.model.expr import Node, Sym, names
 from grader.model.kernel import evaluate
 from grader.model.scene import Stage, Velocity
-from grader.render.worked import math, name, string
+from grader.render.typst_math import math, name
+from grader.render.typst_text import string
 
 
 @dataclass(frozen=True)

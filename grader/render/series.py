@@ -10,15 +10,16 @@ from __future__ import annotations
 import math as _m
 
 from grader.model.scene import Stage
-from grader.render.canvas import Canvas
+from grader.render.drawing import Drawing
 from grader.render.scene_view import SceneView
-from grader.render.worked import math, string
+from grader.render.typst_math import math
+from grader.render.typst_text import string
 
 TALL, WIDE = 3.8, 6.4  # cm: the drop height, and the time until the last arc drawn
 SMALLEST = 0.04  # arcs lower than this share of the drop height are left out (they would be a line)
 
 
-def bounce_series(canvas: Canvas, scene: SceneView, stage: Stage) -> bool:
+def bounce_series(canvas: Drawing, scene: SceneView, stage: Stage) -> bool:
     """The drop and the decaying arcs; False when the numbers cannot be drawn."""
     body, floor = stage.fields["bodies"]
     h0, e = scene.value(stage.fields["height"]), scene.value(stage.fields["restitution"])

@@ -10,9 +10,9 @@ from __future__ import annotations
 import math as _m
 
 from grader.model.scene import Stage
-from grader.render.canvas import Canvas
+from grader.render.drawing import Drawing
 from grader.render.scene_view import SceneView
-from grader.render.worked import string
+from grader.render.typst_text import string
 
 WIDTH = 6.0  # cm the road may take (the figure's column is 7.6 cm, labels included)
 CAR_LENGTH, CAR_MASS = 4.5, 1500.0  # m, kg: a typical car, what a car's drawn length is scaled from
@@ -30,7 +30,7 @@ def car_length(mass: float) -> float:
     return min(6.0, max(3.5, CAR_LENGTH * _m.cbrt(mass / CAR_MASS)))
 
 
-def skid(canvas: Canvas, scene: SceneView, impact: Stage, slide: Stage) -> bool:
+def skid(canvas: Drawing, scene: SceneView, impact: Stage, slide: Stage) -> bool:
     """The bodies of ``impact`` at the impact and at rest after ``slide``; False when it cannot be drawn."""
     first, second = impact.fields["bodies"]
     distance = scene.value(slide.fields["distance"])
@@ -76,7 +76,7 @@ def _body_height(scale: float) -> float:
     return max(0.35, 1.4 * scale)
 
 
-def _car(canvas: Canvas, x0: float, x1: float, road: float, height: float, dash: str | None) -> None:
+def _car(canvas: Drawing, x0: float, x1: float, road: float, height: float, dash: str | None) -> None:
     """A car from ``x0`` to ``x1`` on the road at height ``road``: a body ``height`` tall over two wheels."""
     wheel = 0.12
     canvas.rect((x0, road + 2 * wheel - 0.04), (x1, road + 2 * wheel - 0.04 + height), dash,
@@ -85,7 +85,7 @@ def _car(canvas: Canvas, x0: float, x1: float, road: float, height: float, dash:
         canvas.circle((x, road + wheel), wheel, dash, fill=dash is None)
 
 
-def horizontal_dimension(canvas: Canvas, x0: float, x1: float, y: float, lines: list[str]) -> None:
+def horizontal_dimension(canvas: Drawing, x0: float, x1: float, y: float, lines: list[str]) -> None:
     """A horizontal dimension line from ``x0`` to ``x1`` at height ``y``, labelled below."""
     middle = (x0 + x1) / 2
     if x1 - x0 > 0.6:

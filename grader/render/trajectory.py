@@ -12,10 +12,10 @@ from collections.abc import Sequence
 from itertools import pairwise
 
 from grader.model.scene import Stage
-from grader.render.canvas import Canvas, Point
+from grader.render.drawing import Drawing, Point
 from grader.render.scene_view import SceneView
 from grader.render.skid import horizontal_dimension
-from grader.render.worked import string
+from grader.render.typst_text import string
 
 WIDTH, HEIGHT = 5.6, 3.6  # cm the path may take at most
 
@@ -36,7 +36,7 @@ def _path(x0: float, direction: float, y0: float, vx: float, vy: float, g: float
              y0 + vy * duration * i / steps - g * (duration * i / steps) ** 2 / 2) for i in range(steps + 1)]
 
 
-def trajectory(canvas: Canvas, scene: SceneView, to_wall: Stage, to_ground: Stage | None) -> bool:
+def trajectory(canvas: Drawing, scene: SceneView, to_wall: Stage, to_ground: Stage | None) -> bool:
     """The flight ``to_wall`` (x toward the wall) and, after the rebound, ``to_ground`` (x away from it)."""
     g = scene.values.get("g", _m.nan)
     vx, vy, h0, distance = (scene.value(to_wall.fields[key]) for key in ("horizontal", "vertical", "height",
@@ -84,7 +84,7 @@ def trajectory(canvas: Canvas, scene: SceneView, to_wall: Stage, to_ground: Stag
     return True
 
 
-def _release(canvas: Canvas, scene: SceneView, stage: Stage, height: float, angle: float, corner: Point,
+def _release(canvas: Drawing, scene: SceneView, stage: Stage, height: float, angle: float, corner: Point,
              length: float) -> None:
     """The thrower's point at ``height`` (cm) above the ground, dimensioned, and the throw's velocity (an
     arrow ``length`` cm long), labelled beside it, or at ``corner`` (above the path) where the path leaves

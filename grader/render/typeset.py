@@ -24,8 +24,8 @@ from functools import lru_cache
 from pathlib import Path
 from typing import Any, Literal
 
-from grader.errors import GraderError, UsageError
-from grader.render.worked import text
+from grader.base.errors import GraderError, UsageError
+from grader.render.typst_text import text
 
 TIMESTAMP = 0  # the PDFs' creation date: fixed, so that output is reproducible
 

@@ -7,8 +7,8 @@ import io
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from grader.errors import GraderError
-from grader.files import write_atomic
+from grader.base.errors import GraderError
+from grader.base.files import write_atomic
 
 if TYPE_CHECKING:
     from grader.simulate.walker import Simulation

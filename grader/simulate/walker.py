@@ -26,12 +26,12 @@ from dataclasses import dataclass, field
 from scipy.optimize import brentq
 
 from grader.bank.template import Template
-from grader.errors import GraderError
+from grader.base.errors import GraderError
 from grader.model.expr import Sym, names, parse
 from grader.model.scene import Stage, Velocity
 from grader.physics.effects import CATALOGUE
 from grader.physics.integrate import MAX_STEPS, Budget, SimulationError
-from grader.physics.run import ContactRecord, Options, PhaseRecord, Run, UnknownQuantityError
+from grader.physics.record import ContactRecord, Options, PhaseRecord, Run, UnknownQuantityError
 
 
 @dataclass(frozen=True)

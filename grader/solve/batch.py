@@ -15,7 +15,7 @@ the one place the JSON object is laid out.
 >>> read_value("2.1 kg", template.parameters["h_drop"], "--set h_drop")
 Traceback (most recent call last):
 ...
-grader.errors.GraderError: --set h_drop: 'kg' cannot be converted to mm
+grader.base.errors.GraderError: --set h_drop: 'kg' cannot be converted to mm
 """
 
 from __future__ import annotations
@@ -30,8 +30,8 @@ from typing import Any
 import numpy as np
 
 from grader.bank.template import Parameter, Template
-from grader.errors import GraderError, UsageError, shown, some
-from grader.inputs import CsvColumns, read_csv_columns
+from grader.base.errors import GraderError, UsageError, shown, some
+from grader.base.inputs import CsvColumns, read_csv_columns
 from grader.model.units import MAX_TEXT, NUMBER, parse_unit, split_quantity
 from grader.solve.compiled import Compiled
 from grader.solve.evaluate import AnswerValue, Columns, answer_at

@@ -1,7 +1,7 @@
 """Compiled templates and their alternatives kept on disk, so only the first run of a template pays for sympy.
 
 The key is the template file's hash, the package version and a fingerprint of the solver's
-source: editing either recompiles. The folder is :func:`grader.caching.cache_dir`; if it cannot be
+source: editing either recompiles. The folder is :func:`grader.base.caching.cache_dir`; if it cannot be
 written, templates are compiled each run and nothing fails.
 
 The shipped bank's entries come with the package too (:data:`SHIPPED`, written by ``python -m
@@ -19,10 +19,10 @@ from functools import lru_cache
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Protocol, TypeVar
 
-from grader import caching
 from grader.bank.template import Template
-from grader.caching import cache_dir
-from grader.errors import GraderError
+from grader.base import caching
+from grader.base.caching import cache_dir
+from grader.base.errors import GraderError
 from grader.solve.compiled import FORMAT, Compiled
 
 if TYPE_CHECKING:  # each read where it is asked for: a warm `grader solve` needs neither

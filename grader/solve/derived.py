@@ -14,7 +14,7 @@ import numpy as np
 import sympy as sp
 
 from grader.bank.template import Template
-from grader.errors import TemplateError
+from grader.base.errors import TemplateError
 from grader.model.expr import Node, Num, Op, names
 from grader.model.kernel import evaluate
 from grader.physics.effects import CATALOGUE, Mistake, Relation

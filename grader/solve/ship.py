@@ -15,8 +15,8 @@ import sys
 from collections.abc import Callable, Iterable
 from typing import Any
 
-from grader import caching
 from grader.bank.template import Template, load_bank
+from grader.base import caching
 from grader.solve.cache import KINDS, SHIPPED, entry_name
 
 BUILD_COMMAND = "python -m grader.solve.ship"

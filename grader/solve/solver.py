@@ -22,7 +22,7 @@ from typing import Any
 import sympy as sp
 
 from grader.bank.template import Template
-from grader.errors import TemplateError, shown
+from grader.base.errors import TemplateError, shown
 from grader.model.expr import names
 from grader.model.units import Unit
 from grader.physics.effects import CATALOGUE, Relation

@@ -21,7 +21,7 @@ if TYPE_CHECKING:
     import sympy as sp
 
     from grader.model.scene import Stage
-    from grader.physics.run import Run
+    from grader.physics.record import Run
     from grader.physics.symbolic import Context
 
 

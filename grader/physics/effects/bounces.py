@@ -34,13 +34,13 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from grader.errors import TemplateError
+from grader.base.errors import TemplateError
 from grader.model.units import LENGTH, PURE, dimension_from
 from grader.physics.effects.base import Condition, Effect, Field, Mistake, Relation, Stable
 
 if TYPE_CHECKING:
     from grader.model.scene import Stage
-    from grader.physics.run import Run
+    from grader.physics.record import Run
     from grader.physics.symbolic import Context
 
 SIMULATED_BOUNCES = 5  # bounces simulated in time at least (more when the n-th is asked)

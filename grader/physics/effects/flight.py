@@ -20,7 +20,7 @@ from grader.physics.effects.base import Condition, Effect, Field, Mistake, Relat
 
 if TYPE_CHECKING:
     from grader.model.scene import Stage
-    from grader.physics.run import Run
+    from grader.physics.record import Run
     from grader.physics.symbolic import Context
 
 _FIELDS = (

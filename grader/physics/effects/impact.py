@@ -35,7 +35,7 @@ from grader.physics.effects.base import Condition, Effect, Field, Mistake, Relat
 
 if TYPE_CHECKING:
     from grader.model.scene import Stage
-    from grader.physics.run import Run
+    from grader.physics.record import Run
     from grader.physics.symbolic import Context
 
 
@@ -321,7 +321,7 @@ def simulate_contact(stage: Stage, run: Run, bodies: tuple[str, str], inverse: t
     under the law calibrated to ``e``; their velocities after, in the same order. Recorded under
     ``label`` (default: the impact of the two bodies)."""
     from grader.physics.integrate import Mode  # the simulator's part: loading a template needs none of it
-    from grader.physics.run import ContactRecord
+    from grader.physics.record import ContactRecord
 
     w1, w2 = inverse
     share1, share2 = w1 / (w1 + w2), w2 / (w1 + w2)

@@ -26,7 +26,7 @@ from grader.physics.effects.base import Condition, Effect, Field, Mistake, Relat
 
 if TYPE_CHECKING:
     from grader.model.scene import Stage
-    from grader.physics.run import Run
+    from grader.physics.record import Run
     from grader.physics.symbolic import Context
 
 _LAWS = ("sqrt(2 mu g d)", "sqrt(mu g d)", "sqrt(2 g d)", "2 mu g d")

@@ -17,7 +17,7 @@ import pytest
 from grader.grade import class_summary
 from grader.grade.class_report import INVALID_STUDENTS, class_report
 from grader.grade.class_summary import summarize
-from grader.grade.grading import Graded
+from grader.grade.grading import Graded, Row
 from grader.grade.key import Key, KeyPart, KeyProblem, KeyStudent, load_key
 from tests.demo_output import DemoRun
 
@@ -48,10 +48,10 @@ def make_class(verdicts: dict[str, Sequence[str]], params: Sequence[dict[str, fl
         for index, kind in enumerate(kinds):
             submitted = None if kind == "missing" else typed
             diagnosis = diagnoses[label][index] if diagnoses is not None else ""
-            rows.append((submitted, kind, CREDIT.get(kind, 0.0), 2.0, "1.5", "", "m/s", None, None, "±1 %",
-                         FEEDBACK.get(kind, kind), diagnosis, "a.csv:2"))
+            rows.append(Row(submitted, kind, CREDIT.get(kind, 0.0), 2.0, "1.5", "", "m/s", None, None, "±1 %",
+                            FEEDBACK.get(kind, kind), diagnosis, "a.csv:2"))
         columns[label] = rows
-    return Graded(key, columns, (), (), ())  # type: ignore[arg-type]  # rows of tests' own making
+    return Graded(key, columns, (), (), ())
 
 
 class Page(HTMLParser):
@@ -113,7 +113,7 @@ def test_a_kind_verdicts_does_not_name_is_still_counted_after_the_others() -> No
 
 def test_no_diagnosis_means_no_mistakes_listed() -> None:
     graded = make_class({"1a": ["incorrect", "ecf"]}, diagnoses={"1a": ["", "ecf:1a"]})
-    assert class_summary.diagnosis(graded.columns["1a"][0]) == ""
+    assert graded.columns["1a"][0].diagnosis == ""
     assert summarize(graded).parts[0].mistakes == ()
     assert "No answer was matched to a diagnosed mistake." in class_report(graded)
 

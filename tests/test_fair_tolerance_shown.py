@@ -191,8 +191,8 @@ def test_rules_widened_alike_for_different_reasons_are_compared_together() -> No
     key = Key("key.json", 2, "HW", True, (), ())
     column = _grade_column(cells, key)
     assert [indices for _, indices in column.wrong] == [[2]]  # one group: one comparison, one reconsideration
-    assert [row[9] for row in column.rows] == ["±2.7 %: by T", "±2.7 %: by v", "±2.7 %: by T"]
-    assert [row[1] for row in column.rows] == ["correct", "correct", "incorrect"]
+    assert [row.tolerance for row in column.rows] == ["±2.7 %: by T", "±2.7 %: by v", "±2.7 %: by T"]
+    assert [row.verdict for row in column.rows] == ["correct", "correct", "incorrect"]
 
 
 def test_the_class_report_counts_the_widened_per_part_and_gives_the_widest(widened_key: Path) -> None:

@@ -12,7 +12,8 @@ the same bytes.
 >>> part = KeyPart("1", "e", "1a", 0.5, "", 2.0, {"mode": "rtol", "rtol": 0.01, "atol": 0.0}, None, {})
 >>> key = Key("key.json", 2, "HW <1>", True, (KeyProblem("1", "Drop", ("1a",)),),
 ...           (KeyStudent("s1", "<script>alert(1)</script>", "", "1", {"1a": part}),))
->>> row = ("x", "invalid", 0.0, 2.0, "0.5", "", "", None, None, "±1 %", "could not read this answer: x", "a:2")
+>>> from grader.grade.grading import Row
+>>> row = Row("x", "invalid", 0.0, 2.0, "0.5", "", "", None, None, "±1 %", "could not read this answer: x", "", "a:2")
 >>> page = class_report(Graded(key, {"1a": [row]}, (), (), ()))
 >>> "&lt;script&gt;alert(1)&lt;/script&gt;" in page, "<script" in page, "HW &lt;1&gt;" in page
 (True, False, True)
@@ -37,7 +38,7 @@ from grader.grade.grading import Graded
 from grader.model.tolerance import Widening
 
 REPORT = "report.html"
-CELL_CHARS = 60  # of a typed answer shown in the report; details.csv has it whole
+SHOWN_CHARS = 60  # of a typed answer shown in the report; details.csv has it whole
 
 _STYLE = """
 :root { --ink: #222; --muted: #5f6b7a; --line: #dde2ea; --soft: #f5f7fa; --accent: #1f4e99; --warn: #c62828; }
@@ -280,4 +281,4 @@ def _range(low: float, high: float) -> str:
 
 
 def _cut(text: str) -> str:
-    return text if len(text) <= CELL_CHARS else text[:CELL_CHARS - 1] + "…"
+    return text if len(text) <= SHOWN_CHARS else text[:SHOWN_CHARS - 1] + "…"

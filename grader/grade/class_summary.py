@@ -14,7 +14,8 @@ generically: every kind of :data:`~grader.grade.grading.VERDICTS` is counted, in
 ...     part = KeyPart("1", "e", "1a", 0.5, "", 2.0, tol, None, {})
 ...     return KeyStudent(id, f"Student {id}", "", "1", {"1a": part}, (("1", "h"),), (e,))
 >>> key = Key("key.json", 2, "HW", True, (KeyProblem("1", "Drop", ("1a",)),), (student("a", 1.0), student("b", 2.0)))
->>> row = lambda kind, credit: ("0.5", kind, credit, 2.0, "0.5", "0.5", "", None, None, "±1 %", "", "a.csv:2")
+>>> from grader.grade.grading import Row
+>>> row = lambda kind, credit: Row("0.5", kind, credit, 2.0, "0.5", "0.5", "", None, None, "±1 %", "", "", "a.csv:2")
 >>> graded = Graded(key, {"1a": [row("correct", 1.0), row("invalid", 0.0)]}, (), (), ())
 >>> summary = summarize(graded)
 >>> summary.percent.tolist(), summary.parts[0].counts["invalid"], summary.parts[0].tolerances
@@ -27,7 +28,6 @@ generically: every kind of :data:`~grader.grade.grading.VERDICTS` is counted, in
 
 from __future__ import annotations
 
-import dataclasses
 from collections import Counter
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -37,7 +37,7 @@ from operator import attrgetter, eq, is_not, itemgetter
 import numpy as np
 import numpy.typing as npt
 
-from grader.grade.grading import VERDICTS, Graded, Row, Verdict
+from grader.grade.grading import VERDICTS, Graded, Row
 from grader.grade.key import Key, KeyStudent
 from grader.model.tolerance import Tolerance, Widening, widening
 
@@ -52,17 +52,6 @@ MAX_BINS = 12  # a parameter with at most this many values gets a bin per value
 DRAWN_UP_TO = 1e300  # a parameter reaching beyond ±this is not drawn: a figure's axis overflows near float64's limit
 TOP_MISTAKES = 5  # diagnosed mistakes listed per part
 INVALID_STUDENTS = 50  # students listed with the answers that could not be read; the rest are counted
-
-_FIELDS = tuple(field.name for field in dataclasses.fields(Verdict))[2:]  # a Row: after student_id and label
-_SUBMITTED, _KIND, _CREDIT, _POINTS, _TOLERANCE, _FEEDBACK = (
-    _FIELDS.index(name) for name in ("submitted", "verdict", "credit", "points", "tolerance", "feedback"))
-_DIAGNOSIS = _FIELDS.index("diagnosis") if "diagnosis" in _FIELDS else None
-
-
-def diagnosis(row: Row) -> str:
-    """A verdict row's diagnosis (a ``mistake``'s id, ``ecf:3a`` for an error carried forward), or ``""``."""
-    return "" if _DIAGNOSIS is None else str(row[_DIAGNOSIS] or "")
-
 
 def shown_kinds(kinds: Sequence[str] = VERDICTS) -> tuple[str, ...]:
     """The verdict kinds the report shows, in its order.
@@ -192,12 +181,12 @@ def summarize(graded: Graded) -> ClassSummary:
     for problem in key.problems:
         for label in problem.labels:
             rows = graded.columns[label]
-            verdicts = list(map(itemgetter(_KIND), rows))
-            worth = np.fromiter(map(itemgetter(_POINTS), rows), np.float64, count)
-            scores[label] = np.fromiter(map(itemgetter(_CREDIT), rows), np.float64, count) * worth
+            verdicts = list(map(attrgetter("verdict"), rows))
+            worth = np.fromiter(map(attrgetter("points"), rows), np.float64, count)
+            scores[label] = np.fromiter(map(attrgetter("credit"), rows), np.float64, count) * worth
             points[label] = worth
             missing[label] = _is(verdicts, "missing")
-            answered |= np.fromiter(map(is_not, map(itemgetter(_SUBMITTED), rows), repeat(None)), bool, count)
+            answered |= np.fromiter(map(is_not, map(attrgetter("submitted"), rows), repeat(None)), bool, count)
             parts.append(_part(key, problem.key, label, rows, verdicts, scores[label], worth, kinds))
             if parts[-1].counts.get("invalid"):
                 invalid.update(np.flatnonzero(_is(verdicts, "invalid")).tolist())
@@ -219,14 +208,14 @@ def _kinds_found(graded: Graded) -> set[str]:
     """Kinds in the rows that :data:`VERDICTS` does not name (none, unless grading and VERDICTS disagree)."""
     found: set[str] = set()
     for rows in graded.columns.values():
-        found.update(map(itemgetter(_KIND), rows))
+        found.update(map(attrgetter("verdict"), rows))
     return found - set(VERDICTS)
 
 
 def _part(key: Key, problem: str, label: str, rows: Sequence[Row], verdicts: list[str], scores: Floats,
           worth: Floats, kinds: tuple[str, ...]) -> PartSummary:
     found = Counter(verdicts)
-    mistakes = Counter(diagnosis(row) for row in rows if row[_KIND] == "mistake")  # ecf rows name their part
+    mistakes = Counter(row.diagnosis for row in rows if row.verdict == "mistake")  # ecf rows name their part
     first = key.students[0].parts[label] if key.students else None
     credit = float(scores.sum() / worth.sum()) if worth.sum() > 0 else 0.0
     return PartSummary(label, problem, first.name if first else "", first.unit if first else "",
@@ -242,7 +231,7 @@ def _tolerances(key: Key, label: str, rows: Sequence[Row]) -> tuple[tuple[tuple[
     distinct = dict(zip(map(id, rules), rules, strict=True))
     counted = [(Tolerance.from_json(distinct[found]), count) for found, count in Counter(map(id, rules)).items()]
     widened = {rule.explained() for rule, _ in counted if rule.reason}  # the words grading gave them
-    words = Counter(map(itemgetter(_TOLERANCE), rows))
+    words = Counter(map(attrgetter("tolerance"), rows))
     return _by_count(Counter({text: count for text, count in words.items() if text not in widened})), \
         widening(counted)
 
@@ -258,9 +247,9 @@ def _invalid(graded: Graded, students: list[int]) -> tuple[tuple[KeyStudent, tup
     for index in students:
         rows = ((label, graded.columns[label][index]) for label in graded.key.labels)
         found.append((graded.key.students[index], tuple(
-            InvalidCell(label, "" if row[_SUBMITTED] is None else str(row[_SUBMITTED]),
-                        str(row[_FEEDBACK]).removeprefix("could not read this answer: "))
-            for label, row in rows if row[_KIND] == "invalid")))
+            InvalidCell(label, "" if row.submitted is None else str(row.submitted),
+                        str(row.feedback).removeprefix("could not read this answer: "))
+            for label, row in rows if row.verdict == "invalid")))
     return tuple(found)
 
 

@@ -14,7 +14,7 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from functools import lru_cache
-from typing import NamedTuple
+from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -67,9 +67,28 @@ class Verdict:
         return self.credit * self.points
 
 
-Row = tuple[str | None, str, float, float, str, str, str, float | None, float | None, str, str, str, str]
-"""A verdict's fields after ``student_id`` and ``label``, in :class:`Verdict`'s order: submitted, verdict,
-credit, points, expected, parsed, unit, abs_error, rel_error, tolerance, feedback, diagnosis, source."""
+class Row(NamedTuple):
+    """A verdict's fields after ``student_id`` and ``label``, in :class:`Verdict`'s order: what a class's
+    columns keep (a tuple with names: a million of them cost what tuples cost)."""
+
+    submitted: str | None
+    verdict: str
+    credit: float
+    points: float
+    expected: str
+    parsed: str
+    unit: str
+    abs_error: float | None
+    rel_error: float | None
+    tolerance: str
+    feedback: str
+    diagnosis: str
+    source: str
+
+    @property
+    def score(self) -> float:
+        """Points earned."""
+        return self.credit * self.points
 
 
 @dataclass(frozen=True)
@@ -158,12 +177,12 @@ def _grade_label(cells: Sequence[tuple[KeyPart, Answer | None]], key: Key, stude
             continue
         members = np.array(wrong)
         found = reconsider(physics, key, part.name, part.label, part.unit, tolerance, students[members],
-                           column.numbers[members], column.right[members], [rows[index][10] for index in wrong],
+                           column.numbers[members], column.right[members], [rows[index].feedback for index in wrong],
                            earlier)
         for position, finding in found.items():
             index = wrong[position]
-            rows[index] = (*rows[index][:1], finding.kind, finding.credit, *rows[index][3:10], finding.feedback,
-                           finding.diagnosis, rows[index][12])
+            rows[index] = rows[index]._replace(verdict=finding.kind, credit=finding.credit, feedback=finding.feedback,
+                                               diagnosis=finding.diagnosis)
     earlier.append(Earlier(part.label, part.name, part.unit, column.numbers, column.right))
     return rows
 
@@ -172,9 +191,15 @@ Outcome = tuple[str, float, str, str]
 """A verdict decided without comparing numbers: its kind, credit, sentence and what was read."""
 
 
-_Group = tuple[list[int], list[float], list[float], list[str | None], list[str]]
-"""Cells compared together: their indices, the numbers read, the key's, what was typed in another unit,
-and the words of each one's tolerance (one rule; reasons may differ)."""
+class _Group(NamedTuple):
+    """Cells compared together (one rule and unit): their indices, the numbers read, the key's, what was typed
+    in another unit, and the words of each one's tolerance (one rule; reasons may differ)."""
+
+    members: list[int]
+    submitted: list[float]
+    expected: list[float]
+    typed: list[str | None]
+    words: list[str]
 
 
 @dataclass(frozen=True)
@@ -191,38 +216,35 @@ class _Column:
 def _grade_column(cells: Sequence[tuple[KeyPart, Answer | None]], key: Key) -> _Column:
     """A row for each (part, answer): outcomes decided cell by cell, numbers compared by group."""
     rows: list[Row | None] = [None] * len(cells)
-    # By id of the key's mapping (the key shares equal ones): the rule, its words, and the id of the first
-    # mapping of an equal rule: rules widened alike for different reasons are compared in one group.
-    tolerances: dict[int, tuple[Tolerance, str, int]] = {}
-    rules: dict[Tolerance, int] = {}
-    groups: dict[tuple[int, str], _Group] = {}
+    # The key's tolerance mappings, by value (a few distinct ones): the rule and its words. Rules equal but for
+    # their reasons (widened alike for different reasons) are equal Tolerances: compared in one group.
+    tolerances: dict[tuple[tuple[str, Any], ...], tuple[Tolerance, str]] = {}
+    groups: dict[tuple[Tolerance, str], _Group] = {}
     for index, (part, answer) in enumerate(cells):
-        known = tolerances.get(id(part.tolerance))
+        written = tuple(part.tolerance.items())
+        known = tolerances.get(written)
         if known is None:
             tolerance = Tolerance.from_json(part.tolerance)
-            known = tolerances[id(part.tolerance)] = (tolerance, tolerance.explained(),
-                                                      rules.setdefault(tolerance, id(part.tolerance)))
+            known = tolerances[written] = (tolerance, tolerance.explained())
+        rule, words = known
         outcome = _outcome(part, answer, key)
         if isinstance(outcome, CellNumber):
-            group = groups.get((known[2], part.unit))
+            group = groups.get((rule, part.unit))
             if group is None:
-                group = groups[known[2], part.unit] = ([], [], [], [], [])
-            members, submitted, expected, typed, words = group
-            members.append(index)
-            submitted.append(outcome.value)
-            expected.append(float(part.value))  # type: ignore[arg-type]  # a number: not symbolic, not None
-            typed.append(_converted(outcome, part, answer))
-            words.append(known[1])
+                group = groups[rule, part.unit] = _Group([], [], [], [], [])
+            group.members.append(index)
+            group.submitted.append(outcome.value)
+            group.expected.append(float(part.value))  # type: ignore[arg-type]  # a number: not symbolic, not None
+            group.typed.append(_converted(outcome, part, answer))
+            group.words.append(words)
         else:
-            rows[index] = _row(part, answer, _expected(part), "equal expressions" if part.symbolic else known[1],
+            rows[index] = _row(part, answer, _expected(part), "equal expressions" if part.symbolic else words,
                                *outcome)
     numbers, right = np.full(len(cells), np.nan), np.full(len(cells), np.nan)
     wrong = []
-    for (tolerance_id, unit), group in groups.items():
-        members, submitted, expected = group[:3]
-        numbers[members], right[members] = submitted, expected
-        tolerance = tolerances[tolerance_id][0]
-        wrong.append((tolerance, _compare(cells, group, tolerance, unit, rows)))
+    for (rule, unit), group in groups.items():
+        numbers[group.members], right[group.members] = group.submitted, group.expected
+        wrong.append((rule, _compare(cells, group, rule, unit, rows)))
     return _Column(rows, numbers, right, wrong)  # type: ignore[arg-type]  # every row is filled, here or by _compare
 
 
@@ -281,11 +303,10 @@ def _outcome(part: KeyPart, answer: Answer | None, key: Key) -> Outcome | CellNu
 def _row(part: KeyPart, answer: Answer | None, expected: str, words: str, kind: str, credit: float, said: str,
          parsed: str = "", absolute: float | None = None, relative: float | None = None) -> Row:
     """The verdict's fields; ``expected``: what the key holds, in words; ``words``: the tolerance that decided it."""
-    if answer is None:
-        return None, kind, credit, part.points, expected, parsed, part.unit, absolute, relative, words, said, "", ""
-    shown_text = cut(answer.text, MAX_CELL)  # a longer answer is invalid: its first characters say which
-    return (shown_text, kind, credit, part.points, expected, parsed, part.unit, absolute, relative, words, said, "",
-            f"{answer.file}:{answer.line}")
+    # A longer answer than MAX_CELL is invalid: its first characters say which.
+    shown_text, source = (None, "") if answer is None else (cut(answer.text, MAX_CELL), f"{answer.file}:{answer.line}")
+    return Row(shown_text, kind, credit, part.points, expected, parsed, part.unit, absolute, relative, words, said, "",
+               source)
 
 
 def _symbolic(part: KeyPart, text: str, delimiter: str, key: Key) -> Outcome:
@@ -334,8 +355,9 @@ def totals(graded: Graded) -> Mapping[str, Mapping[str, float]]:
     sums: dict[str, list[float]] = {}
     for problem in key.problems:
         scores = sums.setdefault(problem.key, [0.0] * len(key.students))
-        for label in problem.labels:  # row[2] * row[3]: credit * points, the verdict's score
-            scores[:] = [total + row[2] * row[3] for total, row in zip(scores, graded.columns[label], strict=True)]
+        for label in problem.labels:
+            scores[:] = [total + row.credit * row.points
+                         for total, row in zip(scores, graded.columns[label], strict=True)]
     return {student.id: {problem: scores[index] for problem, scores in sums.items()}
             for index, student in enumerate(key.students)}
 
@@ -345,5 +367,5 @@ def counts(graded: Graded) -> dict[str, int]:
     found = dict.fromkeys(VERDICTS, 0)
     for rows in graded.columns.values():
         for row in rows:
-            found[row[1]] += 1  # the verdict
+            found[row.verdict] += 1
     return found

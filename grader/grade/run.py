@@ -97,7 +97,7 @@ def _graded(key: Key, paths: Sequence[Path], fmt: Literal["auto", "long", "wide"
 
 def _summary(graded: Graded, out: Path, started: float, export: CanvasExport | None) -> GradeSummary:
     students, columns = range(len(graded.key.students)), graded.columns.values()
-    answered = sum(any(rows[index][0] is not None for rows in columns) for index in students)
+    answered = sum(any(rows[index].submitted is not None for rows in columns) for index in students)
     return GradeSummary(out, len(students), answered, len(students) * len(graded.columns),
                         sum(problem.rows for problem in graded.problems if problem.not_graded),
                         sum(problem.rows for problem in graded.problems if problem.routine), counts(graded),

@@ -18,8 +18,8 @@ from typing import NamedTuple
 
 import numpy as np
 
+from grader.base.inputs import CELL_CHARS
 from grader.grade.cells import (
-    MAX_CELL,
     CellBlank,
     CellInvalid,
     CellNumber,
@@ -283,7 +283,7 @@ def _row(part: KeyPart, answer: Answer | None, expected: str, words: str, kind: 
     """The verdict's fields; ``expected``: what the key holds, in words; ``words``: the tolerance that decided it."""
     if answer is None:
         return None, kind, credit, part.points, expected, parsed, part.unit, absolute, relative, words, said, "", ""
-    shown_text = cut(answer.text, MAX_CELL)  # a longer answer is invalid: its first characters say which
+    shown_text = cut(answer.text, CELL_CHARS)  # a longer answer is invalid: its first characters say which
     return (shown_text, kind, credit, part.points, expected, parsed, part.unit, absolute, relative, words, said, "",
             f"{answer.file}:{answer.line}")
 

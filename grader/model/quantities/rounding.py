@@ -116,7 +116,9 @@ def round_figures(values: Any, figures: int) -> np.ndarray:
 
 def half_unit(values: Any, figures: int) -> np.ndarray:
     """Half a unit in the ``figures``-th significant figure of each value: the most rounding it to that
-    many figures moves it (0 for 0, and for what is not finite).
+    many figures moves it (0 for 0, and for what is not finite). A bound, vectorised: the exponent comes
+    from a float ``log10``, which may say 3 for ``999.9999999999999`` where :func:`leading_exponent` says 2,
+    and is never smaller, so the bound is only ever wider.
 
     >>> half_unit(np.array([45.09, 0.6315, 0.0]), 3).tolist()
     [0.05, 0.0005, 0.0]

@@ -104,6 +104,8 @@ _NOT_UNITS = frozenset({"e", "E", "x", "X", "c", "k", "G", "R", "a", "per", *CON
 _TOKEN = re.compile(r"\s*(?:(?P<power>(?:\^|\*\*)\s*[-+]?\s*\d{1,2})|(?P<op>[*/·]|(?<=[A-Za-zµμ])-(?=[A-Za-zµμ]))"
                     r"|(?P<name>[A-Za-zµμ]+|°|%)(?P<bare>[1-9](?!\d))?)")
 
+_POWER = re.compile(r"(?:\^|\*\*)\s*([-+]?\d+)")
+
 
 class UnitMismatchError(ValueError):
     """A student's unit of another dimension than the expected one; the message is for the student."""
@@ -185,6 +187,10 @@ def parse_unit(text: str) -> Unit:
         return Unit(text.strip(), Fraction(1), 0, PURE)
     factors = unit_factors(text)
     if factors is None:
+        beyond = [power for power in map(int, _POWER.findall(text)) if abs(power) > MAX_POWER]
+        if beyond:
+            raise GraderError(f"the power {beyond[0]} in '{text}' is beyond what a unit of mechanics needs; "
+                              f"expected powers from -{MAX_POWER} to {MAX_POWER}")
         raise GraderError(f"cannot read unit '{text}' (write units like m, m/s, m/s^2, kg, deg, %)")
     for word, _ in factors:
         if _expanded(word, lenient=False) is None:

@@ -23,7 +23,17 @@ from grader.base.errors import ExpressionError, GraderError, TemplateError, show
 from grader.base.inputs import YAML_BYTES, parse_yaml, read_bytes
 from grader.base.resources import bank_dir
 from grader.model.expr import Node, Num, Op, Sym, names, parse, to_text
-from grader.model.quantities import ACCELERATION, LENGTH, MASS, Dimension, Unit, dimension_of, parse_unit, words
+from grader.model.quantities import (
+    ACCELERATION,
+    LENGTH,
+    MASS,
+    NUMBER,
+    Dimension,
+    Unit,
+    dimension_of,
+    parse_unit,
+    words,
+)
 from grader.model.scene import Gravity, Scene
 from grader.model.tolerance import Tolerance, ToleranceError
 from grader.physics.effects import CATALOGUE
@@ -512,7 +522,7 @@ def infer_topic(scene: Scene) -> str:
 def _gravity(text: Any, where: str) -> Gravity | None:
     if text is None:
         return None
-    match = re.match(r"^\s*((?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s+(\S+)\s*$", str(text))
+    match = re.match(rf"^\s*({NUMBER.pattern})\s+(\S+)\s*$", str(text))
     unit = _unit(match.group(2), where, "gravity") if match else None
     if not match or unit is None or unit.dimension != ACCELERATION or not 0 < float(match.group(1)) < 1e300:
         raise TemplateError(where, "gravity", "a positive acceleration below 1e300, like '9.81 m/s^2' or "

@@ -97,9 +97,10 @@ def share(students: int, work: Path) -> list[str]:
     from grader.assign.variants import generate
     from grader.bank.template import load_bank
     from grader.grade.compare import is_correct
+    from grader.model.quantities import round_figures
     from grader.model.tolerance import ANSWER_SIG_FIGS
     from grader.solve.cache import routes_for
-    from grader.solve.routes import round_figures, walk_route
+    from grader.solve.routes import walk_route
 
     bank = load_bank()
     generation = generate(load_assignment(ASSIGNMENT), load_roster(roster(work / "share.csv", students)), bank)

@@ -750,7 +750,7 @@ def _check_arguments(arguments: argparse.Namespace) -> None:
 
 def _expected_quantity(text: str, unit: str | None) -> tuple[float | str, str]:
     """``--expected``: a number (``6.26``, or ``6.26 m/s`` when ``--unit`` is not given) or an expression."""
-    from grader.model.units import parse_unit, split_quantity
+    from grader.model.quantities import parse_unit, split_quantity
 
     quantity = split_quantity(text)
     if quantity is None:

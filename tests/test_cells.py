@@ -14,8 +14,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from grader.base.inputs import CELL_CHARS
 from grader.grade.cells import (
-    MAX_CELL,
     CellBlank,
     CellExpression,
     CellInvalid,
@@ -80,7 +80,7 @@ REFUSED_NUMBERS = [
     ("6.26 furlongz", "m", "unknown unit 'furlongz'"), ("m/s", "m/s", "cannot read 'm'"),
     ("abc", "", "cannot read"), ("2 +", "", "not a valid expression"), ("6.26 $", "", "unexpected character '$'"),
     ("10 ft -lb", "J", "cannot read"), ("10 ft- lb", "J", "cannot read"),
-    ("x" * (MAX_CELL + 1), "", "at most 1,000"),
+    ("x" * (CELL_CHARS + 1), "", "at most 1,000"),
     # issue 22: these were "cannot read 'm' as a number", read as 0 without a note, and "nested more than 40
     # levels deep"
     ("1.66 m^99999", "m", "the power 99999 of the unit m is beyond the limit: units are read with powers up to 9"),

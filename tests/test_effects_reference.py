@@ -13,7 +13,7 @@ from typing import Any
 import pytest
 
 from grader.cli import main
-from grader.model.units import dimension_name
+from grader.model.quantities import words as dimension_words
 from grader.physics.effects import CATALOGUE
 from grader.render.figures import STAGE_FIGURES
 from grader.render.reference import EXAMPLES, GENERATED_BY
@@ -83,7 +83,7 @@ def test_every_field_appears_with_its_dimension(name: str, capsys: pytest.Captur
         line = next((line for line in out.splitlines() if line.split()[:1] == [spec.name]), "")
         assert line, f"{name}: field {spec.name} not shown"
         if spec.dimension is not None:
-            words = dimension_name(spec.dimension)
+            words = dimension_words(spec.dimension)
             assert words in " ".join(out.split()), f"{name}: {spec.name} without {words}"
             assert fields[spec.name]["dimension"] == words
         assert fields[spec.name]["required"] is spec.required

@@ -11,7 +11,7 @@ import sympy as sp
 from grader.base.errors import ExpressionError, GraderError
 from grader.model.expr import MAX_DEPTH, MAX_LENGTH, format_number, parse, to_text
 from grader.model.kernel import cosd, evaluate, sind
-from grader.model.units import parse_unit
+from grader.model.quantities import parse_unit
 from grader.physics.symbolic import from_node
 
 REFUSED = [

@@ -17,9 +17,10 @@ from grader.bank.template import Template
 from grader.base.errors import GraderError
 from grader.cli import main
 from grader.grade.compare import is_correct
+from grader.model.quantities import half_unit, round_figures
 from grader.model.tolerance import ANSWER_SIG_FIGS, Tolerance
 from grader.solve.cache import routes_for
-from grader.solve.routes import half_unit, moved_route, round_figures, rounding_bounds, walk_route
+from grader.solve.routes import moved_route, rounding_bounds, walk_route
 from tests.test_golden import GOLDEN
 
 STUDENTS = 200

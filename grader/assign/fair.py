@@ -24,8 +24,9 @@ from typing import Any
 
 import numpy as np
 
+from grader.model.quantities import half_unit
 from grader.model.tolerance import ANSWER_SIG_FIGS, Tolerance, with_unit
-from grader.solve.routes import Moves, Routes, half_unit, rounding_bounds
+from grader.solve.routes import Moves, Routes, rounding_bounds
 
 SAFETY = 2.0
 """How many times the first-order rounding bound a tolerance allows."""

@@ -42,10 +42,9 @@ from grader.assign.assignment import Assignment, ProblemSpec
 from grader.assign.variants import AnswerPart, Generation
 from grader.bank.template import Template
 from grader.base.spreadsheet import csv_text, safe_cell
-from grader.model.tolerance import Tolerance
+from grader.model.tolerance import SYMBOL_RANGE, Tolerance
 
 SCHEMA, VERSION = "grader-key", 2
-SYMBOL_RANGE = (1.0, 10.0)  # where a symbol with no sampled range (a speed v) is drawn to compare expressions
 def key_document(assignment: Assignment, generation: Generation, bank: Mapping[str, Template]) -> dict[str, Any]:
     """The key as a JSON-ready dictionary."""
     used = {p.template: bank[p.template] for p in assignment.problems}

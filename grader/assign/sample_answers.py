@@ -30,9 +30,10 @@ from datetime import datetime, timedelta
 import numpy as np
 
 from grader.assign.assignment import Assignment
-from grader.assign.variants import AnswerPart, Generation, printed_text, variant_generator
+from grader.assign.variants import AnswerPart, Generation, variant_generator
 from grader.bank.template import Template
 from grader.base.spreadsheet import csv_text
+from grader.model.quantities import printed_text, scientific, significant
 from grader.solve.alternatives import carries_forward, values
 from grader.solve.cache import alternatives_for
 
@@ -155,8 +156,8 @@ def _numeric(form: str, value: float, unit: str, rng: np.random.Generator) -> _T
     if form == "decimal comma" and "." in three:
         return _Typed(three.replace(".", ","), form, "correct", float(three))
     if form == "×10^":
-        mantissa, exponent = f"{value:.2e}".split("e")
-        return _Typed(f"{mantissa}×10^{int(exponent)}", form, "correct", float(f"{mantissa}e{exponent}"))
+        mantissa, exponent = scientific(significant(value, 3), 3)
+        return _Typed(f"{mantissa}×10^{exponent}", form, "correct", float(f"{mantissa}e{exponent}"))
     if form == "unrounded" and len(f"{value:.9g}") > len(three):  # 0.07 has no more digits to show
         return _Typed(f"{value:.9g}", form, "correct", float(f"{value:.9g}"))
     if form == "wrong":

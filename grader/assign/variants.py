@@ -9,9 +9,7 @@ rounding along a solution route (:mod:`grader.assign.fair`), would pass ``gradin
 is redrawn from the same generator, at most ``MAX_DRAWS`` times. Whether a draw is degenerate or
 too loose never depends on the rest of the class.
 
->>> from decimal import Decimal
->>> printed_text(2.345, decimals=2, sig_figs=None), printed_text(2398.7, decimals=None, sig_figs=3)
-('2.35', '2400')
+Parameters print by :func:`grader.model.quantities.printed_text`.
 """
 
 from __future__ import annotations
@@ -20,7 +18,6 @@ import hashlib
 from collections import Counter
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
-from decimal import MAX_EMAX, MIN_EMIN, ROUND_HALF_UP, Context, Decimal
 from functools import cached_property
 from typing import Any
 
@@ -31,6 +28,7 @@ from grader.assign.fair import Fair, fair_tolerances
 from grader.bank.template import Parameter, Template
 from grader.base.errors import GraderError
 from grader.model.expr import Sym
+from grader.model.quantities import printed_text
 from grader.model.tolerance import Tolerance
 from grader.solve.cache import compiled_for, routes_for
 from grader.solve.compiled import Compiled
@@ -41,7 +39,6 @@ MAX_DRAWS = 25
 NEAR_ZERO = 0.02  # an answer below 2% of its typical size is too close to zero to grade relatively
 PILOT = 256  # draws that set an answer's typical size, from a generator of their own
 PRINTED_CHARS = 24  # a printed value longer than this is no number a student can read or type
-_EXACT = Context(prec=1000, Emax=MAX_EMAX, Emin=MIN_EMIN)  # any float64, printed exactly
 
 
 @dataclass(frozen=True, slots=True)
@@ -97,26 +94,6 @@ def variant_generator(seed: str, problem_key: str, student_id: str) -> tuple[np.
     digest = hashlib.sha256("\x1f".join((seed, problem_key, student_id)).encode("utf-8")).digest()
     return np.random.Generator(np.random.PCG64(np.random.SeedSequence(int.from_bytes(digest[:16], "big")))), \
         digest[:8].hex()
-
-
-def printed_text(value: float, decimals: int | None, sig_figs: int | None) -> str:
-    """A value as printed on the page: fixed decimals, or significant figures (halves round up).
-    Never ``-0``: a value that rounds to zero prints without a sign.
-
-    >>> printed_text(-0.004, 2, None), printed_text(1e30, None, 2), printed_text(-0.0, None, 3)
-    ('0.00', '1000000000000000000000000000000', '0')
-    """
-    number = Decimal(repr(float(value)))
-    if decimals is not None:
-        rounded = number.quantize(Decimal(1).scaleb(-decimals), ROUND_HALF_UP, context=_EXACT)
-        return str(abs(rounded) if rounded.is_zero() else rounded)
-    if sig_figs is None:
-        raise ValueError("a printed precision needs decimals or sig_figs")
-    if number.is_zero():
-        return "0"
-    exponent = number.adjusted() - (sig_figs - 1)
-    rounded = number.quantize(Decimal(1).scaleb(exponent), ROUND_HALF_UP, context=_EXACT)
-    return f"{rounded:f}" if exponent < 0 else str(int(rounded))
 
 
 def _draw(parameter: Parameter, problem: ProblemSpec, rng: np.random.Generator) -> str:

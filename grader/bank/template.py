@@ -23,9 +23,19 @@ from grader.base.errors import ExpressionError, GraderError, TemplateError, show
 from grader.base.inputs import YAML_BYTES, parse_yaml, read_bytes
 from grader.base.resources import bank_dir
 from grader.model.expr import Node, Num, Op, Sym, names, parse, to_text
+from grader.model.quantities import (
+    ACCELERATION,
+    LENGTH,
+    MASS,
+    NUMBER,
+    Dimension,
+    Unit,
+    dimension_of,
+    parse_unit,
+    words,
+)
 from grader.model.scene import Gravity, Scene
 from grader.model.tolerance import Tolerance, ToleranceError
-from grader.model.units import LENGTH, MASS, Dimension, Unit, dimension_from, dimension_name, dimension_of, parse_unit
 from grader.physics.effects import CATALOGUE
 
 RESERVED = {"g", "pi"}
@@ -338,10 +348,10 @@ def _check_names(template: Template) -> None:
 def _check_dimensions(template: Template) -> None:
     """Each stage field measures what its effect says (a height is a length, a mass a mass), and
     each answer what its unit says; a name a stage introduces takes its field's dimension."""
-    known: dict[str, Dimension] = {n: _dimension(p.unit) for n, p in template.parameters.items()}
-    known |= {n: _dimension(s.unit) for n, s in template.symbols.items()}
+    known: dict[str, Dimension] = {n: p.unit.dimension for n, p in template.parameters.items()}
+    known |= {n: s.unit.dimension for n, s in template.symbols.items()}
     if template.scene.gravity is not None:
-        known["g"] = dimension_from(1, time=-2)
+        known["g"] = ACCELERATION
     for body in template.scene.bodies.values():
         if body.mass is not None:
             _expect(body.mass, MASS, known, template.where, f"bodies.{body.name}.mass")
@@ -362,11 +372,7 @@ def _check_dimensions(template: Template) -> None:
             else:
                 _expect(Sym(value) if spec.kind == "name" else value, spec.dimension, known, template.where, key)
     for name, answer in template.answers.items():
-        _expect(answer.value, _dimension(answer.unit), known, template.where, f"answers.{name}.value")
-
-
-def _dimension(unit: Unit) -> Dimension:
-    return dimension_from(*unit.dimension)
+        _expect(answer.value, answer.unit.dimension, known, template.where, f"answers.{name}.value")
 
 
 def _expect(node: Node, expected: Dimension, known: dict[str, Dimension], where: str, key: str) -> None:
@@ -380,8 +386,8 @@ def _expect(node: Node, expected: Dimension, known: dict[str, Dimension], where:
     if found is None and isinstance(node, Sym):
         known[node.name] = expected
     elif found is not None and found != expected:
-        raise TemplateError(where, key, f"{dimension_name(expected)} (check the parameters' units)",
-                            f"'{to_text(node)}', which is {dimension_name(found)}")
+        raise TemplateError(where, key, f"{words(expected)} (check the parameters' units)",
+                            f"'{to_text(node)}', which is {words(found)}")
 
 
 def _check_statement(template: Template, given: set[str]) -> None:
@@ -516,9 +522,9 @@ def infer_topic(scene: Scene) -> str:
 def _gravity(text: Any, where: str) -> Gravity | None:
     if text is None:
         return None
-    match = re.match(r"^\s*((?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s+(\S+)\s*$", str(text))
+    match = re.match(rf"^\s*({NUMBER.pattern})\s+(\S+)\s*$", str(text))
     unit = _unit(match.group(2), where, "gravity") if match else None
-    if not match or unit is None or unit.dimension != (1, 0, -2, 0) or not 0 < float(match.group(1)) < 1e300:
+    if not match or unit is None or unit.dimension != ACCELERATION or not 0 < float(match.group(1)) < 1e300:
         raise TemplateError(where, "gravity", "a positive acceleration below 1e300, like '9.81 m/s^2' or "
                             "'32.2 ft/s^2'",
                             shown(text))

@@ -3,7 +3,7 @@
 Student text is never run. Numbers are read by regular expressions; arithmetic and symbolic answers
 by our own tokenizer (which writes out the multiplications students leave implicit) and then
 :func:`grader.model.expr.parse` (Python's ``ast`` with an allow-list); units by
-:mod:`grader.grade.quantities` (our grammar, then pint one word at a time).
+:mod:`grader.model.quantities.units` (the templates' grammar and table, with the words students type).
 
 >>> read_number("6.26 m/s", "m/s")
 CellNumber(value=6.26, unit_given='m/s')
@@ -28,10 +28,8 @@ from dataclasses import dataclass
 
 from grader.base.inputs import CELL_CHARS
 from grader.grade.notation import ReadError, check_powers, cut, listed, tree_of, uses_a_name, value_of
-from grader.grade.quantities import MAX_POWER, UnitMismatchError, UnknownUnitError, unit_factor, unit_factors
 from grader.model.expr import Node, to_text
-
-MAX_CELL = CELL_CHARS
+from grader.model.quantities import MAX_POWER, UnitMismatchError, UnknownUnitError, unit_factor, unit_factors
 
 
 @dataclass(frozen=True)
@@ -166,8 +164,8 @@ def undefined_word(text: str) -> bool:
 def _clean(text: str) -> str | CellBlank | CellInvalid:
     """Length checked first, spaces and minus signs unified, control characters refused, superscript
     powers written out (``10⁻³`` is ``10^-3``)."""
-    if len(text) > MAX_CELL:
-        return CellInvalid(f"{len(text):,} characters; an answer has at most {MAX_CELL:,}")
+    if len(text) > CELL_CHARS:
+        return CellInvalid(f"{len(text):,} characters; an answer has at most {CELL_CHARS:,}")
     text = text.translate(_SPACES)
     if not text.isprintable():
         text = "".join(" " if char.isspace() else char for char in text)

@@ -23,15 +23,15 @@ from dataclasses import dataclass
 from typing import Any
 
 from grader.base.errors import GraderError, UsageError, shown
-from grader.grade.cells import MAX_CELL
+from grader.base.inputs import CELL_CHARS
 from grader.grade.diagnosis import Physics
 from grader.grade.grading import Request, Verdict, grade_part, grade_parts
-from grader.grade.key import SYMBOL_RANGE, Key, KeyPart
+from grader.grade.key import Key, KeyPart
 from grader.grade.notation import ReadError, tree_of, value_of
 from grader.grade.submissions import Answer, find_label
 from grader.model.expr import CONSTANTS, FUNCTIONS, names, to_text
-from grader.model.tolerance import Tolerance
-from grader.model.units import parse_unit
+from grader.model.quantities import parse_unit
+from grader.model.tolerance import SYMBOL_RANGE, Tolerance
 
 _GIVEN = Key(where="the command line", version=2, title="grader check", numeric_expressions=True,
              problems=(), students=())
@@ -131,7 +131,7 @@ def _expected(expected: float | str | None, symbols: Sequence[str] | None,
 def _names_in(text: str) -> tuple[str, ...]:
     """The names an expected expression uses, as its symbols when none are given (``2v`` uses v); ``inf``
     and ``nan`` are no names but numbers, refused as not finite."""
-    words = set(re.findall(r"[A-Za-z_]\w*", text[:MAX_CELL])) - set(FUNCTIONS) - set(CONSTANTS)
+    words = set(re.findall(r"[A-Za-z_]\w*", text[:CELL_CHARS])) - set(FUNCTIONS) - set(CONSTANTS)
     return tuple(sorted(word for word in words if word.lower() not in _NOT_FINITE))
 
 

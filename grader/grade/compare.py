@@ -26,13 +26,13 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from decimal import Decimal
 from fractions import Fraction
 
 import numpy as np
 from numpy.typing import ArrayLike
 
 from grader.base.errors import shown
+from grader.model.quantities import leading_exponent
 from grader.model.tolerance import Tolerance, with_unit
 
 LARGEST = float(np.finfo(np.float64).max)
@@ -152,17 +152,6 @@ def _exact_verdict(submitted: float, expected: float, tolerance: Tolerance, angl
 
 def _decimal(value: float) -> Fraction:
     return Fraction(repr(float(value)))
-
-
-def leading_exponent(value: float) -> int:
-    """``floor(log10|value|)`` exactly, of the number as it prints (0 for 0).
-
-    >>> [leading_exponent(x) for x in (1000.0, 999.9999999999999, 1e-5, 5e-324, 1e308, -0.02)]
-    [3, 2, -5, -324, 308, -2]
-    """
-    if value == 0:
-        return 0
-    return int(Decimal(repr(float(value))).adjusted())
 
 
 # ---- feedback ------------------------------------------------------------------------------------

@@ -18,8 +18,8 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
+from grader.base.inputs import CELL_CHARS
 from grader.grade.cells import (
-    MAX_CELL,
     CellBlank,
     CellInvalid,
     CellNumber,
@@ -303,8 +303,9 @@ def _outcome(part: KeyPart, answer: Answer | None, key: Key) -> Outcome | CellNu
 def _row(part: KeyPart, answer: Answer | None, expected: str, words: str, kind: str, credit: float, said: str,
          parsed: str = "", absolute: float | None = None, relative: float | None = None) -> Row:
     """The verdict's fields; ``expected``: what the key holds, in words; ``words``: the tolerance that decided it."""
-    # A longer answer than MAX_CELL is invalid: its first characters say which.
-    shown_text, source = (None, "") if answer is None else (cut(answer.text, MAX_CELL), f"{answer.file}:{answer.line}")
+    # A longer answer than CELL_CHARS is invalid: its first characters say which.
+    shown_text = None if answer is None else cut(answer.text, CELL_CHARS)
+    source = "" if answer is None else f"{answer.file}:{answer.line}"
     return Row(shown_text, kind, credit, part.points, expected, parsed, part.unit, absolute, relative, words, said, "",
                source)
 

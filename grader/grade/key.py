@@ -41,12 +41,11 @@ from grader.base.errors import GraderError, TemplateError, shown
 from grader.base.inputs import CELL_CHARS, decode_text, read_bytes
 from grader.grade.notation import ReadError, check_powers
 from grader.model.expr import names, parse
-from grader.model.tolerance import Tolerance
-from grader.model.units import parse_unit
+from grader.model.quantities import parse_unit
+from grader.model.tolerance import SYMBOL_RANGE, Tolerance
 
 VERSIONS = (1, 2)  # the key schema versions grading reads
 KEY_BYTES = 1 << 30  # 1 GiB: a key holds every student's numbers; 2,000 students take about 2 MB
-SYMBOL_RANGE = (1.0, 10.0)  # version 1 keys give no ranges: a symbolic answer's names are drawn here
 
 _T = TypeVar("_T")
 

@@ -1,2 +1,2 @@
-"""The data every stage shares: safe expressions and their numpy evaluation, exact units, and the
-frozen scene types (bodies, stages). Imports nothing of grader but ``errors``."""
+"""The data every stage shares: safe expressions and their numpy evaluation, quantities (units, dimensions,
+numbers, significant figures), tolerances and the frozen scene types. Imports nothing of grader but ``base``."""

@@ -31,6 +31,9 @@ MAX_DIGITS = 17
 
 FORMS = "{rtol: X, atol: Y}, {sigfigs: N} or {decimals: N}"
 """The forms an instructor writes, for messages."""
+SYMBOL_RANGE = (1.0, 10.0)
+"""Where a symbolic answer's name with no sampled range (a symbol such as a speed v, or any name of a
+version 1 key) is drawn to compare expressions, when the key is written and when it is read."""
 
 
 class ToleranceError(GraderError, ValueError):

@@ -22,8 +22,8 @@ import sympy as sp
 
 from grader.base.errors import TemplateError
 from grader.model.expr import FUNCTIONS, Node, Num, Op, Sym, parse  # noqa: F401  (parse: doctest)
+from grader.model.quantities import Unit
 from grader.model.scene import Scene, Stage
-from grader.model.units import Unit
 
 INNER = "(compiled expression)"  # the ``where`` of an error raised without the template's file
 

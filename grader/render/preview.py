@@ -13,9 +13,9 @@ from __future__ import annotations
 
 import math
 
-from grader.assign.variants import printed_text
 from grader.bank.markup import paragraphs
 from grader.bank.template import Parameter, Template, filled_statement
+from grader.model.quantities import printed_text
 
 
 def example_printed(template: Template) -> dict[str, str]:

@@ -181,10 +181,10 @@ def field_rows(effect: Effect) -> tuple[FieldRow, ...]:
     >>> [(row.name, row.dimension) for row in field_rows(CATALOGUE["swing"])]
     [('body', None), ('speed', 'a speed'), ('length', 'a length'), ('angle', 'an angle')]
     """
-    from grader.model.units import dimension_name
+    from grader.model.quantities import words
 
     return tuple(FieldRow(spec.name, spec.doc, spec.kind_in_words,
-                          None if spec.dimension is None else dimension_name(spec.dimension), spec.required,
+                          None if spec.dimension is None else words(spec.dimension), spec.required,
                           spec.default) for spec in effect.fields)
 
 
@@ -229,8 +229,8 @@ def _worked(effect: Effect, example: Example) -> _Worked:
     import sympy as sp
 
     from grader.bank.scene_parser import parse_scene
+    from grader.model.quantities import parse_unit, split_quantity
     from grader.model.scene import Gravity
-    from grader.model.units import parse_unit, split_quantity
     from grader.physics.symbolic import Context
 
     value, unit = split_quantity(example.gravity) or (0.0, "")
@@ -265,10 +265,10 @@ def _names(effect: Effect, scene: Any, stage: Mapping[str, Any]) -> Any:
     """What :func:`grader.render.readable.readable` knows of an example's names: each field's dimension,
     the masses', the radii's and g's, in the order the stage writes them."""
     from grader.model.expr import Sym, names, parse
-    from grader.model.units import LENGTH, MASS, dimension_from
+    from grader.model.quantities import ACCELERATION, LENGTH, MASS
     from grader.render.readable import Names
 
-    dimensions: dict[str, Any] = {"g": dimension_from(1, time=-2)}
+    dimensions: dict[str, Any] = {"g": ACCELERATION}
     for body in scene.bodies.values():
         if isinstance(body.mass, Sym):
             dimensions[body.mass.name] = MASS

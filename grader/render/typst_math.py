@@ -18,6 +18,7 @@ from fractions import Fraction
 from functools import lru_cache
 
 from grader.model.expr import FUNCTIONS, Node, Num, Op, Sym, format_number
+from grader.model.quantities import scientific, significant_binary
 from grader.render.readable import counted
 from grader.render.typst_text import string
 
@@ -57,18 +58,18 @@ def name(quantity: str) -> str:
 
 
 def number(value: float, figures: int = 4) -> str:
-    """A number in Typst math to ``figures`` significant figures (trailing zeros kept).
+    """A number in Typst math to ``figures`` significant figures (trailing zeros kept), rounded as
+    :func:`grader.model.quantities.significant_binary` says (the answer keys' worked solutions always have).
 
     >>> number(6.0459), number(0.000012346), number(-2.5), number(17683.2)
     ('6.046', '1.235 times 10^(-5)', '-2.500', '17680')
     """
     if value == 0 or not _m.isfinite(value):
         return "0" if value == 0 else str(string("undefined"))
-    rounded = float(f"{value:.{figures - 1}e}")
-    exponent = _m.floor(_m.log10(abs(rounded)))
+    rounded = significant_binary(value, figures)
+    mantissa, exponent = scientific(rounded, figures)
     if -3 <= exponent < 5:
         return f"{rounded:.{max(0, figures - 1 - exponent)}f}"
-    mantissa = f"{rounded / 10 ** exponent:.{figures - 1}f}"
     return f"{mantissa} times 10^({exponent})"
 
 

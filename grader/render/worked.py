@@ -6,9 +6,7 @@ the value with its SI unit, which is inferred from the parameters' units. A step
 a symbol without a value (a mass that cancels) is shown as a multiple of it, never with a
 made-up number.
 
->>> from grader.model.expr import parse
->>> unit_of(dimension(parse("m*v*v/2"), {"m": (0, 1, 0, 0), "v": (1, 0, -1, 0)}))
-'J'
+Dimensions and their SI units come from :mod:`grader.model.quantities`.
 """
 
 from __future__ import annotations
@@ -26,6 +24,7 @@ from grader.assign.variants import ProblemVariant
 from grader.bank.template import Template
 from grader.model.expr import Node, Num, Sym, format_number, names, parse
 from grader.model.kernel import evaluate
+from grader.model.quantities import ACCELERATION, ANGLE, Dimension, dimension_of, si_unit
 from grader.render.readable import Names, readable
 from grader.render.typst_math import math, name, number
 from grader.render.typst_text import Typ, string, text
@@ -36,88 +35,6 @@ from grader.solve.compiled import Compiled
 def _significant(printed: str) -> int:
     digits = printed.lstrip("+-").replace(".", "").lstrip("0")
     return max(1, len(digits))
-
-
-# --- dimensions ----------------------------------------------------------------------------------
-
-Dimension = tuple[Fraction, Fraction, Fraction, Fraction]
-"""Exponents of length, mass, time and angle."""
-
-ZERO: Dimension = (Fraction(0), Fraction(0), Fraction(0), Fraction(0))
-ANGLE: Dimension = (Fraction(0), Fraction(0), Fraction(0), Fraction(1))
-_NAMED = {(1, 0, 0, 0): "m", (1, 0, -1, 0): "m/s", (1, 0, -2, 0): "m/s²", (0, 1, 0, 0): "kg",
-          (1, 1, -1, 0): "N·s", (1, 1, -2, 0): "N", (2, 1, -2, 0): "J", (0, 0, 0, 1): "rad",
-          (0, 0, 1, 0): "s", (2, 0, -2, 0): "m²/s²", (0, 0, -1, 0): "1/s", (0, -1, 0, 0): "1/kg"}
-_SUPERSCRIPT = str.maketrans("-0123456789", "⁻⁰¹²³⁴⁵⁶⁷⁸⁹")
-
-
-def _dim(values: Sequence[int | Fraction]) -> Dimension:
-    return (Fraction(values[0]), Fraction(values[1]), Fraction(values[2]), Fraction(values[3]))
-
-
-def dimension(node: Node, known: Mapping[str, Sequence[int | Fraction]]) -> Dimension | None:
-    """The dimension of an expression from its names' dimensions; ``None`` when it cannot be told
-    (an unknown name, a sum of unlike terms, a power of a dimensioned quantity by a non-number)."""
-    if isinstance(node, Num):
-        return ZERO
-    if isinstance(node, Sym):
-        return ZERO if node.name == "pi" else (_dim(known[node.name]) if node.name in known else None)
-    if node.op in ("sin", "cos", "tan", "sind", "cosd", "exp", "log", "lt", "le", "gt", "ge", "and", "or"):
-        return ZERO
-    if node.op == "atan2":
-        return ANGLE
-    parts = [dimension(a, known) for a in node.args]
-    if node.op in ("add", "sub", "hypot", "Max", "Min"):
-        # Terms must agree; a bare number (0 in Max(0, x)) or a term of unknown dimension takes
-        # the dimension of the others.
-        shaped = {d for d, a in zip(parts, node.args, strict=True) if d is not None and not isinstance(a, Num)}
-        return next(iter(shaped)) if len(shaped) == 1 else (ZERO if not shaped and None not in parts else None)
-    if any(p is None for p in parts):
-        return None
-    dims = [p for p in parts if p is not None]
-    if node.op in ("neg", "abs"):
-        return dims[0]
-    if node.op == "sqrt":
-        return _scaled(dims[0], Fraction(1, 2))
-    if node.op == "mul":
-        return _dim([a + b for a, b in zip(dims[0], dims[1], strict=True)])
-    if node.op == "div":
-        return _dim([a - b for a, b in zip(dims[0], dims[1], strict=True)])
-    if node.op == "pow":
-        exponent = node.args[1]
-        if isinstance(exponent, Num):
-            return _scaled(dims[0], Fraction(exponent.value))
-        return ZERO if dims[0] == ZERO else None
-    return None
-
-
-def _scaled(dim: Dimension, factor: Fraction) -> Dimension:
-    return _dim([d * factor for d in dim])
-
-
-def unit_of(dim: Dimension | None) -> str:
-    """The SI unit of a dimension as text: ``m/s``, ``N·s``, ``J``; products otherwise; ``""`` for a
-    pure number (or an unknown dimension).
-
-    >>> unit_of((1, 2, -1, 0))
-    'kg²·m/s'
-    """
-    if dim is None or all(d == 0 for d in dim):
-        return ""
-    key = tuple(int(d) if d.denominator == 1 else d for d in _dim(dim))
-    if key in _NAMED:
-        return _NAMED[key]
-    up: list[str] = []
-    down: list[str] = []
-    for symbol, power in zip(("kg", "m", "s", "rad"), (key[1], key[0], key[2], key[3]), strict=True):
-        if power == 0:
-            continue
-        size = abs(Fraction(power))
-        shown = symbol if size == 1 else symbol + (str(size).translate(_SUPERSCRIPT) if size.denominator == 1
-                                                   else f"^({size})")
-        (up if power > 0 else down).append(shown)
-    numerator = "·".join(up) or "1"
-    return numerator + ("/" + "·".join(down) if down else "")
 
 
 # --- evaluating the chain ------------------------------------------------------------------------
@@ -222,10 +139,6 @@ def _unit_math(unit: str) -> str:
     return f" thin {string(unit)}" if unit else ""
 
 
-def _si_unit(dimension_: Sequence[int]) -> str:
-    return unit_of(_dim(dimension_))
-
-
 def given_lines(template: Template, variant: ProblemVariant, compiled: Compiled) -> list[str]:
     """``h_drop = 2100 mm = 2.100 m`` for each parameter (math), then the constants."""
     lines = []
@@ -234,9 +147,9 @@ def given_lines(template: Template, variant: ProblemVariant, compiled: Compiled)
         shown = f"{name(parameter_name)} = {printed}"
         if unit.text == "deg":
             shown += f" degree = {number(float(printed) * unit.to_si)}{_unit_math('rad')}"
-        elif unit.to_si != 1.0 or unit.text not in ("", _si_unit(unit.dimension)):
+        elif unit.to_si != 1.0 or unit.text not in ("", si_unit(unit.dimension)):
             shown += f"{_unit_math(unit.text)} = {_shown_parameter(printed, unit.to_si)}" \
-                     f"{_unit_math(_si_unit(unit.dimension))}"
+                     f"{_unit_math(si_unit(unit.dimension))}"
         else:
             shown += _unit_math(unit.text)
         lines.append(shown)
@@ -306,7 +219,7 @@ def worked_form(template: Template, compiled: Compiled | None = None) -> WorkedF
     # A symbol no step uses (a mass the scene needs only for its simulation) gets no note.
     used = set().union(*(names(step.solved) for step in compiled.steps))
     return WorkedForm(tuple(steps), dimensions, symbols,
-                      {n: _si_unit(s.unit.dimension) or "1" for n, s in template.symbols.items()},
+                      {n: si_unit(s.unit.dimension) or "1" for n, s in template.symbols.items()},
                       tuple(_symbol_note(s, template.symbols[s].description) for s in symbols if s in used))
 
 
@@ -346,11 +259,11 @@ def worked(template: Template, variant: ProblemVariant, compiled: Compiled | Non
 def quantity_dimensions(template: Template, compiled: Compiled) -> dict[str, Dimension]:
     """The dimension of every parameter, symbol, constant and step quantity whose dimension can be
     told (a step's from its solved form; a bare number, a velocity that stays 0, says nothing)."""
-    known: dict[str, Dimension] = {n: _dim(p.unit.dimension) for n, p in template.parameters.items()}
-    known.update({n: _dim(s.unit.dimension) for n, s in template.symbols.items()})
-    known.update({c: _dim((1, 0, -2, 0)) for c in compiled.constants if c == "g"})
+    known: dict[str, Dimension] = {n: p.unit.dimension for n, p in template.parameters.items()}
+    known.update({n: s.unit.dimension for n, s in template.symbols.items()})
+    known.update({c: ACCELERATION for c in compiled.constants if c == "g"})
     for step in compiled.steps:
-        found = None if isinstance(step.solved, Num) else dimension(step.solved, known)
+        found = None if isinstance(step.solved, Num) else dimension_of(step.solved, known, strict=False)
         if found is not None:
             known[step.unknown] = found
     return known
@@ -392,7 +305,7 @@ def _step(step: StepForm, scaling: Scaling | None, dim: Dimension | None, contex
     value = scaling.math()
     if value != chain[-1]:
         chain.append(value)
-    unit = unit_of(dim)
+    unit = si_unit(dim)
     multiple = [s for s, p in scaling.powers.items() if p]
     if multiple:
         symbols = ", ".join(f"${name(s)}$ {text('in ' + context.symbol_units[s])}" for s in multiple)

@@ -32,7 +32,7 @@ import numpy as np
 from grader.bank.template import Parameter, Template
 from grader.base.errors import GraderError, UsageError, shown, some
 from grader.base.inputs import CsvColumns, read_csv_columns
-from grader.model.units import MAX_TEXT, NUMBER, parse_unit, split_quantity
+from grader.model.quantities import MAX_TEXT, NUMBER, parse_unit, split_quantity
 from grader.solve.compiled import Compiled
 from grader.solve.evaluate import AnswerValue, Columns, answer_at
 

@@ -44,32 +44,8 @@ import numpy as np
 
 from grader.model.expr import Node, from_json, to_json
 from grader.model.kernel import Kernel, evaluate
+from grader.model.quantities import half_unit
 from grader.solve.compiled import PerAnswer
-
-
-def half_unit(values: Any, figures: int) -> np.ndarray:
-    """Half a unit in the ``figures``-th significant figure of each value: the most rounding it to that
-    many figures moves it (0 for 0, and for what is not finite).
-
-    >>> half_unit(np.array([45.09, 0.6315, 0.0]), 3).tolist()
-    [0.05, 0.0005, 0.0]
-    """
-    x = np.abs(np.asarray(values, dtype=float))
-    with np.errstate(all="ignore"):
-        exponent = np.floor(np.log10(np.where(x > 0, x, 1.0))) - (figures - 1)
-        return np.where((x > 0) & np.isfinite(x), 0.5 * 10.0**exponent, 0.0)
-
-
-def round_figures(values: Any, figures: int) -> np.ndarray:
-    """Values rounded to ``figures`` significant figures (0 stays 0; NaN stays NaN).
-
-    >>> round_figures(np.array([0.0123456, -2345.6, 0.0]), 3).tolist()
-    [0.0123, -2350.0, 0.0]
-    """
-    x = np.asarray(values, dtype=float)
-    with np.errstate(all="ignore"):
-        scale = 10.0 ** (figures - 1 - np.floor(np.log10(np.abs(np.where(x == 0, 1.0, x)))))
-        return np.where(x == 0, 0.0, np.round(x * scale) / scale)
 
 
 @dataclass(frozen=True)

@@ -24,7 +24,7 @@ import sympy as sp
 from grader.bank.template import Template
 from grader.base.errors import TemplateError, shown
 from grader.model.expr import names
-from grader.model.units import Unit
+from grader.model.quantities import Unit
 from grader.physics.effects import CATALOGUE, Relation
 from grader.physics.symbolic import INNER as _INNER
 from grader.physics.symbolic import Context, cosd, from_node, sind, to_node

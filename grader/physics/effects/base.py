@@ -15,7 +15,7 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
-from grader.model.units import Dimension
+from grader.model.quantities import Dimension
 
 if TYPE_CHECKING:
     import sympy as sp

@@ -35,7 +35,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from grader.base.errors import TemplateError
-from grader.model.units import LENGTH, PURE, dimension_from
+from grader.model.quantities import LENGTH, PURE, TIME
 from grader.physics.effects.base import Condition, Effect, Field, Mistake, Relation, Stable
 
 if TYPE_CHECKING:
@@ -56,7 +56,7 @@ _FIELDS = (
           default="the scene has no rebound height"),
     Field("distance", "expr", required=False, doc="total distance travelled until the body rests",
           dimension=LENGTH, default="the scene has no total distance"),
-    Field("time", "expr", required=False, doc="total time until the body rests", dimension=dimension_from(time=1),
+    Field("time", "expr", required=False, doc="total time until the body rests", dimension=TIME,
           default="the scene has no total time"),
 )
 

@@ -15,7 +15,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from grader.model.expr import Sym
-from grader.model.units import LENGTH, SPEED
+from grader.model.quantities import LENGTH, SPEED
 from grader.physics.effects.base import Condition, Effect, Field, Mistake, Relation
 
 if TYPE_CHECKING:

@@ -20,7 +20,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from grader.model.expr import to_text
-from grader.model.units import ANGLE, LENGTH
+from grader.model.quantities import ANGLE, LENGTH
 from grader.physics.effects.base import Condition, Effect, Field, Relation, Stable
 
 if TYPE_CHECKING:

@@ -30,7 +30,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from grader.model.expr import Sym
-from grader.model.units import PURE, SPEED, dimension_from
+from grader.model.quantities import ENERGY, IMPULSE, PURE, SPEED
 from grader.physics.effects.base import Condition, Effect, Field, Mistake, Relation, Route, Stable
 
 if TYPE_CHECKING:
@@ -39,7 +39,6 @@ if TYPE_CHECKING:
     from grader.physics.symbolic import Context
 
 
-ENERGY = dimension_from(2, 1, -2)
 
 _FIELDS = (
     Field("bodies", "bodies", doc="[first, second]: n points from the first into the second"),
@@ -48,7 +47,7 @@ _FIELDS = (
           "keeps it", dimension=SPEED),
     Field("after", "velocities", required=False, doc="per body: names for the velocities after", dimension=SPEED,
           default="v_<body>_n_after (and v_<body>_t_after when oblique)"),
-    Field("impulse", "name", required=False, doc="name for the normal impulse J", dimension=dimension_from(1, 1, -1),
+    Field("impulse", "name", required=False, doc="name for the normal impulse J", dimension=IMPULSE,
           default="J"),
     Field("energy_before", "name", required=False, doc="name for the kinetic energy before", dimension=ENERGY,
           default="T"),

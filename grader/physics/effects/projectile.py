@@ -26,7 +26,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from grader.model.expr import Sym
-from grader.model.units import LENGTH, SPEED, dimension_from
+from grader.model.quantities import LENGTH, SPEED, TIME
 from grader.physics.effects.base import Condition, Effect, Field, Mistake, Relation, Stable
 
 if TYPE_CHECKING:
@@ -44,7 +44,7 @@ _FIELDS = (
     Field("distance", "expr", doc="horizontal distance from the start to the end", dimension=LENGTH),
     Field("end_height", "expr", doc="height above the ground at the end (0 at the ground)", dimension=LENGTH),
     Field("end_vertical", "expr", doc="vertical velocity at the end, up positive", dimension=SPEED),
-    Field("time", "name", required=False, doc="name for the time of flight", dimension=dimension_from(time=1),
+    Field("time", "name", required=False, doc="name for the time of flight", dimension=TIME,
           default="t_flight"),
 )
 _DEFAULT_TIME = next(str(spec.default) for spec in _FIELDS if spec.name == "time")

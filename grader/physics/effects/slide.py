@@ -21,7 +21,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from grader.model.units import LENGTH, PURE, SPEED
+from grader.model.quantities import LENGTH, PURE, SPEED
 from grader.physics.effects.base import Condition, Effect, Field, Mistake, Relation
 
 if TYPE_CHECKING:

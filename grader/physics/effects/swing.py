@@ -25,7 +25,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from grader.model.units import ANGLE, LENGTH, SPEED
+from grader.model.quantities import ANGLE, LENGTH, SPEED
 from grader.physics.effects.base import Condition, Effect, Field, Mistake, Relation, Stable
 
 if TYPE_CHECKING:

@@ -14,7 +14,7 @@ import math
 from typing import TYPE_CHECKING, Any
 
 from grader.model.expr import to_text
-from grader.model.units import ANGLE, SPEED
+from grader.model.quantities import ANGLE, SPEED
 from grader.physics.effects.base import Condition, Effect, Field, Mistake, Relation
 
 if TYPE_CHECKING:

@@ -59,6 +59,44 @@ def some(names: Sequence[str], most: int = 10) -> str:
     return listed + (f" and {len(names) - most:,} more" if len(names) > most else "")
 
 
+def raised_in(error: BaseException, *packages: str) -> bool:
+    """Whether ``error`` was raised by the code of one of ``packages`` (its traceback's last frame is theirs):
+    a library refusing what it was given, as against a bug in the code that called it.
+
+    >>> try:
+    ...     import json; json.loads("{")
+    ... except ValueError as error:
+    ...     raised_in(error, "json"), raised_in(error, "grader"), raised_in(ValueError("made, not raised"), "json")
+    (True, False, False)
+    """
+    trace = error.__traceback__
+    if trace is None:
+        return False
+    while trace.tb_next is not None:
+        trace = trace.tb_next
+    return str(trace.tb_frame.f_globals.get("__name__", "")).split(".")[0] in packages
+
+
+SOLVER_FAILURES = (ArithmeticError, NotImplementedError, RecursionError, TypeError, ValueError, AttributeError)
+"""What deriving a template's answers with sympy may raise besides a :class:`GraderError`; only an error
+:func:`unworkable` says so is the template's, the rest are bugs."""
+
+
+def unworkable(error: BaseException) -> bool:
+    """Whether ``error`` says that the solver cannot work with a template's relations or values, not that grader
+    has a bug: a :class:`GraderError`, arithmetic that fails on the template's values, what sympy cannot do
+    (``NotImplementedError``), nesting deeper than Python goes; a ``TypeError``, ``ValueError`` or
+    ``AttributeError`` only when sympy (or mpmath, which it computes with) raised it, its way of refusing a
+    relation it cannot work with.
+
+    >>> unworkable(ZeroDivisionError()), unworkable(TypeError("raised by grader, not sympy"))
+    (True, False)
+    """
+    if isinstance(error, (GraderError, ArithmeticError, NotImplementedError, RecursionError)):
+        return True
+    return isinstance(error, (TypeError, ValueError, AttributeError)) and raised_in(error, "sympy", "mpmath")
+
+
 class GraderError(Exception):
     """Base of every error caused by input a user can correct (exit code 2)."""
 

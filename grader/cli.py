@@ -45,11 +45,58 @@ class _HelpFormatter(argparse.HelpFormatter):
 
 
 class _Parser(argparse.ArgumentParser):
-    """argparse's parser with :class:`_HelpFormatter`, its commands' parsers too."""
+    """argparse's parser with :class:`_HelpFormatter`, its commands' parsers too. With ``negative_values``, a
+    negative number in any form (``-6.3e2``, which argparse alone takes for an option) is a value: answers and
+    expected values are often negative."""
 
-    def __init__(self, *args: Any, **kwargs: Any) -> None:
+    def __init__(self, *args: Any, negative_values: bool = False, **kwargs: Any) -> None:
+        self.negative_values = negative_values
+        self.options: dict[str, bool] = {}  # each option string: whether it takes a value
         kwargs.setdefault("formatter_class", _HelpFormatter)
         super().__init__(*args, **kwargs)
+
+    def add_argument(self, *args: Any, **kwargs: Any) -> argparse.Action:
+        action = super().add_argument(*args, **kwargs)
+        self.options.update(dict.fromkeys(action.option_strings, action.nargs is None))
+        return action
+
+    def parse_known_args(self, args: Sequence[str] | None = None,  # type: ignore[override]
+                         namespace: argparse.Namespace | None = None) -> tuple[argparse.Namespace, list[str]]:
+        if self.negative_values and args is not None:
+            args = self.values_given(list(args))
+        return super().parse_known_args(args, namespace)
+
+    def values_given(self, args: list[str]) -> list[str]:
+        """``args`` with each negative number argparse would take for an option given as a value: joined to the
+        option before it that takes one (``--expected -6.3e2`` as ``--expected=-6.3e2``, an option abbreviated
+        as argparse allows), else, a positional value, after ``--`` at the end. Arguments that already hold a
+        ``--`` are left as they are.
+
+        >>> parser = _Parser(negative_values=True)
+        >>> _ = parser.add_argument("answer", nargs="?"), parser.add_argument("--expected"), parser.add_argument(
+        ...     "--json", action="store_true")
+        >>> parser.values_given(["-6.3e0", "--json", "--exp", "-6.26e0", "--expected", "-6"])
+        ['--json', '--exp=-6.26e0', '--expected=-6', '--', '-6.3e0']
+        """
+        if "--" in args:
+            return args
+        given: list[str] = []
+        positional: list[str] = []
+        for arg in args:
+            if not _NEGATIVE_NUMBER.match(arg):
+                given.append(arg)
+            elif given and self._takes_value(given[-1]):
+                given[-1] += f"={arg}"
+            else:
+                positional.append(arg)
+        return given + (["--", *positional] if positional else [])
+
+    def _takes_value(self, arg: str) -> bool:
+        """Whether ``arg`` names one option that takes a value (argparse takes a long option's unique prefix)."""
+        if arg in self.options:
+            return self.options[arg]
+        named = [option for option in self.options if option.startswith("--") and option.startswith(arg)]
+        return arg.startswith("--") and "=" not in arg and len(named) == 1 and self.options[named[0]]
 
 
 def _columns() -> int:
@@ -139,11 +186,10 @@ def build_parser() -> argparse.ArgumentParser:
 
     checking = commands.add_parser(
         "check", help="grade one answer as grader grade would: against a key's part, or a given value",
+        negative_values=True,
         description="Grade one answer: against a student's part of a key (--key, --student, --label), or against "
                     "--expected with --unit, a tolerance and, for an expression, --symbols and --domain. "
                     "--batch reads one JSON object a line and prints one result a line.")
-    # argparse takes -6 and -6.3 for values but -6.3e2 for an option: widen its test (answers are often negative)
-    checking._negative_number_matcher = _NEGATIVE_NUMBER
     checking.add_argument("answer", nargs="?", metavar="ANSWER", help="what the student typed, e.g. \"6.3 m/s\"")
     checking.add_argument("--key", type=Path, metavar="DIR/key.json", help="the key grader generate wrote")
     checking.add_argument("--student", metavar="ID", help="a student id (or email) of the key")

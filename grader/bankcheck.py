@@ -38,6 +38,7 @@ from grader.physics.integrate import Settings
 from grader.physics.record import Options
 from grader.render.documents import sources
 from grader.render.typeset import compile_typst, font_paths
+from grader.simulate.comparison import relative_difference
 from grader.simulate.walker import simulate
 from grader.solve.cache import compiled_for
 from grader.solve.evaluate import Columns, solve_columns, solve_one
@@ -176,7 +177,7 @@ class _Checks:
                                           f"form, at {self._shown(row)}")
                     continue
                 assert isinstance(exact, float)
-                differs = abs(value - exact) / abs(exact) if exact else abs(value)
+                differs = relative_difference(value, exact)
                 if differs > AGREEMENT:
                     raise _CheckError(f"simulation: {name} = {value:.10g} simulated, {exact:.10g} in closed form "
                                       f"(relative difference {differs:.2g}, at most {AGREEMENT:g} allowed) at "

@@ -18,7 +18,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from grader import __version__
-from grader.base.errors import GraderError, UsageError, some, visible
+from grader.base.errors import GraderError, UsageError, close_matches, some, visible
 
 if TYPE_CHECKING:
     from grader.bank.listing import Listed
@@ -370,25 +370,10 @@ def _bank_sources(arguments: argparse.Namespace) -> tuple[list[Path], bool]:
 
 
 def _template(arguments: argparse.Namespace) -> Template:
-    """The template the command names: read from its own file, or else the bank's error."""
-    from grader.bank.template import load_named
+    """The template the command names (:func:`grader.bank.template.find_template`)."""
+    from grader.bank.template import find_template
 
-    template = load_named(arguments.template, *_bank_sources(arguments))
-    if template is not None:
-        return template
-    bank = _bank(arguments)  # an unusable folder is refused as such; a missing template gets suggestions
-    if arguments.template not in bank:
-        close = _close_matches(arguments.template, bank)
-        hint = f"; did you mean {' or '.join(close)}?" if close else f"; the bank has {', '.join(sorted(bank))}"
-        raise UsageError(f"unknown template '{arguments.template}'{hint}")
-    return bank[arguments.template]
-
-
-def _close_matches(name: str, choices: Iterable[str]) -> list[str]:
-    """Up to three of ``choices`` that look like ``name`` (a misspelt id), closest first."""
-    import difflib
-
-    return difflib.get_close_matches(name, list(choices), n=3, cutoff=0.5)
+    return find_template(arguments.template, *_bank_sources(arguments))
 
 
 def _list(arguments: argparse.Namespace) -> int:
@@ -729,7 +714,7 @@ def _effects(arguments: argparse.Namespace) -> int:
 
     names = sorted(CATALOGUE)
     if arguments.name is not None and arguments.name not in CATALOGUE:
-        close = _close_matches(arguments.name, names)
+        close = close_matches(arguments.name, names)
         hint = f" (did you mean {' or '.join(close)}?)" if close else ""
         raise UsageError(f"unknown effect '{arguments.name}'{hint}; the effects are {', '.join(names)}")
     if arguments.name is None and not (arguments.json or arguments.markdown):
@@ -750,14 +735,13 @@ def _effects(arguments: argparse.Namespace) -> int:
 
 
 def _check_bank(arguments: argparse.Namespace) -> int:
-    from grader.bank.folders import bank_folders, template_files
+    from grader.bank.folders import template_paths
     from grader.bankcheck import check_bank
 
-    folders = [*arguments.banks_global, *arguments.banks]
-    shipped = not (arguments.no_shipped_bank_global or arguments.no_shipped_bank)
-    width = max(len(path.stem) for folder in bank_folders(folders, shipped) for path in template_files(folder))
+    sources = _bank_sources(arguments)
+    width = max(len(path.stem) for path in template_paths(*sources))
     failed = total = 0
-    for report in check_bank(folders, shipped):
+    for report in check_bank(*sources):
         total += 1
         failed += report.problem is not None
         if arguments.json:

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import re
 import reprlib
-from collections.abc import Sequence
+from collections.abc import Iterable, Sequence
 from typing import Any
 
 _SHOWN = reprlib.Repr()  # keyword arguments need Python 3.12
@@ -95,6 +95,17 @@ def unworkable(error: BaseException) -> bool:
     if isinstance(error, (GraderError, ArithmeticError, NotImplementedError, RecursionError)):
         return True
     return isinstance(error, (TypeError, ValueError, AttributeError)) and raised_in(error, "sympy", "mpmath")
+
+
+def close_matches(name: str, choices: Iterable[str]) -> list[str]:
+    """Up to three of ``choices`` that look like ``name`` (a misspelt id), closest first, for a "did you mean".
+
+    >>> close_matches("drop-rebond", ["drop-rebound", "head-on", "two-rebounds"])
+    ['drop-rebound', 'two-rebounds']
+    """
+    import difflib
+
+    return difflib.get_close_matches(name, list(choices), n=3, cutoff=0.5)
 
 
 class GraderError(Exception):

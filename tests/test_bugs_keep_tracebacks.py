@@ -14,7 +14,7 @@ import sympy as sp
 
 from grader.bank.template import load_bank
 from grader.base.errors import GraderError, TemplateError, unworkable
-from grader.grade import diagnosis, key
+from grader.grade import check, diagnosis, key
 from grader.grade.diagnosis import physics_for
 from grader.grade.key import load_key
 from grader.solve import cache as solve_cache
@@ -114,6 +114,33 @@ def test_a_template_sympy_cannot_work_with_is_a_note_and_grading_goes_on(monkeyp
     monkeypatch.setattr(diagnosis, "alternatives_for", _sympy_refuses)
     physics = physics_for(the_key, {template.id: template})
     assert physics.problems == {} and "template drop-rebound could not be compiled (TypeError: " in physics.notes[0]
+
+
+# --- a student's expression shown identical ---------------------------------------------------------------
+
+def test_a_bug_while_showing_an_expression_identical_is_not_a_verdict(monkeypatch: pytest.MonkeyPatch) -> None:
+    from grader.grade import identity
+    from grader.model.expr import parse
+
+    domains = (("v", (1.0, 10.0)),)
+    assert identity.identical(parse("2*v"), parse("v + v"), domains)
+    monkeypatch.setattr(identity, "_sympy", _sympy_refuses)
+    assert not identity.identical(parse("2*v"), parse("v + v"), domains)  # sympy could not: not shown identical
+    monkeypatch.setattr(identity, "_sympy", _bug)
+    with pytest.raises(TypeError, match="a bug in grader"):
+        identity.identical(parse("2*v"), parse("v + v"), domains)
+
+
+# --- grader check --batch ---------------------------------------------------------------------------
+
+def test_a_bug_while_checking_a_batch_line_is_not_an_error_line(monkeypatch: pytest.MonkeyPatch) -> None:
+    lines = ["[" * 100_000 + "]" * 100_000, '{"submitted": "1", "expected": 1, "tolerance": {"rtol": "x"}}']
+    assert [found["error"] for found in check.batch(lines, None)] == [
+        "maximum recursion depth exceeded while decoding a JSON array from a unicode string",
+        "tolerance.rtol: expected a number from 0 to 1e300, got 'x'"]
+    monkeypatch.setattr(check, "expectation", _bug)
+    with pytest.raises(TypeError, match="a bug in grader"):
+        list(check.batch(lines[1:], None))
 
 
 # --- the cache -----------------------------------------------------------------------------------------

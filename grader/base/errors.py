@@ -77,17 +77,17 @@ def raised_in(error: BaseException, *packages: str) -> bool:
     return str(trace.tb_frame.f_globals.get("__name__", "")).split(".")[0] in packages
 
 
-SOLVER_FAILURES = (ArithmeticError, NotImplementedError, RecursionError, TypeError, ValueError, AttributeError)
-"""What deriving a template's answers with sympy may raise besides a :class:`GraderError`; only an error
-:func:`unworkable` says so is the template's, the rest are bugs."""
+SYMPY_FAILURES = (ArithmeticError, NotImplementedError, RecursionError, TypeError, ValueError, AttributeError)
+"""What working with sympy may raise besides a :class:`GraderError`; only an error :func:`unworkable` says so
+is the template's (or the expression's), the rest are bugs."""
 
 
 def unworkable(error: BaseException) -> bool:
-    """Whether ``error`` says that the solver cannot work with a template's relations or values, not that grader
-    has a bug: a :class:`GraderError`, arithmetic that fails on the template's values, what sympy cannot do
-    (``NotImplementedError``), nesting deeper than Python goes; a ``TypeError``, ``ValueError`` or
-    ``AttributeError`` only when sympy (or mpmath, which it computes with) raised it, its way of refusing a
-    relation it cannot work with.
+    """Whether ``error`` says that sympy cannot work with a template's relations or values (or a student's
+    expression), not that grader has a bug: a :class:`GraderError`, arithmetic that fails on the values, what
+    sympy cannot do (``NotImplementedError``), nesting deeper than Python goes; a ``TypeError``, ``ValueError``
+    or ``AttributeError`` only when sympy (or mpmath, which it computes with) raised it, its way of refusing an
+    expression it cannot work with.
 
     >>> unworkable(ZeroDivisionError()), unworkable(TypeError("raised by grader, not sympy"))
     (True, False)

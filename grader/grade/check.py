@@ -349,7 +349,7 @@ def _chunk(lines: Sequence[str], start: int, key: Key | None, physics: Physics |
             continue
         try:
             submitted, against = _line(line, key, physics)
-        except (GraderError, ValueError, RecursionError) as error:
+        except GraderError as error:
             results[offset] = {"line": start + offset + 1, "error": str(error)}
             continue
         asked.append((offset, against))
@@ -375,6 +375,8 @@ def _line(line: str, key: Key | None, physics: Physics | None) -> tuple[str, Exp
         raise UsageError(str(error)) from None
     except ValueError as error:
         raise UsageError(f"expected a JSON object, got invalid JSON ({error})") from None
+    except RecursionError as error:  # nested deeper than Python reads
+        raise UsageError(str(error)) from None
     if not isinstance(item, dict):
         raise UsageError(f"expected a JSON object, got {shown(item)}")
     extra = sorted(str(name) for name in item if name not in _BATCH_FIELDS)

@@ -14,7 +14,7 @@ import numpy as np
 import sympy as sp
 
 from grader.bank.template import Template
-from grader.base.errors import SOLVER_FAILURES, TemplateError, unworkable
+from grader.base.errors import SYMPY_FAILURES, TemplateError, unworkable
 from grader.model.expr import Node, Num, Op, names
 from grader.model.kernel import evaluate
 from grader.physics.effects import CATALOGUE, Mistake, Relation
@@ -23,7 +23,7 @@ from grader.solve.alternatives import GIVEN, Alternative, Alternatives
 from grader.solve.solver import _Compiler, _si_factor, _Solved, derive
 from grader.solve.stable import numeric_order
 
-_FAILURES = (TemplateError, *SOLVER_FAILURES)
+_FAILURES = (TemplateError, *SYMPY_FAILURES)
 """What an alternative the solver cannot derive or compile may raise: it is left out when the error is
 :func:`~grader.base.errors.unworkable`, and keeps its traceback otherwise (a bug of grader's)."""
 

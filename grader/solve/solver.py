@@ -22,7 +22,7 @@ from typing import Any
 import sympy as sp
 
 from grader.bank.template import Template
-from grader.base.errors import SOLVER_FAILURES, TemplateError, shown, unworkable
+from grader.base.errors import SYMPY_FAILURES, TemplateError, shown, unworkable
 from grader.model.expr import names
 from grader.model.units import Unit
 from grader.physics.effects import CATALOGUE, Relation
@@ -342,7 +342,7 @@ def compile_template(template: Template) -> Compiled:
             raise TemplateError(template.where, "stages or answers", error.expected,
                                 f"{error.key} ({error.got})") from None
         raise
-    except SOLVER_FAILURES as error:
+    except SYMPY_FAILURES as error:
         if not unworkable(error):
             raise
         raise TemplateError(template.where, "stages or answers", "expressions the solver can work with (real, "

@@ -31,13 +31,14 @@ from typing import Any
 
 from grader.assign.assignment import Assignment, ProblemSpec, Student
 from grader.assign.variants import MAX_DRAWS, ProblemDraws, generate, variant_generator
-from grader.bank.folders import bank_folders, template_files
+from grader.bank.folders import template_paths
 from grader.bank.template import Template, load_template, same_id
 from grader.base.errors import GraderError
 from grader.physics.integrate import Settings
 from grader.physics.record import Options
 from grader.render.documents import sources
 from grader.render.typeset import compile_typst, font_paths
+from grader.simulate.comparison import relative_difference
 from grader.simulate.walker import simulate
 from grader.solve.cache import compiled_for
 from grader.solve.evaluate import Columns, solve_columns, solve_one
@@ -80,20 +81,19 @@ def check_bank(folders: Sequence[Path] = (), shipped: bool = True, fonts: tuple[
     """A report per template file of the bank, in the order of the folders, then of the file names;
     a template that does not load, or repeats an id, is reported and the others are still checked."""
     seen: dict[str, Template] = {}
-    for folder in bank_folders(folders, shipped):
-        for path in template_files(folder):
-            started = time.perf_counter()
-            try:
-                template = load_template(path)
-            except GraderError as error:
-                yield Report(path.stem, str(path), f"load: {error}", "", time.perf_counter() - started)
-                continue
-            if template.id in seen:
-                yield Report(template.id, template.where, f"load: {same_id(seen[template.id], template)}", "",
-                             time.perf_counter() - started)
-                continue
-            seen[template.id] = template
-            yield check_template(template, fonts)
+    for path in template_paths(folders, shipped):
+        started = time.perf_counter()
+        try:
+            template = load_template(path)
+        except GraderError as error:
+            yield Report(path.stem, str(path), f"load: {error}", "", time.perf_counter() - started)
+            continue
+        if template.id in seen:
+            yield Report(template.id, template.where, f"load: {same_id(seen[template.id], template)}", "",
+                         time.perf_counter() - started)
+            continue
+        seen[template.id] = template
+        yield check_template(template, fonts)
 
 
 def check_template(template: Template, fonts: tuple[str, ...] = ()) -> Report:
@@ -176,7 +176,7 @@ class _Checks:
                                           f"form, at {self._shown(row)}")
                     continue
                 assert isinstance(exact, float)
-                differs = abs(value - exact) / abs(exact) if exact else abs(value)
+                differs = relative_difference(value, exact)
                 if differs > AGREEMENT:
                     raise _CheckError(f"simulation: {name} = {value:.10g} simulated, {exact:.10g} in closed form "
                                       f"(relative difference {differs:.2g}, at most {AGREEMENT:g} allowed) at "

@@ -18,7 +18,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from grader import __version__
-from grader.base.errors import GraderError, UsageError, some, visible
+from grader.base.errors import GraderError, UsageError, close_matches, some, visible
 
 if TYPE_CHECKING:
     from grader.bank.listing import Listed
@@ -44,12 +44,63 @@ class _HelpFormatter(argparse.HelpFormatter):
         super().__init__(prog, indent_increment, max_help_position, _columns() - 2 if width is None else width)
 
 
-class _Parser(argparse.ArgumentParser):
-    """argparse's parser with :class:`_HelpFormatter`, its commands' parsers too."""
+_NEGATIVE_NUMBER = re.compile(r"^-(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?$")
+"""A negative number as argparse should take it for a value: ``-6.26``, ``-1e308``, ``-.5E-3``."""
 
-    def __init__(self, *args: Any, **kwargs: Any) -> None:
+
+class _Parser(argparse.ArgumentParser):
+    """argparse's parser with :class:`_HelpFormatter`, its commands' parsers too. With ``negative_values``, a
+    negative number in any form (``-6.3e2``, which argparse alone takes for an option) is a value: answers and
+    expected values are often negative."""
+
+    def __init__(self, *args: Any, negative_values: bool = False, **kwargs: Any) -> None:
+        self.negative_values = negative_values
+        self.options: dict[str, bool] = {}  # each option string: whether it takes a value
         kwargs.setdefault("formatter_class", _HelpFormatter)
         super().__init__(*args, **kwargs)
+
+    def add_argument(self, *args: Any, **kwargs: Any) -> argparse.Action:
+        action = super().add_argument(*args, **kwargs)
+        self.options.update(dict.fromkeys(action.option_strings, action.nargs is None))
+        return action
+
+    def parse_known_args(self, args: Sequence[str] | None = None,  # type: ignore[override]
+                         namespace: argparse.Namespace | None = None) -> tuple[argparse.Namespace, list[str]]:
+        if self.negative_values and args is not None:
+            args = self.values_given(list(args))
+        return super().parse_known_args(args, namespace)
+
+    def values_given(self, args: list[str]) -> list[str]:
+        """``args`` with each negative number argparse would take for an option given as a value: joined to the
+        option before it that takes one (``--expected -6.3e2`` as ``--expected=-6.3e2``, an option abbreviated
+        as argparse allows), else, a positional value, after ``--`` at the end. Arguments that already hold a
+        ``--`` are left as they are.
+
+        >>> parser = _Parser(negative_values=True)
+        >>> _ = parser.add_argument("answer", nargs="?"), parser.add_argument("--expected"), parser.add_argument(
+        ...     "--json", action="store_true")
+        >>> parser.values_given(["-6.3e0", "--json", "--exp", "-6.26e0", "--expected", "-6"])
+        ['--json', '--exp=-6.26e0', '--expected=-6', '--', '-6.3e0']
+        """
+        if "--" in args:
+            return args
+        given: list[str] = []
+        positional: list[str] = []
+        for arg in args:
+            if not _NEGATIVE_NUMBER.match(arg):
+                given.append(arg)
+            elif given and self._takes_value(given[-1]):
+                given[-1] += f"={arg}"
+            else:
+                positional.append(arg)
+        return given + (["--", *positional] if positional else [])
+
+    def _takes_value(self, arg: str) -> bool:
+        """Whether ``arg`` names one option that takes a value (argparse takes a long option's unique prefix)."""
+        if arg in self.options:
+            return self.options[arg]
+        named = [option for option in self.options if option.startswith("--") and option.startswith(arg)]
+        return arg.startswith("--") and "=" not in arg and len(named) == 1 and self.options[named[0]]
 
 
 def _columns() -> int:
@@ -139,11 +190,10 @@ def build_parser() -> argparse.ArgumentParser:
 
     checking = commands.add_parser(
         "check", help="grade one answer as grader grade would: against a key's part, or a given value",
+        negative_values=True,
         description="Grade one answer: against a student's part of a key (--key, --student, --label), or against "
                     "--expected with --unit, a tolerance and, for an expression, --symbols and --domain. "
                     "--batch reads one JSON object a line and prints one result a line.")
-    # argparse takes -6 and -6.3 for values but -6.3e2 for an option: widen its test (answers are often negative)
-    checking._negative_number_matcher = _NEGATIVE_NUMBER
     checking.add_argument("answer", nargs="?", metavar="ANSWER", help="what the student typed, e.g. \"6.3 m/s\"")
     checking.add_argument("--key", type=Path, metavar="DIR/key.json", help="the key grader generate wrote")
     checking.add_argument("--student", metavar="ID", help="a student id (or email) of the key")
@@ -320,25 +370,10 @@ def _bank_sources(arguments: argparse.Namespace) -> tuple[list[Path], bool]:
 
 
 def _template(arguments: argparse.Namespace) -> Template:
-    """The template the command names: read from its own file, or else the bank's error."""
-    from grader.bank.template import load_named
+    """The template the command names (:func:`grader.bank.template.find_template`)."""
+    from grader.bank.template import find_template
 
-    template = load_named(arguments.template, *_bank_sources(arguments))
-    if template is not None:
-        return template
-    bank = _bank(arguments)  # an unusable folder is refused as such; a missing template gets suggestions
-    if arguments.template not in bank:
-        close = _close_matches(arguments.template, bank)
-        hint = f"; did you mean {' or '.join(close)}?" if close else f"; the bank has {', '.join(sorted(bank))}"
-        raise UsageError(f"unknown template '{arguments.template}'{hint}")
-    return bank[arguments.template]
-
-
-def _close_matches(name: str, choices: Iterable[str]) -> list[str]:
-    """Up to three of ``choices`` that look like ``name`` (a misspelt id), closest first."""
-    import difflib
-
-    return difflib.get_close_matches(name, list(choices), n=3, cutoff=0.5)
+    return find_template(arguments.template, *_bank_sources(arguments))
 
 
 def _list(arguments: argparse.Namespace) -> int:
@@ -492,6 +527,7 @@ def _table(header: Sequence[str], rows: Sequence[Sequence[str]]) -> str:
 def _simulate(arguments: argparse.Namespace) -> int:
     from grader.physics.integrate import Settings
     from grader.physics.record import Options
+    from grader.simulate.comparison import comparison
     from grader.simulate.walker import simulate
     from grader.solve.batch import read_assignments
     from grader.solve.cache import compiled_for
@@ -516,49 +552,14 @@ def _simulate(arguments: argparse.Namespace) -> int:
         _print_solution(template, closed.params, None, closed.error, arguments.json, None)
         return EXIT_REFUSED
     result = simulate(template, params, options)
-    rows = {}
-    for name, simulated in result.answers.items():
-        answer = closed.answers[name] if closed.answers else None
-        exact = answer.value if answer is not None and isinstance(answer.value, float) else None
-        differs = None
-        if exact is not None and simulated is not None:
-            differs = abs(simulated - exact) / abs(exact) if exact else abs(simulated - exact)
-            differs = min(differs, sys.float_info.max)  # 1e300 against 1e-10 overflows: "huge" is the truth
-        why = {"simulated": result.undefined.get(name) if simulated is None else None,
-               "closed_form": (answer.undefined or "undefined") if answer is not None and exact is None else None}
-        rows[name] = {"simulated": simulated, "closed_form": exact, "rel_diff": differs,
-                      "undefined": {k: v for k, v in why.items() if v is not None} or None}
     if arguments.plot is not None:
         plot_simulation(result, arguments.plot)
-    record = {"template": template.id, "params": result.params, "method": settings.method,
-              "effects": list(result.effects), "steps": result.steps, "seconds": result.seconds, "answers": rows,
-              "fitted": dict(result.fitted), "nominal": dict(result.nominal),
-              "contacts": [{"impact": c.label, "e": c.e, "measured_e": c.measured_e, "zeta": c.zeta,
-                            "duration": c.duration} for c in result.contacts],
-              "notes": list(result.notes),
-              "settings": {"steps_per_contact": settings.steps, "rtol": settings.rtol,
-                           "contact_duration": options.contact_duration,
-                           "weight_during_contact": options.weight_during_contact}}
-    record = _plain_numbers(record)
+    record = comparison(result, closed.answers or {}, options)
     if arguments.json:
         print(json.dumps(record, allow_nan=False))
         return EXIT_OK
     _print_simulation(template, record)
     return EXIT_OK
-
-
-def _plain_numbers(value: Any) -> Any:
-    """A simulation record with every -0 made 0; a number that is not finite is a bug (the
-    simulator refuses what would produce one and reports undefined quantities as None)."""
-    if isinstance(value, dict):
-        return {key: _plain_numbers(item) for key, item in value.items()}
-    if isinstance(value, list | tuple):
-        return [_plain_numbers(item) for item in value]
-    if isinstance(value, float):
-        if value != value or value in (float("inf"), float("-inf")):
-            raise ValueError(f"a simulation produced a number that is not finite: {value}")
-        return value + 0.0
-    return value
 
 
 def _print_simulation(template: Template, record: dict[str, Any]) -> None:
@@ -670,116 +671,24 @@ def _check(arguments: argparse.Namespace) -> int:
     from grader.grade.diagnosis import physics_for
     from grader.grade.key import load_key
 
-    _check_arguments(arguments)
-    key = load_key(arguments.key) if arguments.key is not None else None
+    asked = check.Asked(arguments.answer, arguments.key, arguments.student, arguments.label, arguments.expected,
+                        arguments.unit, arguments.rtol, arguments.atol, arguments.sigfigs, arguments.decimals,
+                        arguments.symbols, tuple(arguments.domains), arguments.batch)
+    asked.refuse_a_mix()
+    key = load_key(asked.key) if asked.key is not None else None
     physics = physics_for(key, _lazy_bank(arguments)) if key is not None else None
-    if arguments.batch is not None:
-        failed, printed = 0, []
-        for result in check.batch(_batch_lines(arguments.batch), key, physics):
-            failed += "error" in result
-            printed.append(_json_line(result))
-            if len(printed) == check.BATCH_CHUNK:  # written a chunk at a time, not a line at a time
-                print("\n".join(printed))
-                printed.clear()
-        if printed:
-            print("\n".join(printed))
+    if asked.batch is not None:
+        failed = 0
+        for block, errors in check.json_blocks(check.batch_lines(asked.batch), key, physics):
+            print(block)
+            failed += errors
         return EXIT_REFUSED if failed else EXIT_OK
-    if key is not None:
-        against = check.from_key(key, arguments.student, arguments.label, physics)
-    else:
-        tolerance = {name: getattr(arguments, name) for name in ("rtol", "atol")
-                     if getattr(arguments, name) is not None}
-        for mode in ("sigfigs", "decimals"):
-            if getattr(arguments, mode) is not None:
-                tolerance = {"mode": mode, "digits": getattr(arguments, mode)}
-        symbols = None if arguments.symbols is None else [s.strip() for s in arguments.symbols.split(",")]
-        expected, unit = _expected_quantity(arguments.expected, arguments.unit)
-        against = check.expectation(expected, unit=unit,
-                                    tolerance=tolerance, symbols=symbols,
-                                    domains=check.domains(arguments.domains))
-    result = check.check(arguments.answer, against)
+    result = check.check(arguments.answer, asked.against(key, physics))
     if arguments.json:
-        print(_json_line(result))
+        print(check.json_line(result))
     else:
         _print_check(result)
     return EXIT_OK
-
-
-def _json_line(result: dict[str, Any]) -> str:
-    r"""A result as one line of strict JSON, UTF-8 as it is (``±1 %``), except lone surrogates (input
-    echoed in an error: a JSON ``\ud800``, a file name that is not UTF-8), which no UTF-8 output can
-    write: they keep their ``\u`` escape.
-
-    >>> _json_line({"error": "unit: cannot read unit '\ud800'", "tolerance": "±1 %"})
-    '{"error": "unit: cannot read unit \'\\ud800\'", "tolerance": "±1 %"}'
-    """
-    text = json.dumps(result, ensure_ascii=False, allow_nan=False)
-    return _SURROGATE.sub(lambda m: f"\\u{ord(m.group()):04x}", text)
-
-
-_NEGATIVE_NUMBER = re.compile(r"^-(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?$")
-"""A negative number as argparse should take it for a value: ``-6.26``, ``-1e308``, ``-.5E-3``."""
-_SURROGATE = re.compile("[\ud800-\udfff]")
-
-
-def _check_arguments(arguments: argparse.Namespace) -> None:
-    """The two ways to call ``grader check``, and ``--batch``; a mix of them is refused with the reason."""
-    given = [f"--{name}" for name in ("expected", "unit", "rtol", "atol", "sigfigs", "decimals", "symbols")
-             if getattr(arguments, name) is not None] + (["--domain"] if arguments.domains else [])
-    chosen = [f"--{name}" for name in ("student", "label") if getattr(arguments, name) is not None]
-    if arguments.batch is not None:
-        if arguments.answer is not None or given or chosen:
-            raise UsageError("--batch takes every answer and expectation from its lines; give it alone "
-                             "(with --key when the lines name a student and label)")
-        return
-    if arguments.answer is None:
-        raise UsageError("expected the answer to check, e.g. grader check \"6.3 m/s\" --expected 6.26 --unit m/s")
-    modes = [flag for flag in ("--sigfigs", "--decimals") if flag in given]
-    if len(modes) > 1 or (modes and {"--rtol", "--atol"} & set(given)):
-        raise UsageError(f"{' and '.join(modes + sorted({'--rtol', '--atol'} & set(given)))}: choose one tolerance "
-                         "mode (--rtol/--atol, --sigfigs or --decimals)")
-    if arguments.key is not None:
-        if given:
-            raise UsageError(f"{', '.join(given)}: with --key the expected answer, unit and tolerance come from "
-                             "the key")
-        if len(chosen) < 2:
-            raise UsageError("--key needs --student ID and --label LABEL (the part as printed, e.g. 1a)")
-    elif chosen or arguments.expected is None:
-        raise UsageError("expected --expected VALUE (and --unit), or --key with --student and --label")
-
-
-def _expected_quantity(text: str, unit: str | None) -> tuple[float | str, str]:
-    """``--expected``: a number (``6.26``, or ``6.26 m/s`` when ``--unit`` is not given) or an expression."""
-    from grader.model.quantities import parse_unit, split_quantity
-
-    quantity = split_quantity(text)
-    if quantity is None:
-        return text, unit or ""  # an expression
-    value, written = quantity
-    if written:
-        try:
-            parse_unit(written)
-        except GraderError:
-            return text, unit or ""  # 2v: an expression
-        if unit is not None and unit.strip() != written:
-            raise UsageError(f"--expected {text} and --unit {unit}: give the unit once")
-        return value, written
-    return value, unit or ""
-
-
-def _batch_lines(path: Path) -> list[str]:
-    from grader.base.caching import read_at_most
-    from grader.base.inputs import decode_text, read_bytes
-
-    limit = 1 << 30
-    if str(path) == "-":
-        if sys.stdin is None:  # started with standard input closed (`grader check --batch - <&-`)
-            raise UsageError("--batch -: standard input is closed; send the lines to it, or give --batch FILE.jsonl")
-        data = read_at_most(sys.stdin.buffer, limit + 1, 1 << 20)
-        if len(data) > limit:
-            raise UsageError(f"standard input: more than {limit:,} bytes; split the batch")
-        return decode_text(data, Path("standard input")).splitlines()
-    return decode_text(read_bytes(path, limit), path).splitlines()
 
 
 def _print_check(result: dict[str, Any]) -> None:
@@ -805,7 +714,7 @@ def _effects(arguments: argparse.Namespace) -> int:
 
     names = sorted(CATALOGUE)
     if arguments.name is not None and arguments.name not in CATALOGUE:
-        close = _close_matches(arguments.name, names)
+        close = close_matches(arguments.name, names)
         hint = f" (did you mean {' or '.join(close)}?)" if close else ""
         raise UsageError(f"unknown effect '{arguments.name}'{hint}; the effects are {', '.join(names)}")
     if arguments.name is None and not (arguments.json or arguments.markdown):
@@ -826,14 +735,13 @@ def _effects(arguments: argparse.Namespace) -> int:
 
 
 def _check_bank(arguments: argparse.Namespace) -> int:
-    from grader.bank.folders import bank_folders, template_files
+    from grader.bank.folders import template_paths
     from grader.bankcheck import check_bank
 
-    folders = [*arguments.banks_global, *arguments.banks]
-    shipped = not (arguments.no_shipped_bank_global or arguments.no_shipped_bank)
-    width = max(len(path.stem) for folder in bank_folders(folders, shipped) for path in template_files(folder))
+    sources = _bank_sources(arguments)
+    width = max(len(path.stem) for path in template_paths(*sources))
     failed = total = 0
-    for report in check_bank(folders, shipped):
+    for report in check_bank(*sources):
         total += 1
         failed += report.problem is not None
         if arguments.json:

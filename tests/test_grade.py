@@ -260,7 +260,7 @@ HOSTILE_KEYS = [  # (what is changed in the key, what the refusal says): each wa
     # no file mid-run, or was taken as it came (points of -5, an id null read as the student "None")
     (lambda d: _first_answer(d).update(points=1e308), "answer e: points: expected a number from 0 to 1,000,000"),
     (lambda d: _first_answer(d).update(points=-5), "answer e: points: expected a number from 0 to 1,000,000"),
-    (lambda d: _first_answer(d).update(value=10 ** 400), "OverflowError"),
+    (lambda d: _first_answer(d).update(value=10 ** 400), "answer e: a value beyond float64"),
     (lambda d: _first_answer(d).update(tolerance={"mode": "sigfigs", "digits": 99}),
      "answer e: tolerance.digits: expected a whole number from 1 to 17, got 99"),
     (lambda d: _first_answer(d).update(unit="kg^99"), "answer e: unit: the power 99"),

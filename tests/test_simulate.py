@@ -6,6 +6,7 @@ import dataclasses
 import json
 import math
 import re
+import sys
 import time
 from pathlib import Path
 
@@ -18,6 +19,7 @@ from grader.cli import main
 from grader.physics.effects import CATALOGUE
 from grader.physics.integrate import Settings, SimulationError
 from grader.physics.record import Options
+from grader.simulate.comparison import relative_difference
 from grader.simulate.walker import simulate
 from grader.solve.compiled import Compiled
 from grader.solve.evaluate import solve_one
@@ -56,7 +58,7 @@ def _compare(template: Template, compiled: Compiled, params: dict[str, float], o
             assert exact is None and value is None, (name, exact, value)
             continue
         assert isinstance(exact, float)
-        differences[name] = abs(value - exact) / abs(exact) if exact else abs(value)
+        differences[name] = relative_difference(value, exact)
     return differences
 
 
@@ -439,3 +441,13 @@ def test_the_line_of_centres_is_found_where_the_simulated_spheres_touch(template
     """Sphere 1 moves along its line until the centres are r1 + r2 apart (a located event); the line of
     centres measured there, then the contact, give the closed form's answers, head-on to near grazing."""
     assert max(_compare(bank[template_id], compiled[template_id], params, ADAPTIVE).values()) < 1e-8
+
+
+def test_the_relative_difference_is_measured_against_zero_by_the_difference_itself() -> None:
+    """No relative difference is measured against an exact 0: the simulated value itself is how far it is (what
+    `grader simulate` printed and `grader check-bank` allowed, each computing it on its own, before one function
+    did both); a difference that overflows is the largest float, so that `--json` stays finite."""
+    assert relative_difference(1.5, 1.0) == 0.5 and relative_difference(-1.0, 1.0) == 2.0
+    assert relative_difference(3e-9, 0.0) == 3e-9 and relative_difference(-3e-9, -0.0) == 3e-9
+    assert relative_difference(0.0, 0.0) == 0.0
+    assert relative_difference(1e300, 1e-10) == relative_difference(1e308, -1e308) == sys.float_info.max

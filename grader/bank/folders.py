@@ -2,8 +2,8 @@ r"""Where a bank's templates are (the shipped folder and the ones given, each te
 topics ``grader list`` groups them by, and what a template's id, title and names may be: what a listing
 needs before any template is read, and to check one read back from the cache.
 
->>> [path.name for path in template_files(bank_folders()[0])][:2]
-['ball-plate.yaml', 'ballistic-pendulum.yaml']
+>>> [path.name for path in template_files(bank_folders()[0])][:2], template_paths()[0].name
+(['ball-plate.yaml', 'ballistic-pendulum.yaml'], 'ball-plate.yaml')
 >>> bool(TEMPLATE_ID.match("pile-driver")), bool(NAME.match("h_drop")), bool(NAME.match("h_drop\n"))
 (True, True, False)
 """
@@ -67,3 +67,8 @@ def bank_folders(folders: Sequence[Path] = (), shipped: bool = True) -> list[Pat
     if not sources:
         raise UsageError("no problem bank: without the shipped bank (--no-shipped-bank), give --bank DIR")
     return sources
+
+
+def template_paths(folders: Sequence[Path] = (), shipped: bool = True) -> list[Path]:
+    """Every template file of the banks (:func:`bank_folders`), folder by folder, each folder's by name."""
+    return [path for folder in bank_folders(folders, shipped) for path in template_files(folder)]

@@ -17,9 +17,9 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from grader.bank.folders import NAME, TEMPLATE_ID, TOPICS, bank_folders, one_line, template_files
+from grader.bank.folders import NAME, TEMPLATE_ID, TOPICS, bank_folders, one_line, template_files, template_paths
 from grader.bank.scene_parser import parse_scene
-from grader.base.errors import ExpressionError, GraderError, TemplateError, shown
+from grader.base.errors import ExpressionError, GraderError, TemplateError, UsageError, close_matches, shown
 from grader.base.inputs import YAML_BYTES, parse_yaml, read_bytes
 from grader.base.resources import bank_dir
 from grader.model.expr import Node, Num, Op, Sym, names, parse, to_text
@@ -241,6 +241,21 @@ def load_named(template_id: str, folders: Sequence[Path] = (), shipped: bool = T
     return found[0] if found else None
 
 
+def find_template(template_id: str, folders: Sequence[Path] = (), shipped: bool = True) -> Template:
+    """The template ``template_id`` of the banks, read from its own file (:func:`load_named`); else the banks
+    are read whole, so that an unusable folder is refused as such, and a template they lack is refused with the
+    ids it may be a misspelling of (or, when none is close, every id)."""
+    template = load_named(template_id, folders, shipped)
+    if template is not None:
+        return template
+    bank = load_banks(folders, shipped)
+    if template_id not in bank:
+        close = close_matches(template_id, bank)
+        hint = f"; did you mean {' or '.join(close)}?" if close else f"; the bank has {', '.join(sorted(bank))}"
+        raise UsageError(f"unknown template '{template_id}'{hint}")
+    return bank[template_id]
+
+
 class Banks(Mapping[str, "Template"]):
     """The banks :func:`load_banks` reads, as a mapping that reads a template from its own file when it is
     asked for (:func:`load_named`): grading needs the few templates a key names, not the whole bank."""
@@ -255,8 +270,7 @@ class Banks(Mapping[str, "Template"]):
         return template
 
     def __iter__(self) -> Iterator[str]:
-        return iter(sorted({path.stem for folder in bank_folders(self.folders, self.shipped)
-                            for path in template_files(folder)}))
+        return iter(sorted({path.stem for path in template_paths(self.folders, self.shipped)}))
 
     def __len__(self) -> int:
         return sum(1 for _ in self)

@@ -229,3 +229,32 @@ def clear(folder: Path) -> tuple[int, int]:
             continue
         removed, size = removed + 1, size + bytes_
     return removed, size
+
+
+ANY = object()
+"""A shape :func:`fits` takes anything for (what the reader checks itself, as an expression tree's reader does)."""
+
+
+def fits(data: Any, shape: Any) -> bool:
+    """Whether an entry's JSON ``data`` has ``shape``, so that reading it back cannot miss a field or meet
+    another type: an entry damaged or made by other code is told apart from a bug in the reader, which keeps
+    its traceback. A shape is :data:`ANY`; a JSON type or a tuple of them (``bool`` is not ``int`` here);
+    ``[shape]``, a list of those; ``{str: shape}``, an object of any names whose values have ``shape``; or
+    ``{"name": shape, ...}``, an object with at least those names.
+
+    >>> fits({"a": [1, 2.5], "b": None}, {"a": [(int, float)], "b": ANY}), fits({"a": [True]}, {"a": [int]})
+    (True, False)
+    >>> fits({"x": {"n": "1"}}, {str: {"n": str}}), fits({"x": []}, {str: {"n": str}}), fits({}, {"a": str})
+    (True, False, False)
+    """
+    if shape is ANY:
+        return True
+    if isinstance(shape, list):
+        return type(data) is list and all(fits(item, shape[0]) for item in data)
+    if isinstance(shape, dict):
+        if type(data) is not dict:
+            return False
+        if list(shape) == [str]:
+            return all(type(name) is str and fits(value, shape[str]) for name, value in data.items())
+        return all(name in data and fits(data[name], value) for name, value in shape.items())
+    return type(data) in (shape if isinstance(shape, tuple) else (shape,))

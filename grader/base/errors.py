@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import re
 import reprlib
-from collections.abc import Sequence
+from collections.abc import Iterable, Sequence
 from typing import Any
 
 _SHOWN = reprlib.Repr()  # keyword arguments need Python 3.12
@@ -57,6 +57,55 @@ def some(names: Sequence[str], most: int = 10) -> str:
     """
     listed = ", ".join(shown(name, 40)[1:-1] for name in names[:most])
     return listed + (f" and {len(names) - most:,} more" if len(names) > most else "")
+
+
+def raised_in(error: BaseException, *packages: str) -> bool:
+    """Whether ``error`` was raised by the code of one of ``packages`` (its traceback's last frame is theirs):
+    a library refusing what it was given, as against a bug in the code that called it.
+
+    >>> try:
+    ...     import json; json.loads("{")
+    ... except ValueError as error:
+    ...     raised_in(error, "json"), raised_in(error, "grader"), raised_in(ValueError("made, not raised"), "json")
+    (True, False, False)
+    """
+    trace = error.__traceback__
+    if trace is None:
+        return False
+    while trace.tb_next is not None:
+        trace = trace.tb_next
+    return str(trace.tb_frame.f_globals.get("__name__", "")).split(".")[0] in packages
+
+
+SYMPY_FAILURES = (ArithmeticError, NotImplementedError, RecursionError, TypeError, ValueError, AttributeError)
+"""What working with sympy may raise besides a :class:`GraderError`; only an error :func:`unworkable` says so
+is the template's (or the expression's), the rest are bugs."""
+
+
+def unworkable(error: BaseException) -> bool:
+    """Whether ``error`` says that sympy cannot work with a template's relations or values (or a student's
+    expression), not that grader has a bug: a :class:`GraderError`, arithmetic that fails on the values, what
+    sympy cannot do (``NotImplementedError``), nesting deeper than Python goes; a ``TypeError``, ``ValueError``
+    or ``AttributeError`` only when sympy (or mpmath, which it computes with) raised it, its way of refusing an
+    expression it cannot work with.
+
+    >>> unworkable(ZeroDivisionError()), unworkable(TypeError("raised by grader, not sympy"))
+    (True, False)
+    """
+    if isinstance(error, (GraderError, ArithmeticError, NotImplementedError, RecursionError)):
+        return True
+    return isinstance(error, (TypeError, ValueError, AttributeError)) and raised_in(error, "sympy", "mpmath")
+
+
+def close_matches(name: str, choices: Iterable[str]) -> list[str]:
+    """Up to three of ``choices`` that look like ``name`` (a misspelt id), closest first, for a "did you mean".
+
+    >>> close_matches("drop-rebond", ["drop-rebound", "head-on", "two-rebounds"])
+    ['drop-rebound', 'two-rebounds']
+    """
+    import difflib
+
+    return difflib.get_close_matches(name, list(choices), n=3, cutoff=0.5)
 
 
 class GraderError(Exception):

@@ -30,6 +30,7 @@ import math
 import os
 import re
 import stat
+import sys
 from collections import Counter
 from collections.abc import Iterator
 from dataclasses import dataclass, field
@@ -61,6 +62,19 @@ def read_bytes(path: Path, limit: int) -> bytes:
         raise GraderError(f"{path}: cannot read ({error.strerror or error})") from None
     if too_large or len(data) > limit:
         raise GraderError(f"{path}: larger than {limit >> 20 or 1} MiB; expected a text file of ordinary size")
+    return data
+
+
+def read_input(path: Path, limit: int) -> bytes | None:
+    """:func:`read_bytes` of ``path``, or, when ``path`` is ``-``, standard input's bytes within the same bound
+    (read 1 MiB at a time: its size is not known); None when standard input is closed (``<&-``)."""
+    if str(path) != "-":
+        return read_bytes(path, limit)
+    if sys.stdin is None:
+        return None
+    data = caching.read_at_most(sys.stdin.buffer, limit + 1, 1 << 20)
+    if len(data) > limit:
+        raise GraderError(f"standard input: more than {limit:,} bytes; split the batch")
     return data
 
 

@@ -20,17 +20,18 @@ import math
 import re
 from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
 
 from grader.base.errors import GraderError, UsageError, shown
-from grader.base.inputs import CELL_CHARS
+from grader.base.inputs import CELL_CHARS, decode_text, read_input
 from grader.grade.diagnosis import Physics
 from grader.grade.grading import Request, Verdict, grade_part, grade_parts
 from grader.grade.key import Key, KeyPart
 from grader.grade.notation import ReadError, tree_of, value_of
 from grader.grade.submissions import Answer, find_label
 from grader.model.expr import CONSTANTS, FUNCTIONS, names, to_text
-from grader.model.quantities import parse_unit
+from grader.model.quantities import parse_unit, split_quantity
 from grader.model.tolerance import SYMBOL_RANGE, Tolerance
 
 _GIVEN = Key(where="the command line", version=2, title="grader check", numeric_expressions=True,
@@ -55,6 +56,130 @@ class Expectation:
     key: Key
     student: str = ""
     physics: Physics | None = None
+
+
+@dataclass(frozen=True)
+class Asked:
+    """What ``grader check`` is asked, as its command line gives it: an answer against a key's part (``key``,
+    ``student``, ``label``), or against a given value (``expected``, ``unit``, a tolerance, ``symbols``,
+    ``domains``), or ``batch``, a file of JSON lines (``-``: standard input)."""
+
+    answer: str | None = None
+    key: Path | None = None
+    student: str | None = None
+    label: str | None = None
+    expected: str | None = None
+    unit: str | None = None
+    rtol: float | None = None
+    atol: float | None = None
+    sigfigs: int | None = None
+    decimals: int | None = None
+    symbols: str | None = None
+    domains: tuple[str, ...] = ()
+    batch: Path | None = None
+
+    def refuse_a_mix(self) -> None:
+        """The two ways to call ``grader check``, and ``--batch``; a mix of them is refused with the reason."""
+        given = [f"--{name}" for name in ("expected", "unit", "rtol", "atol", "sigfigs", "decimals", "symbols")
+                 if getattr(self, name) is not None] + (["--domain"] if self.domains else [])
+        chosen = [f"--{name}" for name in ("student", "label") if getattr(self, name) is not None]
+        if self.batch is not None:
+            if self.answer is not None or given or chosen:
+                raise UsageError("--batch takes every answer and expectation from its lines; give it alone "
+                                 "(with --key when the lines name a student and label)")
+            return
+        if self.answer is None:
+            raise UsageError("expected the answer to check, e.g. grader check \"6.3 m/s\" --expected 6.26 --unit m/s")
+        modes = [flag for flag in ("--sigfigs", "--decimals") if flag in given]
+        if len(modes) > 1 or (modes and {"--rtol", "--atol"} & set(given)):
+            raise UsageError(f"{' and '.join(modes + sorted({'--rtol', '--atol'} & set(given)))}: choose one "
+                             "tolerance mode (--rtol/--atol, --sigfigs or --decimals)")
+        if self.key is not None:
+            if given:
+                raise UsageError(f"{', '.join(given)}: with --key the expected answer, unit and tolerance come from "
+                                 "the key")
+            if len(chosen) < 2:
+                raise UsageError("--key needs --student ID and --label LABEL (the part as printed, e.g. 1a)")
+        elif chosen or self.expected is None:
+            raise UsageError("expected --expected VALUE (and --unit), or --key with --student and --label")
+
+    def against(self, key: Key | None, physics: Physics | None) -> Expectation:
+        """What the answer is checked against: the part of ``key`` (read from :attr:`key`), or the given value."""
+        if key is not None:
+            assert self.student is not None and self.label is not None  # refuse_a_mix saw to it
+            return from_key(key, self.student, self.label, physics)
+        assert self.expected is not None  # refuse_a_mix saw to it
+        tolerance: dict[str, Any] = {name: getattr(self, name) for name in ("rtol", "atol")
+                                     if getattr(self, name) is not None}
+        for mode in ("sigfigs", "decimals"):
+            if getattr(self, mode) is not None:
+                tolerance = {"mode": mode, "digits": getattr(self, mode)}
+        symbols = None if self.symbols is None else [s.strip() for s in self.symbols.split(",")]
+        expected, unit = expected_quantity(self.expected, self.unit)
+        return expectation(expected, unit=unit, tolerance=tolerance, symbols=symbols, domains=domains(self.domains))
+
+
+def expected_quantity(text: str, unit: str | None) -> tuple[float | str, str]:
+    """``--expected``: a number (``6.26``, or ``6.26 m/s`` when ``--unit`` is not given) or an expression.
+
+    >>> expected_quantity("6.26 m/s", None), expected_quantity("2v", None), expected_quantity("6.26", "m/s")
+    ((6.26, 'm/s'), ('2v', ''), (6.26, 'm/s'))
+    """
+    quantity = split_quantity(text)
+    if quantity is None:
+        return text, unit or ""  # an expression
+    value, written = quantity
+    if written:
+        try:
+            parse_unit(written)
+        except GraderError:
+            return text, unit or ""  # 2v: an expression
+        if unit is not None and unit.strip() != written:
+            raise UsageError(f"--expected {text} and --unit {unit}: give the unit once")
+        return value, written
+    return value, unit or ""
+
+
+BATCH_BYTES = 1 << 30
+"""The most ``--batch`` reads (1 GiB): 100,000 lines are a few MB."""
+
+
+def batch_lines(path: Path) -> list[str]:
+    """The lines of ``--batch FILE`` (``-``: standard input), read within :data:`BATCH_BYTES`."""
+    data = read_input(path, BATCH_BYTES)
+    if data is None:
+        raise UsageError("--batch -: standard input is closed; send the lines to it, or give --batch FILE.jsonl")
+    return decode_text(data, Path("standard input") if str(path) == "-" else path).splitlines()
+
+
+def json_blocks(lines: Sequence[str], key: Key | None, physics: Physics | None) -> Iterator[tuple[str, int]]:
+    """The results of :func:`batch` as lines of JSON (:func:`json_line`), a block of :data:`BATCH_CHUNK` lines at
+    a time (written a block at a time, not a line at a time), each with how many of its lines are errors."""
+    block: list[str] = []
+    failed = 0
+    for found in batch(lines, key, physics):
+        failed += "error" in found
+        block.append(json_line(found))
+        if len(block) == BATCH_CHUNK:
+            yield "\n".join(block), failed
+            block, failed = [], 0
+    if block:
+        yield "\n".join(block), failed
+
+
+def json_line(found: dict[str, Any]) -> str:
+    r"""A result as one line of strict JSON, UTF-8 as it is (``±1 %``), except lone surrogates (input
+    echoed in an error: a JSON ``\ud800``, a file name that is not UTF-8), which no UTF-8 output can
+    write: they keep their ``\u`` escape.
+
+    >>> json_line({"error": "unit: cannot read unit '\ud800'", "tolerance": "±1 %"})
+    '{"error": "unit: cannot read unit \'\\ud800\'", "tolerance": "±1 %"}'
+    """
+    text = json.dumps(found, ensure_ascii=False, allow_nan=False)
+    return _SURROGATE.sub(lambda m: f"\\u{ord(m.group()):04x}", text)
+
+
+_SURROGATE = re.compile("[\ud800-\udfff]")
 
 
 def from_key(key: Key, student: str, label: str, physics: Physics | None = None) -> Expectation:
@@ -223,7 +348,7 @@ def _chunk(lines: Sequence[str], start: int, key: Key | None, physics: Physics |
             continue
         try:
             submitted, against = _line(line, key, physics)
-        except (GraderError, ValueError, RecursionError) as error:
+        except GraderError as error:
             results[offset] = {"line": start + offset + 1, "error": str(error)}
             continue
         asked.append((offset, against))
@@ -249,6 +374,8 @@ def _line(line: str, key: Key | None, physics: Physics | None) -> tuple[str, Exp
         raise UsageError(str(error)) from None
     except ValueError as error:
         raise UsageError(f"expected a JSON object, got invalid JSON ({error})") from None
+    except RecursionError as error:  # nested deeper than Python reads
+        raise UsageError(str(error)) from None
     if not isinstance(item, dict):
         raise UsageError(f"expected a JSON object, got {shown(item)}")
     extra = sorted(str(name) for name in item if name not in _BATCH_FIELDS)

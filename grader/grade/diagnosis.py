@@ -25,7 +25,7 @@ from pathlib import Path
 import numpy as np
 
 from grader.bank.template import Template, load_template
-from grader.base.errors import GraderError
+from grader.base.errors import SYMPY_FAILURES, GraderError, unworkable
 from grader.base.resources import bank_dir
 from grader.grade.compare import is_correct, number_text
 from grader.grade.key import Key, KeyProblem
@@ -113,8 +113,9 @@ def _problem_physics(key: Key, problem: KeyProblem, bank: Path | Mapping[str, Te
         return f"the key holds no values of {problem.template}'s parameters"
     try:
         return ProblemPhysics(alternatives_for(template), params)
-    except (GraderError, ArithmeticError, TypeError, ValueError, AttributeError, NotImplementedError,
-            RecursionError) as error:  # what sympy may raise on a colleague's template: grading goes on
+    except (GraderError, *SYMPY_FAILURES) as error:  # a colleague's template sympy cannot work with: grading goes on
+        if not unworkable(error):
+            raise  # a bug of grader's keeps its traceback
         return f"template {problem.template} could not be compiled ({type(error).__name__}: {error})"
 
 

@@ -18,6 +18,7 @@ import threading
 from collections.abc import Callable, Mapping
 from typing import Any
 
+from grader.base.errors import SYMPY_FAILURES, unworkable
 from grader.model.expr import Node, Num, Sym
 
 EXACT_SECONDS = 2.0
@@ -34,9 +35,10 @@ def identical(student: Node, expected: Node, domains: tuple[tuple[str, tuple[flo
             if sympy.cancel(difference) == 0:
                 return True
             return bounded and bool(sympy.simplify(difference) == 0)
-    except (_OutOfTimeError, RecursionError, ValueError, TypeError, ArithmeticError, NotImplementedError,
-            sympy.PolynomialError):
-        return False  # not shown identical: sympy could not, in time, on the student's expression
+    except (_OutOfTimeError, sympy.PolynomialError, *SYMPY_FAILURES) as error:
+        if isinstance(error, _OutOfTimeError | sympy.PolynomialError) or unworkable(error):
+            return False  # not shown identical: sympy could not, in time, on the student's expression
+        raise  # a bug of grader's keeps its traceback
 
 
 def _inside(low: float, high: float) -> Any:

@@ -29,6 +29,7 @@ import itertools
 import json
 import math
 import re
+import sys
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -177,11 +178,11 @@ def load_key(path: Path) -> Key:
         raise GraderError(f"{where}: expected key schema version 1 or 2, got {shown(version)}{why}")
     try:
         return _key(raw, where, version)
+    except _MalformedError as error:
+        raise GraderError(f"{where}: a grader key with a missing or malformed entry ({error}); "
+                          "regenerate it with grader generate") from None
     except _EntryError as error:
         raise GraderError(f"{where}: {error}; correct it, or regenerate the key with grader generate") from None
-    except (KeyError, IndexError, TypeError, ValueError, AttributeError, OverflowError) as error:
-        raise GraderError(f"{where}: a grader key with a missing or malformed entry ({type(error).__name__}: "
-                          f"{shown(str(error))}); regenerate it with grader generate") from None
 
 
 _ESCAPED_SURROGATE = re.compile(r"\\u[dD][89a-fA-F]")
@@ -213,6 +214,30 @@ def _refuse_lone_surrogates(raw: Any, where: str) -> None:
 class _EntryError(ValueError):
     """An entry of the key that is present but unusable (a tolerance, unit, expression, points or text no
     grader key holds); the message says which and why."""
+
+
+class _MalformedError(_EntryError):
+    """The key's JSON lacks an entry grader writes, or has one of another type; the message says which.
+    Every entry is checked before it is used, so an exception of another kind while reading is a bug."""
+
+
+def _object(value: Any, what: str) -> dict[str, Any]:
+    if type(value) is not dict:
+        raise _MalformedError(f"{what}: expected an object, got {shown(value)}")
+    return value
+
+
+def _array(value: Any, what: str) -> list[Any]:
+    if type(value) is not list:
+        raise _MalformedError(f"{what}: expected a list, got {shown(value)}")
+    return value
+
+
+def _field(raw: Mapping[str, Any], name: str, what: str) -> Any:
+    """The entry ``name`` of the object ``raw`` (``what``, for the message)."""
+    if name not in raw:
+        raise _MalformedError(f"{what}: no entry {name!r}")
+    return raw[name]
 
 
 def _no_constant(name: str) -> float:
@@ -300,11 +325,11 @@ def _reader(header: Mapping[str, Any]) -> Callable[[Any], Any]:
     """What becomes of each student as it is decoded: a :class:`KeyStudent` when the entries before
     the students make a usable key; otherwise, or when a student does not read, the student's JSON,
     for :func:`_key` to read and refuse in order, as it would without this shortcut."""
+    usable = header.get("schema") == "grader-key" and type(header.get("version")) is int \
+        and header.get("version") in VERSIONS and "problems" in header
     try:
-        usable = header.get("schema") == "grader-key" and type(header.get("version")) is int \
-            and header.get("version") in VERSIONS
         symbols = _symbols(header["problems"]) if usable else None
-    except Exception:  # refused later, in order, by _key
+    except _EntryError:  # refused later, in order, by _key
         symbols = None
     if symbols is None:
         return lambda student: student
@@ -312,8 +337,8 @@ def _reader(header: Mapping[str, Any]) -> Callable[[Any], Any]:
 
     def read(student: Any) -> Any:
         try:
-            return _student(student, symbols, shared)
-        except Exception:  # refused later, in order, by _key
+            return _student(_object(student, "a student"), symbols, shared)
+        except _EntryError:  # refused later, in order, by _key
             return student
 
     return read
@@ -322,10 +347,11 @@ def _reader(header: Mapping[str, Any]) -> Callable[[Any], Any]:
 # --- the key's objects ----------------------------------------------------------------------------
 
 def _key(raw: Mapping[str, Any], where: str, version: int) -> Key:
-    problems = _problems(raw["problems"])
+    problems = _problems(_field(raw, "problems", "the key"))
     symbols = _symbols(raw["problems"])
     shared: dict[Any, Any] = {}
-    students = tuple(s if isinstance(s, KeyStudent) else _student(s, symbols, shared) for s in raw["students"])
+    students = tuple(s if isinstance(s, KeyStudent) else _student(_object(s, "a student"), symbols, shared)
+                     for s in _array(_field(raw, "students", "the key"), "students"))
     if not students or not problems:
         raise _EntryError(f"expected at least one {'student' if not students else 'problem'}, got none (grader "
                           "generate writes a key for a roster of students and an assignment of problems)")
@@ -333,21 +359,26 @@ def _key(raw: Mapping[str, Any], where: str, version: int) -> Key:
     labels = {label for problem in problems for label in problem.labels}
     for student in students:
         if set(student.parts) != labels:
-            raise ValueError(f"student {student.id} has parts {sorted(student.parts)}, the problems {sorted(labels)}")
-    grading = _grading(raw["assignment"].get("grading"), where)
-    templates = {str(name): str(entry.get("sha256", "")) for name, entry in raw.get("templates", {}).items()}
-    return Key(where, version, _text(raw["assignment"]["title"], "assignment.title"), grading.numeric_expressions,
-               problems, students, templates, grading.ecf_credit, grading.mistake_credit)
+            raise _MalformedError(f"student {student.id} has parts {sorted(student.parts)}, the problems "
+                                  f"{sorted(labels)}")
+    assignment = _object(_field(raw, "assignment", "the key"), "assignment")
+    grading = _grading(assignment.get("grading"), where)
+    templates = {name: str(_object(entry, f"templates.{name}").get("sha256", ""))
+                 for name, entry in _object(raw.get("templates", {}), "templates").items()}
+    return Key(where, version, _text(_field(assignment, "title", "assignment"), "assignment.title"),
+               grading.numeric_expressions, problems, students, templates, grading.ecf_credit, grading.mistake_credit)
 
 
 def _problems(raw: Any) -> tuple[KeyProblem, ...]:
     """The key's problems, each key and each part's label given once (two problems with one key would
     be graded, and totalled, twice; two parts with one label would share one column of answers)."""
-    problems = tuple(KeyProblem(str(p["key"]), _text(p.get("title", ""), "a problem's title"),
-                                tuple(_label(a["label"], f"problems[{index}].answers[{number}].label")
-                                      for number, a in enumerate(p["answers"])),
+    problems = tuple(KeyProblem(str(_field(p, "key", f"problems[{index}]")), _text(p.get("title", ""),
+                                                                                   "a problem's title"),
+                                tuple(_label(_field(a, "label", f"problems[{index}].answers[{number}]"),
+                                             f"problems[{index}].answers[{number}].label")
+                                      for number, a in enumerate(_answers(p, index))),
                                 _text(p.get("template", ""), "a problem's template"))
-                     for index, p in enumerate(raw))
+                     for index, p in enumerate(_array(raw, "problems")))
     _once([p.key for p in problems], lambda index: f"problems[{index}].key", "the problem key", "each problem once")
     places = [f"problems[{index}].answers[{number}].label" for index, p in enumerate(problems)
               for number in range(len(p.labels))]
@@ -388,16 +419,26 @@ def _grading(raw: Any, where: str) -> Grading:
         raise _EntryError(f"{error.key}: expected {error.expected}, got {error.got}") from None
 
 
+def _answers(problem: Any, index: int) -> list[dict[str, Any]]:
+    """The answers of the key's problem ``index`` (its entry in ``problems``), each an object."""
+    where = f"problems[{index}]"
+    answers = _array(_field(_object(problem, where), "answers", where), f"{where}.answers")
+    return [_object(answer, f"{where}.answers[{number}]") for number, answer in enumerate(answers)]
+
+
 def _symbols(problems: Any) -> dict[str, dict[str, tuple[float, float]]]:
     """Per label, where each name of a symbolic answer is drawn (empty for numeric answers)."""
-    return {str(a["label"]): {str(n): _range(a["label"], n, r) for n, r in a.get("symbols", {}).items()}
-            for p in problems for a in p["answers"]}
+    return {str(_field(a, "label", "an answer")): {n: _range(a["label"], n, r)
+                                                   for n, r in _object(a.get("symbols", {}), "symbols").items()}
+            for index, p in enumerate(_array(problems, "problems")) for a in _answers(p, index)}
 
 
 def _range(label: str, name: str, bounds: Any) -> tuple[float, float]:
     """A symbol's range: two finite numbers, low below high, whose span is finite too (random points are
     drawn across it)."""
-    low, high = (float(bounds[0]), float(bounds[1])) if isinstance(bounds, list) and len(bounds) == 2 else (0.0, 0.0)
+    numbers = isinstance(bounds, list) and len(bounds) == 2 and all(
+        type(bound) in (int, float) and abs(bound) <= sys.float_info.max for bound in bounds)  # not 10**400, NaN
+    low, high = (float(bounds[0]), float(bounds[1])) if numbers else (0.0, 0.0)
     if not (low < high and math.isfinite(high - low)):
         raise _EntryError(f"answer {label}: symbols.{name}: expected [LOW, HIGH] with LOW < HIGH, finite, got "
                           f"{shown(bounds)}")
@@ -414,24 +455,27 @@ def _text(value: Any, what: str) -> str:
 
 def _student(raw: Mapping[str, Any], symbols: Mapping[str, Mapping[str, tuple[float, float]]],
              shared: dict[Any, Any]) -> KeyStudent:
-    student_id = _text(raw["id"], "a student's id")
+    student_id = _text(_field(raw, "id", "a student"), "a student's id")
     if not student_id.strip():
         raise _EntryError(f"a student's id: expected an id, got {shown(student_id)}")
     parts: dict[str, KeyPart] = {}
     parameters: list[tuple[str, str]] = []
     values: list[float] = []
     keys: set[str] = set()
-    for problem in raw["problems"]:
-        key = _one(shared, str(problem["key"]))
+    for number, problem in enumerate(_array(_field(raw, "problems", f"student {student_id}"),
+                                            f"student {student_id}: problems")):
+        where = f"student {student_id}: problems[{number}]"
+        problem = _object(problem, where)
+        key = _one(shared, str(_field(problem, "key", where)))
         if key in keys:
             raise _EntryError(f"student {student_id}: the problem key {shown(key)} appears twice; expected each "
                               "problem once")
         keys.add(key)
-        for name, answer in problem["answers"].items():
+        for name, answer in _object(_field(problem, "answers", where), f"{where}.answers").items():
             try:
-                part = _part(key, _one(shared, str(name)), answer, symbols, shared)
+                part = _part(key, _one(shared, name), _object(answer, f"answer {name}"), symbols, shared)
             except _EntryError as error:
-                raise _EntryError(f"student {student_id}: {error}") from None
+                raise type(error)(f"student {student_id}: {error}") from None
             if part.label in parts:
                 raise _EntryError(f"student {student_id}: answer {name}: the label {shown(part.label)} appears twice "
                                   f"(also answer {parts[part.label].name}); expected each part's label once")
@@ -449,15 +493,18 @@ def _student(raw: Mapping[str, Any], symbols: Mapping[str, Mapping[str, tuple[fl
 
 def _part(problem: str, name: str, raw: Mapping[str, Any],
           symbols: Mapping[str, Mapping[str, tuple[float, float]]], shared: dict[Any, Any]) -> KeyPart:
-    value = raw["value"]
+    value = _field(raw, "value", f"answer {name}")
     if type(value) is not float:  # a float is the usual value, and needs only the check below
         if isinstance(value, bool) or not (value is None or isinstance(value, (int, float, str))):
-            raise ValueError(f"answer {name}: a value that is no number, expression or null")
+            raise _MalformedError(f"answer {name}: a value that is no number, expression or null")
+        if isinstance(value, int) and abs(value) > sys.float_info.max:
+            raise _MalformedError(f"answer {name}: a value beyond float64")
         value = float(value) if isinstance(value, (int, float)) else value
     if isinstance(value, float) and not math.isfinite(value):
-        raise ValueError(f"answer {name}: a value that is not finite")
-    label = _one(shared, _text(raw["label"], f"answer {name}: label"))
-    unit, points = _unit(raw.get("unit", ""), name, shared), _one(shared, _points(raw["points"], name))
+        raise _MalformedError(f"answer {name}: a value that is not finite")
+    label = _one(shared, _text(_field(raw, "label", f"answer {name}"), f"answer {name}: label"))
+    unit = _unit(raw.get("unit", ""), name, shared)
+    points = _one(shared, _points(_field(raw, "points", f"answer {name}"), name))
     domains = symbols.get(label, {})  # the label's own: one mapping for the whole class
     if isinstance(value, str):
         used = shared.get(("names", value))
@@ -473,8 +520,8 @@ def _part(problem: str, name: str, raw: Mapping[str, Any],
     undefined = raw.get("undefined")
     if not (undefined is None or isinstance(undefined, str)):
         raise _EntryError(f"answer {name}: undefined: expected the reason as text, got {shown(undefined)}")
-    return KeyPart(problem, name, label, value, unit, points, _tolerance(raw["tolerance"], name, shared),
-                   undefined, domains)
+    return KeyPart(problem, name, label, value, unit, points,
+                   _tolerance(_field(raw, "tolerance", f"answer {name}"), name, shared), undefined, domains)
 
 
 def _names(expression: str, name: str) -> frozenset[str]:
@@ -512,14 +559,14 @@ def _one(shared: dict[Any, Any], value: _T) -> _T:
     return shared.setdefault(value, value)  # type: ignore[no-any-return]
 
 
-def _tolerance(raw: Mapping[str, Any], name: str, shared: dict[Any, Any]) -> Mapping[str, Any]:
+def _tolerance(raw: Any, name: str, shared: dict[Any, Any]) -> Mapping[str, Any]:
     """The part's tolerance (version 1 has no mode: ``{"rtol", "atol"}``), one mapping for equal ones,
     each checked once (a tolerance grading would refuse is refused here, naming the answer)."""
-    try:
-        key = ("tolerance", tuple(raw.items()), tuple(map(type, raw.values())))  # True is not 1 here
-        found = shared.get(key)
-    except TypeError:  # a value that cannot be hashed: Tolerance.from_json says what is wrong with it
-        key, found = None, None
+    raw = _object(raw, f"answer {name}: tolerance")
+    plain = all(value is None or type(value) in (str, int, float, bool) for value in raw.values())
+    # True is not 1 here; a list or an object among the values is not kept: Tolerance.from_json refuses it
+    key = ("tolerance", tuple(raw.items()), tuple(map(type, raw.values()))) if plain else None
+    found = shared.get(key) if key is not None else None
     if found is None:
         found = {"mode": "rtol", **raw}
         try:

@@ -21,8 +21,7 @@ from typing import TYPE_CHECKING, Any, Protocol, TypeVar
 
 from grader.bank.template import Template
 from grader.base import caching
-from grader.base.caching import cache_dir
-from grader.base.errors import GraderError
+from grader.base.caching import ANY, cache_dir
 from grader.solve.compiled import FORMAT, Compiled
 
 if TYPE_CHECKING:  # each read where it is asked for: a warm `grader solve` needs neither
@@ -36,6 +35,21 @@ SHIPPED = caching.PACKAGE / "solve" / "shipped"
 """The compiled forms of the shipped bank, carried by the package."""
 KINDS = ("", "-alternatives", "-routes")
 """What is kept of a template: its compiled form, its alternatives, its routes (the end of the entry's name)."""
+
+_NUMBERS = {str: (int, float)}
+SHAPES = {
+    "": {"format": int, "template": str, "source_hash": str, "parameters": [str], "constants": _NUMBERS,
+         "steps": [{"unknown": str, "relation": str, "equation": [ANY], "solved": ANY}],
+         "checks": [{"holds": ANY, "message": str, "subject": ANY}],
+         "answers": {str: {"unit": str, "numeric": ANY, "symbolic": ANY, "undefined": [{"when": ANY, "reason": str}]}}},
+    "-alternatives": {"template": str, "source_hash": str, "constants": _NUMBERS,
+                      "items": [{"answer": str, "kind": str, "id": str, "says": str, "value": ANY}]},
+    "-routes": {"template": str, "source_hash": str, "constants": _NUMBERS, "symbols": [str],
+                "items": [{"answer": str, "id": str, "says": str, "names": [str], "steps": [ANY], "value": ANY,
+                           "composed": [ANY], "slopes": [ANY]}]},
+}
+"""What each kind's ``to_json`` writes, as :func:`grader.base.caching.fits` checks an entry before it is read
+(expression trees, :data:`~grader.base.caching.ANY` here, are checked by their reader)."""
 
 __all__ = ["KINDS", "SHIPPED", "SOLVER_FOLDERS", "alternatives_for", "cache_dir", "compiled_for", "entry_name",
            "routes_for", "source_fingerprint"]
@@ -116,14 +130,14 @@ def entry_name(template: Template, kind: str) -> str:
 
 def _cached(template: Template, kind: str, read: Callable[[Any], _T], compile_now: Callable[[], _T]) -> _T:
     """What ``compile_now`` makes for a template, kept as :func:`entry_name` says (``read`` reads it back): from the
-    package's shipped entries, else the cache; an entry ``read`` cannot read, or made from another template, is
-    made again."""
+    package's shipped entries, else the cache; an entry not of the kind's shape (:data:`SHAPES`), or that ``read``
+    refuses, or made from another template, is made again."""
     name = entry_name(template, kind)
-    kept = _kept(template, read, caching.read_entry(SHIPPED / name, shipped=True))
+    kept = _kept(template, kind, read, caching.read_entry(SHIPPED / name, shipped=True))
     if kept is not None:
         return kept
     path = caching.entry(name)
-    kept = _kept(template, read, caching.read_entry(path))
+    kept = _kept(template, kind, read, caching.read_entry(path))
     if kept is not None:
         return kept
     made = compile_now()
@@ -131,14 +145,15 @@ def _cached(template: Template, kind: str, read: Callable[[Any], _T], compile_no
     return made
 
 
-def _kept(template: Template, read: Callable[[Any], _T], stored: Any) -> _T | None:
-    """What an entry holds, if it is this template's."""
-    if stored is not None:
-        try:
-            kept = read(stored)
-        except (ValueError, KeyError, TypeError, IndexError, AttributeError, RecursionError, GraderError):
-            pass  # what grader writes reads back: anything else is not grader's, or not this grader's
-        else:
-            if kept.template_id == template.id and kept.source_hash == template.source_hash:
-                return kept
-    return None
+def _kept(template: Template, kind: str, read: Callable[[Any], _T], stored: Any) -> _T | None:
+    """What an entry holds, if it is this template's: None for an entry missing, not of the kind's shape, made
+    from another template, or that ``read`` refuses (a ``ValueError``: another format, an expression tree it does
+    not write; a ``RecursionError``: a tree nested deeper than Python reads). Any other exception is a bug of
+    the reader and keeps its traceback (a regression would otherwise be a silent recompile on every run)."""
+    if (stored is None or not caching.fits(stored, SHAPES[kind]) or stored["template"] != template.id
+            or stored["source_hash"] != template.source_hash):
+        return None
+    try:
+        return read(stored)
+    except (ValueError, RecursionError):
+        return None

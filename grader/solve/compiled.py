@@ -129,7 +129,8 @@ class Compiled:
 
     @classmethod
     def from_json(cls, data: Mapping[str, Any]) -> Compiled:
-        """Inverse of :meth:`to_json`; another format is a ``ValueError``."""
+        """Inverse of :meth:`to_json` for data of the shape it writes; another format, an equation of other
+        than two sides, or a tree :func:`~grader.model.expr.from_json` refuses, is a ``ValueError``."""
         def tree(value: Any) -> Node | None:
             return None if value is None else from_json(value)
         if data["format"] != FORMAT:
@@ -137,10 +138,17 @@ class Compiled:
         return cls(
             template_id=data["template"], source_hash=data["source_hash"],
             parameters=tuple(data["parameters"]), constants=dict(data["constants"]),
-            steps=tuple(Step(s["unknown"], s["relation"], (from_json(s["equation"][0]), from_json(s["equation"][1])),
-                             from_json(s["solved"])) for s in data["steps"]),
+            steps=tuple(Step(s["unknown"], s["relation"], _sides(s["equation"]), from_json(s["solved"]))
+                        for s in data["steps"]),
             checks=tuple(Check(from_json(c["holds"]), c["message"], tree(c["subject"])) for c in data["checks"]),
             answers={name: CompiledAnswer(name, a["unit"], tree(a["numeric"]), tree(a["symbolic"]),
                                           tuple(Undefined(from_json(u["when"]), u["reason"]) for u in a["undefined"]))
                      for name, a in data["answers"].items()},
         )
+
+
+def _sides(equation: list[Any]) -> tuple[Node, Node]:
+    """An equation's two sides as :meth:`Compiled.to_json` writes them; another number of sides is a ``ValueError``."""
+    if len(equation) != 2:
+        raise ValueError(f"an equation of {len(equation)} sides")
+    return from_json(equation[0]), from_json(equation[1])

@@ -14,7 +14,7 @@ import numpy as np
 import sympy as sp
 
 from grader.bank.template import Template
-from grader.base.errors import TemplateError
+from grader.base.errors import SYMPY_FAILURES, TemplateError, unworkable
 from grader.model.expr import Node, Num, Op, names
 from grader.model.kernel import evaluate
 from grader.physics.effects import CATALOGUE, Mistake, Relation
@@ -23,9 +23,9 @@ from grader.solve.alternatives import GIVEN, Alternative, Alternatives
 from grader.solve.solver import _Compiler, _si_factor, _Solved, derive
 from grader.solve.stable import numeric_order
 
-_FAILURES = (TemplateError, ArithmeticError, TypeError, ValueError, AttributeError, NotImplementedError,
-             RecursionError)
-"""What an alternative the solver cannot derive or compile raises: it is left out."""
+_FAILURES = (TemplateError, *SYMPY_FAILURES)
+"""What an alternative the solver cannot derive or compile may raise: it is left out when the error is
+:func:`~grader.base.errors.unworkable`, and keeps its traceback otherwise (a bug of grader's)."""
 
 
 def compile_alternatives(template: Template) -> Alternatives:
@@ -74,7 +74,9 @@ class AlternativeCompiler(_Compiler):
                 relations = [r for index, real in enumerate(self.stages) for r in replaced.get(index, real)]
                 try:
                     composed = _composed(derive(relations, self.inputs, self.inputs), self.main)
-                except _FAILURES:
+                except _FAILURES as error:
+                    if not unworkable(error):
+                        raise
                     continue
                 trees = {name: tree for name in self.numeric if (tree := self._value(composed, name)) is not None}
             # A constant tells nothing about what the student did (the loss of a "body" that sticks: 0).
@@ -97,7 +99,9 @@ class AlternativeCompiler(_Compiler):
                 knowns = (self.inputs - {self.ctx.symbols[parameter]}) | {given}
                 try:
                     composed = _composed(derive([student, *self.relations], knowns, knowns, branches=True), self.main)
-                except _FAILURES:
+                except _FAILURES as error:
+                    if not unworkable(error):
+                        raise
                     continue
                 for name in self.numeric[index + 1:]:
                     tree = self._value(composed, name, extra=(given,))
@@ -122,7 +126,9 @@ class AlternativeCompiler(_Compiler):
         try:
             in_units = self._user_units(expr.xreplace(dict(composed))) / _si_factor(self.template.answers[name].unit)
             return _unclipped(self._tree(in_units, name, extra))
-        except _FAILURES:
+        except _FAILURES as error:
+            if not unworkable(error):
+                raise
             return None
 
     def _differs(self, tree: Node, right: Node | None) -> bool:

@@ -11,9 +11,10 @@ from typing import Any
 import sympy as sp
 
 from grader.bank.template import Template
+from grader.base.errors import TemplateError, unworkable
 from grader.model.expr import Node
 from grader.physics.effects import CATALOGUE
-from grader.physics.symbolic import cosd, from_node, hypot, sind, to_node
+from grader.physics.symbolic import INNER, cosd, from_node, hypot, sind, to_node
 from grader.solve.derived import _FAILURES
 from grader.solve.routes import Route, Routes
 from grader.solve.solver import _Compiler, _needed, _si_factor, _Solved, derive
@@ -51,7 +52,9 @@ class RouteCompiler(_Compiler):
                              for r in (route.relations if at == index else real)]
                 try:
                     found.append((route.id, route.says, derive(relations, self.inputs, self.inputs)))
-                except _FAILURES:
+                except _FAILURES as error:
+                    if not unworkable(error):
+                        raise
                     continue
         return found
 
@@ -65,8 +68,8 @@ class RouteCompiler(_Compiler):
             for id, says, chain in chains:
                 try:
                     route = self._route(name, id, says, chain)
-                except _FAILURES:
-                    if id == "chain":
+                except _FAILURES as error:
+                    if id == "chain" or not unworkable(error):
                         raise
                     continue
                 if route is not None and (route.names, str(route.steps)) not in seen:
@@ -74,7 +77,9 @@ class RouteCompiler(_Compiler):
                     found.append(route)
             try:
                 ratio = self._ratio_route(name, chains[0][2])
-            except _FAILURES:
+            except _FAILURES as error:
+                if not unworkable(error):
+                    raise
                 ratio = None
             if ratio is not None:
                 found.append(ratio)
@@ -167,5 +172,5 @@ def _smooth(expr: Any) -> Any:
 
 def _tree(expr: Any) -> Node:
     if sp.sympify(expr).has(sp.Derivative, sp.Subs, sp.Heaviside, sp.DiracDelta, sp.zoo, sp.nan, sp.oo):
-        raise ValueError(f"no numeric form for {expr}")
+        raise TemplateError(INNER, str(expr), "a numeric form (no derivative, step or infinity)")
     return numeric_order(to_node(sp.sympify(expr)))

@@ -22,7 +22,7 @@ from typing import Any
 import sympy as sp
 
 from grader.bank.template import Template
-from grader.base.errors import TemplateError, shown
+from grader.base.errors import SYMPY_FAILURES, TemplateError, shown, unworkable
 from grader.model.expr import names
 from grader.model.quantities import Unit
 from grader.physics.effects import CATALOGUE, Relation
@@ -272,6 +272,11 @@ class _Compiler:
         return tuple(checks)
 
     def _tree_condition(self, holds: Any) -> Any:
+        """A condition (an undefined answer's, a check's) as a tree; one sympy finds always true or always false
+        (the angle of a velocity the template leaves out) is the template's error."""
+        if holds in (sp.true, sp.false):
+            raise TemplateError(_INNER, str(holds), "a condition that depends on the parameters",
+                                f"one that is always {str(holds).lower()}")
         difference = stabilize(holds.lhs - holds.rhs, self.degree_angles)
         # Against zero, a positive factor changes nothing: 381*v*x/1250 > 0 is x > 0.
         kept = [f for f in sp.Mul.make_args(difference) if not f.is_positive]
@@ -327,7 +332,8 @@ def compile_template(template: Template) -> Compiled:
     """Derive and compile a template's answers (sympy; slow the first time, then cached).
 
     Templates come from colleagues: an expression sympy cannot handle (``h**h**h**h`` to solve for,
-    ``1/0``, a constant beyond float64) is a :class:`TemplateError` naming the file, not a traceback.
+    ``1/0``, a constant beyond float64) is a :class:`TemplateError` naming the file, not a traceback; an
+    exception that is not :func:`unworkable` is a bug of grader's and keeps its traceback.
     """
     try:
         return _Compiler(template).compile()
@@ -336,7 +342,9 @@ def compile_template(template: Template) -> Compiled:
             raise TemplateError(template.where, "stages or answers", error.expected,
                                 f"{error.key} ({error.got})") from None
         raise
-    except (ArithmeticError, TypeError, ValueError, AttributeError, NotImplementedError, RecursionError) as error:
+    except SYMPY_FAILURES as error:
+        if not unworkable(error):
+            raise
         raise TemplateError(template.where, "stages or answers", "expressions the solver can work with (real, "
                             "finite, solvable one unknown at a time)",
                             f"{type(error).__name__}: {shown(str(error), 120)}") from None

@@ -445,11 +445,13 @@ def _range(label: str, name: str, bounds: Any) -> tuple[float, float]:
     return low, high
 
 
-def _text(value: Any, what: str) -> str:
+def _text(value: Any, what: str, field: str = "") -> str:
     """A text entry (an id, name, label, unit, title): text of at most CELL_CHARS characters, as in a
-    roster (half a character anywhere in the key is refused as it is read: :func:`_refuse_lone_surrogates`)."""
+    roster (half a character anywhere in the key is refused as it is read: :func:`_refuse_lone_surrogates`).
+    ``what`` and ``field`` name it in the message (``answer e``, ``label``): joined only if there is one."""
     if not isinstance(value, str) or len(value) > CELL_CHARS:
-        raise _EntryError(f"{what}: expected text of at most {CELL_CHARS} characters, got {shown(value)}")
+        where = f"{what}: {field}" if field else what
+        raise _EntryError(f"{where}: expected text of at most {CELL_CHARS} characters, got {shown(value)}")
     return value
 
 
@@ -493,7 +495,8 @@ def _student(raw: Mapping[str, Any], symbols: Mapping[str, Mapping[str, tuple[fl
 
 def _part(problem: str, name: str, raw: Mapping[str, Any],
           symbols: Mapping[str, Mapping[str, tuple[float, float]]], shared: dict[Any, Any]) -> KeyPart:
-    value = _field(raw, "value", f"answer {name}")
+    what = f"answer {name}"  # in a message, if there is one
+    value = _field(raw, "value", what)
     if type(value) is not float:  # a float is the usual value, and needs only the check below
         if isinstance(value, bool) or not (value is None or isinstance(value, (int, float, str))):
             raise _MalformedError(f"answer {name}: a value that is no number, expression or null")
@@ -502,9 +505,10 @@ def _part(problem: str, name: str, raw: Mapping[str, Any],
         value = float(value) if isinstance(value, (int, float)) else value
     if isinstance(value, float) and not math.isfinite(value):
         raise _MalformedError(f"answer {name}: a value that is not finite")
-    label = _one(shared, _text(_field(raw, "label", f"answer {name}"), f"answer {name}: label"))
+    label = _text(_field(raw, "label", what), what, "label")
+    label = _one(shared, label)
     unit = _unit(raw.get("unit", ""), name, shared)
-    points = _one(shared, _points(_field(raw, "points", f"answer {name}"), name))
+    points = _one(shared, _points(_field(raw, "points", what), name))
     domains = symbols.get(label, {})  # the label's own: one mapping for the whole class
     if isinstance(value, str):
         used = shared.get(("names", value))
@@ -521,7 +525,7 @@ def _part(problem: str, name: str, raw: Mapping[str, Any],
     if not (undefined is None or isinstance(undefined, str)):
         raise _EntryError(f"answer {name}: undefined: expected the reason as text, got {shown(undefined)}")
     return KeyPart(problem, name, label, value, unit, points,
-                   _tolerance(_field(raw, "tolerance", f"answer {name}"), name, shared), undefined, domains)
+                   _tolerance(_field(raw, "tolerance", what), name, shared), undefined, domains)
 
 
 def _names(expression: str, name: str) -> frozenset[str]:
@@ -562,11 +566,13 @@ def _one(shared: dict[Any, Any], value: _T) -> _T:
 def _tolerance(raw: Any, name: str, shared: dict[Any, Any]) -> Mapping[str, Any]:
     """The part's tolerance (version 1 has no mode: ``{"rtol", "atol"}``), one mapping for equal ones,
     each checked once (a tolerance grading would refuse is refused here, naming the answer)."""
-    raw = _object(raw, f"answer {name}: tolerance")
-    plain = all(value is None or type(value) in (str, int, float, bool) for value in raw.values())
-    # True is not 1 here; a list or an object among the values is not kept: Tolerance.from_json refuses it
-    key = ("tolerance", tuple(raw.items()), tuple(map(type, raw.values()))) if plain else None
-    found = shared.get(key) if key is not None else None
+    if type(raw) is not dict:
+        raise _MalformedError(f"answer {name}: tolerance: expected an object, got {shown(raw)}")
+    key: tuple[Any, ...] | None = ("tolerance", tuple(raw.items()), tuple(map(type, raw.values())))  # True is not 1
+    try:
+        found = shared.get(key)
+    except TypeError:  # a list or an object among the values cannot be a key: Tolerance.from_json refuses it
+        key, found = None, None
     if found is None:
         found = {"mode": "rtol", **raw}
         try:

@@ -41,7 +41,7 @@ from grader import __version__
 from grader.assign.assignment import Assignment, ProblemSpec
 from grader.assign.variants import AnswerPart, Generation
 from grader.bank.template import Template
-from grader.base.spreadsheet import csv_text, safe_cell
+from grader.base.spreadsheet import csv_text, number_cell, safe_cell
 from grader.model.tolerance import SYMBOL_RANGE, Tolerance
 
 SCHEMA, VERSION = "grader-key", 2
@@ -144,7 +144,13 @@ def key_csv(generation: Generation) -> str:
     return csv_text(rows())
 
 
-def _csv_value(part: AnswerPart) -> float | str:
+VALUE_FIGURES = 12
+"""key.csv is for people: its ``value`` is the answer rounded to this many significant figures, which hides
+the float's binary noise (``0.7999999999999999``) and keeps more than any tolerance needs; key.json keeps
+the value exactly, and grading reads that."""
+
+
+def _csv_value(part: AnswerPart) -> str:
     if part.value is None:
         return safe_cell(f"undefined: {part.undefined}")
-    return part.value if isinstance(part.value, float) else safe_cell(part.value)
+    return number_cell(part.value, VALUE_FIGURES) if isinstance(part.value, float) else safe_cell(part.value)

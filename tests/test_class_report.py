@@ -4,6 +4,8 @@ grading path loads matplotlib only to draw it. The browser opens it in ``test_re
 
 from __future__ import annotations
 
+import dataclasses
+import html
 import json
 import re
 import subprocess
@@ -19,6 +21,7 @@ from grader.grade.class_report import INVALID_STUDENTS, class_report
 from grader.grade.class_summary import summarize
 from grader.grade.grading import Graded, Row
 from grader.grade.key import Key, KeyPart, KeyProblem, KeyStudent, load_key
+from grader.grade.row_problems import RowProblem
 from tests.demo_output import DemoRun
 
 TOLERANCE = {"mode": "rtol", "rtol": 0.01, "atol": 0.0}
@@ -128,6 +131,42 @@ def test_diagnosed_mistakes_are_listed_most_frequent_first(monkeypatch: pytest.M
     page = class_report(graded)
     assert "<code>e_squared</code></td><td class=\"n\">4</td>" in page
     assert "1a: 10 diagnosed in all" in page  # 9 of them listed
+
+
+def test_diagnosed_mistakes_are_said_in_words_with_their_ids() -> None:
+    """Issue 28: the report showed only ids (energy.kept_as_lost); it says each as the effect's list does."""
+    graded = make_class({"1a": ["mistake", "mistake", "correct"]}, diagnoses={"1a": ["energy.kept_as_lost"] * 2 + [""]})
+    words = "the energy kept (T') reported as the energy lost"
+    graded = dataclasses.replace(graded, mistakes={("1a", "energy.kept_as_lost"): words})
+    page = class_report(graded)
+    assert f"<td>{html.escape(words)} <small class=\"muted\"><code>energy.kept_as_lost</code></small></td>" in page
+
+
+def test_the_demo_report_says_its_mistakes_in_words_and_its_axes_units(demo_run: DemoRun) -> None:
+    """Grading fills in each mistake's words from the templates' effects; each panel's axis names its
+    parameter's unit, which the key records."""
+    page = (demo_run.out / "grades" / "report.html").read_text(encoding="utf-8")
+    assert "using e² instead of e <small class=\"muted\"><code>impact.e_squared</code></small>" in page
+    assert "h_drop (mm)" in page  # a panel's axis, as SVG text
+    assert load_key(demo_run.out / "key.json").problems[0].units == {"h_drop": "mm", "h_rebound": "mm"}
+
+
+def test_the_rows_not_graded_are_named_with_their_reasons() -> None:
+    """Issue 28: "1 submitted rows were not graded" named nobody; the first few are named, with the reason."""
+    problems = tuple(RowProblem("a.csv", line, who, label, reason) for line, who, label, reason in [
+        (4, "ann@x.edu", "", "unknown student 'ann@x.edu' (not in the answer key)"),
+        (9, "s00001", "7z", "unknown label '7z' (expected one of 1a)"),
+        *((10 + n, f"x{n}", "", f"unknown student 'x{n}' (not in the answer key)") for n in range(5))])
+    graded = make_class({"1a": ["correct", "correct"]})
+    one = class_report(dataclasses.replace(graded, problems=problems[:1]))
+    assert ("1 submitted row was not graded (see problems.csv): unknown student &#x27;ann@x.edu&#x27; (not in the "
+            "answer key) (a.csv line 4)</p>") in one
+    many = class_report(dataclasses.replace(graded, problems=(
+        *problems, RowProblem("a.csv", 0, "", "", "3 more rows …", rows=3))))
+    assert ("10 submitted rows were not graded (see problems.csv): unknown student &#x27;ann@x.edu&#x27; (not in "
+            "the answer key) (a.csv line 4); s00001: unknown label &#x27;7z&#x27; (expected one of 1a) (a.csv line 9)"
+            ) in many
+    assert "x2" in many and "x3" not in many and "; 5 more</p>" in many
 
 
 HOSTILE = ["<script>alert(1)</script>", 'x" onerror="alert(1)', "<img src=x onerror=alert(1)>",

@@ -132,7 +132,23 @@ def test_every_answer_gets_the_verdict_it_deserves(demo_run: DemoRun, answers: l
         answer = final.get((row["student_id"], row["label"]))
         expected = ("missing", "") if answer is None else (answer.deserves, answer.diagnosis)
         assert (row["verdict"], row["diagnosis"]) == expected, (answer, row)
-        assert original_cell(row["submitted"]) == ("" if answer is None else answer.text)  # "-5.59" is guarded
+        assert original_cell(row["submitted"]) == ("" if answer is None else answer.text)  # "-5.59°" is guarded
+
+
+def test_numbers_are_numbers_and_sentences_guarded_in_details_and_key_csv(demo_run: DemoRun) -> None:
+    """Issue 28: details.csv wrote '-0.369 for a negative number (text to a spreadsheet), and its errors and
+    key.csv's values printed binary noise (0.00019999999999975593, 0.7999999999999999)."""
+    details = rows(demo_run.out / "grades" / "details.csv")
+    negative = [row for row in details if row["expected"].startswith(("-", "'-"))]
+    assert negative and all(re.fullmatch(r"-[0-9.e-]+", row["expected"]) for row in negative)
+    assert all(re.fullmatch(r"-[0-9.e-]+", row["parsed"]) for row in details if row["parsed"].startswith(("-", "'-")))
+    sentences = [row["feedback"] for row in details if row["feedback"][:2] in ("-0", "-1", "'-")]
+    assert sentences and all(text.startswith("'-") for text in sentences)  # "-5.59° is …" is no number
+    for row in details:
+        for column in ("abs_error", "rel_error"):
+            assert not row[column] or float(row[column]) == float(f"{float(row[column]):.6g}"), row
+    values = [row["value"] for row in rows(demo_run.out / "key.csv") if re.fullmatch(r"-?[0-9.]+", row["value"])]
+    assert values and all(len(value.replace("-", "").replace(".", "").lstrip("0")) <= 12 for value in values)
 
 
 def test_the_class_shows_errors_carried_forward_and_each_kind_of_diagnosed_mistake(demo_run: DemoRun) -> None:

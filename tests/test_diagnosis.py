@@ -14,6 +14,7 @@ import pytest
 import yaml
 
 from grader.bank.template import Template, parse_template
+from grader.base.resources import bank_dir
 from grader.cli import main
 from grader.grade.diagnosis import physics_for
 from grader.grade.grading import Verdict, grade
@@ -268,6 +269,53 @@ def test_without_the_template_the_key_was_made_from_grading_goes_on_with_a_note(
         answers = (Answer("s.csv", 2, "s1", "1a", "0.524", ",", None),)
         result = grade(key, Submissions(answers, (), (), ()), physics)
         assert result.verdicts[0].verdict == "incorrect" and result.notes == physics.notes
+
+
+def test_a_key_finds_its_own_bank_folder_again_or_says_which_bank_to_give(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """Issue 28: a key made from an instructor's own templates, graded without --bank, gave no error carried
+    forward or diagnosis. The key records the folder (relative to itself) and grading finds it again, the
+    key and the folder moved together too; a changed file is not used, and the note says which --bank."""
+    course = tmp_path / "course"
+    (course / "mybank").mkdir(parents=True)
+    (course / "mybank" / "drop-rebound.yaml").write_bytes((bank_dir() / "drop-rebound.yaml").read_bytes())
+    (course / "hw.yaml").write_text("title: HW\ncourse: C\nseed: s\nproblems:\n  - template: drop-rebound\n")
+    (course / "roster.csv").write_text("id,name,email,section\n1,Ana,a@x.edu,1\n")
+    assert main(["--no-shipped-bank", "--bank", str(course / "mybank"), "generate", str(course / "hw.yaml"),
+                 "--roster", str(course / "roster.csv"), "--out", str(course / "hw7"), "--no-pdf"]) == 0
+    document = json.loads((course / "hw7" / "key.json").read_text(encoding="utf-8"))
+    assert document["templates"]["drop-rebound"]["bank"] == "../mybank"
+    student = document["students"][0]["problems"][0]
+    e = student["answers"]["e"]["value"]
+    (tmp_path / "s.csv").write_text(f"student_id,label,answer\n1,1a,{e * e:.4g}\n", encoding="utf-8")
+    (tmp_path / "empty").mkdir()
+    moved = tmp_path / "moved"
+    (course / "hw7" / "key.json").replace(course / "key.json")  # a key beside its bank: "../mybank" from hw7
+    document["templates"]["drop-rebound"]["bank"] = "mybank"
+    (course / "key.json").write_text(json.dumps(document), encoding="utf-8")
+    course.rename(moved)
+
+    def grade_it() -> tuple[str, str]:
+        capsys.readouterr()
+        main(["--no-shipped-bank", "--bank", str(tmp_path / "empty"), "grade", "--key", str(moved / "key.json"),
+              str(tmp_path / "s.csv"), "--out", str(tmp_path / "g"), "--force"])
+        details = (tmp_path / "g" / "details.csv").read_text(encoding="utf-8")
+        return details.splitlines()[1], capsys.readouterr().err
+
+    row, err = grade_it()
+    assert ",mistake," in row and "note: problem" not in err
+    (moved / "mybank" / "drop-rebound.yaml").write_text(
+        (moved / "mybank" / "drop-rebound.yaml").read_text(encoding="utf-8") + "\n# edited\n", encoding="utf-8")
+    row, err = grade_it()
+    assert ",incorrect," in row
+    assert (f"the key records that it came from {moved / 'mybank'}, and it has changed since: give grader grade "
+            "--bank DIR, where DIR holds drop-rebound.yaml as it was when the key was written (SHA-256 ") in err
+
+
+def test_a_key_from_the_shipped_bank_records_no_folder(demo_run: DemoRun) -> None:
+    """The shipped bank is found without being told: the demo's key names no folder (and reads as before)."""
+    document = json.loads((demo_run.out / "key.json").read_text(encoding="utf-8"))
+    assert all("bank" not in entry for entry in document["templates"].values())
 
 
 @pytest.fixture

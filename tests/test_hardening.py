@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import gc
 import json
+import re
 import tempfile
 import time
 import tracemalloc
@@ -355,7 +356,23 @@ def test_points_beyond_a_million_or_negative_are_refused(tmp_path: Path, capsys:
 def test_a_guarded_key_csv_cell_gives_back_the_original(text: str) -> None:
     cell = safe_cell(text)
     assert original_cell(cell) == text
-    assert not cell.startswith(("=", "+", "-", "@", "\t", "\r", "\n", "\uff1d", "\uff0b", "\uff0d", "\uff20"))
+    number = re.fullmatch(r"-[0-9]*\.?[0-9]*(e[-+]?[0-9]+)?", text, re.I) and any(c.isdigit() for c in text)
+    assert number or not cell.startswith(("=", "+", "-", "@", "\t", "\r", "\n", "\uff1d", "\uff0b", "\uff0d",
+                                          "\uff20"))
+
+
+@pytest.mark.parametrize("text", ["-0.369", "-2", "-1.5e-07", "-.5", "-3.", "-1E+300"])
+def test_a_negative_number_is_written_as_a_number(text: str) -> None:
+    """Issue 28: details.csv wrote '-0.369, text a spreadsheet's sum skips; a plain number runs nothing."""
+    assert safe_cell(text) == text
+
+
+@pytest.mark.parametrize("text", ["-0.369 m/s is 3 % above 0.358 m/s", "-1+1", "-2+3+cmd|' /C calc'!A0", "-", "-e5",
+                                  "-1e", "-0.5 ", "-١", "-inf", "-nan", "--1", "-1,5"])
+def test_a_text_starting_with_a_minus_stays_guarded(text: str) -> None:
+    """What is not a plain number (a sentence, a formula, a digit a spreadsheet does not read as one) is
+    text a spreadsheet would read as a formula: guarded."""
+    assert safe_cell(text) == "'" + text
 
 
 def test_a_formula_like_id_is_guarded_in_key_csv_and_kept_in_key_json(tmp_path: Path,

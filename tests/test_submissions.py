@@ -120,6 +120,18 @@ def test_leading_zeros_eaten_by_a_spreadsheet_are_restored_and_said(tmp_path: Pa
         (4, "leading zeros restored: 00789 -> 789", True)]
 
 
+def test_an_email_typed_in_the_id_column_is_matched_by_email_and_said(tmp_path: Path) -> None:
+    """Issue 28: a student who typed their email for their id scored 0 as an unknown student, though
+    ``grader check --student`` takes an email."""
+    path = write(tmp_path, "a.csv", "student_id,label,answer\n ann.lee@UNI.edu ,1a,1\n456,1a,2\nno@uni.edu,1a,3\n")
+    result = read(path)
+    assert summary(result)[0] == [(2, "00123", "1a", "1"), (3, "456", "1a", "2")]
+    assert [(p.line, p.reason, p.caveat) for p in result.problems] == [
+        (2, "an email in the id column, matched by email: ann.lee@UNI.edu -> 00123", True),
+        (4, "unknown student 'no@uni.edu' (not in the answer key)", False)]
+    assert result.notes == ("1 row names its student by email in the id column: matched by email (see problems.csv)",)
+
+
 def test_ids_are_text(tmp_path: Path) -> None:
     path = write(tmp_path, "a.csv", "id,1a\n00123,1\n")
     assert read_submissions([path], [StudentRef("00123", ""), StudentRef("123", "")], ["1a"]).answers[0].student_id \

@@ -11,8 +11,9 @@ and the tolerance's ``mode``: its tolerances are ``{"rtol", "atol"}``; a version
      "assignment": {"title", "course", "seed", "due", "instructions", "source_sha256",
                     "grading": {"numeric_expressions": true, "ecf_credit": 1.0, "mistake_credit": 0.0,
                                 "intermediate_sig_figs": 4, "max_tolerance": 0.05}},
-     "templates": {ID: {"version", "sha256"}},
-     "problems": [{"key", "template", "title",
+     "templates": {ID: {"version", "sha256", "bank": the folder it came from, relative to the key's folder
+                        where possible (only a template from outside the shipped bank; a key before it has none)}},
+     "problems": [{"key", "template", "title", "parameters": {NAME: its unit, as printed},
                    "answers": [{"name", "label", "unit", "points",
                                 "symbols": {NAME: [low, high]} (symbolic answers only: where each
                                            name is drawn to compare expressions)}]}],
@@ -32,6 +33,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import os
 from collections.abc import Iterator, Mapping, Sequence
 from functools import lru_cache
 from pathlib import Path
@@ -41,12 +43,15 @@ from grader import __version__
 from grader.assign.assignment import Assignment, ProblemSpec
 from grader.assign.variants import AnswerPart, Generation
 from grader.bank.template import Template
-from grader.base.spreadsheet import csv_text, safe_cell
+from grader.base.resources import bank_dir
+from grader.base.spreadsheet import csv_text, number_cell, safe_cell
 from grader.model.tolerance import SYMBOL_RANGE, Tolerance
 
 SCHEMA, VERSION = "grader-key", 2
-def key_document(assignment: Assignment, generation: Generation, bank: Mapping[str, Template]) -> dict[str, Any]:
-    """The key as a JSON-ready dictionary."""
+def key_document(assignment: Assignment, generation: Generation, bank: Mapping[str, Template],
+                 key_folder: Path | None = None) -> dict[str, Any]:
+    """The key as a JSON-ready dictionary; ``key_folder``, where it is written: the bank folders of the
+    templates are recorded relative to it (grading finds them again from the key)."""
     used = {p.template: bank[p.template] for p in assignment.problems}
     first = generation.students[0].problems if generation.students else ()
     # One tolerance dict per distinct tolerance (and reason: equality leaves it out), shared by every
@@ -62,8 +67,10 @@ def key_document(assignment: Assignment, generation: Generation, bank: Mapping[s
                                    "mistake_credit": assignment.grading.mistake_credit,
                                    "intermediate_sig_figs": assignment.grading.intermediate_sig_figs,
                                    "max_tolerance": assignment.grading.max_tolerance}},
-        "templates": {t.id: {"version": t.version, "sha256": t.source_hash} for t in used.values()},
+        "templates": {t.id: {"version": t.version, "sha256": t.source_hash, **_bank_folder(t, key_folder)}
+                      for t in used.values()},
         "problems": [{"key": v.key, "template": v.template, "title": used[v.template].title,
+                      "parameters": {name: p.unit.text for name, p in used[v.template].parameters.items()},
                       "answers": [_part(a, used[v.template], spec) for a in v.answers]}
                      for v, spec in zip(first, assignment.problems, strict=False)],
         "collisions": dict(generation.collisions),
@@ -75,6 +82,20 @@ def key_document(assignment: Assignment, generation: Generation, bank: Mapping[s
                                    for v in s.problems]}
                      for s in generation.students],
     }
+
+
+def _bank_folder(template: Template, key_folder: Path | None) -> dict[str, str]:
+    """``{"bank": FOLDER}``: the folder a template's file is in, relative to the key's folder where it can be
+    (a key moved with its bank still finds it), else absolute; nothing for the shipped bank's templates,
+    which grading finds without being told."""
+    folder = Path(template.where).parent.resolve()
+    if folder == bank_dir().resolve():
+        return {}
+    try:
+        where = os.path.relpath(folder, (key_folder or Path.cwd()).resolve())
+    except ValueError:  # another drive (Windows): no relative path
+        where = str(folder)
+    return {"bank": Path(where).as_posix()}
 
 
 def _part(part: AnswerPart, template: Template, problem: ProblemSpec) -> dict[str, Any]:
@@ -144,7 +165,13 @@ def key_csv(generation: Generation) -> str:
     return csv_text(rows())
 
 
-def _csv_value(part: AnswerPart) -> float | str:
+VALUE_FIGURES = 12
+"""key.csv is for people: its ``value`` is the answer rounded to this many significant figures, which hides
+the float's binary noise (``0.7999999999999999``) and keeps more than any tolerance needs; key.json keeps
+the value exactly, and grading reads that."""
+
+
+def _csv_value(part: AnswerPart) -> str:
     if part.value is None:
         return safe_cell(f"undefined: {part.undefined}")
-    return part.value if isinstance(part.value, float) else safe_cell(part.value)
+    return number_cell(part.value, VALUE_FIGURES) if isinstance(part.value, float) else safe_cell(part.value)

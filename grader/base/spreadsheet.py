@@ -1,31 +1,48 @@
 """CSV files people open in a spreadsheet: written with one writer, and every text cell that could be read as a
 formula guarded (docs/design.md: formula injection).
 
->>> csv_text([["id", "answer"], [safe_cell("2026001"), safe_cell("=1+1")]])
-"id,answer\\n2026001,'=1+1\\n"
+The rule. Excel, LibreOffice Calc and Google Sheets read a cell that starts with ``= + - @`` (or a tab, CR or
+LF before one) as a formula, and OWASP's guidance on CSV injection is to escape such a cell with a leading
+``'``. A cell whose whole text is a plain decimal number (``-0.369``, ``-1.5e-07``) is the one exception: every
+spreadsheet reads it as that number, nothing in it can run, and a ``'`` would only turn the number into
+text a column's sum skips. Anything else that starts so stays guarded, a sentence too: ``-0.369 m/s is 3 %
+above …`` is no number, so a spreadsheet tries it as a formula (Excel shows ``#NAME?`` or an error), and the
+rest of such a sentence may be what a student typed (``-1+1|…`` is how a formula that runs a command
+begins).
+
+>>> csv_text([["id", "answer", "expected"], [safe_cell("2026001"), safe_cell("=1+1"), safe_cell("-0.369")]])
+"id,answer,expected\\n2026001,'=1+1,-0.369\\n"
 """
 
 from __future__ import annotations
 
 import csv
 import io
+import math
+import re
 from collections.abc import Iterable, Iterator, Sequence
 
 # A formula's first characters, their full-width forms (an East Asian keyboard's ＝, which a spreadsheet may
 # read as =) and small forms, and the guard's own.
 _GUARDED_START = frozenset("=+-@\t\r\n'" "\uff1d\uff0b\uff0d\uff20" "\ufe66\ufe62\ufe63\ufe6b")
+# A negative number as a spreadsheet reads one, and nothing else: ASCII digits, a point, an exponent.
+_NEGATIVE_NUMBER = re.compile(r"-(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][-+]?[0-9]+)?")
 
 
 def safe_cell(text: str) -> str:
-    """A CSV text cell a spreadsheet will not run as a formula (docs/design.md: formula injection): a cell
-    starting with ``= + - @`` (or their full-width forms ``＝ ＋ － ＠``, or small forms), tab, CR or LF gets a
-    leading ``'``, and so does one that already starts with ``'``, so the original is always recovered by
-    :func:`original_cell`.
+    """A CSV text cell a spreadsheet will not run as a formula (the module's rule): a cell starting with
+    ``= + - @`` (or their full-width forms ``＝ ＋ － ＠``, or small forms), tab, CR or LF gets a leading ``'``,
+    unless its whole text is a negative number; one that already starts with ``'`` gets another, so the
+    original is always recovered by :func:`original_cell`.
 
     >>> safe_cell("=HYPERLINK(1)"), safe_cell("Ana"), safe_cell("'quoted"), safe_cell("＝HYPERLINK(1)")
     ("'=HYPERLINK(1)", 'Ana', "''quoted", "'＝HYPERLINK(1)")
+    >>> safe_cell("-0.369"), safe_cell("-1.5e-07"), safe_cell("-0.369 m/s is 3 % above"), safe_cell("-1+1")
+    ('-0.369', '-1.5e-07', "'-0.369 m/s is 3 % above", "'-1+1")
     """
-    return "'" + text if text[:1] in _GUARDED_START else text
+    if text[:1] not in _GUARDED_START or _NEGATIVE_NUMBER.fullmatch(text):
+        return text
+    return "'" + text
 
 
 def original_cell(cell: str) -> str:
@@ -35,6 +52,23 @@ def original_cell(cell: str) -> str:
     ('=1+1', "'quoted", 'Ana')
     """
     return cell[1:] if cell.startswith("'") else cell
+
+
+def number_cell(value: float, figures: int | None = None) -> str:
+    """A number as a CSV cell: the shortest text that reads back as the same float (a whole number without
+    ``.0``), or, for a column people read, ``value`` rounded to ``figures`` significant figures first, so
+    that arithmetic's binary noise (``0.7999999999999999``) does not show.
+
+    >>> number_cell(0.00019999999999975593), number_cell(0.00019999999999975593, 6), number_cell(2.0)
+    ('0.00019999999999975593', '0.0002', '2')
+    >>> number_cell(3.4149999999999996, 12), number_cell(-1.5e-07, 6)
+    ('3.415', '-1.5e-07')
+    """
+    if not math.isfinite(value):
+        raise ValueError("a CSV cell is not a finite number")  # a bug: no report holds one
+    if figures is not None:
+        value = float(f"{value:.{figures}g}")
+    return repr(value + 0.0).removesuffix(".0") if value.is_integer() and abs(value) < 1e15 else repr(value)
 
 
 def csv_text(rows: Iterable[Sequence[object]]) -> str:

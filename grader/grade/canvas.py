@@ -219,7 +219,7 @@ class _Finder:
     def find(self, who: Mapping[str, str], cells: Mapping[str, str]) -> tuple[str | None, str]:
         """The key student's id, or None; and a caveat ("" if none)."""
         if who.get("SIS User ID"):
-            found, why = self.roster.find(who["SIS User ID"], by_email=False)
+            found, why, _ = self.roster.find(who["SIS User ID"], by_email=False)
             if found is not None:
                 return found, why
         login = who["SIS Login ID"]

@@ -25,6 +25,7 @@ import html
 
 import numpy as np
 
+from grader.base.errors import visible
 from grader.grade.class_summary import (
     DRAWN_UP_TO,
     HARD_DROP,
@@ -98,9 +99,7 @@ def _header(summary: ClassSummary) -> str:
     if len(percent):
         stats += [("mean score", _percent(float(percent.mean()))),
                   ("median score", _percent(float(np.median(percent))))]
-    notes = list(summary.notes)
-    if summary.rows_not_graded:
-        notes.insert(0, f"{summary.rows_not_graded:,} submitted rows were not graded: see problems.csv")
+    notes = [*_not_graded(summary), *summary.notes]
     sections = [("scores", "Scores"), ("parts", "Parts"), ("mistakes", "Diagnosed mistakes"),
                 ("difficulty", "Difficulty per variant"), ("invalid", "Unreadable answers"),
                 ("tolerances", "Tolerances")]
@@ -110,6 +109,24 @@ def _header(summary: ClassSummary) -> str:
             + "</div>\n" + "".join(f"<p class=\"note\">{_e(note)}</p>\n" for note in notes)
             + "<nav>" + "".join(f"<a href=\"#{anchor}\">{name}</a>" for anchor, name in sections)
             + "</nav>\n</header>")
+
+
+def _not_graded(summary: ClassSummary) -> list[str]:
+    """``2 submitted rows were not graded (see problems.csv): unknown student 'ann@x' (not in the answer key)
+    (a.csv line 4); 456: unknown label '7z' (…) (a.csv line 9)``: the first few, each with its reason."""
+    count, shown = summary.rows_not_graded, summary.not_graded
+    if not count:
+        return []
+    rows = "row was" if count == 1 else "rows were"
+    named = "; ".join(f"{_who(p.student_id, p.reason)}{visible(p.reason)} ({visible(p.file)} line {p.line})"
+                      for p in shown)
+    more = f"; {count - len(shown):,} more" if count > len(shown) else ""
+    return [f"{count:,} submitted {rows} not graded (see problems.csv)" + (f": {named}{more}" if named else "")]
+
+
+def _who(student_id: str, reason: str) -> str:
+    """``456: ``, naming the student of a row not graded, where its reason does not already."""
+    return f"{visible(student_id)}: " if student_id and student_id not in reason else ""
 
 
 def _scores(summary: ClassSummary) -> str:
@@ -139,18 +156,26 @@ def _parts(summary: ClassSummary) -> str:
 
 
 def _mistakes(summary: ClassSummary) -> str:
-    rows = [f"<tr><td>{_e(part.label)}</td><td><code>{_e(mistake)}</code></td><td class=\"n\">{count:,}</td>"
+    rows = [f"<tr><td>{_e(part.label)}</td><td>{_mistake(part, mistake)}</td><td class=\"n\">{count:,}</td>"
             f"<td class=\"n\">{_percent(100 * count / part.students)}</td></tr>"
             for part in summary.parts for mistake, count in part.mistakes]
     text = "<h2 id=\"mistakes\">Diagnosed mistakes</h2>\n"
     if not rows:
         return text + "<p>No answer was matched to a diagnosed mistake.</p>"
     more = [part for part in summary.parts if part.diagnosed > sum(count for _, count in part.mistakes)]
-    return (text + "<p>The most frequent typical mistakes that wrong answers matched, part by part, with how many "
-            "students made each.</p>\n<table>\n<tr><th>part</th><th>mistake</th><th class=\"n\">students</th>"
+    return (text + "<p>The most frequent typical mistakes that wrong answers matched, part by part (as each "
+            "effect's list of mistakes says them, with the id details.csv gives), with how many students made "
+            "each.</p>\n<table>\n<tr><th>part</th><th>mistake</th><th class=\"n\">students</th>"
             "<th class=\"n\">of the class</th></tr>\n" + "\n".join(rows) + "\n</table>"
             + "".join(f"\n<p class=\"note\">{_e(part.label)}: {part.diagnosed:,} diagnosed in all (see details.csv)</p>"
                       for part in more))
+
+
+def _mistake(part: PartSummary, mistake: str) -> str:
+    """A diagnosed mistake in words (as the effect's list says it), with its id as details.csv names it."""
+    says = part.says.get(mistake)
+    code = f"<code>{_e(mistake)}</code>"
+    return code if says is None else f"{_e(says)} <small class=\"muted\">{code}</small>"
 
 
 def _difficulty(summary: ClassSummary) -> str:
@@ -165,8 +190,9 @@ def _difficulty(summary: ClassSummary) -> str:
     if corners:
         text.append("<ul class=\"corners\">" + "".join(
             f"<li><span class=\"hard\">Problem {_e(problem.key)}</span>, <code>{_e(parameter.name)}</code> "
-            f"{_e(_range(part.low, part.high))}: {_students(part.students)} scored {_percent(100 * part.mean)} "
-            f"(the problem: {_percent(100 * problem.mean)})</li>" for problem, parameter, part in corners)
+            f"{_e(_range(part.low, part.high, parameter.unit))}: {_students(part.students)} scored "
+            f"{_percent(100 * part.mean)} (the problem: {_percent(100 * problem.mean)})</li>"
+            for problem, parameter, part in corners)
             + "</ul>")
     else:
         text.append("<p>No range of any parameter scored clearly below its problem.</p>")
@@ -182,8 +208,9 @@ def _problem(problem: ProblemSummary, name: str) -> str:
             f"{_e(', '.join(problem.labels))}; {_students(attempted)} answered, mean score "
             f"{_percent(100 * problem.mean)}</p>")
     varied = problem.drawn
-    fixed = [f"{p.name} = {_range(p.bins[0].low, p.bins[0].high)}" for p in problem.parameters if len(p.bins) == 1]
-    beyond = [f"{p.name} ({_range(p.bins[0].low, p.bins[-1].high)})" for p in problem.parameters
+    fixed = [f"{p.name} = {_range(p.bins[0].low, p.bins[0].high, p.unit)}" for p in problem.parameters
+             if len(p.bins) == 1]
+    beyond = [f"{p.name} ({_range(p.bins[0].low, p.bins[-1].high, p.unit)})" for p in problem.parameters
               if len(p.bins) > 1 and not p.drawable]
     notes = []
     if fixed:
@@ -276,8 +303,10 @@ def _number(value: float) -> str:
     return f"{value:g}"
 
 
-def _range(low: float, high: float) -> str:
-    return f"{low:.4g}" if low == high else f"{low:.4g} to {high:.4g}"
+def _range(low: float, high: float, unit: str = "") -> str:
+    """``1500 to 1800 mm``, or one value."""
+    text = f"{low:.4g}" if low == high else f"{low:.4g} to {high:.4g}"
+    return f"{text} {unit}" if unit else text
 
 
 def _cut(text: str) -> str:

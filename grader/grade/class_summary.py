@@ -30,7 +30,7 @@ from __future__ import annotations
 
 from collections import Counter
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from itertools import repeat
 from operator import attrgetter, eq, is_not, itemgetter
 
@@ -39,6 +39,7 @@ import numpy.typing as npt
 
 from grader.grade.grading import VERDICTS, Graded, Row
 from grader.grade.key import Key, KeyStudent
+from grader.grade.row_problems import RowProblem
 from grader.model.tolerance import Tolerance, Widening, widening
 
 Floats = npt.NDArray[np.float64]
@@ -52,6 +53,7 @@ MAX_BINS = 12  # a parameter with at most this many values gets a bin per value
 DRAWN_UP_TO = 1e300  # a parameter reaching beyond ±this is not drawn: a figure's axis overflows near float64's limit
 TOP_MISTAKES = 5  # diagnosed mistakes listed per part
 INVALID_STUDENTS = 50  # students listed with the answers that could not be read; the rest are counted
+NOT_GRADED_SHOWN = 5  # submitted rows not graded named in the report's header; problems.csv lists them all
 
 def shown_kinds(kinds: Sequence[str] = VERDICTS) -> tuple[str, ...]:
     """The verdict kinds the report shows, in its order.
@@ -77,6 +79,7 @@ class PartSummary:
     widened: Widening | None  # the verdicts decided by a tolerance widened for rounding, and the widest
     mistakes: tuple[tuple[str, int], ...]  # the most frequent diagnoses, with their counts
     diagnosed: int  # verdicts with a diagnosis in all
+    says: dict[str, str] = field(default_factory=dict)  # each of those mistakes in words, where grading knew them
 
     @property
     def students(self) -> int:
@@ -103,6 +106,16 @@ class Parameter:
     name: str
     values: Floats  # per student of the key (NaN: none in the key)
     bins: tuple[ParameterBin, ...]  # over the students who attempted the problem
+    unit: str = ""  # as printed on the sheets ("": none, or a key that does not record it)
+
+    @property
+    def axis(self) -> str:
+        """The parameter as a figure's axis names it: its name and unit.
+
+        >>> Parameter("h_drop", np.array([1.0]), (), "mm").axis, Parameter("e", np.array([1.0]), ()).axis
+        ('h_drop (mm)', 'e')
+        """
+        return f"{self.name} ({self.unit})" if self.unit else self.name
 
     @property
     def drawable(self) -> bool:
@@ -164,6 +177,7 @@ class ClassSummary:
     invalid: tuple[tuple[KeyStudent, tuple[InvalidCell, ...]], ...]  # the first INVALID_STUDENTS
     invalid_students: int  # in all
     rows_not_graded: int
+    not_graded: tuple[RowProblem, ...]  # the first NOT_GRADED_SHOWN of those rows, each with its reason
     notes: tuple[str, ...]
 
 
@@ -187,16 +201,17 @@ def summarize(graded: Graded) -> ClassSummary:
             points[label] = worth
             missing[label] = _is(verdicts, "missing")
             answered |= np.fromiter(map(is_not, map(attrgetter("submitted"), rows), repeat(None)), bool, count)
-            parts.append(_part(key, problem.key, label, rows, verdicts, scores[label], worth, kinds))
+            parts.append(_part(graded, problem.key, label, rows, verdicts, scores[label], worth, kinds))
             if parts[-1].counts.get("invalid"):
                 invalid.update(np.flatnonzero(_is(verdicts, "invalid")).tolist())
     possible = sum(points.values(), np.zeros(count))
     earned = sum(scores.values(), np.zeros(count))
     percent = np.divide(100.0 * earned, possible, out=np.zeros(count), where=possible > 0)
+    not_graded = [problem for problem in graded.problems if problem.not_graded]
     return ClassSummary(key, kinds, percent, int(answered.sum()), tuple(parts),
                         _problems(key, scores, points, missing), _invalid(graded, sorted(invalid)[:INVALID_STUDENTS]),
-                        len(invalid), sum(problem.rows for problem in graded.problems if problem.not_graded),
-                        graded.notes)
+                        len(invalid), sum(problem.rows for problem in not_graded),
+                        tuple(problem for problem in not_graded if problem.rows == 1)[:NOT_GRADED_SHOWN], graded.notes)
 
 
 def _is(verdicts: list[str], kind: str) -> npt.NDArray[np.bool_]:
@@ -212,15 +227,18 @@ def _kinds_found(graded: Graded) -> set[str]:
     return found - set(VERDICTS)
 
 
-def _part(key: Key, problem: str, label: str, rows: Sequence[Row], verdicts: list[str], scores: Floats,
+def _part(graded: Graded, problem: str, label: str, rows: Sequence[Row], verdicts: list[str], scores: Floats,
           worth: Floats, kinds: tuple[str, ...]) -> PartSummary:
+    key = graded.key
     found = Counter(verdicts)
     mistakes = Counter(row.diagnosis for row in rows if row.verdict == "mistake")  # ecf rows name their part
     first = key.students[0].parts[label] if key.students else None
     credit = float(scores.sum() / worth.sum()) if worth.sum() > 0 else 0.0
+    top = _by_count(mistakes)[:TOP_MISTAKES]
+    says = {mistake: graded.mistakes[label, mistake] for mistake, _ in top if (label, mistake) in graded.mistakes}
     return PartSummary(label, problem, first.name if first else "", first.unit if first else "",
                        tuple(sorted(set(worth.tolist()))), {kind: found.get(kind, 0) for kind in kinds}, credit,
-                       *_tolerances(key, label, rows), _by_count(mistakes)[:TOP_MISTAKES], sum(mistakes.values()))
+                       *_tolerances(key, label, rows), top, sum(mistakes.values()), says)
 
 
 def _tolerances(key: Key, label: str, rows: Sequence[Row]) -> tuple[tuple[tuple[str, int], ...], Widening | None]:
@@ -265,7 +283,7 @@ def _problems(key: Key, scores: dict[str, Floats], points: dict[str, Floats],
         attempted = np.zeros(count, dtype=bool)
         for label in problem.labels:
             attempted |= ~missing[label]
-        mine = tuple(Parameter(name, values, binned(values[attempted], share[attempted]))
+        mine = tuple(Parameter(name, values, binned(values[attempted], share[attempted]), problem.units.get(name, ""))
                      for (owner, name), values in parameters if owner == problem.key)
         found.append(ProblemSummary(problem.key, problem.title, problem.labels, share, attempted, mine))
     return tuple(found)

@@ -3,8 +3,10 @@
 
 For each problem of the key, its template's alternatives (:mod:`grader.solve.alternatives`) are
 evaluated at once for every student whose answer to a part is a wrong number. The template is read
-from the bank by the id the key names, and used only when it is the file the key was made from (the
-SHA-256 the key records); a problem without it is graded as before, and a note says why.
+from the bank by the id the key names, else from the bank folder the key records it came from (an
+instructor's own, given to ``grader generate``; relative to the key's folder), and used only when it is
+the file the key was made from (the SHA-256 the key records); a problem without it is graded as before,
+and a note says why and which ``--bank`` to give.
 
 Rules, in order, for one wrong number:
 
@@ -97,16 +99,10 @@ def _problem_physics(key: Key, problem: KeyProblem, bank: Path | Mapping[str, Te
     recorded = key.templates.get(problem.template)
     if not recorded:
         return f"the key does not record which file of template {problem.template} it was made from"
-    where = "the problem bank" if isinstance(bank, Mapping) else str(bank)
-    try:
-        template = bank.get(problem.template) if isinstance(bank, Mapping) else load_template(
-            bank / f"{problem.template}.yaml")
-    except (GraderError, OSError) as error:
-        return f"template {problem.template} could not be read from {where} ({error})"
-    if template is None:
-        return f"template {problem.template} is not in {where}"
-    if template.source_hash != recorded:
-        return f"template {problem.template} in {where} has changed since the key was written"
+    found = _template(key, problem.template, recorded, bank)
+    if isinstance(found, str):
+        return found
+    template = found
     absent = np.full(len(key.students), math.nan)
     params = {name: key.parameter_columns.get((problem.key, name), absent) for name in template.parameters}
     if key.students and any(np.isnan(column).all() for column in params.values()):
@@ -117,6 +113,54 @@ def _problem_physics(key: Key, problem: KeyProblem, bank: Path | Mapping[str, Te
         if not unworkable(error):
             raise  # a bug of grader's keeps its traceback
         return f"template {problem.template} could not be compiled ({type(error).__name__}: {error})"
+
+
+def _template(key: Key, template_id: str, recorded: str, bank: Path | Mapping[str, Template]) -> Template | str:
+    """The template the key was made from (its SHA-256 ``recorded``): from ``bank``, else from the bank
+    folder the key records; or why neither has it, and the ``--bank`` that would."""
+    where = "the problem bank" if isinstance(bank, Mapping) else str(bank)
+    found = _read(template_id, recorded, bank)
+    if isinstance(found, Template):
+        return found
+    said = _said(template_id, where, found)
+    folder = key.banks.get(template_id)
+    if folder is None:  # the shipped bank's, or a key written before the folders were recorded
+        return said
+    place = Path(key.where).parent / folder
+    again = _read(template_id, recorded, place)
+    if isinstance(again, Template):
+        return again
+    there = {_ABSENT: "it is not there", _CHANGED: "it has changed since"}.get(again, f"it could not be read ({again})")
+    return (f"{said}; the key records that it came from {place}, and {there}: give grader grade --bank DIR, where "
+            f"DIR holds {template_id}.yaml as it was when the key was written (SHA-256 {recorded[:12]}…)")
+
+
+_ABSENT, _CHANGED = "absent", "changed"
+
+
+def _read(template_id: str, recorded: str, bank: Path | Mapping[str, Template]) -> Template | str:
+    """The template from ``bank`` if it is the one the key recorded; else why not: :data:`_ABSENT`,
+    :data:`_CHANGED`, or the error that reading it gave."""
+    try:
+        if isinstance(bank, Mapping):
+            template = bank.get(template_id)
+        else:
+            path = bank / f"{template_id}.yaml"
+            template = load_template(path) if path.exists() else None
+    except (GraderError, OSError) as error:
+        return str(error)
+    if template is None:
+        return _ABSENT
+    return template if template.source_hash == recorded else _CHANGED
+
+
+def _said(template_id: str, where: str, why: str) -> str:
+    """Why a template was not used from ``where`` (a :func:`_read` reason), in a sentence."""
+    if why == _ABSENT:
+        return f"template {template_id} is not in {where}"
+    if why == _CHANGED:
+        return f"template {template_id} in {where} has changed since the key was written"
+    return f"template {template_id} could not be read from {where} ({why})"
 
 
 def reconsider(problem: ProblemPhysics, key: Key, name: str, label: str, unit: str, tolerance: Tolerance,

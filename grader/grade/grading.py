@@ -12,7 +12,7 @@ pass; the verdicts are kept as rows of plain values (a class of 100,000 has a mi
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from functools import lru_cache
 from typing import Any, NamedTuple
 
@@ -101,6 +101,9 @@ class Graded:
     problems: tuple[RowProblem, ...]
     ignored_columns: tuple[str, ...]
     notes: tuple[str, ...]
+    # What each diagnosed mistake a part may get says, in words (completing "your answer matches …"), by
+    # (label, the mistake's id): the class report says the mistakes, not only their ids.
+    mistakes: Mapping[tuple[str, str], str] = field(default_factory=dict)
 
     @property
     def verdicts(self) -> tuple[Verdict, ...]:
@@ -126,7 +129,22 @@ def grade(key: Key, submissions: Submissions, physics: Physics | None = None) ->
             cells = [(student.parts[label], answers.get(student.id)) for student in key.students]
             columns[label] = _grade_label(cells, key, everyone, physics.problems.get(problem.key), earlier)
     return Graded(key, columns, submissions.problems, submissions.ignored_columns,
-                  (*submissions.notes, *physics.notes))
+                  (*submissions.notes, *physics.notes), mistake_words(key, physics))
+
+
+def mistake_words(key: Key, physics: Physics) -> dict[tuple[str, str], str]:
+    """What each diagnosed mistake of each part says, by (label, the mistake's id)."""
+    words: dict[tuple[str, str], str] = {}
+    first = key.students[0].parts if key.students else {}
+    for problem in key.problems:
+        found = physics.problems.get(problem.key)
+        if found is None:
+            continue
+        for label in problem.labels:
+            for alternative in found.alternatives.for_answer(first[label].name):
+                if alternative.kind == "mistake":
+                    words.setdefault((label, alternative.id), alternative.says)
+    return words
 
 
 def grade_part(part: KeyPart, student_id: str, answer: Answer | None, key: Key,

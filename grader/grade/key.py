@@ -98,12 +98,14 @@ class KeyStudent:
 
 @dataclass(frozen=True)
 class KeyProblem:
-    """A problem: its key (``1``), title, its parts' labels in order, and its template's id."""
+    """A problem: its key (``1``), title, its parts' labels in order, its template's id and its parameters'
+    units."""
 
     key: str
     title: str
     labels: tuple[str, ...]
     template: str = ""
+    units: Mapping[str, str] = field(default_factory=dict)  # each parameter's unit (a key before them has none)
 
 
 @dataclass(frozen=True)
@@ -119,6 +121,9 @@ class Key:
     templates: Mapping[str, str] = field(default_factory=dict)  # id -> SHA-256 of the file the key was made from
     ecf_credit: float = 1.0  # of a part right for the student's own earlier answer (0: no error carried forward)
     mistake_credit: float = 0.0  # of a part that matches a diagnosed mistake
+    # id -> the bank folder its file was in, as the key records it (relative to the key's folder where it could
+    # be; none for the shipped bank's templates, nor in a key written before it was recorded)
+    banks: Mapping[str, str] = field(default_factory=dict)
 
     @functools.cached_property
     def labels(self) -> tuple[str, ...]:
@@ -363,10 +368,13 @@ def _key(raw: Mapping[str, Any], where: str, version: int) -> Key:
                                   f"{sorted(labels)}")
     assignment = _object(_field(raw, "assignment", "the key"), "assignment")
     grading = _grading(assignment.get("grading"), where)
-    templates = {name: str(_object(entry, f"templates.{name}").get("sha256", ""))
-                 for name, entry in _object(raw.get("templates", {}), "templates").items()}
+    entries = {name: _object(entry, f"templates.{name}")
+               for name, entry in _object(raw.get("templates", {}), "templates").items()}
+    templates = {name: str(entry.get("sha256", "")) for name, entry in entries.items()}
+    banks = {name: _text(entry["bank"], f"templates.{name}.bank") for name, entry in entries.items() if "bank" in entry}
     return Key(where, version, _text(_field(assignment, "title", "assignment"), "assignment.title"),
-               grading.numeric_expressions, problems, students, templates, grading.ecf_credit, grading.mistake_credit)
+               grading.numeric_expressions, problems, students, templates, grading.ecf_credit, grading.mistake_credit,
+               banks)
 
 
 def _problems(raw: Any) -> tuple[KeyProblem, ...]:
@@ -377,7 +385,7 @@ def _problems(raw: Any) -> tuple[KeyProblem, ...]:
                                 tuple(_label(_field(a, "label", f"problems[{index}].answers[{number}]"),
                                              f"problems[{index}].answers[{number}].label")
                                       for number, a in enumerate(_answers(p, index))),
-                                _text(p.get("template", ""), "a problem's template"))
+                                _text(p.get("template", ""), "a problem's template"), _units(p, index))
                      for index, p in enumerate(_array(raw, "problems")))
     _once([p.key for p in problems], lambda index: f"problems[{index}].key", "the problem key", "each problem once")
     places = [f"problems[{index}].answers[{number}].label" for index, p in enumerate(problems)
@@ -385,6 +393,13 @@ def _problems(raw: Any) -> tuple[KeyProblem, ...]:
     _once([label for p in problems for label in p.labels], places.__getitem__, "the label",
           "each part's label once")
     return problems
+
+
+def _units(problem: Mapping[str, Any], index: int) -> dict[str, str]:
+    """A problem's parameters' units, by name (a key written before they were recorded has none)."""
+    where = f"problems[{index}].parameters"
+    return {_text(name, where): _text(unit, f"{where}.{name}")
+            for name, unit in _object(problem.get("parameters", {}), where).items()}
 
 
 def _once(values: list[str], place: Callable[[int], str], what: str, expected: str) -> None:

@@ -17,9 +17,10 @@ from pathlib import Path
 
 from grader.base.errors import visible
 from grader.base.files import write_atomic
-from grader.base.spreadsheet import csv_pieces, safe_cell
+from grader.base.spreadsheet import csv_pieces, number_cell, safe_cell
 from grader.grade.canvas import CanvasExport
 from grader.grade.class_report import REPORT, class_report
+from grader.grade.compare import number_text
 from grader.grade.grading import Graded, totals
 
 GRADES, DETAILS, PROBLEMS, CANVAS = "grades.csv", "details.csv", "problems.csv", "canvas.csv"
@@ -70,9 +71,8 @@ def details_csv(graded: Graded, students_per_piece: int = 2000) -> Iterator[str]
                  diagnosis, source) = verdicts[index]
                 yield (who, label, "" if submitted is None else safe_cell(visible(submitted)), words[verdict],
                        numbers[credit], numbers[points], numbers[credit * points], safe_cell(expected),
-                       safe_cell(visible(parsed)), words[unit], "" if abs_error is None else _number(abs_error),
-                       "" if rel_error is None else _number(rel_error), words[tolerance], safe_cell(visible(feedback)),
-                       words[diagnosis], safe_cell(visible(source)))
+                       safe_cell(visible(parsed)), words[unit], _error(abs_error), _error(rel_error), words[tolerance],
+                       safe_cell(visible(feedback)), words[diagnosis], safe_cell(visible(source)))
 
     return csv_pieces(rows(), students_per_piece * max(1, len(columns)))
 
@@ -119,16 +119,20 @@ def _cell(value: object) -> str:
     if value is None:
         return ""
     if isinstance(value, float):
-        return _number(value)
+        return number_cell(value)
     if isinstance(value, int):
         return str(value)
     return safe_cell(visible(str(value)))
 
 
-def _number(value: float) -> str:
+def _error(value: float | None) -> str:
+    """details.csv's ``abs_error`` or ``rel_error``, for people: 6 significant figures, as ``expected`` and
+    ``parsed`` (the verdict was decided on the numbers unrounded)."""
+    if value is None:
+        return ""
     if not math.isfinite(value):
         raise ValueError("a report cell is not a finite number")  # a bug: verdicts never hold one
-    return repr(value + 0.0).removesuffix(".0") if value.is_integer() and abs(value) < 1e15 else repr(value)
+    return number_text(value)
 
 
 class _Cells(dict[object, str]):

@@ -115,7 +115,7 @@ def _panel(axes: Any, parameter: Parameter, problem: ProblemSummary) -> None:
     axes.set_ylim(-5, 105)
     axes.set_yticks([0, 25, 50, 75, 100])
     axes.xaxis.get_major_locator().set_params(nbins=4)  # fewer ticks: each costs matplotlib a few ms
-    axes.set_xlabel(parameter.name)
+    axes.set_xlabel(parameter.axis)
     _plain(axes)
 
 

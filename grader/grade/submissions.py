@@ -54,6 +54,7 @@ from grader.grade.columns import Layout, find_layout
 from grader.grade.latest import Answer, Contests, SubmittedRow
 from grader.grade.row_problems import (
     ASIDE,
+    EMAIL_AS_ID,
     EMPTY,
     FUTURE,
     LABEL,
@@ -140,7 +141,9 @@ def _refuse_repeated(paths: Sequence[Path]) -> None:
 
 
 class Roster:
-    """The key's students, found by id (exact, or once leading zeros are restored) or by email."""
+    """The key's students, found by id (exact, or once leading zeros are restored) or by email; in an id
+    column, a cell that is no id but a student's email (as ``grader check --student`` takes either) is
+    that student, with a caveat."""
 
     def __init__(self, students: Sequence[StudentRef]) -> None:
         self.ids = {s.id for s in students}
@@ -152,23 +155,30 @@ class Roster:
             if s.email.strip():
                 self.emails[s.email.strip().lower()].append(s.id)
 
-    def find(self, text: str, by_email: bool) -> tuple[str | None, str]:
-        """The student ``text`` names, and a caveat ("" if none) or why nobody (when ``None``)."""
+    def find(self, text: str, by_email: bool) -> tuple[str | None, str, Kind | None]:
+        """The student ``text`` names, and a caveat ("" if none) with its kind, or why nobody (when ``None``)."""
         if by_email:
-            found = self.emails.get(text.lower(), [])
-            if len(found) == 1:
-                return found[0], ""
-            return None, (f"unknown student email {shown(text)} (not in the answer key)" if not found
-                          else f"the email {shown(text)} belongs to {len(found)} students of the answer key")
+            return self._by_email(text, None)
         if text in self.ids:
-            return text, ""
+            return text, "", None
         found = self.stripped.get(text.lstrip("0"), []) if text.strip("0") else []
         if len(found) == 1:
-            return found[0], f"leading zeros restored: {text} -> {found[0]}"
+            return found[0], f"leading zeros restored: {text} -> {found[0]}", ZEROS
         if found:
             return None, (f"student {shown(text)} is ambiguous: with its leading zeros restored it could be "
-                          f"{' or '.join(sorted(found))}; write the id in full")
-        return None, f"unknown student {shown(text)} (not in the answer key)"
+                          f"{' or '.join(sorted(found))}; write the id in full"), None
+        if text.strip().lower() in self.emails:
+            return self._by_email(text, EMAIL_AS_ID)
+        return None, f"unknown student {shown(text)} (not in the answer key)", None
+
+    def _by_email(self, text: str, caveat: Kind | None) -> tuple[str | None, str, Kind | None]:
+        """The one student whose email is ``text`` (any case); in an id column (``caveat``), said so."""
+        found = self.emails.get(text.strip().lower(), [])
+        if len(found) == 1:
+            return found[0], f"an email in the id column, matched by email: {text.strip()} -> {found[0]}" \
+                if caveat else "", caveat
+        return None, (f"unknown student email {shown(text)} (not in the answer key)" if not found
+                      else f"the email {shown(text)} belongs to {len(found)} students of the answer key"), None
 
     def known(self, text: str, by_email: bool) -> bool:
         return self.find(text, by_email)[0] is not None
@@ -189,6 +199,7 @@ class _Reader:
         self.now, self.zoned, self.unzoned = now, False, False
         self.future: list[tuple[str, int]] = []  # the first row with a timestamp after now, and how many
         self.futures = 0
+        self.emailed = 0  # rows whose id column held a student's email
 
     def read(self, file: str, index: int, row: CsvRow, table: CsvStream, layout: Layout) -> None:
         """Enter ``row`` in its contest (with its caveats to the log), or its problem to the log."""
@@ -201,13 +212,15 @@ class _Reader:
             problem = row.problem
             self._problem(MALFORMED, order, file, who, label, lambda: problem.split(": ", 1)[-1])
             return
-        student_id, why = self.find(who, layout.by_email) if who else (None, "no student given")
+        student_id, why, caveat = self.find(who, layout.by_email) if who else (None, "no student given", None)
         if student_id is None:
             nobody = _not_a_student(row, layout)
             self._problem(ASIDE if nobody else UNKNOWN, order, file, who, label, lambda: nobody or why)
             return
-        if why:
-            self._problem(ZEROS, order, file, student_id, "", lambda: why)
+        if caveat is not None:
+            if caveat is EMAIL_AS_ID:
+                self.emailed += 1
+            self._problem(caveat, order, file, student_id, "", lambda: why)
         if layout.wide:
             answers = tuple((label, row.cells[column]) for column, label in layout.labels.items() if row.cells[column])
             if not answers:
@@ -264,6 +277,9 @@ class _Reader:
             notes.append(f"{self.futures:,} row{'s have' if self.futures > 1 else ' has'} a timestamp after this "
                          f"run's time ({self.now:%Y-%m-%d %H:%M} UTC), the first {file} line {line}: such a row "
                          "wins over every submission before it; see problems.csv")
+        if self.emailed:
+            notes.append(f"{self.emailed:,} row{'s name their' if self.emailed > 1 else ' names its'} student by "
+                         "email in the id column: matched by email (see problems.csv)")
         if self.log.unlisted():
             notes.append(f"problems.csv lists the first {self.log.listed:,} rows of each kind of problem; "
                          f"{self.log.unlisted():,} more are counted there, not listed")

@@ -80,7 +80,7 @@ def write_outputs(job: Job, assignment: Assignment, roster: Sequence[Student], b
     with _frozen_for_the_run():
         with collector_paused(keep_frozen=True):
             generation = generate(assignment, roster, bank)
-            write_atomic(staging / "key.json", key_json(key_document(assignment, generation, bank)))
+            write_atomic(staging / "key.json", key_json(key_document(assignment, generation, bank, job.out)))
             write_atomic(staging / "key.csv", key_csv(generation))
         written = 2 + (_write_pdfs(job, assignment, generation, bank, staging) if job.pdf else 0)
     return generation, written

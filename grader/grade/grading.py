@@ -12,7 +12,8 @@ pass; the verdicts are kept as rows of plain values (a class of 100,000 has a mi
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+from datetime import datetime
 from functools import lru_cache
 from typing import Any, NamedTuple
 
@@ -32,8 +33,10 @@ from grader.grade.compare import errors, feedbacks, is_correct, number_text
 from grader.grade.diagnosis import Earlier, Physics, ProblemPhysics, physics_for, reconsider
 from grader.grade.equivalence import equivalent, refused
 from grader.grade.key import Key, KeyPart
+from grader.grade.lateness import deductions, late_by, minutes, part_deduction
 from grader.grade.notation import cut
 from grader.grade.submissions import Answer, RowProblem, Submissions
+from grader.grade.timestamps import instant
 from grader.model.tolerance import Tolerance
 
 VERDICTS = ("correct", "ecf", "mistake", "incorrect", "invalid", "missing")
@@ -60,6 +63,8 @@ class Verdict:
     feedback: str
     diagnosis: str = ""  # ecf: "ecf:" and the part carried forward (ecf:3a); mistake: its id (impact.e_squared)
     source: str = ""  # "file:line" of the row the answer came from
+    late: int | None = None  # minutes late (None: no due time, no answer, or a row without a timestamp)
+    deduction: float = 0.0  # points the late policy took for it (the student's floor applied)
 
     @property
     def score(self) -> float:
@@ -84,6 +89,8 @@ class Row(NamedTuple):
     feedback: str
     diagnosis: str
     source: str
+    late: int | None = None
+    deduction: float = 0.0
 
     @property
     def score(self) -> float:
@@ -94,13 +101,14 @@ class Row(NamedTuple):
 @dataclass(frozen=True)
 class Graded:
     """A grading run: per part label, in the key's order, a verdict row for every student of the key,
-    in its order; and every row not graded."""
+    in its order; every row not graded; and per student, the points the late policy took."""
 
     key: Key
     columns: Mapping[str, Sequence[Row]]
     problems: tuple[RowProblem, ...]
     ignored_columns: tuple[str, ...]
     notes: tuple[str, ...]
+    deductions: Mapping[str, float] = field(default_factory=dict)
 
     @property
     def verdicts(self) -> tuple[Verdict, ...]:
@@ -112,21 +120,92 @@ class Graded:
 
 def grade(key: Key, submissions: Submissions, physics: Physics | None = None) -> Graded:
     """Grade every student of the key; a part nobody answered is ``missing``. ``physics`` carries errors
-    forward and diagnoses mistakes (by default from the shipped bank, :func:`physics_for`)."""
+    forward and diagnoses mistakes (by default from the shipped bank, :func:`physics_for`). Where a
+    student gave several answers to a part (the key's ``attempts`` is ``best``), the best counts; then
+    the key's late policy is applied (:func:`_late_work`)."""
     physics = physics_for(key) if physics is None else physics
-    by_label: dict[str, dict[str, Answer]] = {label: {} for label in key.labels}
+    by_label: dict[str, dict[str, list[Answer]]] = {label: {} for label in key.labels}
     for answer in submissions.answers:
-        by_label[answer.label][answer.student_id] = answer
-    columns = {}
+        by_label[answer.label].setdefault(answer.student_id, []).append(answer)
+    problems: list[RowProblem] = []
+    columns: dict[str, list[Row]] = {}
+    stamps: dict[str, list[datetime | None]] = {}
     everyone = np.arange(len(key.students))
     for problem in key.problems:
         earlier: list[Earlier] = []
         for label in problem.labels:
-            answers = by_label.pop(label)
+            answers = _best(key, label, by_label.pop(label), physics.problems.get(problem.key), problems)
             cells = [(student.parts[label], answers.get(student.id)) for student in key.students]
             columns[label] = _grade_label(cells, key, everyone, physics.problems.get(problem.key), earlier)
-    return Graded(key, columns, submissions.problems, submissions.ignored_columns,
-                  (*submissions.notes, *physics.notes))
+            stamps[label] = [None if answer is None else answer.timestamp for _, answer in cells]
+    deductions, notes = _late_work(key, columns, stamps)
+    return Graded(key, columns, (*submissions.problems, *problems), submissions.ignored_columns,
+                  (*submissions.notes, *physics.notes, *notes), deductions)
+
+
+def _due(key: Key, index: int) -> datetime | None:
+    """Student ``index``'s due time: their extension, else the assignment's."""
+    return key.students[index].due or key.deadline
+
+
+def _best(key: Key, label: str, answers: Mapping[str, list[Answer]], physics: ProblemPhysics | None,
+          problems: list[RowProblem]) -> dict[str, Answer]:
+    """Per student, the answer to ``label`` that counts: the only one, or, of several (``attempts: best``),
+    the one that scores most after its own late deduction (ties: the earliest). Every attempt is graded on
+    its own (an error is not carried forward while choosing: the earlier parts are not chosen yet); each
+    one not counted is a problem (routine) naming the one that is."""
+    chosen = {student_id: found[0] for student_id, found in answers.items() if len(found) == 1}
+    if len(chosen) == len(answers):
+        return chosen
+    positions = key.positions
+    cells, students = [], []
+    for student_id, found in answers.items():
+        if len(found) > 1:
+            cells += [(key.students[positions[student_id]].parts[label], answer) for answer in found]
+            students += [positions[student_id]] * len(found)
+    rows = _grade_label(cells, key, np.array(students), physics, [])
+    scored: dict[str, list[tuple[float, Answer]]] = {}
+    for (part, answer), index, row in zip(cells, students, rows, strict=True):
+        assert answer is not None  # every cell holds an attempt
+        lost = 0.0 if key.late is None else float(part_deduction(
+            key.late, row.score, part.points, late_by(answer.timestamp, _due(key, index))))
+        scored.setdefault(answer.student_id, []).append((row.score - lost, answer))
+    for student_id, attempts in scored.items():
+        attempts.sort(key=lambda pair: (-pair[0], instant(pair[1].timestamp), pair[1].line))
+        (best, winner), *others = attempts
+        chosen[student_id] = winner
+        problems.extend(RowProblem(answer.file, answer.line, student_id, label, f"not counted: {winner.file} line "
+                                   f"{winner.line} scored more ({best:g} points, this one {score:g}; the best "
+                                   "attempt counts)" if score < best else f"not counted: {winner.file} line "
+                                   f"{winner.line}, submitted first, scored as much (the best attempt counts)",
+                                   routine=True) for score, answer in others)
+    return chosen
+
+
+def _late_work(key: Key, columns: dict[str, list[Row]],
+               stamps: Mapping[str, Sequence[datetime | None]]) -> tuple[dict[str, float], list[str]]:
+    """Each answer's lateness and deduction written into its row; the points each student lost, and notes
+    (answers whose lateness is not known). Nothing to do for a key without due times."""
+    if key.deadline is None and not any(student.due for student in key.students):
+        return {}, []
+    labels, deducted, unknown = key.labels, {}, 0
+    for index, student in enumerate(key.students):
+        due = _due(key, index)
+        rows = [columns[label][index] for label in labels]
+        lateness = [None if row.submitted is None else late_by(stamps[label][index], due)
+                    for label, row in zip(labels, rows, strict=True)]
+        unknown += sum(row.submitted is not None and late is None for row, late in zip(rows, lateness, strict=True))
+        shares = [0.0] * len(rows)
+        if key.late is not None and any(late is not None and late > key.late.grace for late in lateness):
+            total, exact = deductions(key.late, [(row.score, row.points, late)
+                                                 for row, late in zip(rows, lateness, strict=True)])
+            deducted[student.id], shares = float(total), [float(share) for share in exact]
+        for label, row, late, share in zip(labels, rows, lateness, shares, strict=True):
+            if late is not None:
+                columns[label][index] = row._replace(late=minutes(late), deduction=share)
+    notes = [f"{unknown:,} answers have no timestamp (or one that does not read): how late they were is not "
+             "known, and they lose nothing; see problems.csv"] if unknown else []
+    return deducted, notes
 
 
 def grade_part(part: KeyPart, student_id: str, answer: Answer | None, key: Key,
@@ -350,8 +429,26 @@ def _expected(part: KeyPart) -> str:
     return part.value if isinstance(part.value, str) else number_text(part.value)
 
 
+def final_scores(graded: Graded) -> dict[str, float]:
+    """Per student, the total after the late policy's deduction (what grades.csv and canvas.csv carry)."""
+    return {student_id: sum(by_problem.values()) - graded.deductions.get(student_id, 0.0)
+            for student_id, by_problem in totals(graded).items()}
+
+
+def lateness(graded: Graded) -> list[int | None]:
+    """Per student of the key, in its order, the minutes late of their latest answer that counts (None:
+    no answer whose lateness is known)."""
+    found: list[int | None] = [None] * len(graded.key.students)
+    for rows in graded.columns.values():
+        for index, row in enumerate(rows):
+            if row.late is not None:
+                found[index] = max(row.late, found[index] or 0)
+    return found
+
+
 def totals(graded: Graded) -> Mapping[str, Mapping[str, float]]:
-    """Per student, per problem key: the score (its parts' scores added in the key's order)."""
+    """Per student, per problem key: the score before any late deduction (its parts' scores added in the
+    key's order)."""
     key = graded.key
     sums: dict[str, list[float]] = {}
     for problem in key.problems:

@@ -64,6 +64,7 @@ SUPERSEDED = Kind("rows superseded by a later submission of the same student", r
 ZEROS = Kind("rows whose student id had its leading zeros restored", caveat=True)
 UNREADABLE_TIME = Kind("rows whose timestamp does not read", caveat=True)
 FUTURE = Kind("rows with a timestamp after this run's time", caveat=True)
+SAME = Kind("answers the same as one the student submitted before (the best attempt counts)", routine=True)
 REPLACED = Kind("answers of a wide submission replaced by a later long row", caveat=True)
 
 Order = tuple[int, int]

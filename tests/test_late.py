@@ -19,7 +19,7 @@ from grader.assign.deadlines import LatePolicy, late_from, student_due, zone
 from grader.base.errors import GraderError, TemplateError
 from grader.cli import main
 from grader.grade.key import load_key
-from grader.grade.lateness import deductions
+from grader.grade.lateness import deductions, intervals
 
 CHICAGO = "America/Chicago"
 POLICY = {"grace": "15 min", "deduct": "10 %", "per": "day", "lowest": "40 %", "after": "7 days"}
@@ -125,17 +125,18 @@ def test_without_a_late_policy_late_work_is_graded_as_on_time_and_its_lateness_r
     (timedelta(days=2, hours=23), 7), (timedelta(days=5), 5)])
 def test_canvas_counts_a_partial_day_as_a_whole_one(late: timedelta, expected: float) -> None:
     """10 % a day of 10 points, no floor: a second late loses a day's 10 %; 1 day 1 minute, 20 %."""
-    total, _ = deductions(LatePolicy(Fraction(1, 10)), [(10.0, 10.0, late)])
+    policy = LatePolicy(Fraction(1, 10))
+    total, _ = deductions(policy, ((10.0, 10.0, intervals(policy, late)),))
     assert 10 - total == expected
 
 
 def test_hourly_deductions_and_the_floor_over_parts_submitted_together() -> None:
     hourly = late_from({"deduct": "5 %", "per": "hour"}, "a.yaml")
-    assert deductions(hourly, [(8.0, 10.0, timedelta(hours=2, minutes=30))])[0] == Fraction(3, 2)  # 3 h: 15 %
+    assert deductions(hourly, ((8.0, 10.0, intervals(hourly, timedelta(hours=2, minutes=30))),))[0] == Fraction(3, 2)
     # Canvas floors the assignment, not each part: 10 + 0 of 20 at 50 % a day, floor 40 % (8): loses 2.
     policy = late_from({"deduct": "50 %", "lowest": "40 %"}, "a.yaml")
-    total, shares = deductions(policy, [(10.0, 10.0, timedelta(hours=1)), (0.0, 10.0, timedelta(hours=1))])
-    assert (total, shares) == (2, [1, 1])
+    total, shares = deductions(policy, ((10.0, 10.0, 1), (0.0, 10.0, 1)))
+    assert (total, shares) == (2, (1, 1))
 
 
 def test_an_old_key_without_deadlines_reads_and_grades_as_before(tmp_path: Path) -> None:
@@ -241,3 +242,19 @@ def test_the_best_attempt_counts_per_part_after_its_own_late_deduction(tmp_path:
     assert reasons["3"].startswith("not counted: ") and "scored more (5 points, this one 0" in reasons["3"]
     assert reasons["4"].startswith("the same answer as ") and "line 2" in reasons["4"]
     assert "scored more (4.5 points, this one 0" in reasons["5"]
+
+
+@pytest.mark.parametrize(("attempts", "sources", "total"), [
+    ("latest", ["3", "3"], "5"), ("first", ["2", "2"], "5"), ("best", ["2", "3"], "10")])
+def test_in_a_wide_file_latest_and_first_take_a_submission_whole_and_best_each_part(
+        tmp_path: Path, attempts: str, sources: list[str], total: str) -> None:
+    (tmp_path / "key.json").write_text(json.dumps(key_document(attempts=attempts)), encoding="utf-8")
+    (tmp_path / "wide.csv").write_text("Timestamp,student_id,1a,1b\n2026-12-04 10:00,on,2,1\n"
+                                       "2026-12-04 11:00,on,5,3\n", encoding="utf-8")
+    out = tmp_path / "out"
+    assert main(["grade", "--key", str(tmp_path / "key.json"), str(tmp_path / "wide.csv"), "--out", str(out)]) == 0
+    details = {row["label"]: row for row in csv.DictReader(io.StringIO((out / "details.csv").read_text()))
+               if row["student_id"] == "on"}
+    assert [details[label]["source"].rsplit(":", 1)[1] for label in ("1a", "1b")] == sources
+    grades = {row["student_id"]: row for row in csv.DictReader(io.StringIO((out / "grades.csv").read_text()))}
+    assert grades["on"]["total"] == total

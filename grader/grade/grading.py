@@ -12,7 +12,7 @@ pass; the verdicts are kept as rows of plain values (a class of 100,000 has a mi
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from datetime import datetime
 from functools import lru_cache
 from typing import Any, NamedTuple
@@ -33,7 +33,7 @@ from grader.grade.compare import errors, feedbacks, is_correct, number_text
 from grader.grade.diagnosis import Earlier, Physics, ProblemPhysics, physics_for, reconsider
 from grader.grade.equivalence import equivalent, refused
 from grader.grade.key import Key, KeyPart
-from grader.grade.lateness import deductions, late_by, minutes, part_deduction
+from grader.grade.lateness import deductions, intervals, late_by, minutes, part_deduction
 from grader.grade.notation import cut
 from grader.grade.submissions import Answer, RowProblem, Submissions
 from grader.grade.timestamps import instant
@@ -64,7 +64,7 @@ class Verdict:
     diagnosis: str = ""  # ecf: "ecf:" and the part carried forward (ecf:3a); mistake: its id (impact.e_squared)
     source: str = ""  # "file:line" of the row the answer came from
     late: int | None = None  # minutes late (None: no due time, no answer, or a row without a timestamp)
-    deduction: float = 0.0  # points the late policy took for it (the student's floor applied)
+    deduction: float = 0.0  # points the late policy took for it (its share of the student's deduction)
 
     @property
     def score(self) -> float:
@@ -89,8 +89,6 @@ class Row(NamedTuple):
     feedback: str
     diagnosis: str
     source: str
-    late: int | None = None
-    deduction: float = 0.0
 
     @property
     def score(self) -> float:
@@ -99,22 +97,40 @@ class Row(NamedTuple):
 
 
 @dataclass(frozen=True)
+class LateWork:
+    """How late the answers that count came, for a key with due times: per part label, per student of the
+    key in its order, the minutes late (None: nothing submitted, or no timestamp) and the part's share of
+    the deduction; per student id, the points the late policy took (only those who lost any). Kept beside
+    the verdicts, not in them: a class of 100,000 has a million."""
+
+    minutes: Mapping[str, Sequence[int | None]]
+    shares: Mapping[str, Sequence[float]]
+    deductions: Mapping[str, float]
+
+
+@dataclass(frozen=True)
 class Graded:
     """A grading run: per part label, in the key's order, a verdict row for every student of the key,
-    in its order; every row not graded; and per student, the points the late policy took."""
+    in its order; every row not graded; and how late the answers were (None: the key has no due time)."""
 
     key: Key
     columns: Mapping[str, Sequence[Row]]
     problems: tuple[RowProblem, ...]
     ignored_columns: tuple[str, ...]
     notes: tuple[str, ...]
-    deductions: Mapping[str, float] = field(default_factory=dict)
+    late: LateWork | None = None
+
+    @property
+    def deductions(self) -> Mapping[str, float]:
+        """Per student id, the points the late policy took (only those who lost any)."""
+        return {} if self.late is None else self.late.deductions
 
     @property
     def verdicts(self) -> tuple[Verdict, ...]:
         """Every verdict, student by student, part by part (built on each call: the reports read the rows)."""
-        labels = self.key.labels
-        return tuple(Verdict(student.id, label, *self.columns[label][index])
+        labels, late = self.key.labels, self.late
+        return tuple(Verdict(student.id, label, *self.columns[label][index],
+                             *((late.minutes[label][index], late.shares[label][index]) if late else ()))
                      for index, student in enumerate(self.key.students) for label in labels)
 
 
@@ -138,9 +154,9 @@ def grade(key: Key, submissions: Submissions, physics: Physics | None = None) ->
             cells = [(student.parts[label], answers.get(student.id)) for student in key.students]
             columns[label] = _grade_label(cells, key, everyone, physics.problems.get(problem.key), earlier)
             stamps[label] = [None if answer is None else answer.timestamp for _, answer in cells]
-    deductions, notes = _late_work(key, columns, stamps)
+    late, notes = _late_work(key, columns, stamps)
     return Graded(key, columns, (*submissions.problems, *problems), submissions.ignored_columns,
-                  (*submissions.notes, *physics.notes, *notes), deductions)
+                  (*submissions.notes, *physics.notes, *notes), late)
 
 
 def _due(key: Key, index: int) -> datetime | None:
@@ -168,7 +184,7 @@ def _best(key: Key, label: str, answers: Mapping[str, list[Answer]], physics: Pr
     for (part, answer), index, row in zip(cells, students, rows, strict=True):
         assert answer is not None  # every cell holds an attempt
         lost = 0.0 if key.late is None else float(part_deduction(
-            key.late, row.score, part.points, late_by(answer.timestamp, _due(key, index))))
+            key.late, row.score, part.points, intervals(key.late, late_by(answer.timestamp, _due(key, index)))))
         scored.setdefault(answer.student_id, []).append((row.score - lost, answer))
     for student_id, attempts in scored.items():
         attempts.sort(key=lambda pair: (-pair[0], instant(pair[1].timestamp), pair[1].line))
@@ -182,30 +198,41 @@ def _best(key: Key, label: str, answers: Mapping[str, list[Answer]], physics: Pr
     return chosen
 
 
-def _late_work(key: Key, columns: dict[str, list[Row]],
-               stamps: Mapping[str, Sequence[datetime | None]]) -> tuple[dict[str, float], list[str]]:
-    """Each answer's lateness and deduction written into its row; the points each student lost, and notes
-    (answers whose lateness is not known). Nothing to do for a key without due times."""
+def _late_work(key: Key, columns: Mapping[str, Sequence[Row]],
+               stamps: Mapping[str, Sequence[datetime | None]]) -> tuple[LateWork | None, list[str]]:
+    """How late each answer was and what the key's late policy takes for it (:mod:`grader.grade.lateness`),
+    and notes (answers whose lateness is not known); None for a key without due times."""
     if key.deadline is None and not any(student.due for student in key.students):
-        return {}, []
-    labels, deducted, unknown = key.labels, {}, 0
-    for index, student in enumerate(key.students):
-        due = _due(key, index)
-        rows = [columns[label][index] for label in labels]
-        lateness = [None if row.submitted is None else late_by(stamps[label][index], due)
-                    for label, row in zip(labels, rows, strict=True)]
-        unknown += sum(row.submitted is not None and late is None for row, late in zip(rows, lateness, strict=True))
-        shares = [0.0] * len(rows)
-        if key.late is not None and any(late is not None and late > key.late.grace for late in lateness):
-            total, exact = deductions(key.late, [(row.score, row.points, late)
-                                                 for row, late in zip(rows, lateness, strict=True)])
-            deducted[student.id], shares = float(total), [float(share) for share in exact]
-        for label, row, late, share in zip(labels, rows, lateness, shares, strict=True):
-            if late is not None:
-                columns[label][index] = row._replace(late=minutes(late), deduction=share)
+        return None, []
+    policy, everyone = key.late, range(len(key.students))
+    dues = [_due(key, index) for index in everyone]
+    found: dict[tuple[datetime | None, datetime | None], tuple[int | None, int]] = {}  # rows share stamps
+    minutes_late, charged, unknown = {}, {}, 0
+    for label, rows in columns.items():
+        late: list[int | None] = [None] * len(dues)
+        charges = [0] * len(dues)
+        for index, (row, stamp, due) in enumerate(zip(rows, stamps[label], dues, strict=True)):
+            if row.submitted is None:
+                continue
+            known = found.get((stamp, due))
+            if known is None:
+                by = late_by(stamp, due)
+                known = found[stamp, due] = (minutes(by), 0 if policy is None else intervals(policy, by))
+            late[index], charges[index] = known
+            unknown += known[0] is None
+        minutes_late[label], charged[label] = late, charges
+    shares = {label: [0.0] * len(dues) for label in columns}
+    deducted = {}
+    if policy is not None:
+        for index in sorted({index for charges in charged.values() for index, charge in enumerate(charges) if charge}):
+            total, exact = deductions(policy, tuple((rows[index].score, rows[index].points, charged[label][index])
+                                                    for label, rows in columns.items()))
+            deducted[key.students[index].id] = float(total)
+            for label, share in zip(columns, exact, strict=True):
+                shares[label][index] = float(share)
     notes = [f"{unknown:,} answers have no timestamp (or one that does not read): how late they were is not "
              "known, and they lose nothing; see problems.csv"] if unknown else []
-    return deducted, notes
+    return LateWork(minutes_late, shares, deducted), notes
 
 
 def grade_part(part: KeyPart, student_id: str, answer: Answer | None, key: Key,
@@ -439,10 +466,8 @@ def lateness(graded: Graded) -> list[int | None]:
     """Per student of the key, in its order, the minutes late of their latest answer that counts (None:
     no answer whose lateness is known)."""
     found: list[int | None] = [None] * len(graded.key.students)
-    for rows in graded.columns.values():
-        for index, row in enumerate(rows):
-            if row.late is not None:
-                found[index] = max(row.late, found[index] or 0)
+    for late in graded.late.minutes.values() if graded.late else ():
+        found = [mine if theirs is None else max(theirs, mine or 0) for mine, theirs in zip(found, late, strict=True)]
     return found
 
 

@@ -9,11 +9,11 @@ so that when every part came in one submission the deduction is Canvas' (``deduc
 possible, floored). Where the floor holds the deduction back, each late part's share is cut in proportion.
 
 >>> from grader.assign.deadlines import LatePolicy
->>> late = timedelta(days=1, minutes=1)  # two days: 20 % of the points possible, 20
->>> deductions(LatePolicy(Fraction(1, 10)), [(10.0, 10.0, late), (6.0, 10.0, late)])
-(Fraction(4, 1), [Fraction(2, 1), Fraction(2, 1)])
->>> deductions(LatePolicy(Fraction(1, 10), lowest=Fraction(2, 5)), [(9.0, 10.0, late), (0.0, 10.0, late)])
-(Fraction(1, 1), [Fraction(1, 2), Fraction(1, 2)])
+>>> late = intervals(LatePolicy(Fraction(1, 10)), timedelta(days=1, minutes=1))  # two days: 20 % of 20 points
+>>> deductions(LatePolicy(Fraction(1, 10)), ((10.0, 10.0, late), (6.0, 10.0, late)))
+(Fraction(4, 1), (Fraction(2, 1), Fraction(2, 1)))
+>>> deductions(LatePolicy(Fraction(1, 10), lowest=Fraction(2, 5)), ((9.0, 10.0, late), (0.0, 10.0, late)))
+(Fraction(1, 1), (Fraction(1, 2), Fraction(1, 2)))
 
 (9 of 20 would lose 4; the floor, 40 % of 20, holds it at 8.)
 """
@@ -21,11 +21,14 @@ possible, floored). Where the floor holds the deduction back, each late part's s
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
 from datetime import datetime, timedelta
 from fractions import Fraction
+from functools import lru_cache
 
 from grader.assign.deadlines import LatePolicy
+
+CLOSED = -1
+"""The intervals of an answer past the policy's ``after``: it earns nothing."""
 
 
 def late_by(stamp: datetime | None, due: datetime | None) -> timedelta | None:
@@ -40,29 +43,36 @@ def minutes(late: timedelta | None) -> int | None:
     return None if late is None else math.ceil(late / timedelta(minutes=1))
 
 
-def part_deduction(policy: LatePolicy, score: float, points: float, late: timedelta | None) -> Fraction:
-    """What a part of ``points`` scoring ``score``, ``late`` by so much, loses before the floor: all it
-    scored past ``after``, else ``deduct`` of its points per interval late (used to compare attempts)."""
+def intervals(policy: LatePolicy, late: timedelta | None) -> int:
+    """The intervals an answer ``late`` by so much is charged for: 0 when on time (or not known),
+    :data:`CLOSED` past ``after``."""
     if late is None:
-        return Fraction(0)
-    if policy.closed(late):
+        return 0
+    return CLOSED if policy.closed(late) else policy.intervals(late)
+
+
+def part_deduction(policy: LatePolicy, score: float, points: float, charged: int) -> Fraction:
+    """What a part of ``points`` scoring ``score``, charged for ``charged`` intervals, loses before the
+    floor: all it scored when :data:`CLOSED`, else ``deduct`` of its points per interval (used as is to
+    compare a student's attempts at one part)."""
+    if charged == CLOSED:
         return Fraction(score)
-    return policy.deduct * policy.intervals(late) * Fraction(points)
+    return policy.deduct * charged * Fraction(points)
 
 
-def deductions(policy: LatePolicy, parts: Sequence[tuple[float, float, timedelta | None]]) -> tuple[
-        Fraction, list[Fraction]]:
-    """A student's deduction and each part's share, for ``parts`` of (score, points, lateness or None)."""
+@lru_cache(maxsize=4096)  # a class's students repeat a few patterns of scores and intervals
+def deductions(policy: LatePolicy, parts: tuple[tuple[float, float, int], ...]) -> tuple[
+        Fraction, tuple[Fraction, ...]]:
+    """A student's deduction and each part's share, for ``parts`` of (score, points, intervals charged)."""
     possible = sum(Fraction(points) for _, points, _ in parts)
-    closed = [late is not None and policy.closed(late) for _, _, late in parts]
-    kept = sum(Fraction(score) for (score, _, _), shut in zip(parts, closed, strict=True) if not shut)
-    wanted = [Fraction(0) if shut else part_deduction(policy, score, points, late)
-              for (score, points, late), shut in zip(parts, closed, strict=True)]
+    kept = sum(Fraction(score) for score, _, charged in parts if charged != CLOSED)
+    wanted = [Fraction(0) if charged == CLOSED else part_deduction(policy, score, points, charged)
+              for score, points, charged in parts]
     room = max(Fraction(0), kept - policy.lowest * possible)
     total = sum(wanted, Fraction(0))
     if total > room:
         wanted = [share * room / total for share in wanted]
         total = room
-    shares = [Fraction(score) if shut else share
-              for (score, _, _), shut, share in zip(parts, closed, wanted, strict=True)]
-    return total + sum((share for share, shut in zip(shares, closed, strict=True) if shut), Fraction(0)), shares
+    shares = tuple(Fraction(score) if charged == CLOSED else share
+                   for (score, _, charged), share in zip(parts, wanted, strict=True))
+    return total + sum((Fraction(score) for score, _, charged in parts if charged == CLOSED), Fraction(0)), shares

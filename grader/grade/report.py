@@ -61,7 +61,10 @@ def details_csv(graded: Graded, students_per_piece: int = 2000) -> Iterator[str]
 
     Each cell is what :func:`_cell` makes of the verdict's field (the loop knows the field's type).
     """
-    columns = [(safe_cell(label), graded.columns[label]) for label in graded.key.labels]
+    unknown = [None] * len(graded.key.students)  # no due time: no lateness, no deduction
+    late = graded.late
+    columns = [(safe_cell(label), graded.columns[label], late.minutes[label] if late else unknown,
+                late.shares[label] if late else unknown) for label in graded.key.labels]
     numbers = _Cells()  # credits, points and scores: a few values
     words = _Cells()  # verdicts, units, tolerances: a few texts
 
@@ -69,14 +72,15 @@ def details_csv(graded: Graded, students_per_piece: int = 2000) -> Iterator[str]
         yield DETAILS_HEADER
         for index, student in enumerate(graded.key.students):
             who = safe_cell(student.id)
-            for label, verdicts in columns:
+            for label, verdicts, minutes, shares in columns:
                 (submitted, verdict, credit, points, expected, parsed, unit, abs_error, rel_error, tolerance, feedback,
-                 diagnosis, source, late, deduction) = verdicts[index]
+                 diagnosis, source) = verdicts[index]
                 yield (who, label, "" if submitted is None else safe_cell(visible(submitted)), words[verdict],
                        numbers[credit], numbers[points], numbers[credit * points], safe_cell(expected),
                        safe_cell(visible(parsed)), words[unit], "" if abs_error is None else _number(abs_error),
                        "" if rel_error is None else _number(rel_error), words[tolerance], safe_cell(visible(feedback)),
-                       words[diagnosis], safe_cell(visible(source)), numbers[late], numbers[deduction])
+                       words[diagnosis], safe_cell(visible(source)), numbers[minutes[index]],
+                       numbers[shares[index] or 0.0])
 
     return csv_pieces(rows(), students_per_piece * max(1, len(columns)))
 

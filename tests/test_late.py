@@ -210,7 +210,7 @@ def test_generate_writes_the_deadline_and_extensions_into_the_key(tmp_path: Path
     document = json.loads((tmp_path / "out" / "key.json").read_text(encoding="utf-8"))
     assert {name: document["assignment"][name] for name in ("deadline", "timezone", "late")} == {
         "deadline": DUE, "timezone": CHICAGO,
-        "late": {"grace": "0 s", "deduct": "10 %", "per": "day", "lowest": "0 %"}}
+        "late": {"grace": "0 min", "deduct": "10 %", "per": "day", "lowest": "0 %"}}
     assert [student.get("due") for student in document["students"]] == ["2026-12-05T00:59:00-06:00", None]
     key = load_key(tmp_path / "out" / "key.json")
     assert key.students[0].due == datetime.fromisoformat(DUE) + timedelta(hours=1)

@@ -31,6 +31,7 @@ import zoneinfo
 from collections.abc import Mapping
 from dataclasses import dataclass
 from datetime import datetime, timedelta
+from decimal import Decimal
 from fractions import Fraction
 from functools import lru_cache
 from typing import Any
@@ -134,7 +135,7 @@ def duration(text: str) -> timedelta | None:
         if unit not in _UNITS:
             return None
         seconds += Fraction(piece["number"]) * _UNITS[unit]
-    return timedelta(seconds=float(seconds)) if seconds < 10**9 else None  # 30 years: beyond any term
+    return timedelta(microseconds=round(seconds * 10**6)) if seconds < 10**9 else None  # 30 years: beyond any term
 
 
 def _duration(value: Any, where: str, field: str) -> timedelta:
@@ -153,15 +154,26 @@ def _percent(value: Any, where: str, field: str) -> Fraction:
 
 
 def _percent_text(value: Fraction) -> str:
-    return f"{float(value * 100):g} %"
+    """A percentage written back exactly (it was read from a decimal, so it ends).
+
+    >>> _percent_text(Fraction("0.3333333")), _percent_text(Fraction(1, 10))
+    ('33.33333 %', '10 %')
+    """
+    percent = Decimal(value.numerator * 100) / Decimal(value.denominator)
+    return f"{percent.normalize():f} %"
 
 
 def _duration_text(value: timedelta) -> str:
-    seconds = value.total_seconds()
-    for name, size in (("days", 86400), ("hours", 3600), ("min", 60)):
-        if seconds and seconds % size == 0:
-            return f"{seconds / size:g} {name}"
-    return f"{seconds:g} s"
+    """A duration written back exactly, in the largest unit that divides it.
+
+    >>> _duration_text(timedelta(days=7)), _duration_text(timedelta(minutes=90)), _duration_text(timedelta(0))
+    ('7 days', '90 min', '0 min')
+    """
+    microseconds = value // timedelta(microseconds=1)
+    for name, size in (("days", 86400), ("hours", 3600), ("min", 60)) if microseconds else (("min", 60),):
+        if microseconds % (size * 10**6) == 0:
+            return f"{microseconds // (size * 10**6)} {name}"
+    return f"{Decimal(microseconds).scaleb(-6).normalize():f} s"
 
 
 @lru_cache(maxsize=64)

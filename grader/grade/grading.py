@@ -219,7 +219,7 @@ def _late_work(key: Key, columns: Mapping[str, Sequence[Row]],
                 by = late_by(stamp, due)
                 known = found[stamp, due] = (minutes(by), 0 if policy is None else intervals(policy, by))
             late[index], charges[index] = known
-            unknown += known[0] is None
+            unknown += known[0] is None and due is not None  # a student with no due time: nothing to know
         minutes_late[label], charged[label] = late, charges
     shares = {label: [0.0] * len(dues) for label in columns}
     deducted = {}

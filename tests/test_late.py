@@ -258,3 +258,14 @@ def test_in_a_wide_file_latest_and_first_take_a_submission_whole_and_best_each_p
     assert [details[label]["source"].rsplit(":", 1)[1] for label in ("1a", "1b")] == sources
     grades = {row["student_id"]: row for row in csv.DictReader(io.StringIO((out / "grades.csv").read_text()))}
     assert grades["on"]["total"] == total
+
+
+def test_microsoft_forms_completion_time_is_the_timestamp(tmp_path: Path) -> None:
+    (tmp_path / "key.json").write_text(json.dumps(key_document()), encoding="utf-8")
+    (tmp_path / "forms.csv").write_text("Start time,Completion time,student_id,1a,1b\n"
+                                        "12/5/2026 23:50,12/5/2026 23:59,dayone,2,3\n", encoding="utf-8")
+    out = tmp_path / "out"
+    assert main(["grade", "--key", str(tmp_path / "key.json"), str(tmp_path / "forms.csv"), "--out", str(out),
+                 "--format", "wide"]) == 0
+    grades = {row["student_id"]: row for row in csv.DictReader(io.StringIO((out / "grades.csv").read_text()))}
+    assert (grades["dayone"]["late"], grades["dayone"]["deduction"]) == ("1440", "1")

@@ -32,8 +32,8 @@ Timestamps (:mod:`grader.grade.timestamps`) without a zone are in the assignment
 says otherwise; a note says so when some rows have a zone and some do not). When every competing row has a
 timestamp, the latest wins (ties: the later row); when any of them has none (or one that does not read: a
 caveat), the last row wins, in file order, then argument order (the key's ``attempts`` may make it the first,
-or the best: :mod:`grader.grade.latest`). A timestamp more than a day after the run's own time (beyond any
-time zone) wins all the same, with a caveat and a note: a clock was wrong, or the time was typed.
+or the best: :mod:`grader.grade.latest`). A timestamp after the run's own time wins all the same, with a
+caveat and a note: a clock was wrong, or the time was typed.
 """
 
 from __future__ import annotations
@@ -42,7 +42,7 @@ import os
 from collections import defaultdict
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from datetime import UTC, datetime, timedelta, tzinfo
+from datetime import UTC, datetime, tzinfo
 from functools import lru_cache
 from pathlib import Path
 from typing import Literal
@@ -71,8 +71,6 @@ from grader.grade.timestamps import in_zone, instant, read_timestamp
 
 __all__ = ["Answer", "RowProblem", "StudentRef", "Submissions", "find_label", "read_submissions"]
 
-FUTURE_MARGIN = timedelta(days=1)
-"""A timestamp later than the run's own time by more than this (more than any time zone's offset) is a caveat."""
 
 
 @dataclass(frozen=True)
@@ -241,7 +239,7 @@ class _Reader:
             stamp = in_zone(stamp, self.zone)
         else:
             self.zoned = True
-        if instant(stamp) > self.now + FUTURE_MARGIN:
+        if stamp > self.now:  # in the assignment's zone, a time without one is no longer a guess
             self.futures += 1
             if not self.future:
                 self.future.append((file, order[1]))

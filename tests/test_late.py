@@ -14,7 +14,7 @@ from typing import Any
 
 import pytest
 
-from grader.assign.assignment import load_assignment, load_roster
+from grader.assign.assignment import check_extensions, load_assignment, load_roster
 from grader.assign.deadlines import LatePolicy, late_from, student_due, zone
 from grader.base.errors import GraderError, TemplateError
 from grader.cli import main
@@ -269,3 +269,11 @@ def test_microsoft_forms_completion_time_is_the_timestamp(tmp_path: Path) -> Non
                  "--format", "wide"]) == 0
     grades = {row["student_id"]: row for row in csv.DictReader(io.StringIO((out / "grades.csv").read_text()))}
     assert (grades["dayone"]["late"], grades["dayone"]["deduction"]) == ("1440", "1")
+
+
+def test_a_delay_in_the_roster_needs_the_assignments_due_time(tmp_path: Path) -> None:
+    roster = tmp_path / "roster.csv"
+    roster.write_text("id,name,email,section,due\n7,A,,L1,+2 days\n", encoding="utf-8")
+    with pytest.raises(GraderError, match=r"roster.csv: student '7': due: '\+2 days' is a delay, but the "
+                                          r"assignment's due is no date-time"):
+        check_extensions(load_assignment(assignment(tmp_path, 'due: "Friday"\n')), load_roster(roster), roster)

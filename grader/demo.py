@@ -14,6 +14,7 @@ import shutil
 import time
 from collections.abc import Mapping
 from dataclasses import dataclass
+from datetime import timedelta
 from pathlib import Path
 
 from grader.assign.sample_answers import due_time, sample_answers, submissions_csv
@@ -46,9 +47,10 @@ def demo(out: Path, bank: Mapping[str, Template], jobs: int = 1, force: bool = F
             shutil.copyfile(source, staging / source.name)
         generation, _ = write_outputs(job, assignment, roster, bank, staging)
         write_atomic(staging / SUBMISSIONS, submissions_csv(sample_answers(assignment, generation, bank)))
-        # Graded as at the due date, by which the simulated class submitted (not a caveat for each row).
+        # Graded as at a day after the due date, by which the simulated class submitted, its late resubmission
+        # (within 12 hours) included: no row is after the run's time.
         graded = grade_into(staging / GRADES, staging / KEY, [staging / SUBMISSIONS], out / GRADES,
-                            [str(out / SUBMISSIONS)], bank, now=due_time(assignment.due))
+                            [str(out / SUBMISSIONS)], bank, now=due_time(assignment.due) + timedelta(days=1))
         files = sum(path.is_file() for path in staging.rglob("*"))
     generated = Summary(out, len(roster), len(assignment.problems), generation.collisions, files,
                         time.perf_counter() - started)

@@ -11,6 +11,7 @@ import subprocess
 import sys
 from datetime import UTC, datetime
 from pathlib import Path
+from zoneinfo import ZoneInfo
 
 import pytest
 
@@ -148,12 +149,16 @@ def test_a_timestamp_after_the_runs_time_still_wins_but_is_a_caveat_and_a_note(t
                                 f"{path} line 2: such a row wins over every submission before it; see problems.csv")
 
 
-def test_a_timestamp_within_a_day_of_the_runs_time_is_no_caveat(tmp_path: Path) -> None:
-    """A time without a zone, written east of UTC, may read as hours ahead: not a caveat."""
+def test_a_time_without_a_zone_is_in_the_assignments_zone_when_compared_with_the_runs(tmp_path: Path) -> None:
+    """20:00 in Tokyo is 11:00 UTC: before a run at 12:00 UTC, no caveat; read as UTC, it is after it (a time
+    without a zone was once taken as UTC, and a day's margin hid the hours it read ahead)."""
     path = tmp_path / "a.csv"
     path.write_text("student_id,label,answer,timestamp\n456,1a,1,2026-12-05 20:00\n")
-    result = read_submissions([path], STUDENTS, ["1a"], now=datetime(2026, 12, 5, 8, 0, tzinfo=UTC))
+    now = datetime(2026, 12, 5, 12, 0, tzinfo=UTC)
+    result = read_submissions([path], STUDENTS, ["1a"], now=now, zone=ZoneInfo("Asia/Tokyo"))
     assert result.problems == () and result.notes == ()
+    assert [p.reason.split(" UTC)")[0] for p in read_submissions([path], STUDENTS, ["1a"], now=now).problems] == [
+        "timestamp '2026-12-05 20:00' is after this run's time (2026-12-05 12:00"]
 
 
 # --- memory --------------------------------------------------------------------------------------------

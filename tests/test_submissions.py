@@ -92,7 +92,7 @@ def test_google_forms_headers_timestamps_and_ignored_columns(tmp_path: Path) -> 
     result = read(path)
     assert summary(result)[0] == [(2, "00123", "1a", "6.26"), (2, "00123", "1b", "0.5"), (2, "00123", "2", "12")]
     assert summary(result)[1] == [(3, "", "superseded by " + str(path) + " line 2 (submitted later)")]
-    assert result.answers[0].timestamp == datetime(2026, 12, 4, 23, 59, 7)
+    assert result.answers[0].timestamp == datetime(2026, 12, 4, 23, 59, 7, tzinfo=UTC)  # in the zone given (UTC)
     assert result.ignored_columns == ("Email Address", "Name")  # an id column exists: the email is not used
 
 
@@ -160,7 +160,7 @@ def test_duplicates_with_timestamps_across_two_files_the_latest_wins(tmp_path: P
     assert summary(result)[1] == [(3, "1b", f"superseded by {second} line 3 (submitted later)"),
                                   (2, "1a", f"superseded by {first} line 2 (submitted later)")]
     assert result.notes == ("some timestamps have a time zone and some do not: those without were taken as UTC "
-                            "to compare them",)
+                            "(the assignment's zone) to compare them",)
 
 
 def test_duplicates_without_timestamps_the_last_row_wins_in_file_then_argument_order(tmp_path: Path) -> None:

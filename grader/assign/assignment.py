@@ -13,11 +13,22 @@ from __future__ import annotations
 import difflib
 import re
 import unicodedata
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
+from datetime import datetime
 from pathlib import Path
 from typing import Any
 
+from grader.assign.deadlines import (
+    DEFAULT_ZONE,
+    LatePolicy,
+    extension,
+    late_from,
+    local_time,
+    student_due,
+    zone,
+    zone_from,
+)
 from grader.bank.template import Parameter, Template, tolerance_in
 from grader.base.errors import GraderError, TemplateError, shown
 from grader.base.inputs import read_csv, read_yaml
@@ -50,13 +61,15 @@ class Grading:
     ``intermediate_sig_figs``, the significant figures the sheet asks students to keep in intermediate
     steps (answers are given to three), from which each variant's rounding allowance is bounded;
     ``max_tolerance``, the widest relative tolerance a variant may get for that allowance (a variant that
-    would need more is redrawn)."""
+    would need more is redrawn); ``attempts``, which of a student's submissions counts when a form allows
+    resubmission (``latest``, ``best`` or ``first``; per submission in a wide file, per part in a long one)."""
 
     numeric_expressions: bool = True
     ecf_credit: float = 1.0
     mistake_credit: float = 0.0
     intermediate_sig_figs: int = 4
     max_tolerance: float = 0.05
+    attempts: str = "latest"
 
     @property
     def rounding_rule(self) -> str:
@@ -71,7 +84,9 @@ class Grading:
 
 @dataclass(frozen=True)
 class Assignment:
-    """An assignment: what every student gets, and the seed their variants come from."""
+    """An assignment: what every student gets, and the seed their variants come from; ``due`` as printed,
+    and when it reads as a date-time, ``deadline``, in the IANA zone ``timezone``; how ``late`` work is
+    credited (None: accepted as on time, its lateness reported)."""
 
     where: str
     title: str
@@ -81,16 +96,21 @@ class Assignment:
     instructions: str
     problems: tuple[ProblemSpec, ...]
     grading: Grading = Grading()
+    timezone: str = DEFAULT_ZONE
+    deadline: datetime | None = None
+    late: LatePolicy | None = None
 
 
 @dataclass(frozen=True)
 class Student:
-    """A roster row."""
+    """A roster row; ``due``: the student's extension as the roster writes it (a date-time in the
+    assignment's zone, or a delay such as ``+2 days``), or ""."""
 
     id: str
     name: str
     email: str
     section: str
+    due: str = ""
 
 
 def load_assignment(path: Path) -> Assignment:
@@ -99,7 +119,7 @@ def load_assignment(path: Path) -> Assignment:
     raw = read_yaml(path)
     if not isinstance(raw, Mapping):
         raise TemplateError(where, "(file)", "a mapping with title, course, seed, problems", type(raw).__name__)
-    allowed = {"title", "course", "seed", "due", "instructions", "problems", "grading"}
+    allowed = {"title", "course", "seed", "due", "timezone", "late", "instructions", "problems", "grading"}
     if set(raw) - allowed:
         raise TemplateError(where, ", ".join(sorted(map(str, set(raw) - allowed))),
                             f"only {', '.join(sorted(allowed))}", "unknown key(s)")
@@ -114,13 +134,22 @@ def load_assignment(path: Path) -> Assignment:
     seed = raw.get("seed")
     if isinstance(seed, bool) or not isinstance(seed, (int, str)) or not str(seed).strip():
         raise TemplateError(where, "seed", "a number or text (the assignment seed)", shown(seed))
+    due = _text(raw, "due", where, required=False)
+    timezone = zone_from(raw.get("timezone", DEFAULT_ZONE), where)
+    deadline = local_time(due, timezone)
+    late = None if raw.get("late") is None else late_from(raw["late"], where)
+    if deadline is None and (late is not None or "timezone" in raw):
+        needs = "the late policy" if late is not None else "the timezone"
+        raise TemplateError(where, "due", f"a date-time such as 2026-12-04 23:59 ({needs} needs one)", shown(due))
     return Assignment(where, _text(raw, "title", where), _text(raw, "course", where), str(seed).strip(),
-                      _text(raw, "due", where, required=False), _text(raw, "instructions", where, required=False),
-                      problems, grading_from(raw.get("grading"), where))
+                      due, _text(raw, "instructions", where, required=False),
+                      problems, grading_from(raw.get("grading"), where), str(timezone), deadline, late)
 
 
+ATTEMPTS = ("latest", "best", "first")
 GRADING_FIELDS = {"numeric_expressions": "true or false", "ecf_credit": "0 to 1", "mistake_credit": "0 to 1",
-                  "intermediate_sig_figs": "2 to 10", "max_tolerance": "0.001 to 0.5"}
+                  "intermediate_sig_figs": "2 to 10", "max_tolerance": "0.001 to 0.5",
+                  "attempts": " | ".join(ATTEMPTS)}
 """The fields of ``grading`` (in an assignment, and in the key that copies it) and their ranges."""
 
 
@@ -168,8 +197,12 @@ def grading_from(raw: Any, where: str, field: str = "grading") -> Grading:
     if not (_number(widest) and 0.001 <= widest <= 0.5):
         raise TemplateError(where, f"{field}.max_tolerance",
                             "a relative tolerance from 0.001 to 0.5 (0.05 is ±5 %)", shown(widest))
+    attempts = raw.get("attempts", Grading.attempts)
+    if attempts not in ATTEMPTS:
+        raise TemplateError(where, f"{field}.attempts", "latest, best or first (which of a student's submissions "
+                            "counts)", shown(attempts))
     return Grading(numeric_expressions=value, **credits, intermediate_sig_figs=figures,
-                   max_tolerance=float(widest))
+                   max_tolerance=float(widest), attempts=attempts)
 
 
 def _text(raw: Mapping[str, Any], key: str, where: str, required: bool = True) -> str:
@@ -254,6 +287,16 @@ def check_against_bank(assignment: Assignment, bank: Mapping[str, Template]) -> 
                                 ", ".join(sorted(unknown)))
 
 
+def check_extensions(assignment: Assignment, roster: Sequence[Student], path: Path) -> None:
+    """Every extension of the roster has a due time: a delay (``+2 days``) needs the assignment's."""
+    for student in roster:
+        try:
+            student_due(student.due, assignment.deadline, zone(assignment.timezone))
+        except ValueError as error:
+            raise GraderError(f"{path}: student {shown(student.id)}: due: {error}; give the assignment a due "
+                              "date-time, or the student a date-time") from None
+
+
 def _admitted(parameter: Parameter, value: float, where: str, key: str) -> None:
     refusal = parameter.refusal(value)
     if refusal is not None:
@@ -261,7 +304,8 @@ def _admitted(parameter: Parameter, value: float, where: str, key: str) -> None:
 
 
 def load_roster(path: Path) -> tuple[Student, ...]:
-    """Read a roster: columns id, name, email, section (UTF-8 with or without BOM; , ; or tab)."""
+    """Read a roster: columns id, name, email, section, and optionally due, a student's extension (UTF-8
+    with or without BOM; , ; or tab)."""
     table = read_csv(path)
     columns = {name.lower(): name for name in table.header}
     missing = [c for c in _ROSTER_COLUMNS if c not in columns]
@@ -275,10 +319,15 @@ def load_roster(path: Path) -> tuple[Student, ...]:
         values = {c: row.cells[columns[c]] for c in _ROSTER_COLUMNS}
         _check_id(values["id"], f"{path}: line {row.line}")
         _check_name(values["name"], f"{path}: line {row.line}")
+        due = row.cells[columns["due"]].strip() if "due" in columns else ""
+        try:
+            extension(due)
+        except ValueError as error:
+            raise GraderError(f"{path}: line {row.line}: due: {error}") from None
         if values["id"] in seen:
             raise GraderError(f"{path}: line {row.line}: student id '{values['id']}' appears twice")
         seen.add(values["id"])
-        students.append(Student(values["id"], values["name"], values["email"], values["section"]))
+        students.append(Student(values["id"], values["name"], values["email"], values["section"], due))
     if not students:
         raise GraderError(f"{path}: the roster has no students")
     return tuple(students)

@@ -5,12 +5,15 @@ of the run, so generating twice gives byte-identical files.
 
 Schema ``grader-key`` version 2 (version 1, still read by grading, lacks ``grading``, ``symbols``,
 and the tolerance's ``mode``: its tolerances are ``{"rtol", "atol"}``; a version 2 key from before
-``ecf_credit`` and ``mistake_credit`` is graded with their defaults, 1 and 0)::
+``ecf_credit``, ``mistake_credit`` and ``attempts`` is graded with their defaults, 1, 0 and latest; one
+without ``deadline`` measures no lateness, as before)::
 
     {"schema": "grader-key", "version": 2, "generator": "grader X.Y.Z",
      "assignment": {"title", "course", "seed", "due", "instructions", "source_sha256",
+                    "deadline": "2026-12-04T23:59:00-06:00", "timezone": "America/Chicago" (only when
+                        due is a date-time), "late": {"grace", "deduct", "per", "lowest", "after"} or null,
                     "grading": {"numeric_expressions": true, "ecf_credit": 1.0, "mistake_credit": 0.0,
-                                "intermediate_sig_figs": 4, "max_tolerance": 0.05}},
+                                "intermediate_sig_figs": 4, "max_tolerance": 0.05, "attempts": "latest"}},
      "templates": {ID: {"version", "sha256", "bank": the folder it came from, relative to the key's folder
                         where possible (only a template from outside the shipped bank; a key before it has none)}},
      "problems": [{"key", "template", "title", "parameters": {NAME: its unit, as printed},
@@ -18,7 +21,7 @@ and the tolerance's ``mode``: its tolerances are ``{"rtol", "atol"}``; a version
                                 "symbols": {NAME: [low, high]} (symbolic answers only: where each
                                            name is drawn to compare expressions)}]}],
      "collisions": {PROBLEM_KEY: number of students sharing their numbers with another},
-     "students": [{"id", "name", "email", "section",
+     "students": [{"id", "name", "email", "section", "due" (an extension: the student's own due time),
                    "problems": [{"key", "template", "variant_seed",
                                  "params": {NAME: value as printed, a number},
                                  "printed": {NAME: the text on the page, e.g. "2.10"},
@@ -40,7 +43,8 @@ from pathlib import Path
 from typing import Any
 
 from grader import __version__
-from grader.assign.assignment import Assignment, ProblemSpec
+from grader.assign.assignment import Assignment, ProblemSpec, Student
+from grader.assign.deadlines import student_due, zone
 from grader.assign.variants import AnswerPart, Generation
 from grader.bank.template import Template
 from grader.base.resources import bank_dir
@@ -60,13 +64,14 @@ def key_document(assignment: Assignment, generation: Generation, bank: Mapping[s
     return {
         "schema": SCHEMA, "version": VERSION, "generator": f"grader {__version__}",
         "assignment": {"title": assignment.title, "course": assignment.course, "seed": assignment.seed,
-                       "due": assignment.due, "instructions": assignment.instructions,
+                       "due": assignment.due, **_deadline(assignment), "instructions": assignment.instructions,
                        "source_sha256": hashlib.sha256(Path(assignment.where).read_bytes()).hexdigest(),
                        "grading": {"numeric_expressions": assignment.grading.numeric_expressions,
                                    "ecf_credit": assignment.grading.ecf_credit,
                                    "mistake_credit": assignment.grading.mistake_credit,
                                    "intermediate_sig_figs": assignment.grading.intermediate_sig_figs,
-                                   "max_tolerance": assignment.grading.max_tolerance}},
+                                   "max_tolerance": assignment.grading.max_tolerance,
+                                   "attempts": assignment.grading.attempts}},
         "templates": {t.id: {"version": t.version, "sha256": t.source_hash, **_bank_folder(t, key_folder)}
                       for t in used.values()},
         "problems": [{"key": v.key, "template": v.template, "title": used[v.template].title,
@@ -75,7 +80,7 @@ def key_document(assignment: Assignment, generation: Generation, bank: Mapping[s
                      for v, spec in zip(first, assignment.problems, strict=False)],
         "collisions": dict(generation.collisions),
         "students": [{"id": s.student.id, "name": s.student.name, "email": s.student.email,
-                      "section": s.student.section,
+                      "section": s.student.section, **_extension(s.student, assignment),
                       "problems": [{"key": v.key, "template": v.template, "variant_seed": v.variant_seed,
                                     "params": v.params, "printed": v.printed,
                                     "answers": {a.name: _answer(a, tolerances) for a in v.answers}}
@@ -96,6 +101,20 @@ def _bank_folder(template: Template, key_folder: Path | None) -> dict[str, str]:
     except ValueError:  # another drive (Windows): no relative path
         where = str(folder)
     return {"bank": Path(where).as_posix()}
+
+
+def _deadline(assignment: Assignment) -> dict[str, Any]:
+    """The assignment's due time (with its offset), zone and late policy, when its due is a date-time."""
+    if assignment.deadline is None:
+        return {}
+    late = None if assignment.late is None else assignment.late.to_json()
+    return {"deadline": assignment.deadline.isoformat(), "timezone": assignment.timezone, "late": late}
+
+
+def _extension(student: Student, assignment: Assignment) -> dict[str, str]:
+    """A student's own due time (with its offset), when the roster gives one."""
+    due = student_due(student.due, assignment.deadline, zone(assignment.timezone))
+    return {} if due is None else {"due": due.isoformat()}
 
 
 def _part(part: AnswerPart, template: Template, problem: ProblemSpec) -> dict[str, Any]:

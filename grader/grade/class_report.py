@@ -35,7 +35,7 @@ from grader.grade.class_summary import (
     ProblemSummary,
     summarize,
 )
-from grader.grade.grading import Graded
+from grader.grade.grading import Graded, lateness
 from grader.model.tolerance import Widening
 
 REPORT = "report.html"
@@ -78,7 +78,7 @@ def class_report(graded: Graded) -> str:
     """The page, for a grading run."""
     summary = summarize(graded)
     title = f"{summary.key.title}: class report"
-    body = "\n".join([_header(summary), _scores(summary), _parts(summary), _mistakes(summary),
+    body = "\n".join([_header(summary), _late(graded), _scores(summary), _parts(summary), _mistakes(summary),
                       _difficulty(summary), _invalid(summary), _tolerances(summary)])
     return ("<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
             "<meta http-equiv=\"Content-Security-Policy\" content=\"default-src 'none'; style-src 'unsafe-inline'\">\n"
@@ -127,6 +127,34 @@ def _not_graded(summary: ClassSummary) -> list[str]:
 def _who(student_id: str, reason: str) -> str:
     """``456: ``, naming the student of a row not graded, where its reason does not already."""
     return f"{visible(student_id)}: " if student_id and student_id not in reason else ""
+
+
+def _late(graded: Graded) -> str:
+    """How many students submitted late, by how much, and what the late policy took (nothing without a
+    due time in the key)."""
+    key = graded.key
+    if key.deadline is None and not any(student.due for student in key.students):
+        return ""
+    late = sorted(minutes for minutes in lateness(graded) if minutes)
+    if not late:
+        return "<p class=\"note\">Late work: nobody's answers that count came in after their due time.</p>"
+    lost = [points for points in graded.deductions.values() if points]
+    policy = (f"; {_students(len(lost))} lost points for it ({_number(sum(lost))} in all)" if key.late is not None
+              else "; without a late policy, late work is graded as on time")
+    return (f"<p class=\"note\">Late work: {_students(len(late))} had answers that count come in after their due "
+            f"time, by {_e(_lateness(late[len(late) // 2]))} (the median) and up to {_e(_lateness(late[-1]))}"
+            f"{policy}; details.csv has each answer's minutes late and deduction.</p>")
+
+
+def _lateness(minutes: int) -> str:
+    """Minutes late in words.
+
+    >>> _lateness(1441), _lateness(59)
+    ('1 d 0 h 1 min', '59 min')
+    """
+    days, rest = divmod(minutes, 1440)
+    hours, left = divmod(rest, 60)
+    return f"{days} d {hours} h {left} min" if days else f"{hours} h {left} min" if hours else f"{left} min"
 
 
 def _scores(summary: ClassSummary) -> str:

@@ -22,7 +22,7 @@ STUDENT = ("student id", "id", "sid", "sis user id", "username")  # "student_id"
 EMAIL = ("email", "email address")
 LABEL = ("label", "part", "question")
 ANSWER = ("answer", "response", "value")
-TIMESTAMP = ("timestamp", "submitted", "submitted at")
+TIMESTAMP = ("timestamp", "submitted", "submitted at", "completion time", "submission time")  # MS Forms, Gradescope
 _AFTER_LABEL = " .:)("
 
 _EXPECTED = ("a long file (one answer a row: student_id, label, answer, optionally timestamp) or a wide file "

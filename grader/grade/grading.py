@@ -13,6 +13,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
+from datetime import datetime
 from functools import lru_cache
 from typing import Any, NamedTuple
 
@@ -32,8 +33,10 @@ from grader.grade.compare import errors, feedbacks, is_correct, number_text
 from grader.grade.diagnosis import Earlier, Physics, ProblemPhysics, physics_for, reconsider
 from grader.grade.equivalence import equivalent, refused
 from grader.grade.key import Key, KeyPart
+from grader.grade.lateness import deductions, intervals, late_by, minutes, part_deduction
 from grader.grade.notation import cut
 from grader.grade.submissions import Answer, RowProblem, Submissions
+from grader.grade.timestamps import instant
 from grader.model.tolerance import Tolerance
 
 VERDICTS = ("correct", "ecf", "mistake", "incorrect", "invalid", "missing")
@@ -60,6 +63,8 @@ class Verdict:
     feedback: str
     diagnosis: str = ""  # ecf: "ecf:" and the part carried forward (ecf:3a); mistake: its id (impact.e_squared)
     source: str = ""  # "file:line" of the row the answer came from
+    late: int | None = None  # minutes late (None: no due time, no answer, or a row without a timestamp)
+    deduction: float = 0.0  # points the late policy took for it (its share of the student's deduction)
 
     @property
     def score(self) -> float:
@@ -92,9 +97,21 @@ class Row(NamedTuple):
 
 
 @dataclass(frozen=True)
+class LateWork:
+    """How late the answers that count came, for a key with due times: per part label, per student of the
+    key in its order, the minutes late (None: nothing submitted, or no timestamp) and the part's share of
+    the deduction; per student id, the points the late policy took (only those who lost any). Kept beside
+    the verdicts, not in them: a class of 100,000 has a million."""
+
+    minutes: Mapping[str, Sequence[int | None]]
+    shares: Mapping[str, Sequence[float]]
+    deductions: Mapping[str, float]
+
+
+@dataclass(frozen=True)
 class Graded:
     """A grading run: per part label, in the key's order, a verdict row for every student of the key,
-    in its order; and every row not graded."""
+    in its order; every row not graded; and how late the answers were (None: the key has no due time)."""
 
     key: Key
     columns: Mapping[str, Sequence[Row]]
@@ -104,32 +121,45 @@ class Graded:
     # What each diagnosed mistake a part may get says, in words (completing "your answer matches …"), by
     # (label, the mistake's id): the class report says the mistakes, not only their ids.
     mistakes: Mapping[tuple[str, str], str] = field(default_factory=dict)
+    late: LateWork | None = None
+
+    @property
+    def deductions(self) -> Mapping[str, float]:
+        """Per student id, the points the late policy took (only those who lost any)."""
+        return {} if self.late is None else self.late.deductions
 
     @property
     def verdicts(self) -> tuple[Verdict, ...]:
         """Every verdict, student by student, part by part (built on each call: the reports read the rows)."""
-        labels = self.key.labels
-        return tuple(Verdict(student.id, label, *self.columns[label][index])
+        labels, late = self.key.labels, self.late
+        return tuple(Verdict(student.id, label, *self.columns[label][index],
+                             *((late.minutes[label][index], late.shares[label][index]) if late else ()))
                      for index, student in enumerate(self.key.students) for label in labels)
 
 
 def grade(key: Key, submissions: Submissions, physics: Physics | None = None) -> Graded:
     """Grade every student of the key; a part nobody answered is ``missing``. ``physics`` carries errors
-    forward and diagnoses mistakes (by default from the shipped bank, :func:`physics_for`)."""
+    forward and diagnoses mistakes (by default from the shipped bank, :func:`physics_for`). Where a
+    student gave several answers to a part (the key's ``attempts`` is ``best``), the best counts; then
+    the key's late policy is applied (:func:`_late_work`)."""
     physics = physics_for(key) if physics is None else physics
-    by_label: dict[str, dict[str, Answer]] = {label: {} for label in key.labels}
+    by_label: dict[str, dict[str, list[Answer]]] = {label: {} for label in key.labels}
     for answer in submissions.answers:
-        by_label[answer.label][answer.student_id] = answer
-    columns = {}
+        by_label[answer.label].setdefault(answer.student_id, []).append(answer)
+    problems: list[RowProblem] = []
+    columns: dict[str, list[Row]] = {}
+    stamps: dict[str, list[datetime | None]] = {}
     everyone = np.arange(len(key.students))
     for problem in key.problems:
         earlier: list[Earlier] = []
         for label in problem.labels:
-            answers = by_label.pop(label)
+            answers = _best(key, label, by_label.pop(label), physics.problems.get(problem.key), problems)
             cells = [(student.parts[label], answers.get(student.id)) for student in key.students]
             columns[label] = _grade_label(cells, key, everyone, physics.problems.get(problem.key), earlier)
-    return Graded(key, columns, submissions.problems, submissions.ignored_columns,
-                  (*submissions.notes, *physics.notes), mistake_words(key, physics))
+            stamps[label] = [None if answer is None else answer.timestamp for _, answer in cells]
+    late, notes = _late_work(key, columns, stamps)
+    return Graded(key, columns, (*submissions.problems, *problems), submissions.ignored_columns,
+                  (*submissions.notes, *physics.notes, *notes), mistake_words(key, physics), late)
 
 
 def mistake_words(key: Key, physics: Physics) -> dict[tuple[str, str], str]:
@@ -145,6 +175,82 @@ def mistake_words(key: Key, physics: Physics) -> dict[tuple[str, str], str]:
                 if alternative.kind == "mistake":
                     words.setdefault((label, alternative.id), alternative.says)
     return words
+
+
+def _due(key: Key, index: int) -> datetime | None:
+    """Student ``index``'s due time: their extension, else the assignment's."""
+    return key.students[index].due or key.deadline
+
+
+def _best(key: Key, label: str, answers: Mapping[str, list[Answer]], physics: ProblemPhysics | None,
+          problems: list[RowProblem]) -> dict[str, Answer]:
+    """Per student, the answer to ``label`` that counts: the only one, or, of several (``attempts: best``),
+    the one that scores most after its own late deduction (ties: the earliest). Every attempt is graded on
+    its own (an error is not carried forward while choosing: the earlier parts are not chosen yet); each
+    one not counted is a problem (routine) naming the one that is."""
+    chosen = {student_id: found[0] for student_id, found in answers.items() if len(found) == 1}
+    if len(chosen) == len(answers):
+        return chosen
+    positions = key.positions
+    cells, students = [], []
+    for student_id, found in answers.items():
+        if len(found) > 1:
+            cells += [(key.students[positions[student_id]].parts[label], answer) for answer in found]
+            students += [positions[student_id]] * len(found)
+    rows = _grade_label(cells, key, np.array(students), physics, [])
+    scored: dict[str, list[tuple[float, Answer]]] = {}
+    for (part, answer), index, row in zip(cells, students, rows, strict=True):
+        assert answer is not None  # every cell holds an attempt
+        lost = 0.0 if key.late is None else float(part_deduction(
+            key.late, row.score, part.points, intervals(key.late, late_by(answer.timestamp, _due(key, index)))))
+        scored.setdefault(answer.student_id, []).append((row.score - lost, answer))
+    for student_id, attempts in scored.items():
+        attempts.sort(key=lambda pair: (-pair[0], instant(pair[1].timestamp), pair[1].line))
+        (best, winner), *others = attempts
+        chosen[student_id] = winner
+        problems.extend(RowProblem(answer.file, answer.line, student_id, label, f"not counted: {winner.file} line "
+                                   f"{winner.line} scored more ({best:g} points, this one {score:g}; the best "
+                                   "attempt counts)" if score < best else f"not counted: {winner.file} line "
+                                   f"{winner.line}, submitted first, scored as much (the best attempt counts)",
+                                   routine=True) for score, answer in others)
+    return chosen
+
+
+def _late_work(key: Key, columns: Mapping[str, Sequence[Row]],
+               stamps: Mapping[str, Sequence[datetime | None]]) -> tuple[LateWork | None, list[str]]:
+    """How late each answer was and what the key's late policy takes for it (:mod:`grader.grade.lateness`),
+    and notes (answers whose lateness is not known); None for a key without due times."""
+    if key.deadline is None and not any(student.due for student in key.students):
+        return None, []
+    policy, everyone = key.late, range(len(key.students))
+    dues = [_due(key, index) for index in everyone]
+    found: dict[tuple[datetime | None, datetime | None], tuple[int | None, int]] = {}  # rows share stamps
+    minutes_late, charged, unknown = {}, {}, 0
+    for label, rows in columns.items():
+        late: list[int | None] = [None] * len(dues)
+        charges = [0] * len(dues)
+        for index, (row, stamp, due) in enumerate(zip(rows, stamps[label], dues, strict=True)):
+            if row.submitted is None:
+                continue
+            known = found.get((stamp, due))
+            if known is None:
+                by = late_by(stamp, due)
+                known = found[stamp, due] = (minutes(by), 0 if policy is None else intervals(policy, by))
+            late[index], charges[index] = known
+            unknown += known[0] is None and due is not None  # a student with no due time: nothing to know
+        minutes_late[label], charged[label] = late, charges
+    shares = {label: [0.0] * len(dues) for label in columns}
+    deducted = {}
+    if policy is not None:
+        for index in sorted({index for charges in charged.values() for index, charge in enumerate(charges) if charge}):
+            total, exact = deductions(policy, tuple((rows[index].score, rows[index].points, charged[label][index])
+                                                    for label, rows in columns.items()))
+            deducted[key.students[index].id] = float(total)
+            for label, share in zip(columns, exact, strict=True):
+                shares[label][index] = float(share)
+    notes = [f"{unknown:,} answers have no timestamp (or one that does not read): how late they were is not "
+             "known, and they lose nothing; see problems.csv"] if unknown else []
+    return LateWork(minutes_late, shares, deducted), notes
 
 
 def grade_part(part: KeyPart, student_id: str, answer: Answer | None, key: Key,
@@ -372,8 +478,24 @@ def _expected(part: KeyPart) -> str:
     return part.value if isinstance(part.value, str) else number_text(part.value)
 
 
+def final_scores(graded: Graded) -> dict[str, float]:
+    """Per student, the total after the late policy's deduction (what grades.csv and canvas.csv carry)."""
+    return {student_id: sum(by_problem.values()) - graded.deductions.get(student_id, 0.0)
+            for student_id, by_problem in totals(graded).items()}
+
+
+def lateness(graded: Graded) -> list[int | None]:
+    """Per student of the key, in its order, the minutes late of their latest answer that counts (None:
+    no answer whose lateness is known)."""
+    found: list[int | None] = [None] * len(graded.key.students)
+    for late in graded.late.minutes.values() if graded.late else ():
+        found = [mine if theirs is None else max(theirs, mine or 0) for mine, theirs in zip(found, late, strict=True)]
+    return found
+
+
 def totals(graded: Graded) -> Mapping[str, Mapping[str, float]]:
-    """Per student, per problem key: the score (its parts' scores added in the key's order)."""
+    """Per student, per problem key: the score before any late deduction (its parts' scores added in the
+    key's order)."""
     key = graded.key
     sums: dict[str, list[float]] = {}
     for problem in key.problems:

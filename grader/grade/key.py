@@ -30,14 +30,17 @@ import json
 import math
 import re
 import sys
+import zoneinfo
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
+from datetime import UTC, datetime, tzinfo
 from pathlib import Path
 from typing import Any, TypeVar
 
 import numpy as np
 
 from grader.assign.assignment import MAX_POINTS, Grading, grading_from
+from grader.assign.deadlines import DEFAULT_ZONE, LatePolicy, late_from, zone_from
 from grader.base.errors import GraderError, TemplateError, shown
 from grader.base.inputs import CELL_CHARS, decode_text, read_bytes
 from grader.grade.notation import ReadError, check_powers
@@ -85,6 +88,7 @@ class KeyStudent:
     # ``parameters`` tuple. A key without ``params`` (or a value that is no number) leaves them out.
     parameters: tuple[tuple[str, str], ...] = ()
     values: tuple[float, ...] = ()
+    due: datetime | None = None  # the student's own due time (an extension), if any
 
     @property
     def possible(self) -> float:
@@ -124,6 +128,10 @@ class Key:
     # id -> the bank folder its file was in, as the key records it (relative to the key's folder where it could
     # be; none for the shipped bank's templates, nor in a key written before it was recorded)
     banks: Mapping[str, str] = field(default_factory=dict)
+    attempts: str = "latest"  # which submission counts: latest, best or first
+    deadline: datetime | None = None  # the assignment's due time (None: lateness is not measured)
+    zone: tzinfo = UTC  # of timestamps that give none
+    late: LatePolicy | None = None  # None: late work is accepted as on time
 
     @functools.cached_property
     def labels(self) -> tuple[str, ...]:
@@ -372,9 +380,39 @@ def _key(raw: Mapping[str, Any], where: str, version: int) -> Key:
                for name, entry in _object(raw.get("templates", {}), "templates").items()}
     templates = {name: str(entry.get("sha256", "")) for name, entry in entries.items()}
     banks = {name: _text(entry["bank"], f"templates.{name}.bank") for name, entry in entries.items() if "bank" in entry}
+    zone, deadline, late = _deadline(assignment, where)
     return Key(where, version, _text(_field(assignment, "title", "assignment"), "assignment.title"),
                grading.numeric_expressions, problems, students, templates, grading.ecf_credit, grading.mistake_credit,
-               banks)
+               banks, grading.attempts, deadline, zone, late)
+
+
+def _deadline(assignment: Mapping[str, Any], where: str) -> tuple[zoneinfo.ZoneInfo, datetime | None,
+                                                                   LatePolicy | None]:
+    """The key's zone, due time and late policy, checked as an assignment's are (a key without them, as
+    keys before deadlines: UTC, none, none)."""
+    try:
+        zone = zone_from(assignment.get("timezone", DEFAULT_ZONE), where, "assignment.timezone")
+        late = None if assignment.get("late") is None else late_from(assignment["late"], where, "assignment.late")
+    except TemplateError as error:
+        raise _EntryError(f"{error.key}: expected {error.expected}, got {error.got}") from None
+    deadline = assignment.get("deadline")
+    if deadline is None:
+        if late is not None:
+            raise _EntryError("assignment.late: a late policy without a deadline")
+        return zone, None, None
+    return zone, _instant(deadline, "assignment.deadline"), late
+
+
+def _instant(value: Any, what: str) -> datetime:
+    """A due time as the key writes it: ISO 8601 with its offset."""
+    try:
+        when = datetime.fromisoformat(value) if isinstance(value, str) else None
+    except ValueError:
+        when = None
+    if when is None or when.tzinfo is None:
+        raise _EntryError(f"{what}: expected a date-time with its offset such as 2026-12-04T23:59:00-06:00, got "
+                          f"{shown(value)}")
+    return when
 
 
 def _problems(raw: Any) -> tuple[KeyProblem, ...]:
@@ -504,8 +542,9 @@ def _student(raw: Mapping[str, Any], symbols: Mapping[str, Mapping[str, tuple[fl
                 values.append(_one(shared, float(value)))
     name, email, section = (_text(raw.get(entry, ""), f"student {student_id}: {entry}")
                             for entry in ("name", "email", "section"))
+    due = None if raw.get("due") is None else _instant(raw["due"], f"student {student_id}: due")
     return KeyStudent(student_id, name, email, section, parts, _one(shared, ("parameters", tuple(parameters)))[1],
-                      tuple(values))
+                      tuple(values), due)
 
 
 def _part(problem: str, name: str, raw: Mapping[str, Any],

@@ -1,10 +1,16 @@
-"""The latest submission wins: rows that answer the same thing compete, and every row that loses is a
-routine :class:`~grader.grade.row_problems.RowProblem` naming its winner.
+"""Which attempt counts: rows that answer the same thing compete, and every row that loses is a
+routine :class:`~grader.grade.row_problems.RowProblem` naming its winner. The rule is the key's
+``attempts``: ``latest`` (the default), ``first`` or ``best``.
 
-A wide row is one submission: per student, the latest wide row wins whole. Then, per (student, label),
-the winning wide row's answer competes with the long rows of that label. When every competing row has a
-timestamp, the latest wins (ties: the later row); when any of them has none, the last row wins, in file
-order, then argument order.
+For ``latest`` and ``first``, a wide row is one submission: per student, the latest (first) wide row wins
+whole. Then, per (student, label), the winning wide row's answer competes with the long rows of that
+label. When every competing row has a timestamp, the latest (earliest) wins (ties: the later row; for
+``first``, the earlier); when any of them has none, the last (first) row wins, in file order, then argument
+order.
+
+For ``best``, every answer competes per (student, label), whichever row it came in (as PrairieLearn counts
+each question's best submission): grading decides (:func:`grader.grade.grading.grade`), so every distinct
+answer is kept, and of equal answers the earliest (by timestamp, then place), which scores no less.
 
 Rows are entered as they are read, and a contest keeps only the rows that may still win (the last row,
 and while every row has a timestamp, the latest): five million resubmissions of one answer cost the
@@ -27,7 +33,7 @@ from dataclasses import dataclass
 from datetime import datetime
 from typing import TypeVar
 
-from grader.grade.row_problems import REPLACED, SUPERSEDED, Order, ProblemLog, RowProblem
+from grader.grade.row_problems import REPLACED, SAME, SUPERSEDED, Order, ProblemLog, RowProblem
 from grader.grade.timestamps import instant
 
 _K = TypeVar("_K", str, tuple[str, str])
@@ -76,18 +82,20 @@ class SubmittedRow:
 @dataclass(slots=True)
 class Contest:
     """The rows competing for one answer: the last row, the latest while every row has a timestamp, and
-    how many rows have a timestamp and how many have none."""
+    how many rows have a timestamp and how many have none; with ``first``, the first row and the earliest
+    in their places."""
 
     last: SubmittedRow
     latest: SubmittedRow | None
     timed: int
     untimed: int
+    first: bool = False
 
     @classmethod
-    def of(cls, row: SubmittedRow) -> Contest:
-        """A contest of one row."""
+    def of(cls, row: SubmittedRow, first: bool = False) -> Contest:
+        """A contest of one row (``first``: the first attempt counts, not the latest)."""
         timed = row.timestamp is not None
-        return cls(row, row if timed else None, int(timed), int(not timed))
+        return cls(row, row if timed else None, int(timed), int(not timed), first)
 
     def add(self, row: SubmittedRow) -> list[SubmittedRow]:
         """Enter ``row``; returns the rows that can no longer win."""
@@ -96,9 +104,9 @@ class Contest:
             self.untimed += 1
         else:
             self.timed += 1
-            if self.latest is None or _later(row, self.latest):
+            if self.latest is None or _later(row, self.latest) != self.first:
                 self.latest = row
-        if row.order > self.last.order:
+        if (row.order > self.last.order) != self.first:
             self.last = row
         if self.untimed:
             self.latest = None  # a row without a timestamp: the last row wins, whatever the others say
@@ -116,27 +124,67 @@ class Contest:
 
     def why(self) -> str:
         """Why the other rows lost."""
-        rule = ("submitted later" if not self.untimed else "no timestamps: the last row wins" if not self.timed
-                else "not every row has a timestamp: the last row wins")
+        if self.first:
+            rule = ("submitted earlier: the first attempt counts" if not self.untimed
+                    else "no timestamps: the first row counts" if not self.timed
+                    else "not every row has a timestamp: the first row counts")
+        else:
+            rule = ("submitted later" if not self.untimed else "no timestamps: the last row wins" if not self.timed
+                    else "not every row has a timestamp: the last row wins")
         return f"superseded by {self.winner.file} line {self.winner.line} ({rule})"
+
+
+@dataclass(slots=True)
+class Attempts:
+    """The answers competing for one (student, label) when the best counts: of each distinct text, the
+    earliest row (an equal answer submitted later scores no more)."""
+
+    label: str
+    rows: dict[str, SubmittedRow]
+
+    def add(self, row: SubmittedRow) -> SubmittedRow | None:
+        """Enter ``row``; returns the row its answer's text no longer needs (``row`` or the one it replaces)."""
+        text = row.text(self.label)
+        kept = self.rows.setdefault(text, row)
+        if kept is row:
+            return None
+        if _earlier(row, kept):
+            self.rows[text] = row
+            return kept
+        return row
 
 
 def _later(row: SubmittedRow, than: SubmittedRow) -> bool:
     return (instant(row.timestamp), row.order) > (instant(than.timestamp), than.order)
 
 
+def _earlier(row: SubmittedRow, than: SubmittedRow) -> bool:
+    """Whether ``row`` came before ``than``: by timestamp when both have one, else by place."""
+    if row.timestamp is not None and than.timestamp is not None and row.timestamp != than.timestamp:
+        return instant(row.timestamp) < instant(than.timestamp)
+    return row.order < than.order
+
+
 class Contests:
     """Every contest of a run, as rows are entered: per student of wide rows, per (student, label) of long
     rows. The rows that lose go to ``log``, each listed with its winner once the winner is known."""
 
-    def __init__(self, log: ProblemLog) -> None:
-        self.log = log
+    def __init__(self, log: ProblemLog, attempts: str = "latest") -> None:
+        self.log, self.first = log, attempts == "first"
         self.wide: dict[str, Contest] = {}
         self.long: dict[tuple[str, str], Contest] = {}
+        self.best: dict[tuple[str, str], Attempts] | None = {} if attempts == "best" else None
 
     def enter(self, row: SubmittedRow) -> None:
-        """A row read: it competes with the student's others of its kind."""
-        if row.wide:
+        """A row read: it competes with the student's others of its kind (when the best counts, each of
+        its answers with the student's others of that label)."""
+        if self.best is not None:
+            for label, _ in row.answers:
+                attempts = self.best.setdefault((row.student_id, label), Attempts(label, {}))
+                dropped = attempts.add(row)
+                if dropped is not None:
+                    self._same(dropped, label, attempts.rows[dropped.text(label)])
+        elif row.wide:
             self._enter(self.wide, row.student_id, row, "")
         else:
             self._enter(self.long, (row.student_id, row.answers[0][0]), row, row.answers[0][0])
@@ -144,7 +192,7 @@ class Contests:
     def _enter(self, contests: dict[_K, Contest], key: _K, row: SubmittedRow, label: str) -> None:
         contest = contests.get(key)
         if contest is None:
-            contests[key] = Contest.of(row)
+            contests[key] = Contest.of(row, self.first)
             return
         for lost in contest.add(row):
             self._lost(lost, label, contest)
@@ -159,9 +207,23 @@ class Contests:
         else:
             self.log.count(SUPERSEDED, row.file)
 
+    def _same(self, row: SubmittedRow, label: str, kept: SubmittedRow) -> None:
+        """An answer the same as one submitted before it: the earlier counts, if the best of them does."""
+        if self.log.wants(SAME, row.order):
+            self.log.add(SAME, row.order, row.file, RowProblem(
+                row.file, row.line, row.student_id, label, f"the same answer as {kept.file} line {kept.line}, "
+                "submitted before it (the best attempt counts: of equal ones, the first)", caveat=row.wide,
+                routine=not row.wide))
+        else:
+            self.log.count(SAME, row.file)
+
     def answers(self, labels: Sequence[str]) -> list[Answer]:
         """The winning answers, once every row is entered: the winning wide rows' answers compete with the
-        long rows of their labels; every row or answer that lost goes to the log."""
+        long rows of their labels; every row or answer that lost goes to the log. When the best counts,
+        every answer kept competes: grading chooses."""
+        if self.best is not None:
+            return [Answer(row.file, row.line, student_id, label, text, row.delimiter, row.timestamp)
+                    for (student_id, label), attempts in self.best.items() for text, row in attempts.rows.items()]
         for student_id, contest in self.wide.items():
             self._finish(contest, "")
             for label, _ in contest.winner.answers:

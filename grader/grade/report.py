@@ -21,7 +21,7 @@ from grader.base.spreadsheet import csv_pieces, number_cell, safe_cell
 from grader.grade.canvas import CanvasExport
 from grader.grade.class_report import REPORT, class_report
 from grader.grade.compare import number_text
-from grader.grade.grading import Graded, totals
+from grader.grade.grading import Graded, final_scores, lateness, totals
 
 GRADES, DETAILS, PROBLEMS, CANVAS = "grades.csv", "details.csv", "problems.csv", "canvas.csv"
 
@@ -37,28 +37,35 @@ def write_reports(graded: Graded, folder: Path, export: CanvasExport | None = No
 
 
 def grades_csv(graded: Graded) -> str:
-    """One row per student of the key: a column per problem, the total and what was possible."""
+    """One row per student of the key: a column per problem, the minutes late of their latest answer that
+    counts (empty: not known, or nothing submitted), the points the late policy took, the total after it,
+    and what was possible."""
     key = graded.key
-    scores = totals(graded)
+    scores, final, late = totals(graded), final_scores(graded), lateness(graded)
     rows: list[list[object]] = [["student_id", "name", "section", *(f"problem {p.key}" for p in key.problems),
-                                 "total", "possible"]]
-    for student in key.students:
+                                 "late", "deduction", "total", "possible"]]
+    for student, minutes in zip(key.students, late, strict=True):
         per_problem = [scores[student.id][p.key] for p in key.problems]
-        rows.append([student.id, student.name, student.section, *per_problem, sum(per_problem), student.possible])
+        rows.append([student.id, student.name, student.section, *per_problem, minutes,
+                     graded.deductions.get(student.id, 0.0), final[student.id], student.possible])
     return _csv(rows)
 
 
 DETAILS_HEADER = ("student_id", "label", "submitted", "verdict", "credit", "points", "score", "expected", "parsed",
-                  "unit", "abs_error", "rel_error", "tolerance", "feedback", "diagnosis", "source")
+                  "unit", "abs_error", "rel_error", "tolerance", "feedback", "diagnosis", "source", "late", "deduction")
 
 
 def details_csv(graded: Graded, students_per_piece: int = 2000) -> Iterator[str]:
-    """One row per (student, part): what was submitted, the verdict and why. The text comes in pieces
+    """One row per (student, part): what was submitted, the verdict and why, and how many minutes late the
+    row it came from was (empty: not known) with the points the late policy took. The text comes in pieces
     of ``students_per_piece`` students, to be written as it comes (a class of 100,000 has a million rows).
 
     Each cell is what :func:`_cell` makes of the verdict's field (the loop knows the field's type).
     """
-    columns = [(safe_cell(label), graded.columns[label]) for label in graded.key.labels]
+    unknown = [None] * len(graded.key.students)  # no due time: no lateness, no deduction
+    late = graded.late
+    columns = [(safe_cell(label), graded.columns[label], late.minutes[label] if late else unknown,
+                late.shares[label] if late else unknown) for label in graded.key.labels]
     numbers = _Cells()  # credits, points and scores: a few values
     words = _Cells()  # verdicts, units, tolerances: a few texts
 
@@ -66,13 +73,14 @@ def details_csv(graded: Graded, students_per_piece: int = 2000) -> Iterator[str]
         yield DETAILS_HEADER
         for index, student in enumerate(graded.key.students):
             who = safe_cell(student.id)
-            for label, verdicts in columns:
+            for label, verdicts, minutes, shares in columns:
                 (submitted, verdict, credit, points, expected, parsed, unit, abs_error, rel_error, tolerance, feedback,
                  diagnosis, source) = verdicts[index]
                 yield (who, label, "" if submitted is None else safe_cell(visible(submitted)), words[verdict],
                        numbers[credit], numbers[points], numbers[credit * points], safe_cell(expected),
                        safe_cell(visible(parsed)), words[unit], _error(abs_error), _error(rel_error), words[tolerance],
-                       safe_cell(visible(feedback)), words[diagnosis], safe_cell(visible(source)))
+                       safe_cell(visible(feedback)), words[diagnosis], safe_cell(visible(source)),
+                       numbers[minutes[index]], numbers[shares[index] or 0.0])
 
     return csv_pieces(rows(), students_per_piece * max(1, len(columns)))
 
@@ -87,12 +95,13 @@ def problems_csv(graded: Graded, export: CanvasExport | None = None) -> Iterator
 
 
 def canvas_csv(graded: Graded, export: CanvasExport | None = None) -> Iterator[str]:
-    """A Canvas gradebook import: the student columns Canvas wants, one column of the assignment, and
-    its ``Points Possible`` row. Without an ``export``, a row per student of the key, named as the key
+    """A Canvas gradebook import: the student columns Canvas wants, one column of the assignment (each
+    score after the late policy's deduction), and its ``Points Possible`` row. Without an ``export``, a row
+    per student of the key, named as the key
     names them; with one, its student rows and columns as exported, and its ``Title (id)`` header. In
     pieces, as :func:`_csv_pieces` (an export may have 100,000 students)."""
     key = graded.key
-    scores = {student_id: sum(by_problem.values()) for student_id, by_problem in totals(graded).items()}
+    scores = final_scores(graded)
     columns: tuple[str, ...]
     body: Iterable[Sequence[object]]
     if export is None:

@@ -65,6 +65,7 @@ ZEROS = Kind("rows whose student id had its leading zeros restored", caveat=True
 EMAIL_AS_ID = Kind("rows whose id column held a student's email, matched by email", caveat=True)
 UNREADABLE_TIME = Kind("rows whose timestamp does not read", caveat=True)
 FUTURE = Kind("rows with a timestamp after this run's time", caveat=True)
+SAME = Kind("answers the same as one the student submitted before (the best attempt counts)", routine=True)
 REPLACED = Kind("answers of a wide submission replaced by a later long row", caveat=True)
 
 Order = tuple[int, int]

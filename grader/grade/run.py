@@ -91,7 +91,7 @@ def grade_into(folder: Path, key_path: Path, paths: Sequence[Path], out: Path, n
 def _graded(key: Key, paths: Sequence[Path], fmt: Literal["auto", "long", "wide"], names: Sequence[str],
             bank: Path | Mapping[str, Template] | None, now: datetime | None = None) -> Graded:
     submissions = read_submissions(paths, [StudentRef(s.id, s.email) for s in key.students], key.labels, fmt,
-                                   names, now=now)
+                                   names, now=now, zone=key.zone, attempts=key.attempts)
     return grade(key, submissions, physics_for(key, bank))
 
 

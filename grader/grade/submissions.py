@@ -28,11 +28,12 @@ Files are read row by row and nothing is kept per row but the rows that may stil
 (:mod:`grader.grade.latest`) and the problems listed: memory is bounded by the file's text and the key,
 whatever the number of rows.
 
-Timestamps (:mod:`grader.grade.timestamps`) without a zone are taken as UTC when compared with times that
-have one (a note says so). When every competing row has a timestamp, the latest wins (ties: the later
-row); when any of them has none (or one that does not read: a caveat), the last row wins, in file order,
-then argument order. A timestamp more than a day after the run's own time (beyond any time zone) wins all
-the same, with a caveat and a note: a clock was wrong, or the time was typed.
+Timestamps (:mod:`grader.grade.timestamps`) without a zone are in the assignment's zone (UTC unless the key
+says otherwise; a note says so when some rows have a zone and some do not). When every competing row has a
+timestamp, the latest wins (ties: the later row); when any of them has none (or one that does not read: a
+caveat), the last row wins, in file order, then argument order (the key's ``attempts`` may make it the first,
+or the best: :mod:`grader.grade.latest`). A timestamp after the run's own time wins all the same, with a
+caveat and a note: a clock was wrong, or the time was typed.
 """
 
 from __future__ import annotations
@@ -41,7 +42,7 @@ import os
 from collections import defaultdict
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from datetime import datetime, timedelta
+from datetime import UTC, datetime, tzinfo
 from functools import lru_cache
 from pathlib import Path
 from typing import Literal
@@ -67,12 +68,10 @@ from grader.grade.row_problems import (
     ProblemLog,
     RowProblem,
 )
-from grader.grade.timestamps import instant, read_timestamp
+from grader.grade.timestamps import in_zone, instant, read_timestamp
 
 __all__ = ["Answer", "RowProblem", "StudentRef", "Submissions", "find_label", "read_submissions"]
 
-FUTURE_MARGIN = timedelta(days=1)
-"""A timestamp later than the run's own time by more than this (more than any time zone's offset) is a caveat."""
 
 
 @dataclass(frozen=True)
@@ -96,17 +95,20 @@ class Submissions:
 
 def read_submissions(paths: Sequence[Path], students: Sequence[StudentRef], labels: Sequence[str],
                      fmt: Literal["auto", "long", "wide"] = "auto", names: Sequence[str] = (), *,
-                     listed: int = LISTED, now: datetime | None = None) -> Submissions:
-    """Every answer of ``paths`` to one of ``labels`` by one of ``students``, the latest of each.
+                     listed: int = LISTED, now: datetime | None = None, zone: tzinfo = UTC,
+                     attempts: str = "latest") -> Submissions:
+    """Every answer of ``paths`` to one of ``labels`` by one of ``students``, the latest of each (or, as
+    ``attempts`` says, the first, or every distinct one for grading to choose the best).
     Answers and problems name their file as in ``names`` when given (one per path), else by its path.
     Of each kind of problem the first ``listed`` are listed, the rest counted; ``now``: the run's time (a
-    timestamp after it is a caveat), by default the clock's.
+    timestamp after it is a caveat), by default the clock's; ``zone``: that of timestamps that give none.
 
     Raises :class:`GraderError` for a file that cannot be used as a whole (unreadable, neither UTF-8
     nor UTF-16 nor clean Windows-1252, no recognisable header); a bad row is a :class:`RowProblem`.
     """
     _refuse_repeated(paths)
-    reader = _Reader(Roster(students), labels, ProblemLog(listed), instant(now or timestamps.clock()))
+    reader = _Reader(Roster(students), labels, ProblemLog(listed), instant(now or timestamps.clock()), zone,
+                     attempts)
     ignored: dict[str, None] = {}
     notes: list[str] = []
     shown_as = [shown_path(name) for name in names or paths]
@@ -192,11 +194,12 @@ class _Reader:
     """What reading the rows keeps: the contests of the rows that may still win, the problems, and what the
     notes need (time zones seen, timestamps after the run's time)."""
 
-    def __init__(self, roster: Roster, labels: Sequence[str], log: ProblemLog, now: datetime) -> None:
+    def __init__(self, roster: Roster, labels: Sequence[str], log: ProblemLog, now: datetime, zone: tzinfo,
+                 attempts: str) -> None:
         self.roster, self.labels, self.log = roster, labels, log
         self.find = lru_cache(maxsize=65536)(roster.find)  # a file of a million rows names a few thousand students
-        self.contests = Contests(log)
-        self.now, self.zoned, self.unzoned = now, False, False
+        self.contests = Contests(log, attempts)
+        self.now, self.zone, self.zoned, self.unzoned = now, zone, False, False
         self.future: list[tuple[str, int]] = []  # the first row with a timestamp after now, and how many
         self.futures = 0
         self.emailed = 0  # rows whose id column held a student's email
@@ -246,9 +249,10 @@ class _Reader:
             return None
         if stamp.tzinfo is None:
             self.unzoned = True
+            stamp = in_zone(stamp, self.zone)
         else:
             self.zoned = True
-        if instant(stamp) > self.now + FUTURE_MARGIN:
+        if stamp > self.now:  # in the assignment's zone, a time without one is no longer a guess
             self.futures += 1
             if not self.future:
                 self.future.append((file, order[1]))
@@ -270,8 +274,8 @@ class _Reader:
         """Notes about the rows as a whole."""
         notes = []
         if self.zoned and self.unzoned:
-            notes.append("some timestamps have a time zone and some do not: those without were taken as UTC "
-                         "to compare them")
+            notes.append(f"some timestamps have a time zone and some do not: those without were taken as {self.zone} "
+                         "(the assignment's zone) to compare them")
         if self.futures:
             file, line = self.future[0]
             notes.append(f"{self.futures:,} row{'s have' if self.futures > 1 else ' has'} a timestamp after this "

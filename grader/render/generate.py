@@ -16,7 +16,14 @@ from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 
-from grader.assign.assignment import Assignment, Student, check_against_bank, load_assignment, load_roster
+from grader.assign.assignment import (
+    Assignment,
+    Student,
+    check_against_bank,
+    check_extensions,
+    load_assignment,
+    load_roster,
+)
 from grader.assign.keyfile import key_csv, key_document, key_json
 from grader.assign.variants import Generation, generate
 from grader.bank.template import Template
@@ -66,6 +73,7 @@ def load_inputs(job: Job, bank: Mapping[str, Template]) -> tuple[Assignment, tup
     assignment = load_assignment(job.assignment)
     roster = load_roster(job.roster)
     check_against_bank(assignment, bank)
+    check_extensions(assignment, roster, job.roster)
     if job.pdf:
         from grader.render.typeset import font_paths
 

@@ -15,6 +15,7 @@ from grader.assign.variants import ProblemVariant
 from grader.bank.template import Template, load_bank, parse_template
 from grader.base.errors import TemplateError
 from grader.render.worked import worked
+from grader.solve.cache import compiled_for
 from grader.solve.compiled import Compiled
 from grader.solve.evaluate import solve_one
 from grader.solve.solver import compile_template
@@ -88,11 +89,31 @@ def test_a_block_that_fixes_nothing_at_a_draw_refuses_it(head_on_before: tuple[T
 
 
 def test_two_solutions_nothing_tells_apart_are_refused_naming_both() -> None:
+    """Given the height at which the ball strikes the wall, the time of flight is a root of a quadratic: rising
+    at some draws, falling at others, and nothing in the scene says which; the refusal names both times."""
+    template = load_bank()["wall-throw"]
+    raw = yaml.safe_load(Path(template.where).read_text())
+    forward = solve_one(template, compiled_for(template), template.example).answers
+    assert forward is not None
+    turned = swapped(raw, template, "y_hit", "D", [0.5, 5.0], float(forward["y_hit"].value or 0))
+    with pytest.raises(TemplateError, match="two physical solutions that nothing in it") as error:
+        compile_template(parse_template(turned, "test:turned", "turned"))
+    # Independently: h0 + v_y t - g t²/2 = y_hit at the example (v0 = 15 m/s at 25°, h0 = 1.5 m), both roots.
+    t = sp.symbols("t")
+    v_y, g = 15 * sp.sin(sp.pi * 25 / 180), sp.Rational(981, 100)
+    y_hit = sp.Float(forward["y_hit"].value, 17)
+    times = sorted(float(r) for r in sp.solve(sp.Rational(3, 2) + v_y * t - g * t**2 / 2 - y_hit, t))
+    assert f"which give t_1 = {times[0]:.6g} or t_1 = {times[1]:.6g} (SI) at " in str(error.value)
+
+
+@pytest.mark.slow
+def test_a_velocity_before_from_the_energy_lost_is_refused_naming_both_roots() -> None:
     """Given the share of energy lost, cart 1's velocity before is a root of a quadratic: both roots are
-    collisions (the template's constraint on it went with it), and the refusal names them."""
+    collisions (the template's constraint on it went with it), and the refusal names them (a 3x3 block,
+    some seconds of sympy)."""
     template = load_bank()["head-on"]
     raw = yaml.safe_load(Path(template.where).read_text())
-    forward = solve_one(template, compile_template(template), template.example).answers
+    forward = solve_one(template, compiled_for(template), template.example).answers
     assert forward is not None
     turned = swapped(raw, template, "loss_pct", "v1", [10.0, 40.0], float(forward["loss_pct"].value or 0))
     with pytest.raises(TemplateError, match="two physical solutions that nothing in it") as error:

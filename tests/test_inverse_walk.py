@@ -100,17 +100,14 @@ def _check(trips: list[Trip]) -> None:
 
 def test_the_head_on_templates_turn_round() -> None:
     """A velocity before from a velocity after, e from the share of energy lost, cart 1's velocity before from
-    its velocity after and e (the 2x2 block): answered; the share of energy lost gives a velocity before only up
-    to a quadratic's two roots, and the template is refused naming both."""
+    its velocity after and e (the 2x2 block): answered to 1e-9 (a velocity before from the share of energy lost,
+    a quadratic's two roots, is refused naming both: tests/test_blocks.py)."""
     bank = load_bank()
-    trips = (round_trips(bank["head-on"], {("v1_out", "v1"), ("loss_pct", "e"), ("loss_pct", "v1")})
+    trips = (round_trips(bank["head-on"], {("v1_out", "v1"), ("loss_pct", "e")})
              + round_trips(bank["head-on-inverse"], {("e", "v1")}))
     _check(trips)
     assert [(t.answer, t.parameter) for t in trips if t.refusal is None] == [("v1_out", "v1"), ("loss_pct", "e"),
                                                                               ("e", "v1")]
-    refused = [t for t in trips if t.refusal is not None]
-    assert [(t.answer, t.parameter) for t in refused] == [("loss_pct", "v1")]
-    assert "two physical solutions" in (refused[0].refusal or "")
 
 
 @pytest.mark.slow

@@ -245,10 +245,10 @@ def solve_block(block: list[Relation], unknowns: list[Any], relations: list[Rela
     conditions = [c.holds for relation in relations for c in relation.requires
                   if sp.sympify(c.holds).free_symbols & set(unknowns)
                   and sp.sympify(c.holds).free_symbols <= known | set(unknowns)]
-    roots = [root for root in sp.solve(numerators, unknowns, dict=True)
+    roots = [root for root in sp.solve(numerators, unknowns, dict=True, check=False, simplify=False)
              if set(root) == set(unknowns) and not any(v.free_symbols & set(unknowns) for v in root.values())
              and all(v.is_real is not False for v in root.values())
-             and all(sp.simplify(d.xreplace(root)) != 0 for d in denominators)
+             and not any(d.xreplace(root).is_zero for d in denominators)
              and all(sp.sympify(c).xreplace(root) is not sp.false for c in conditions)]
     ambiguous_at: tuple[Mapping[Any, float], dict[Any, Any]] | None = None
     if len(roots) > 1:
@@ -257,7 +257,7 @@ def solve_block(block: list[Relation], unknowns: list[Any], relations: list[Rela
         return None
     if len(roots) > 1:
         labels = " and ".join(f"({chr(97 + i)}) {relation.label}" for i, relation in enumerate(block))
-        differing = [u for u in unknowns if sp.simplify(roots[0][u] - roots[1][u]) != 0] or unknowns
+        differing = [u for u in unknowns if sp.expand(roots[0][u] - roots[1][u]) != 0] or unknowns
         first = next((u for u in differing if u in asked), differing[0])
         if ambiguous_at is not None:
             inputs, at = ambiguous_at

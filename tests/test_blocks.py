@@ -14,6 +14,7 @@ import yaml
 from grader.assign.variants import ProblemVariant
 from grader.bank.template import Template, load_bank, parse_template
 from grader.base.errors import TemplateError
+from grader.cli import main
 from grader.render.worked import worked
 from grader.solve.cache import compiled_for
 from grader.solve.compiled import Compiled
@@ -121,3 +122,12 @@ def test_a_velocity_before_from_the_energy_lost_is_refused_naming_both_roots() -
     # The example's own v1 (4 m/s) and the quadratic's other root, 16/7, both collisions (v1 > v2 = -2).
     assert ("which give v1 = 4 or v1 = 2.28571 (SI) at e = 0.6, f_loss = 0.628364, m1 = 2, m2 = 3, v2 = -2"
             in str(error.value))
+
+
+def test_show_says_which_steps_are_solved_together(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """`grader show` marks a block before its first step."""
+    (tmp_path / "head-on-before.yaml").write_text((DATA / "head-on-before.yaml").read_text(), encoding="utf-8")
+    assert main(["show", "head-on-before", "--bank", str(tmp_path)]) == 0
+    chain = capsys.readouterr().out.split("Step chain")[1].splitlines()
+    assert chain[1] == "  (steps 1-2: these equations solved together for v1, J)"
+    assert chain[2].startswith("  1. impulse along n")

@@ -456,6 +456,9 @@ def _show(arguments: argparse.Namespace) -> int:
     for number, step in enumerate(compiled.steps, 1):
         lhs, rhs, solved = (to_text(readable(side, names)) for side in (*step.equation, step.solved))
         lines += [f"  {number}. {step.relation}", f"       {lhs} = {rhs}", f"       => {step.unknown} = {solved}"]
+        if step.block and step.unknown == step.block[0]:
+            lines.insert(-3, f"  (steps {number}-{number + len(step.block) - 1}: these equations solved together "
+                             f"for {', '.join(step.block)})")
     print("\n".join(map(visible, lines)))
     return EXIT_OK
 

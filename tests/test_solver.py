@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import pytest
 import yaml
@@ -44,16 +45,33 @@ def test_default_names_never_collide_with_the_templates_or_each_other(
 def test_each_step_solves_one_equation_for_one_new_unknown(two_bounces: tuple[Template, Compiled],
                                                            compiled: dict[str, Compiled],
                                                            bank: dict[str, Template]) -> None:
-    """A step's equation uses only what is known by then, plus the one unknown it solves for."""
+    """A step's equation uses only what is known by then, plus the one unknown it solves for; a block's
+    equations use only what is known before it, plus the block's unknowns, and its steps follow one another.
+    No shipped template needs a block."""
     cases = [two_bounces, *((bank[t], compiled[t]) for t in bank)]
     for template, chain in cases:
         known = set(template.parameters) | set(template.symbols) | {"g"}
+        assert not any(step.block for step in chain.steps), template.id
         for step in chain.steps:
             used = names(step.equation[0]) | names(step.equation[1])
             assert step.unknown in used, (template.id, step)
             assert used - known == {step.unknown}, (template.id, step)
             assert names(step.solved) <= known, (template.id, step)
             known.add(step.unknown)
+
+
+def test_a_block_s_steps_follow_one_another_and_use_what_is_known_before_it() -> None:
+    """The head-on impact asked the other way round: (a) and (b) together give v1 and J from what is given."""
+    raw = yaml.safe_load((Path(__file__).parent / "data" / "head-on-before.yaml").read_text())
+    template = parse_template(raw, "test:head-on-before", "head-on-before")
+    steps = compile_template(template).steps
+    known = set(template.parameters)
+    block = set(steps[0].block)
+    assert block == {"v1", "J"} and [step.unknown for step in steps[:2]] == list(steps[0].block)
+    for step in steps[:2]:
+        assert step.block == steps[0].block
+        assert names(step.equation[0]) | names(step.equation[1]) <= known | block
+        assert names(step.solved) <= known
 
 
 def test_inverse_template_derives_e_from_the_heights(compiled: dict[str, Compiled]) -> None:
@@ -79,8 +97,8 @@ def test_forward_and_inverse_from_one_scene() -> None:
 
 
 def test_coupled_unknowns_are_refused_with_what_ties_them() -> None:
-    """Given only the second bounce, e appears in both impacts with h1 between them: a chain of
-    one-unknown steps cannot untangle that, and the message says which unknowns are tied."""
+    """Given only the second bounce, e appears in both impacts with h1 between them, through square roots of
+    heights: no block of the equations is polynomial, and the message says which unknowns are tied."""
     raw = yaml.safe_load(TWO_BOUNCES)
     raw["parameters"]["h2"] = raw["parameters"].pop("e") | {"domain": "(0, inf)", "unit": "m"}
     raw["answers"] = {"e": {"value": "e", "unit": ""}}

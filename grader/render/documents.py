@@ -336,7 +336,8 @@ def _glance_value(part: AnswerPart) -> Typ:
 
 
 def _key_step(step: WorkedStep) -> KeyStep:
-    chain = f"$display({step.chain[0]} = {step.chain[1]})$" + "".join(
+    # A block's equation, labelled (a), (b), has no chain: its values come with the block's solution.
+    chain = "" if not step.chain else f"$display({step.chain[0]} = {step.chain[1]})$" + "".join(
         f" $display(= {part})$" for part in step.chain[2:])
     return KeyStep(step.relation, _math(f"display({step.equation})" if step.equation else ""), Typ(chain), step.note)
 

@@ -14,7 +14,7 @@ from __future__ import annotations
 import math as _m
 import re
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from fractions import Fraction
 from typing import Any
 
@@ -188,6 +188,7 @@ class StepForm:
     equation: str | None
     solved: Node
     solved_math: str
+    block: tuple[str, ...] = ()  # the unknowns of the block of equations solved together (empty: one equation)
 
 
 @dataclass(frozen=True)
@@ -212,9 +213,11 @@ def worked_form(template: Template, compiled: Compiled | None = None) -> WorkedF
     steps = []
     for step in compiled.steps:
         lhs, rhs, solved = (readable(side, reader) for side in (*step.equation, step.solved))
-        equation = None if (lhs == Sym(step.unknown) and rhs == solved) else f"{math(lhs)} = {math(rhs)}"
+        # A block's equations are each shown, labelled, before the block's solution.
+        shown = step.block or not (lhs == Sym(step.unknown) and rhs == solved)
+        equation = f"{math(lhs)} = {math(rhs)}" if shown else None
         steps.append(StepForm(step.unknown, relation_markup(step.relation, quantities), equation, solved,
-                              math(solved)))
+                              math(solved), step.block))
     symbols = tuple(sorted(template.symbols))
     # A symbol no step uses (a mass the scene needs only for its simulation) gets no note.
     used = set().union(*(names(step.solved) for step in compiled.steps))
@@ -247,13 +250,38 @@ def worked(template: Template, variant: ProblemVariant, compiled: Compiled | Non
         shown, {n: f"{variant.printed[n]} degree" for n, p in template.parameters.items() if p.unit.text == "deg"},
         form.symbol_units, _undefined(template, variant))
     steps = []
-    for step in form.steps:
+    for index, step in enumerate(form.steps):
+        if step.block:
+            if step.unknown == step.block[0]:
+                steps += _block_equations(form.steps[index:index + len(step.block)])
+            step = replace(step, relation=simultaneous(len(step.block)), equation=None)
         scaling = scaled.get(step.unknown)
         steps.append(_step(step, scaling, form.dimensions.get(step.unknown), context))
         if scaling is not None:
             shown[step.unknown] = scaling.math()
     values = chain_values(compiled, {**si, **{s: 1.0 for s in form.symbols}})
     return Worked(tuple(given_lines(template, variant, compiled)), form.notes, tuple(steps), values)
+
+
+def _letter(index: int) -> str:
+    return f"({chr(ord('a') + index)})"
+
+
+def _block_equations(members: Sequence[StepForm]) -> list[WorkedStep]:
+    """A block's equations as a textbook writes them before solving them together: each labelled (a),
+    (b), ... with its relation, and no value yet."""
+    return [WorkedStep(Typ(f"{text(_letter(index) + ' ')}{member.relation}"), member.equation, (), Typ(""))
+            for index, member in enumerate(members)]
+
+
+def simultaneous(count: int) -> Typ:
+    """``simultaneous solution of (a) and (b) gives``, for a block of ``count`` equations.
+
+    >>> str(simultaneous(3))
+    '#"simultaneous solution of (a), (b) and (c) gives";'
+    """
+    letters = [_letter(index) for index in range(count)]
+    return text(f"simultaneous solution of {', '.join(letters[:-1])} and {letters[-1]} gives")
 
 
 def quantity_dimensions(template: Template, compiled: Compiled) -> dict[str, Dimension]:

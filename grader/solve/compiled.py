@@ -41,12 +41,15 @@ class PerAnswer(Generic[_Item]):
 
 @dataclass(frozen=True)
 class Step:
-    """One step of the chain: from ``relation``'s equation ``lhs = rhs``, ``unknown = solved``."""
+    """One step of the chain: from ``relation``'s equation ``lhs = rhs``, ``unknown = solved``. A step of a
+    block of equations solved together names the block's unknowns in ``block``, in order (its steps follow
+    one another, each with one of the block's equations); a step of one equation has none."""
 
     unknown: str
     relation: str
     equation: tuple[Node, Node]
     solved: Node
+    block: tuple[str, ...] = ()
 
     def __str__(self) -> str:
         lhs, rhs = (to_text(side) for side in self.equation)
@@ -119,7 +122,8 @@ class Compiled:
             "parameters": list(self.parameters), "constants": dict(self.constants),
             "steps": [{"unknown": s.unknown, "relation": s.relation,
                        "equation": [to_json(s.equation[0]), to_json(s.equation[1])],
-                       "solved": to_json(s.solved)} for s in self.steps],
+                       "solved": to_json(s.solved)} | ({"block": list(s.block)} if s.block else {})
+                      for s in self.steps],
             "checks": [{"holds": to_json(c.holds), "message": c.message, "subject": tree(c.subject)}
                        for c in self.checks],
             "answers": {name: {"unit": a.unit, "numeric": tree(a.numeric), "symbolic": tree(a.symbolic),
@@ -138,8 +142,8 @@ class Compiled:
         return cls(
             template_id=data["template"], source_hash=data["source_hash"],
             parameters=tuple(data["parameters"]), constants=dict(data["constants"]),
-            steps=tuple(Step(s["unknown"], s["relation"], _sides(s["equation"]), from_json(s["solved"]))
-                        for s in data["steps"]),
+            steps=tuple(Step(s["unknown"], s["relation"], _sides(s["equation"]), from_json(s["solved"]),
+                             tuple(map(str, s.get("block", ())))) for s in data["steps"]),
             checks=tuple(Check(from_json(c["holds"]), c["message"], tree(c["subject"])) for c in data["checks"]),
             answers={name: CompiledAnswer(name, a["unit"], tree(a["numeric"]), tree(a["symbolic"]),
                                           tuple(Undefined(from_json(u["when"]), u["reason"]) for u in a["undefined"]))

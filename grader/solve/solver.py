@@ -1,5 +1,10 @@
-"""From a scene and what is known, a chain of steps (one equation, one unknown each), compiled
-into expression trees over the parameters that the numpy kernels evaluate.
+"""From a scene and what is known, a chain of steps, compiled into expression trees over the parameters
+that the numpy kernels evaluate.
+
+A step is a block of the scene's equations in block-triangular order (docs/design.md, The solver): one
+equation giving one unknown, as a student writes it, wherever the chain can go on so; where it cannot, the
+smallest set of equations that fixes as many unknowns as it has (a 2x2 linear system: momentum and
+restitution), solved together in closed form, with the root the scene's conditions select.
 
 Sympy does the algebra once per template; :mod:`grader.solve.cache` keeps the result, so a later run
 needs neither sympy nor this module.
@@ -15,8 +20,8 @@ needs neither sympy nor this module.
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Mapping
-from dataclasses import dataclass
+from collections.abc import Iterable, Mapping, Sequence
+from dataclasses import dataclass, replace
 from typing import Any
 
 import sympy as sp
@@ -25,7 +30,7 @@ from grader.bank.template import Template
 from grader.base.errors import SYMPY_FAILURES, TemplateError, shown, unworkable
 from grader.model.expr import names
 from grader.model.quantities import Unit
-from grader.physics.effects import CATALOGUE, Relation
+from grader.physics.effects import CATALOGUE, Condition, Relation
 from grader.physics.symbolic import INNER as _INNER
 from grader.physics.symbolic import Context, cosd, from_node, sind, to_node
 from grader.solve.compiled import Check, Compiled, CompiledAnswer, Step, Undefined
@@ -39,26 +44,40 @@ class _Solved:
     display: Any
     numeric: Any
     branch: bool = False  # the magnitude only: the sign is the one the unknown has in the scene's own solution
+    block: tuple[Any, ...] = ()  # the unknowns solved together with this one (empty: a step of one equation)
+    requires: tuple[Condition, ...] = ()  # what the step needs of the values (a block: that it fixes its unknowns)
 
 
 def derive(relations: list[Relation], knowns: Iterable[Any], given: Iterable[Any],
-           branches: bool = False) -> list[_Solved]:
-    """Solve relations one unknown at a time, earliest relation first, as far as they go.
+           branches: bool = False, wanted: Iterable[Any] = (), points: Sequence[Mapping[Any, float]] = ()
+           ) -> list[_Solved]:
+    """Solve relations one unknown at a time, earliest relation first, as far as they go; then, while
+    something in ``wanted`` is still unknown, the next block of equations solved together
+    (:func:`next_block`), and one at a time again.
 
     ``given`` are the knowns that are inputs (not derived): a stable form that asks for its
     symbols to be given is used only then. With ``branches``, a relation may also give an unknown
-    known only up to sign (a step marked ``branch``), where no other relation gives it.
+    known only up to sign (a step marked ``branch``), where no other relation gives it. ``points`` (the
+    inputs' values in SI at the template's example and at draws across its sampling) tell apart the roots
+    of a block that the scene's conditions select only once the values are known (:func:`solve_block`).
     """
-    known, given_set = set(knowns), set(given)
+    known, given_set, targets = set(knowns), set(given), set().union(*(sp.sympify(w).free_symbols for w in wanted))
     used: set[int] = set()
     chain: list[_Solved] = []
     while True:
         step = _next_step(relations, known, given_set, used) or (
             _next_branch(relations, known, used) if branches else None)
-        if step is None:
+        if step is not None:
+            chain.append(step)
+            known.add(step.unknown)
+            continue
+        if not targets - known:
             return chain
-        chain.append(step)
-        known.add(step.unknown)
+        block = next_block(relations, known, used, points, chain, targets)
+        if block is None:
+            return chain
+        chain += block
+        known |= {solved.unknown for solved in block}
 
 
 def _next_step(relations: list[Relation], known: set[Any], given: set[Any], used: set[int]) -> _Solved | None:
@@ -89,6 +108,242 @@ def _next_branch(relations: list[Relation], known: set[Any], used: set[int]) -> 
             used.add(index)
             return _Solved(unknown, relation, relation.branches[unknown], relation.branches[unknown], branch=True)
     return None
+
+
+MAX_BLOCK = 4
+"""The most equations solved together; a larger block is left unsolved (the template is refused)."""
+MAX_DEGREE = 4
+"""The highest Bezout number (the product of the equations' degrees) of a block solved in closed form:
+linear systems, and quadratics or two coupled ones, whose roots sympy writes with square roots."""
+
+
+def next_block(relations: list[Relation], known: set[Any], used: set[int],
+               points: Sequence[Mapping[Any, float]] = (), chain: list[_Solved] | None = None,
+               asked: set[Any] | None = None) -> list[_Solved] | None:
+    """The first block of the open relations, in block-triangular order, that has one solution; its
+    relations are marked used. None if there is none.
+
+    The open relations (unused, with an unknown) are matched to their unknowns (a maximum bipartite
+    matching, relations with fewer unknowns first, then in order); a relation then depends on the relations
+    matched to its other unknowns, and the strongly connected components of that graph (Tarjan),
+    dependencies first, are the blocks. A block is solvable when every unknown its equations hold is
+    matched inside it. Such a block is solved together (:func:`solve_block`). One whose solutions nothing
+    tells apart is refused, naming them, if no other block lets the chain go on.
+    """
+    unknowns_of = {index: relation.symbols() - known for index, relation in enumerate(relations)
+                   if index not in used and relation.symbols() - known}
+    # Relations with fewer unknowns are matched first: where the open relations fix more than they hold
+    # (momentum, impulse and restitution say the same thing), the small closed blocks are the ones kept.
+    open_relations = sorted(unknowns_of, key=lambda index: (len(unknowns_of[index]), index))
+    owner = _matching(open_relations, unknowns_of)
+    matched = {index: unknown for unknown, index in owner.items()}
+    graph = {index: [owner[u] for u in sorted(unknowns_of[index], key=str) if u in owner and owner[u] != index]
+             for index in open_relations if index in matched}
+    ambiguous = []
+    for component in strongly_connected(graph):
+        members = sorted(component)
+        unknowns = [matched[index] for index in members]
+        if len(members) > MAX_BLOCK or set().union(*(unknowns_of[index] for index in members)) != set(unknowns):
+            continue
+        found = solve_block([relations[index] for index in members], unknowns, relations, known,
+                            lambda: [(point, _values_at(point, chain or [])) for point in points], asked)
+        if isinstance(found, str):
+            ambiguous.append(found)
+        elif found is not None:
+            used.update(members)
+            return found
+    if ambiguous:
+        raise TemplateError(_INNER, ambiguous[0], "a scene that tells its solutions apart",
+                            "two physical solutions that nothing in it (a sign, a domain, a condition) tells apart: "
+                            "give the quantity that decides between them, or ask the question the other way round")
+    return None
+
+
+def _matching(rows: list[int], columns_of: Mapping[int, set[Any]]) -> dict[Any, int]:
+    """A maximum matching of rows to columns (augmenting paths, rows in order, columns by name): each
+    matched column's row."""
+    owner: dict[Any, int] = {}
+
+    def augment(row: int, seen: set[Any]) -> bool:
+        for column in sorted(columns_of[row], key=str):
+            if column not in seen:
+                seen.add(column)
+                if column not in owner or augment(owner[column], seen):
+                    owner[column] = row
+                    return True
+        return False
+
+    for row in rows:
+        augment(row, set())
+    return owner
+
+
+def strongly_connected(graph: Mapping[int, list[int]]) -> list[list[int]]:
+    """The strongly connected components of ``graph`` (Tarjan), each after every component it reaches:
+    with an edge from a relation to the relations it needs, dependencies come first.
+
+    >>> strongly_connected({0: [1], 1: [0], 2: [0], 3: []})
+    [[1, 0], [2], [3]]
+    """
+    index: dict[int, int] = {}
+    low: dict[int, int] = {}
+    stack: list[int] = []
+    on_stack: set[int] = set()
+    found: list[list[int]] = []
+
+    def visit(node: int) -> None:
+        index[node] = low[node] = len(index)
+        stack.append(node)
+        on_stack.add(node)
+        for successor in graph.get(node, []):
+            if successor not in index:
+                visit(successor)
+                low[node] = min(low[node], low[successor])
+            elif successor in on_stack:
+                low[node] = min(low[node], index[successor])
+        if low[node] == index[node]:
+            component = []
+            while True:
+                member = stack.pop()
+                on_stack.discard(member)
+                component.append(member)
+                if member == node:
+                    break
+            found.append(component)
+
+    for node in graph:
+        if node not in index:
+            visit(node)
+    return found
+
+
+def solve_block(block: list[Relation], unknowns: list[Any], relations: list[Relation], known: set[Any],
+                values: Any = lambda: None, asked: set[Any] | None = None) -> list[_Solved] | str | None:
+    """The one solution of ``block``'s equations for ``unknowns`` (``unknowns[i]`` shown beside ``block[i]``),
+    as steps; None if they have no closed form here (not polynomial in the unknowns, or of a Bezout number
+    above :data:`MAX_DEGREE`) or no admissible root; a sentence naming two roots if more than one is.
+
+    A root is admissible when it is real, leaves no denominator of the equations zero, fits the unknowns'
+    assumptions and breaks no condition of the scene's relations (``e >= 0``, the bodies approach) that
+    sympy can decide. Where several remain, ``values()`` (the known quantities at the template's example and
+    at draws across its sampling) decides: the root that alone is real and meets every condition at each of
+    them where any does (:func:`_selected`); where two do at one point, or different roots at two, none is
+    chosen, and the sentence names both at that point, for an unknown of ``asked`` whose roots differ if
+    there is one.
+    """
+    asked = asked or set()
+    numerators, denominators, degree = [], [], 1
+    for relation in block:
+        numerator, denominator = sp.fraction(sp.together(sp.sympify(relation.lhs) - sp.sympify(relation.rhs)))
+        if not numerator.is_polynomial(*unknowns):
+            return None
+        degree *= max(1, sp.Poly(numerator, *unknowns).total_degree())
+        numerators.append(numerator)
+        denominators.append(denominator)
+    if degree > MAX_DEGREE:
+        return None
+    conditions = [c.holds for relation in relations for c in relation.requires
+                  if sp.sympify(c.holds).free_symbols & set(unknowns)
+                  and sp.sympify(c.holds).free_symbols <= known | set(unknowns)]
+    roots = [root for root in sp.solve(numerators, unknowns, dict=True, check=False, simplify=False)
+             if set(root) == set(unknowns) and not any(v.free_symbols & set(unknowns) for v in root.values())
+             and all(v.is_real is not False for v in root.values())
+             and not any(d.xreplace(root).is_zero for d in denominators)
+             and all(sp.sympify(c).xreplace(root) is not sp.false for c in conditions)]
+    ambiguous_at: tuple[Mapping[Any, float], dict[Any, Any]] | None = None
+    if len(roots) > 1:
+        roots, ambiguous_at = _selected(roots, conditions, values())
+    if not roots:
+        return None
+    if len(roots) > 1:
+        labels = " and ".join(f"({chr(97 + i)}) {relation.label}" for i, relation in enumerate(block))
+        differing = [u for u in unknowns if sp.expand(roots[0][u] - roots[1][u]) != 0] or unknowns
+        first = next((u for u in differing if u in asked), differing[0])
+        if ambiguous_at is not None:
+            inputs, at = ambiguous_at
+            one, other = (f"{first} = {float(sp.re(sp.N(root[first].xreplace(at)))):.6g}" for root in roots[:2])
+            return f"the equations {labels}, which give {one} or {other} (SI) at {_where(inputs)}"
+        one, other = (f"{first} = {shown(str(root[first]), 80)}" for root in roots[:2])
+        return f"the equations {labels}, which give {one} or {other}"
+    together = tuple(unknowns) if len(unknowns) > 1 else ()
+    steps = [_Solved(unknown, relation, tidy := _as_written(roots[0][unknown]), tidy, block=together)
+             for unknown, relation in zip(unknowns, block, strict=True)]
+    return [replace(steps[0], requires=_determined(block, numerators, unknowns, roots[0])), *steps[1:]]
+
+
+def _as_written(root: Any) -> Any:
+    """A block's root as a textbook writes it, the shorter of: factored (``m1 m2 (1 + e)(v2 - v1_out)/(e m2 -
+    m1)``, whose difference of inputs is also formed first), or a quotient whose numerator is collected on the
+    quantities it holds linearly and its denominator does not (``((1 + e) m2 v2 - (m1 + m2) v1_out)/(e m2 -
+    m1)``).
+
+    >>> m1, m2 = sp.symbols("m1 m2", positive=True)
+    >>> e, v2, v1_out = sp.symbols("e v2 v1_out", real=True)
+    >>> _as_written((m2*v2 + e*m2*v2 - m1*v1_out - m2*v1_out)/(e*m2 - m1))
+    (m2*v2*(e + 1) + v1_out*(-m1 - m2))/(e*m2 - m1)
+    """
+    numerator, denominator = sp.fraction(sp.together(root))
+    linear = sorted((symbol for symbol in numerator.free_symbols - denominator.free_symbols
+                     if numerator.is_polynomial(symbol) and sp.degree(numerator, symbol) == 1), key=str)
+    collected = sp.collect(sp.expand(numerator), linear, func=sp.factor) / sp.factor(denominator)
+    factored = sp.factor(root)
+    return factored if sp.count_ops(factored) <= sp.count_ops(collected) else collected
+
+
+def _determined(block: list[Relation], numerators: list[Any], unknowns: list[Any],
+                root: Mapping[Any, Any]) -> tuple[Condition, ...]:
+    """That the block fixes its unknowns at the values drawn: its Jacobian's determinant at the root is not
+    zero, to 1e-9 of the sum of its terms' sizes (where it vanishes, as for a cart of ``e`` times the
+    other's mass whose rebound is the other's velocity, any velocity before fits: the draw is refused)."""
+    determinant = sp.factor(sp.Matrix(numerators).jacobian(unknowns).det().xreplace(root))
+    if determinant.is_nonzero:  # a sum of positive masses: the block fixes its unknowns at every draw
+        return ()
+    size = sp.Add(*[sp.Abs(term) for term in sp.Add.make_args(sp.expand(determinant))])
+    labels = " and ".join(f"({chr(97 + i)}) {relation.label}" for i, relation in enumerate(block))
+    return (Condition(sp.Gt(sp.Abs(determinant), size / 10**9),
+                      f"the equations {labels} do not fix {', '.join(map(str, unknowns))} for these values: their "
+                      f"determinant, {determinant}, is zero (to 1e-9 of its terms), so the scene has no single "
+                      "solution here"),)
+
+
+def _selected(roots: list[Mapping[Any, Any]], conditions: list[Any],
+              points: list[tuple[Mapping[Any, float], dict[Any, Any]]]
+              ) -> tuple[list[Mapping[Any, Any]], tuple[Mapping[Any, float], dict[Any, Any]] | None]:
+    """The one root that is the only admissible one (:func:`_admissible`) at every point where any is, and
+    None; or all the roots, with the first point (its inputs, and every value known there) that shows they
+    are not told apart (two admissible there, or another root than at an earlier point). With no point
+    deciding, all the roots and None."""
+    chosen = None
+    for point in points:
+        admissible = [index for index, root in enumerate(roots) if _admissible(root, conditions, point[1])]
+        if not admissible:
+            continue
+        if len(admissible) > 1 or (chosen is not None and admissible[0] != chosen):
+            return roots, point
+        chosen = admissible[0]
+    return ([roots[chosen]], None) if chosen is not None else (roots, None)
+
+
+def _where(inputs: Mapping[Any, float]) -> str:
+    """A point's inputs in SI, as the refusal of a block names them: ``m1 = 2, v1 = 4``."""
+    return ", ".join(f"{symbol} = {value:.6g}" for symbol, value in sorted(inputs.items(), key=lambda i: str(i[0])))
+
+
+def _admissible(root: Mapping[Any, Any], conditions: list[Any], at: Mapping[Any, Any]) -> bool:
+    """Whether a root is real and finite, and meets every condition, at the values ``at``."""
+    values = {unknown: sp.N(value.xreplace(at)) for unknown, value in root.items()}
+    if not all(v.is_finite and abs(sp.im(v)) <= 1e-12 * (1 + abs(sp.re(v))) for v in values.values()):
+        return False
+    real = {unknown: sp.re(value) for unknown, value in values.items()}
+    return all(sp.sympify(c).xreplace({**at, **real}) is not sp.false for c in conditions)
+
+
+def _values_at(point: Mapping[Any, float], chain: list[_Solved]) -> dict[Any, Any]:
+    """The inputs at ``point`` and every quantity the chain has found so far, evaluated there."""
+    values: dict[Any, Any] = {symbol: sp.Float(value) for symbol, value in point.items()}
+    for solved in chain:
+        values[solved.unknown] = sp.N(solved.numeric.doit().xreplace(values))
+    return values
 
 
 def _solve(relation: Relation, unknown: Any) -> Any:
@@ -145,8 +400,8 @@ class _Compiler:
             self.inputs.add(self.ctx.symbols["g"])
 
     def compile(self) -> Compiled:
-        chain = derive(self.relations, self.inputs, self.inputs)
         wanted = {name: from_node(spec.value, self.ctx.symbols) for name, spec in self.template.answers.items()}
+        chain = derive(self.relations, self.inputs, self.inputs, wanted=wanted.values(), points=self._points())
         known = self.inputs | {s.unknown for s in chain}
         for name, expr in wanted.items():
             missing = expr.free_symbols - known
@@ -160,13 +415,44 @@ class _Compiler:
             # doit(): display forms keep sqrt(2*g*h) whole; the numeric composition wants it evaluated.
             composed[solved.unknown] = solved.numeric.doit().xreplace(composed)
         answers = {name: self._answer(name, expr, chain, composed) for name, expr in wanted.items()}
-        checks = self._checks(composed)
+        checks = self._checks(composed, [c for solved in chain for c in solved.requires])
         self._check_every_parameter_used(chain, wanted.values(), checks)
         return Compiled(
             template_id=self.template.id, source_hash=self.template.source_hash,
             parameters=tuple(self.template.parameters),
             constants={"g": float(self.template.scene.gravity.si)} if self.template.scene.gravity else {},
             steps=tuple(self._step(s) for s in chain), checks=checks, answers=answers)
+
+    def _points(self, count: int = 8) -> list[dict[Any, float]]:
+        """The inputs in SI (symbols without value at 1) at the template's example, if it gives every parameter,
+        then at ``count`` points spread over the parameters' sampling (a fixed low-discrepancy sequence, so
+        a template compiles the same every time): where a block's roots are told apart only by the values."""
+        spread = []
+        for k in range(1, count + 1):
+            values = {}
+            for j, (name, parameter) in enumerate(self.template.parameters.items()):
+                fraction = (k * 0.6180339887498949 + j * 0.41421356237309503) % 1
+                kind, ends = parameter.sample.kind, parameter.sample.values
+                if kind == "choice":
+                    value = ends[k % len(ends)]
+                elif kind == "log_uniform":
+                    value = ends[0] * (ends[1] / ends[0]) ** fraction
+                else:
+                    value = ends[0] + fraction * (ends[1] - ends[0])
+                    value = round(value) if kind == "integers" else value
+                values[name] = value
+            spread.append(values)
+        complete = not set(self.template.parameters) - set(self.template.example)
+        example = [dict(self.template.example)] if complete else []
+        points = []
+        for values in example + spread:
+            point = {self.ctx.symbols[name]: float(values[name]) * parameter.unit.to_si
+                     for name, parameter in self.template.parameters.items()}
+            point.update({self.ctx.symbols[name]: 1.0 for name in self.template.symbols})
+            if self.template.scene.gravity is not None and "g" in self.ctx.symbols:
+                point[self.ctx.symbols["g"]] = float(self.template.scene.gravity.si)
+            points.append(point)
+        return points
 
     def _check_every_parameter_used(self, chain: list[_Solved], wanted: Iterable[Any],
                                     checks: Iterable[Check]) -> None:
@@ -200,12 +486,14 @@ class _Compiler:
         tied = sorted({str(s) for unknowns in left for s in unknowns})
         if not tied:
             return "; no stage involves it"
-        return (f"; the equations left tie {', '.join(tied)} together (two or more unknowns each) and the "
-                "solver takes one equation and one unknown at a time: give one of them as a parameter")
+        return (f"; the equations left tie {', '.join(tied)} together (two or more unknowns each) and no set of "
+                f"at most {MAX_BLOCK} of them fixes as many unknowns as it has with one closed-form solution "
+                "(polynomial, of degree at most 4 together): give one of them as a parameter")
 
     def _step(self, solved: _Solved) -> Step:
         return Step(solved.unknown.name, solved.relation.label,
-                    (to_node(solved.relation.lhs), to_node(solved.relation.rhs)), to_node(for_reader(solved.display)))
+                    (to_node(solved.relation.lhs), to_node(solved.relation.rhs)), to_node(for_reader(solved.display)),
+                    tuple(unknown.name for unknown in solved.block))
 
     def _answer(self, name: str, expr: Any, chain: list[_Solved], composed: Mapping[Any, Any]) -> CompiledAnswer:
         spec = self.template.answers[name]
@@ -245,11 +533,14 @@ class _Compiler:
         converted = converted.replace(lambda e: isinstance(e, sp.sin), lambda e: sind(e.args[0] * 180 / sp.pi))
         return converted.replace(lambda e: isinstance(e, sp.cos), lambda e: cosd(e.args[0] * 180 / sp.pi))
 
-    def _checks(self, composed: Mapping[Any, Any]) -> tuple[Check, ...]:
+    def _checks(self, composed: Mapping[Any, Any], steps: Iterable[Condition] = ()) -> tuple[Check, ...]:
+        """``steps``' own conditions (a block's determinant), then those of the scene's relations, that the
+        composed quantities decide, as checks over the parameters."""
         known = self.inputs | set(composed)
         checks = []
-        for relation in self.relations:
-            for condition in relation.requires:
+        # A block's own condition first: where it fails, the scene's conditions on its roots say nothing.
+        for conditions in [tuple(steps), *(relation.requires for relation in self.relations)]:
+            for condition in conditions:
                 # A condition applies as soon as its own quantities are known, whatever else its relation has.
                 if not sp.sympify(condition.holds).free_symbols <= known:
                     continue

@@ -79,17 +79,21 @@ def _flight(stage: Stage, ctx: Context, law: str = "y0 + vy t - g t^2/2", root: 
     drop = y0 - y1
     solutions: dict[Any, Any] = {y1: height_at}
     stable: dict[Any, tuple[Stable, ...]] = {}
-    if half:
+    # To a wall, the height there says nothing of whether the body rises or falls as it reaches it: the time
+    # comes from the distance, and from the height only as a block's root that the scene's values select.
+    if half and not wall:
         root_of = sp.sqrt(vy**2 + 2 * g * drop / (2 * half))
         solutions[t] = (vy + root_of) / (2 * half * g) if root == "+" else (root_of - vy) / (2 * half * g)
         if root == "+":
             up, down = sp.Max(vy, 0), sp.Min(vy, 0)
             stable[t] = (Stable((up + (2 * g * drop / (2 * half) + up**2) / (root_of - down)) / (2 * half * g)),)
+    requires: tuple[Condition, ...]
     if wall:
         label = (f"vertical motion of {body}: gravity alone, so its height when it reaches the wall, after the "
                  f"time {t}, is")
         requires = (Condition(sp.Ge(y1, 0), f"{body} reaches the ground before it gets to the wall (its height at "
-                              f"the wall, {text['end_height']}, would be {{value}})", subject=y1),)
+                              f"the wall, {text['end_height']}, would be {{value}})", subject=y1),
+                    Condition(sp.Ge(t, 0), f"{body} reaches the wall after it is thrown ({t} >= 0)"))
     else:
         ground = text["end_height"] == "0"
         fallen = text["height"] if ground else f"({text['height']} − {text['end_height']})"

@@ -12,7 +12,7 @@ from __future__ import annotations
 import hashlib
 import math
 import re
-from collections.abc import Iterator, Mapping, Sequence
+from collections.abc import Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -340,23 +340,58 @@ def _check_names(template: Template) -> None:
             missing = names(part) - given if part is not None else set()
             if missing:
                 raise TemplateError(where, f"bodies.{body.name}.{key}", "parameters or symbols only",
-                                    ", ".join(sorted(missing)))
+                                    unknown_names(missing, given))
     for answer in template.answers.values():
         missing = names(answer.value) - quantities
         if missing:
             raise TemplateError(where, f"answers.{answer.name}.value", "names of the scene's quantities",
-                                f"unknown {', '.join(sorted(missing))}")
+                                unknown_names(missing, quantities))
         missing = set(answer.symbolic) - given
         if missing:
             raise TemplateError(where, f"answers.{answer.name}.symbolic", "parameters or symbols",
-                                ", ".join(sorted(missing)))
+                                unknown_names(missing, given))
+    _check_misspelt_quantities(template, given)
     for index, constraint in enumerate(template.constraints):
         missing = names(constraint.holds) - set(template.parameters)
         if missing:
             raise TemplateError(where, f"constraints[{index}].require", "an expression in the parameters",
-                                f"unknown {', '.join(sorted(missing))}")
+                                unknown_names(missing, template.parameters))
     _check_statement(template, given)
     _check_dimensions(template)
+
+
+def unknown_names(missing: Iterable[str], known: Iterable[str]) -> str:
+    """``unknown e_ (did you mean e?)``: names a template uses and does not define, each with the defined names it
+    may be a misspelling of.
+
+    >>> unknown_names(["e_", "zz"], ["e", "h_drop"])
+    'unknown e_ (did you mean e?), zz'
+    """
+    shown_names = []
+    for name in sorted(missing):
+        close = close_matches(name, known)
+        shown_names.append(f"{name} (did you mean {' or '.join(close)}?)" if close else name)
+    return "unknown " + ", ".join(shown_names)
+
+
+def _check_misspelt_quantities(template: Template, given: set[str]) -> None:
+    """A name a stage uses that is not given is a quantity the solver finds; one that only that stage uses (no
+    other stage, no answer) and that looks like a parameter or symbol the scene and the answers never use is that
+    name misspelt (``restitution: e_`` for the parameter ``e``), said so here rather than as an answer nothing
+    fixes."""
+    asked = {n for answer in template.answers.values() for n in names(answer.value)}
+    unused = sorted(given - template.scene.names() - asked)
+    for stage in template.scene.stages:
+        elsewhere = asked.union(*(other.quantities for other in template.scene.stages if other is not stage))
+        for name in sorted(stage.quantities - given - RESERVED - elsewhere):
+            close = close_matches(name, unused)
+            if close:
+                field = next((key for key, text in stage.source.items() if re.search(rf"\b{name}\b", text)), "")
+                raise TemplateError(template.where, f"stages[{stage.index}].{field}".rstrip("."),
+                                    "names of parameters, symbols or quantities the solver finds",
+                                    f"{unknown_names([name], close)}: {' and '.join(close)} "
+                                    f"{'is a parameter or symbol' if len(close) == 1 else 'are parameters or symbols'} "
+                                    "no stage or answer uses")
 
 
 def _check_dimensions(template: Template) -> None:

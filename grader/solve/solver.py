@@ -23,7 +23,7 @@ from typing import Any
 import sympy as sp
 
 from grader.bank.template import Template
-from grader.base.errors import SYMPY_FAILURES, TemplateError, shown, unworkable
+from grader.base.errors import SYMPY_FAILURES, TemplateError, unworkable
 from grader.model.expr import names
 from grader.model.quantities import Unit
 from grader.physics.effects import CATALOGUE, Relation

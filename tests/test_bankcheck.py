@@ -202,8 +202,8 @@ def test_discarded_draws_are_explained_and_a_template_without_any_keeps_its_shor
     assert code == 0 and reports["bullet-block"].startswith("ok    200 draws: "), out
     explained = re.search(r"; (\d+) of 200 draws discarded: \1 with answer v_block's tolerance widened past the ±5 % "
                           r"cap by rounding J along the worked solution \(typical ±([\d.]+) %\): list block first in "
-                          r"stages\[0\]\.bodies \(.*\), narrow the sampling toward variants that rounding moves less, or "
-                          r"raise grading\.max_tolerance \(", reports["bullet-block"])
+                          r"stages\[0\]\.bodies \(.*\), narrow the sampling toward variants that rounding moves "
+                          r"less, or raise grading\.max_tolerance \(", reports["bullet-block"])
     assert explained is not None and int(explained.group(1)) >= 20 and float(explained.group(2)) > 5, out
     assert "discarded" not in reports["drop-rebound-copy"]
     assert re.fullmatch(r"ok    200 draws: .*; sheet and key typeset \(\d+\.\d s\)", reports["drop-rebound-copy"])

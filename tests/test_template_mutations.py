@@ -21,9 +21,10 @@ from typing import Any
 import pytest
 import yaml
 
-from grader.bank.template import load_template
+from grader.bank.template import Template, load_template
 from grader.base.errors import GraderError, TemplateError
 from grader.base.resources import bank_dir
+from grader.solve.compiled import Compiled
 from grader.solve.evaluate import solve_one
 from grader.solve.solver import compile_template
 
@@ -141,7 +142,7 @@ def outcome(template_id: str, change: Callable[[dict[str, Any]], None], folder: 
     path.write_text(text, encoding="utf-8")
     try:
         template = load_template(path)
-        compiled = compile_template(template)
+        compiled = _compiled(template, str(folder))
         values = {name: template.example.get(name, parameter.sample.values[0])
                   for name, parameter in template.parameters.items()}
         refused = solve_one(template, compiled, values).error
@@ -150,6 +151,26 @@ def outcome(template_id: str, change: Callable[[dict[str, Any]], None], folder: 
     except GraderError as error:
         return problems(str(error), text, str(path))
     return problems(refused, text, None) if refused else []
+
+
+_COMPILED: dict[tuple[str, str], Compiled | TemplateError] = {}
+
+
+def _compiled(template: Template, folder: str) -> Compiled:
+    """``compile_template``, once for all the mutations that change nothing it reads (a description, a sampling
+    range, the statement, the example): the run's time goes to the mutations that change the physics."""
+    parameters = {name: (p.unit, p.domain, p.integer) for name, p in template.parameters.items()}
+    answers = {name: (a.value, a.unit, a.symbolic) for name, a in template.answers.items()}
+    key = (folder, repr((template.id, template.scene, parameters, template.symbols, answers)))
+    if key not in _COMPILED:
+        try:
+            _COMPILED[key] = compile_template(template)
+        except TemplateError as error:
+            _COMPILED[key] = error
+    found = _COMPILED[key]
+    if isinstance(found, TemplateError):
+        raise found
+    return found
 
 
 SAMPLED = random.Random(24).sample(range(len(MUTATIONS)), 200)

@@ -21,7 +21,7 @@ from typing import Any
 import pytest
 import yaml
 
-from grader.bank.template import Template, load_template
+from grader.bank.template import Template, load_template, misspelt_as
 from grader.base.errors import GraderError, TemplateError
 from grader.base.resources import bank_dir
 from grader.solve.compiled import Compiled
@@ -132,6 +132,18 @@ def problems(message: str, text: str, where: str | None) -> list[str]:
     return wrong
 
 
+def misspelling_unnamed(message: str, mutated: dict[str, Any], original: dict[str, Any]) -> list[str]:
+    """A name the mutation brought in that misspells a parameter or symbol no stage uses any more (``e_`` for
+    ``e``), reported as an answer nothing fixes rather than as the unknown name it is."""
+    if "nothing fixes" not in message:
+        return []
+    given = {str(name) for key in ("parameters", "symbols") for name in mutated.get(key) or {}}
+    stages = set(re.findall(r"\w+", str(mutated.get("stages"))))
+    brought = stages - set(re.findall(r"\w+", str(original.get("stages"))))
+    return [f"{name}, a misspelling of {close[0]}, reported as nothing fixes" for name in sorted(brought)
+            if (close := misspelt_as(name, given - stages))]
+
+
 def outcome(template_id: str, change: Callable[[dict[str, Any]], None], folder: Path) -> list[str]:
     """Load, compile and solve a mutated template at its example (a parameter without one at the low end of
     its sampling); what is wrong with the message it gets, if any (empty when it works or says it well)."""
@@ -147,7 +159,8 @@ def outcome(template_id: str, change: Callable[[dict[str, Any]], None], folder: 
                   for name, parameter in template.parameters.items()}
         refused = solve_one(template, compiled, values).error
     except TemplateError as error:
-        return problems(str(error), text, str(path)) + ([] if error.key else ["no field"])
+        return problems(str(error), text, str(path)) + ([] if error.key else ["no field"]) + \
+            misspelling_unnamed(str(error), mutated, SHIPPED[template_id])
     except GraderError as error:
         return problems(str(error), text, str(path))
     return problems(refused, text, None) if refused else []

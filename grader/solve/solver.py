@@ -381,4 +381,5 @@ def _failure_in_words(error: BaseException) -> str:
         return "expressions nested too deeply to work with"
     if isinstance(error, NotImplementedError):
         return "an equation the algebra cannot solve for its unknown: give that quantity as a parameter"
-    return "expressions the algebra cannot work with (a value or a comparison it cannot decide)"
+    return ("expressions the algebra cannot work with (a value or a comparison it cannot decide): check each "
+            "stage's velocities before and after and the constants, e.g. a body left at rest that must move")

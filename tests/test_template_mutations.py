@@ -209,3 +209,38 @@ def test_a_sample_of_mutated_templates_is_told_what_to_change(tmp_path: Path) ->
 def test_every_mutation_of_a_template_is_told_what_to_change(template_id: str, tmp_path: Path) -> None:
     """Every mutation of one template (about a thousand)."""
     _check([index for index, (found, _, _) in enumerate(MUTATIONS) if found == template_id], tmp_path)
+
+
+def _refusal(tmp_path: Path, template_id: str, old: str, new: str) -> str:
+    """The message of a shipped template with ``old`` replaced by ``new``, loaded and compiled."""
+    text = (bank_dir() / f"{template_id}.yaml").read_text(encoding="utf-8")
+    assert old in text
+    path = tmp_path / f"{template_id}.yaml"
+    path.write_text(text.replace(old, new, 1), encoding="utf-8")
+    with pytest.raises(TemplateError) as refused:
+        compile_template(load_template(path))
+    return str(refused.value).removeprefix(f"{path}: ")
+
+
+def test_a_misspelt_restitution_is_an_unknown_name_not_an_answer_nothing_fixes(tmp_path: Path) -> None:
+    assert _refusal(tmp_path, "head-on", "restitution: e", "restitution: e_") == (
+        "stages[0].restitution: expected names of parameters, symbols or quantities the solver finds, got unknown "
+        "name e_ (did you mean e?): the parameter e, which no stage or answer uses")
+
+
+def test_an_atan2_sympy_rewrites_as_atan_compiles(tmp_path: Path) -> None:
+    """Every domain positive, sympy writes ``atan2(v_y, 1)`` as ``atan(v_y)``: it was "got atan(v_y) (atan)"."""
+    text = (bank_dir() / "wall-throw.yaml").read_text(encoding="utf-8")
+    path = tmp_path / "wall-throw.yaml"
+    path.write_text(text.replace("end_vertical: v_y_hit", "end_vertical: atan2(v_y_hit, 1)", 1), encoding="utf-8")
+    assert "atan2(v_y_hit, 1)" in path.read_text(encoding="utf-8")
+    assert compile_template(load_template(path)).answers
+
+
+def test_quantities_the_template_left_unnamed_are_named_by_their_stage_field(tmp_path: Path) -> None:
+    """The ball's velocity after the impact left out: the equations left tie the impulse and that velocity, which
+    the author never named; the message says where each belongs."""
+    message = _refusal(tmp_path, "drop-rebound", "    after: {ball: v_after}\n", "")
+    assert message.startswith("answers.e: expected an answer the scene determines from the parameters, got nothing "
+                              "fixes e; the equations left tie J (stages[1].impulse, unnamed), e, v_ball_n_after "
+                              "(stages[1].after.ball: ball's velocity after, unnamed) together"), message

@@ -175,8 +175,7 @@ _IN_WORDS = {"asin": "an inverse sine", "acos": "an inverse cosine", "acot": "an
              "Piecewise": "cases", "re": "a real part", "im": "an imaginary part", "arg": "a complex argument",
              "LambertW": "Lambert's W", "floor": "a rounding down", "ceiling": "a rounding up",
              "ImaginaryUnit": "imaginary (the square root of a negative quantity)",
-             "ComplexInfinity": "infinite (a division by zero)", "Infinity": "infinite",
-             "NegativeInfinity": "infinite", "NaN": "undefined (0/0, or infinity less infinity)"}
+             "ComplexInfinity": "infinite (a division by zero)"}
 """What the solver may write that the kernels cannot compute, in words (the author wrote none of it)."""
 
 

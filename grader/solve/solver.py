@@ -206,23 +206,17 @@ class _Compiler:
 
     def _named(self, name: str) -> str:
         """A quantity as a message names it: a name the template wrote as is; one the solver gave (the template
-        left it unnamed) with the stage field it belongs to, e.g. ``J (stages[1].impulse, unnamed)``."""
-        if name in self.template.scene.names():
-            return name
-        velocity = re.fullmatch(r"v_(\w+)_([nt])_after(?:_(\d+))?", name)
-        base, index = (name, self.ctx.defaults.get(name)) if velocity is None else (name, None)
-        if velocity is not None and velocity.group(1) in self.template.scene.bodies:
-            stages = [s.index for s in self.template.scene.stages if "after" in {f.name for f in
-                      CATALOGUE[s.effect].fields} and velocity.group(1) in s.fields.get("bodies", ())]
-            index = int(velocity.group(3)) if velocity.group(3) else stages[0] if stages else None
-            place = f"stages[{index}].after.{velocity.group(1)}" if index is not None else "after"
-            return f"{name} ({place}: {velocity.group(1)}'s velocity after, unnamed)"
+        left it unnamed: :meth:`Context.unused_name`, ``base`` or ``base_<stage>``) with the stage field it
+        belongs to, e.g. ``J (stages[1].impulse, unnamed)``."""
         numbered = re.fullmatch(r"(\w+?)_(\d+)", name)
-        if index is None and numbered is not None:
-            base, index = numbered.group(1), int(numbered.group(2))
-        if index is None or index >= len(self.template.scene.stages):
+        base, index = (name, self.ctx.defaults[name]) if name in self.ctx.defaults else \
+            (numbered.group(1), int(numbered.group(2))) if numbered else (name, None)
+        if name in self.template.scene.names() or index is None or index >= len(self.template.scene.stages):
             return name
         stage = self.template.scene.stages[index]
+        velocity = re.fullmatch(r"v_(\w+)_[nt]_after", base)
+        if velocity is not None:
+            return f"{name} (stages[{index}].after.{velocity.group(1)}: {velocity.group(1)}'s velocity after, unnamed)"
         field = next((f.name for f in CATALOGUE[stage.effect].fields if f.default == base), None)
         return f"{name} (stages[{index}].{field}, unnamed)" if field else name
 

@@ -138,8 +138,8 @@ def misspelling_unnamed(message: str, mutated: dict[str, Any], original: dict[st
     if "nothing fixes" not in message:
         return []
     given = {str(name) for key in ("parameters", "symbols") for name in mutated.get(key) or {}}
-    stages = set(re.findall(r"\w+", str(mutated.get("stages"))))
-    brought = stages - set(re.findall(r"\w+", str(original.get("stages"))))
+    stages = set(re.findall(r"[A-Za-z_]\w*", str(mutated.get("stages"))))
+    brought = stages - set(re.findall(r"[A-Za-z_]\w*", str(original.get("stages"))))
     return [f"{name}, a misspelling of {close[0]}, reported as nothing fixes" for name in sorted(brought)
             if (close := misspelt_as(name, given - stages))]
 
@@ -225,7 +225,7 @@ def _refusal(tmp_path: Path, template_id: str, old: str, new: str) -> str:
 def test_a_misspelt_restitution_is_an_unknown_name_not_an_answer_nothing_fixes(tmp_path: Path) -> None:
     assert _refusal(tmp_path, "head-on", "restitution: e", "restitution: e_") == (
         "stages[0].restitution: expected names of parameters, symbols or quantities the solver finds, got unknown "
-        "name e_ (did you mean e?): the parameter e, which no stage or answer uses")
+        "name e_ (did you mean e?): the parameter e, which no stage uses")
 
 
 def test_an_atan2_sympy_rewrites_as_atan_compiles(tmp_path: Path) -> None:

@@ -406,11 +406,10 @@ def _edits(first: str, second: str, most: int) -> int:
 
 def _check_misspelt_quantities(template: Template, given: set[str]) -> None:
     """A name a stage uses that is not given is a quantity the solver finds; one that only that stage uses (no
-    other stage, no answer) and that looks like a parameter or symbol the scene and the answers never use is that
-    name misspelt (``restitution: e_`` for the parameter ``e``), said so here rather than as an answer nothing
-    fixes."""
+    other stage, no answer) and that looks like a parameter or symbol no stage uses is that name misspelt
+    (``restitution: e_`` for the parameter ``e``), said so here rather than as an answer nothing fixes."""
     asked = {n for answer in template.answers.values() for n in names(answer.value)}
-    unused = sorted(given - template.scene.names() - asked)
+    unused = sorted(given - template.scene.names())
     for stage in template.scene.stages:
         elsewhere = asked.union(*(other.quantities for other in template.scene.stages if other is not stage))
         for name in sorted(stage.quantities - given - RESERVED - elsewhere):
@@ -420,8 +419,7 @@ def _check_misspelt_quantities(template: Template, given: set[str]) -> None:
                 kinds = [f"the {'parameter' if other in template.parameters else 'symbol'} {other}" for other in close]
                 raise TemplateError(template.where, f"stages[{stage.index}].{field}".rstrip("."),
                                     "names of parameters, symbols or quantities the solver finds",
-                                    f"{unknown_names([name], close)}: {' and '.join(kinds)}, which no stage or "
-                                    "answer uses")
+                                    f"{unknown_names([name], close)}: {' and '.join(kinds)}, which no stage uses")
 
 
 def _check_dimensions(template: Template) -> None:

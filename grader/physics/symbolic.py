@@ -138,6 +138,10 @@ def to_node(expr: Any) -> Node:
         return Sym("pi")
     if isinstance(expr, sp.Rational):
         return Num(Fraction(int(expr.p), int(expr.q)))
+    if isinstance(expr, sp.Number) and not expr.is_finite:  # sympy's oo or nan: a 0/0 or 1/0 in the scene
+        raise TemplateError(INNER, "stages or answers", "only real, finite expressions of functions the kernels know",
+                            "a value that is infinite or undefined (a 0/0 or a division by zero: e.g. a body left at "
+                            "rest that must move)")
     if isinstance(expr, sp.Number):
         return Num(float(expr))
     if isinstance(expr, sp.NumberSymbol):

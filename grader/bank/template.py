@@ -376,15 +376,17 @@ def unknown_names(missing: Iterable[str], known: Iterable[str]) -> str:
 
 def misspelt_as(name: str, known: Iterable[str]) -> list[str]:
     """The names of ``known`` that ``name`` may be a misspelling of: one letter added, dropped, changed or two
-    swapped (two edits in a name of 8 letters or more), or another letter case; closest first, at most three.
+    swapped (two edits in a name of 8 letters or more, and fewer edits than letters), or another letter case;
+    closest first, at most three.
     Tighter than :func:`close_matches`: ``E_lost`` is not ``f_loss``.
 
-    >>> misspelt_as("e_", ["e", "h"]), misspelt_as("E_lost", ["f_loss", "E_loss"]), misspelt_as("V", ["v"])
+    >>> misspelt_as("e_", ["e", "h"]), misspelt_as("E_lost", ["f_loss", "E_loss"]), misspelt_as("V", ["v", "m"])
     (['e'], ['E_loss'], ['v'])
     """
     most = 2 if len(name) >= 8 else 1
-    found = sorted((distance, other) for other in known
-                   if (distance := _edits(name.lower(), other.lower(), most)) <= most)
+    found = sorted((distance, other) for other in known  # a letter for a letter is no misspelling: E is not m
+                   if (distance := _edits(name.lower(), other.lower(), most)) <= most
+                   and distance < max(len(name), len(other)))
     return [other for _, other in found[:3]]
 
 

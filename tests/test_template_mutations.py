@@ -139,7 +139,7 @@ def misspelling_unnamed(message: str, mutated: dict[str, Any], original: dict[st
         return []
     given = {str(name) for key in ("parameters", "symbols") for name in mutated.get(key) or {}}
     stages = set(re.findall(r"[A-Za-z_]\w*", str([mutated.get("stages"), mutated.get("bodies")])))
-    brought = stages - set(re.findall(r"[A-Za-z_]\w*", str(original.get("stages"))))
+    brought = stages - set(re.findall(r"[A-Za-z_]\w*", str([original.get("stages"), original.get("bodies")])))
     return [f"{name}, a misspelling of {close[0]}, reported as nothing fixes" for name in sorted(brought)
             if (close := misspelt_as(name, given - stages))]
 

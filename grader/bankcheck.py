@@ -22,6 +22,7 @@ Sits above every stage, like :mod:`grader.demo`: it samples (assign), solves (so
 
 from __future__ import annotations
 
+import re
 import time
 from collections import Counter
 from collections.abc import Callable, Iterator, Sequence
@@ -29,11 +30,15 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from grader.assign.assignment import Assignment, ProblemSpec, Student
+from grader.assign.fair import Capped
 from grader.assign.variants import MAX_DRAWS, ProblemDraws, generate, variant_generator
 from grader.bank.folders import template_paths
 from grader.bank.template import Template, load_template, same_id
 from grader.base.errors import GraderError
+from grader.model.expr import Sym
 from grader.physics.integrate import Settings
 from grader.physics.record import Options
 from grader.render.documents import sources
@@ -55,6 +60,10 @@ MOST_DEGENERATE = 0.10
 # ... or so many draws are refused or degenerate that generate's MAX_DRAWS draws could all fail for some
 # student of a class of 2,000 with a chance above 1e-6 (2000 * 0.4**25 = 2e-7).
 MOST_UNUSABLE = 0.40
+# A cause of discarded draws (a constraint, an answer near zero, a rounding route past the cap) that discards at
+# least this share of the draws is told what to change; a rarer one is only named.
+ADVISED = 0.05
+_NUMBER = re.compile(r"[-+]?\d+(?:\.\d+)?(?:e[-+]?\d+)?")
 
 
 @dataclass(frozen=True)
@@ -124,9 +133,10 @@ class _Checks:
         worst = _stage("simulation", lambda: self._simulate(draws, [rows[i] for i in usable[:SIMULATED]]))
         _stage("typesetting", self._typeset)
         refused = sum(reason is not None for reason in result.refusals)
+        discarded = f"; {DRAWS - len(usable)} of {DRAWS} draws discarded: {self.discarded}" if self.discarded else ""
         return (f"{DRAWS} draws: {len(usable)} usable, {refused} refused, {self.degenerate} degenerate, "
                 f"{self.capped} past the ±{self.cap * 100:g} % tolerance cap ({self.widened} with a widened "
-                f"tolerance); simulation within {worst:.0e} on {SIMULATED}; sheet and key typeset")
+                f"tolerance); simulation within {worst:.0e} on {SIMULATED}; sheet and key typeset{discarded}")
 
     def _answered(self, rows: Sequence[dict[str, str]], result: Columns, draws: ProblemDraws) -> list[int]:
         """The rows answered and not degenerate; a failure when too few are (see ``MOST_DEGENERATE``)."""
@@ -148,17 +158,59 @@ class _Checks:
         usable = [row for row in answered if flaws[row] is None and fair.flaws[row] is None]
         self.cap, self.capped = self.assignment.grading.max_tolerance, len(capped)
         self.widened = sum(any(fair.tolerances[name][row].reason for name in fair.tolerances) for row in usable)
+        self.discarded = self._explained([reason for reason in result.refusals if reason is not None],
+                                         [str(flaws[row]) for row in degenerate],
+                                         [cause for row in capped if (cause := fair.capped[row]) is not None])
         if len(usable) < (1 - MOST_UNUSABLE) * DRAWS:
             example = f", e.g. {fair.flaws[capped[0]]} at {self._shown(rows[capped[0]])}" if capped else ""
-            advice = ("narrow the sampling toward variants that rounding moves less, or raise grading.max_tolerance"
-                      if len(capped) > DRAWS - len(answered) + len(degenerate) else "widen what the constraints allow")
             raise _CheckError(f"draws: only {len(usable)} of {DRAWS} sampled draws are usable ({DRAWS - len(answered)} "
                               f"refused, {len(degenerate)} degenerate, {len(capped)} past the tolerance cap{example}); "
                               f"generate draws at most {MAX_DRAWS} times per student, so in a class of 2,000 some "
                               f"student would get no variant (at most {MOST_UNUSABLE:.0%} of the draws may be "
-                              f"unusable: {advice})")
+                              f"unusable): {self.discarded}")
         self.degenerate = len(degenerate)
         return usable
+
+    def _explained(self, refusals: Sequence[str], flaws: Sequence[str], capped: Sequence[Capped]) -> str:
+        """Why draws were discarded, one cause a clause, most first: what refused them or which answer sat at a
+        degenerate point or passed the tolerance cap; a cause of at least ``ADVISED`` of the draws says what to
+        change."""
+        causes: list[tuple[int, str, str]] = []
+        by_reason: dict[str, list[str]] = {}
+        for reason in refusals:  # a physics check's reason holds the value: group without numbers
+            by_reason.setdefault(_NUMBER.sub("#", reason), []).append(reason)
+        for same in by_reason.values():
+            causes.append((len(same), f"refused{'' if len(set(same)) == 1 else ', e.g.'} because {same[0]}",
+                           "narrow the sampling to where it holds, or widen what the constraints allow"))
+        for flaw, count in Counter(flaw.split(" = ")[0] for flaw in flaws).items():
+            causes.append((count, f"with {flaw} too close to zero to grade with a relative tolerance",
+                           "narrow the sampling away from where it vanishes, or give the answer an atol")
+                          if flaw.startswith("answer ") else
+                          (count, f"with {flaw} within 0.01 of 0 or 1",
+                           "narrow the sampling away from e = 0 and e = 1"))
+        groups: dict[tuple[str, str, str], list[float]] = {}
+        for cause in capped:
+            groups.setdefault((cause.answer, cause.route, cause.moved_by), []).append(cause.needed)
+        for (answer, route, moved_by), needed in groups.items():
+            causes.append((len(needed), f"with answer {answer}'s tolerance widened past the ±{self.cap * 100:g} % cap "
+                           f"by rounding {moved_by} along {route} (typical ±{float(np.median(needed)) * 100:.2g} %)",
+                           self._advice(answer, route)))
+        return "; ".join(f"{count} {what}" + (f": {advice}" if count >= ADVISED * DRAWS else "")
+                         for count, what, advice in sorted(causes, key=lambda cause: -cause[0]))
+
+    def _advice(self, answer: str, route: str) -> str:
+        """What to change for an answer that rounding moves past the cap."""
+        general = "narrow the sampling toward variants that rounding moves less, or raise grading.max_tolerance"
+        spec = self.template.answers[answer].value
+        for stage in self.template.scene.stages:
+            after = stage.fields.get("after") or {}
+            shared = isinstance(spec, Sym) and len(after) == 2 and all(
+                velocity.n == spec and velocity.t is None for velocity in after.values())
+            if shared and route == "the worked solution":
+                second = stage.fields["bodies"][1]
+                return (f"list {second} first in stages[{stage.index}].bodies (the worked solution finds {answer}, "
+                        f"shared by both bodies, from the first body's momentum, which cancels here), {general}")
+        return general
 
     def _simulate(self, draws: ProblemDraws, rows: Sequence[dict[str, str]]) -> float:
         """The largest relative difference between simulated and closed-form answers."""

@@ -53,7 +53,8 @@ def test_sympy_refusing_a_templates_relation_is_the_templates_error(monkeypatch:
     with pytest.raises(TemplateError) as refused:
         solver.compile_template(template)
     assert str(refused.value).startswith(f"{template.where}: stages or answers: expected expressions the solver "
-                                         "can work with (real, finite, solvable one unknown at a time), got TypeError")
+                                         "can work with (real, finite, solvable one unknown at a time), got "
+                                         "expressions the algebra cannot work with")
 
 
 # --- the key ---------------------------------------------------------------------------------------

@@ -41,12 +41,26 @@ def widened(rtol: float) -> float:
 
 
 @dataclass(frozen=True)
+class Capped:
+    """Why a variant's widened tolerance passes the cap: the ``answer``, the route whose rounding moves it most
+    (``route``, as a reason says it: ``the worked solution``), the values written down that move it most
+    (``moved_by``), and the relative tolerance it would need (``needed``, a fraction)."""
+
+    answer: str
+    route: str
+    moved_by: str
+    needed: float
+
+
+@dataclass(frozen=True)
 class Fair:
     """Per answer and parameter set: the tolerance (``tolerances[name][row]``), and per row why the
-    variant must be redrawn (``flaws[row]``, None if it need not)."""
+    variant must be redrawn (``flaws[row]``, None if it need not) and, when it is the cap, which answer and
+    route pass it (``capped[row]``)."""
 
     tolerances: Mapping[str, list[Tolerance]]
     flaws: list[str | None]
+    capped: list[Capped | None]
 
 
 def fair_tolerances(routes: Routes, configured: Mapping[str, Tolerance], units: Mapping[str, str],
@@ -70,6 +84,7 @@ def fair_tolerances(routes: Routes, configured: Mapping[str, Tolerance], units: 
 
     moves = rounding_bounds(routes, params, figures, doubtful)
     flaws: list[str | None] = [None] * size
+    capped: list[Capped | None] = [None] * size
     tolerances: dict[str, list[Tolerance]] = {}
     for name, tolerance in configured.items():
         tolerances[name] = [tolerance] * size
@@ -78,46 +93,50 @@ def fair_tolerances(routes: Routes, configured: Mapping[str, Tolerance], units: 
         needed, wider = short(name, moves[name].bound)
         value = np.asarray(values[name], dtype=float)
         for row in np.flatnonzero(wider & np.asarray(answered[name], dtype=bool)):
-            tolerances[name][row], flaw = _widen(name, tolerance, float(value[row]), float(needed[row]),
-                                                 moves[name], routes, int(row), units[name], figures, cap)
-            flaws[row] = flaws[row] or flaw
-    return Fair(tolerances, flaws)
+            tolerances[name][row], flaw, passed = _widen(name, tolerance, float(value[row]), float(needed[row]),
+                                                         moves[name], routes, int(row), units[name], figures, cap)
+            if flaws[row] is None:
+                flaws[row], capped[row] = flaw, passed
+    return Fair(tolerances, flaws, capped)
 
 
 def _widen(name: str, tolerance: Tolerance, value: float, needed: float, moves: Moves, routes: Routes, row: int,
-           unit: str, figures: int, cap: float) -> tuple[Tolerance, str | None]:
-    """The widened tolerance of one answer, and why the variant must be redrawn (or None)."""
+           unit: str, figures: int, cap: float) -> tuple[Tolerance, str | None, Capped | None]:
+    """The widened tolerance of one answer, why the variant must be redrawn (or None), and, when that is the
+    cap, what passes it."""
     if not math.isfinite(needed):
         return tolerance, (f"answer {name}: how far rounding along a solution route moves it cannot be bounded here "
-                           "(a step of the route is not finite)")
+                           "(a step of the route is not finite)"), None
     absolute = tolerance.rtol == 0 and tolerance.atol > 0
     if value == 0:  # no relative band fits; an atol that rounding overruns at 0 cannot be capped relatively
-        return tolerance, f"answer {name} is 0 and rounding along a solution route moves it more than its tolerance"
-    reason = _reason(name, value, moves, routes, row, unit, figures, absolute)
+        return tolerance, f"answer {name} is 0 and rounding along a solution route moves it more than its tolerance", \
+            None
+    moved_by, route = _moved_by(moves, routes, row)
+    bound = float(moves.bound[row])
+    # Relative, as the tolerance it explains; a band in the answer's unit (an atol) is explained in that unit.
+    moved = with_unit(f"{bound:.2g}", unit) if absolute else f"{bound / abs(value) * 100:.2g} %"
+    reason = f"rounding {moved_by} to {figures} figures along {route} moves {name} by up to {moved}"
     if absolute:
         wide = Tolerance(rtol=0.0, atol=widened(needed), reason=reason)
     else:
         wide = Tolerance(rtol=widened((needed - tolerance.atol) / abs(value)), atol=tolerance.atol, reason=reason)
     if wide.atol + wide.rtol * abs(value) > cap * abs(value):
         return tolerance, (f"answer {name} = {value:.4g} would need {wide.describe(unit)} to allow for rounding "
-                           f"({reason}), more than grading.max_tolerance (±{cap * 100:g} %)")
-    return wide, None
+                           f"({reason}), more than grading.max_tolerance (±{cap * 100:g} %)"), \
+            Capped(name, route, moved_by, wide.rtol + wide.atol / abs(value))
+    return wide, None, None
 
 
-def _reason(name: str, value: float, moves: Moves, routes: Routes, row: int, unit: str, figures: int,
-            absolute: bool) -> str:
-    """``rounding T and T′ to 4 figures along the energy route moves loss_pct by up to 1.3 %``."""
+def _moved_by(moves: Moves, routes: Routes, row: int) -> tuple[str, str]:
+    """The values written down that move an answer most along the route that moves it most (``T and T′``), and
+    that route as a reason says it (``the energy route``)."""
     index = int(moves.route[row])
     route = routes.items[index]
     shares = moves.shares[index][:, row]
     total = float(np.nansum(shares))
     named = [display_name(n) for n, share in zip(route.names, shares, strict=True)
              if total > 0 and share >= 0.2 * total][:4] or [display_name(n) for n in route.names[-1:]]
-    listed = named[0] if len(named) == 1 else ", ".join(named[:-1]) + f" and {named[-1]}"
-    bound = float(moves.bound[row])
-    # Relative, as the tolerance it explains; a band in the answer's unit (an atol) is explained in that unit.
-    moved = with_unit(f"{bound:.2g}", unit) if absolute else f"{bound / abs(value) * 100:.2g} %"
-    return f"rounding {listed} to {figures} figures along {route.says} moves {name} by up to {moved}"
+    return named[0] if len(named) == 1 else ", ".join(named[:-1]) + f" and {named[-1]}", route.says
 
 
 def display_name(name: str) -> str:

@@ -12,7 +12,7 @@ from __future__ import annotations
 import hashlib
 import math
 import re
-from collections.abc import Iterator, Mapping, Sequence
+from collections.abc import Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -340,23 +340,88 @@ def _check_names(template: Template) -> None:
             missing = names(part) - given if part is not None else set()
             if missing:
                 raise TemplateError(where, f"bodies.{body.name}.{key}", "parameters or symbols only",
-                                    ", ".join(sorted(missing)))
+                                    unknown_names(missing, given))
     for answer in template.answers.values():
         missing = names(answer.value) - quantities
         if missing:
             raise TemplateError(where, f"answers.{answer.name}.value", "names of the scene's quantities",
-                                f"unknown {', '.join(sorted(missing))}")
+                                unknown_names(missing, quantities))
         missing = set(answer.symbolic) - given
         if missing:
             raise TemplateError(where, f"answers.{answer.name}.symbolic", "parameters or symbols",
-                                ", ".join(sorted(missing)))
+                                unknown_names(missing, given))
+    _check_misspelt_quantities(template, given)
     for index, constraint in enumerate(template.constraints):
         missing = names(constraint.holds) - set(template.parameters)
         if missing:
             raise TemplateError(where, f"constraints[{index}].require", "an expression in the parameters",
-                                f"unknown {', '.join(sorted(missing))}")
+                                unknown_names(missing, template.parameters))
     _check_statement(template, given)
     _check_dimensions(template)
+
+
+def unknown_names(missing: Iterable[str], known: Iterable[str]) -> str:
+    """``unknown name e_ (did you mean e?)``: names a template uses and does not define, each with the defined names it
+    may be a misspelling of.
+
+    >>> unknown_names(["e_", "zz"], ["e", "h_drop"])
+    'unknown names e_ (did you mean e?), zz'
+    """
+    shown_names = []
+    for name in sorted(missing):
+        close = misspelt_as(name, known)
+        shown_names.append(f"{name} (did you mean {' or '.join(close)}?)" if close else name)
+    return f"unknown name{'s' if len(shown_names) > 1 else ''} " + ", ".join(shown_names)
+
+
+def misspelt_as(name: str, known: Iterable[str]) -> list[str]:
+    """The names of ``known`` that ``name`` may be a misspelling of: one letter added, dropped, changed or two
+    swapped (two edits in a name of 8 letters or more, and fewer edits than letters), or another letter case;
+    closest first, at most three.
+    Tighter than :func:`close_matches`: ``E_lost`` is not ``f_loss``.
+
+    >>> misspelt_as("e_", ["e", "h"]), misspelt_as("E_lost", ["f_loss", "E_loss"]), misspelt_as("V", ["v", "m"])
+    (['e'], ['E_loss'], ['v'])
+    """
+    most = 2 if len(name) >= 8 else 1
+    found = sorted((distance, other) for other in known  # a letter for a letter is no misspelling: E is not m
+                   if (distance := _edits(name.lower(), other.lower(), most)) <= most
+                   and distance < max(len(name), len(other)))
+    return [other for _, other in found[:3]]
+
+
+def _edits(first: str, second: str, most: int) -> int:
+    """The edits (a letter added, dropped, changed; two neighbours swapped) from one name to another, or
+    ``most + 1`` when there are more than ``most``."""
+    if abs(len(first) - len(second)) > most:
+        return most + 1
+    before, row = None, list(range(len(second) + 1))
+    for i, a in enumerate(first, 1):
+        current = [i] + [0] * len(second)
+        for j, b in enumerate(second, 1):
+            current[j] = min(row[j] + 1, current[j - 1] + 1, row[j - 1] + (a != b))
+            if before is not None and i > 1 and j > 1 and a == second[j - 2] and first[i - 2] == b:
+                current[j] = min(current[j], before[j - 2] + 1)
+        before, row = row, current
+    return min(row[-1], most + 1)
+
+
+def _check_misspelt_quantities(template: Template, given: set[str]) -> None:
+    """A name a stage uses that is not given is a quantity the solver finds; one that only that stage uses (no
+    other stage, no answer) and that looks like a parameter or symbol no stage uses is that name misspelt
+    (``restitution: e_`` for the parameter ``e``), said so here rather than as an answer nothing fixes."""
+    asked = {n for answer in template.answers.values() for n in names(answer.value)}
+    unused = sorted(given - template.scene.names())
+    for stage in template.scene.stages:
+        elsewhere = asked.union(*(other.quantities for other in template.scene.stages if other is not stage))
+        for name in sorted(stage.quantities - given - RESERVED - elsewhere):
+            close = misspelt_as(name, unused)
+            if close:
+                field = next((key for key, text in stage.source.items() if re.search(rf"\b{name}\b", text)), "")
+                kinds = [f"the {'parameter' if other in template.parameters else 'symbol'} {other}" for other in close]
+                raise TemplateError(template.where, f"stages[{stage.index}].{field}".rstrip("."),
+                                    "names of parameters, symbols or quantities the solver finds",
+                                    f"{unknown_names([name], close)}: {' and '.join(kinds)}, which no stage uses")
 
 
 def _check_dimensions(template: Template) -> None:
@@ -462,7 +527,7 @@ def _jinja_fill(template: Template, given: set[str], values: dict[str, str]) -> 
         asked = sorted(unknown & set(template.answers))
         raise TemplateError(template.where, "statement", "only parameters, symbols and g",
                             f"the answer {', '.join(asked)}, which the student finds" if asked
-                            else f"unknown {', '.join(sorted(unknown))}")
+                            else unknown_names(unknown, given | {"g"}))
     try:
         return fill_statement(template.statement, values)
     except StatementRefused as error:

@@ -138,6 +138,10 @@ def to_node(expr: Any) -> Node:
         return Sym("pi")
     if isinstance(expr, sp.Rational):
         return Num(Fraction(int(expr.p), int(expr.q)))
+    if isinstance(expr, sp.Number) and not expr.is_finite:  # sympy's oo or nan: a 0/0 or 1/0 in the scene
+        raise TemplateError(INNER, "stages or answers", "only real, finite expressions of functions the kernels know",
+                            "a value that is infinite or undefined (a 0/0 or a division by zero: e.g. a body left at "
+                            "rest that must move)")
     if isinstance(expr, sp.Number):
         return Num(float(expr))
     if isinstance(expr, sp.NumberSymbol):
@@ -154,13 +158,29 @@ def to_node(expr: Any) -> Node:
         return Op(name, (to_node(expr.lhs), to_node(expr.rhs)))
     if isinstance(expr, (sp.And, sp.Or)):
         return Op("and" if isinstance(expr, sp.And) else "or", tuple(to_node(a) for a in expr.args))
+    if isinstance(expr, sp.atan):  # sympy's own rewriting of atan2(y, x) where x > 0: the same as atan2(y/x, 1)
+        return Op("atan2", (to_node(expr.args[0]), Num(Fraction(1))))
     name = {sp.Abs: "abs", sp.atan2: "atan2"}.get(type(expr), type(expr).__name__)
     if name not in FUNCTIONS:
-        raise TemplateError(INNER, str(expr), "only real, finite expressions of functions the kernels know", name)
+        words = _IN_WORDS.get(name, "a function no expression may call")
+        made = (f"a value that is {words}" if not expr.args else f"a step the solver could only write with {words}, "
+                "having solved for a quantity inside a function: give that quantity as a parameter, or name the "
+                "function's result instead")
+        raise TemplateError(INNER, "stages or answers", "only real, finite expressions of functions the kernels know",
+                            made)
     args = tuple(to_node(a) for a in expr.args)
     if name in ("Max", "Min") and len(args) > 2:  # sympy's Max takes any number of arguments
         return Op(name, (args[0], to_node(type(expr)(*expr.args[1:]))))
     return Op(name, args)
+
+
+_IN_WORDS = {"asin": "an inverse sine", "acos": "an inverse cosine", "acot": "an inverse cotangent",
+             "asinh": "an inverse hyperbolic sine", "acosh": "an inverse hyperbolic cosine",
+             "Piecewise": "cases", "re": "a real part", "im": "an imaginary part", "arg": "a complex argument",
+             "LambertW": "Lambert's W", "floor": "a rounding down", "ceiling": "a rounding up",
+             "ImaginaryUnit": "imaginary (the square root of a negative quantity)",
+             "ComplexInfinity": "infinite (a division by zero)"}
+"""What the solver may write that the kernels cannot compute, in words (the author wrote none of it)."""
 
 
 def _add(expr: sp.Add) -> Node:

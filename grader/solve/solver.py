@@ -20,6 +20,7 @@ needs neither sympy nor this module.
 
 from __future__ import annotations
 
+import re
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, replace
 from typing import Any
@@ -486,9 +487,25 @@ class _Compiler:
         tied = sorted({str(s) for unknowns in left for s in unknowns})
         if not tied:
             return "; no stage involves it"
-        return (f"; the equations left tie {', '.join(tied)} together (two or more unknowns each) and no set of "
-                f"at most {MAX_BLOCK} of them fixes as many unknowns as it has with one closed-form solution "
-                "(polynomial, of degree at most 4 together): give one of them as a parameter")
+        return (f"; the equations left tie {', '.join(map(self._named, tied))} together (two or more unknowns each) "
+                f"and no set of at most {MAX_BLOCK} of them fixes as many unknowns as it has with one closed-form "
+                "solution (polynomial, of degree at most 4 together): give one of them as a parameter")
+
+    def _named(self, name: str) -> str:
+        """A quantity as a message names it: a name the template wrote as is; one the solver gave (the template
+        left it unnamed: :meth:`Context.unused_name`, ``base`` or ``base_<stage>``) with the stage field it
+        belongs to, e.g. ``J (stages[1].impulse, unnamed)``."""
+        numbered = re.fullmatch(r"(\w+?)_(\d+)", name)
+        base, index = (name, self.ctx.defaults[name]) if name in self.ctx.defaults else \
+            (numbered.group(1), int(numbered.group(2))) if numbered else (name, None)
+        if name in self.template.scene.names() or index is None or index >= len(self.template.scene.stages):
+            return name
+        stage = self.template.scene.stages[index]
+        velocity = re.fullmatch(r"v_(\w+)_[nt]_after", base)
+        if velocity is not None:
+            return f"{name} (stages[{index}].after.{velocity.group(1)}: {velocity.group(1)}'s velocity after, unnamed)"
+        field = next((f.name for f in CATALOGUE[stage.effect].fields if f.default == base), None)
+        return f"{name} (stages[{index}].{field}, unnamed)" if field else name
 
     def _step(self, solved: _Solved) -> Step:
         return Step(solved.unknown.name, solved.relation.label,
@@ -566,7 +583,7 @@ class _Compiler:
         """A condition (an undefined answer's, a check's) as a tree; one sympy finds always true or always false
         (the angle of a velocity the template leaves out) is the template's error."""
         if holds in (sp.true, sp.false):
-            raise TemplateError(_INNER, str(holds), "a condition that depends on the parameters",
+            raise TemplateError(_INNER, "stages or answers", "a condition that depends on the parameters",
                                 f"one that is always {str(holds).lower()}")
         difference = stabilize(holds.lhs - holds.rhs, self.degree_angles)
         # Against zero, a positive factor changes nothing: 381*v*x/1250 > 0 is x > 0.
@@ -630,12 +647,24 @@ def compile_template(template: Template) -> Compiled:
         return _Compiler(template).compile()
     except TemplateError as error:
         if error.where == _INNER:  # raised below the solver, which does not know the file
-            raise TemplateError(template.where, "stages or answers", error.expected,
-                                f"{error.key} ({error.got})") from None
+            raise TemplateError(template.where, error.key, error.expected, error.got) from None
         raise
     except SYMPY_FAILURES as error:
         if not unworkable(error):
             raise
         raise TemplateError(template.where, "stages or answers", "expressions the solver can work with (real, "
-                            "finite, solvable one unknown at a time)",
-                            f"{type(error).__name__}: {shown(str(error), 120)}") from None
+                            "finite, solvable one unknown at a time)", _failure_in_words(error)) from None
+
+
+def _failure_in_words(error: BaseException) -> str:
+    """What the algebra could not do, for an author (who wrote no Python and no sympy)."""
+    if isinstance(error, ZeroDivisionError):
+        return "a division by zero (a constant 0 where a quantity divides)"
+    if isinstance(error, ArithmeticError):
+        return "arithmetic beyond what a number can hold"
+    if isinstance(error, RecursionError):
+        return "expressions nested too deeply to work with"
+    if isinstance(error, NotImplementedError):
+        return "an equation the algebra cannot solve for its unknown: give that quantity as a parameter"
+    return ("expressions the algebra cannot work with (a value or a comparison it cannot decide): check each "
+            "stage's velocities before and after and the constants, e.g. a body left at rest that must move")

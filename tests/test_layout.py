@@ -234,3 +234,14 @@ def test_the_cache_fingerprint_changes_with_solver_source_only(tmp_path: Path) -
     effect = copy / "physics" / "effects" / "impact.py"
     effect.write_text(effect.read_text(encoding="utf-8") + "\n# physics\n", encoding="utf-8")
     assert source_fingerprint(copy) != before
+
+
+def test_every_package_folder_is_in_the_wheel() -> None:
+    """pyproject.toml lists the packages a wheel carries: a new folder left out installs without it (the
+    editable install used in development would not notice; the slow wheel test would, much later)."""
+    import tomllib
+
+    listed = set(tomllib.loads((PACKAGE.parent / "pyproject.toml").read_text(encoding="utf-8"))
+                 ["tool"]["setuptools"]["packages"])
+    folders = {".".join(path.parent.relative_to(PACKAGE.parent).parts) for path in PACKAGE.rglob("__init__.py")}
+    assert folders <= listed, f"package folders pyproject.toml does not list: {sorted(folders - listed)}"

@@ -30,7 +30,7 @@ from grader.assign.deadlines import (
     zone_from,
 )
 from grader.bank.template import Parameter, Template, tolerance_in
-from grader.base.errors import GraderError, TemplateError, shown
+from grader.base.errors import GraderError, TemplateError, refuse_unknown_fields, shown
 from grader.base.inputs import read_csv, read_yaml
 from grader.model.tolerance import ANSWER_SIG_FIGS, FORMS
 
@@ -173,12 +173,7 @@ def grading_from(raw: Any, where: str, field: str = "grading") -> Grading:
     if not isinstance(raw, Mapping):
         raise TemplateError(where, field, "a mapping {" + ", ".join(f"{name}: {values}" for name, values
                                                                       in GRADING_FIELDS.items()) + "}", shown(raw))
-    for name in raw:
-        if name not in GRADING_FIELDS:
-            close = difflib.get_close_matches(str(name), list(GRADING_FIELDS), n=1, cutoff=0.6)
-            hint = f" (did you mean {close[0]}?)" if close else ""
-            raise TemplateError(where, f"{field}.{shown(name, 40) if not isinstance(name, str) else name}",
-                                f"one of {', '.join(sorted(GRADING_FIELDS))}{hint}", "an unknown field")
+    refuse_unknown_fields(raw, sorted(GRADING_FIELDS), where, field)
     value = raw.get("numeric_expressions", True)
     if not isinstance(value, bool):
         raise TemplateError(where, f"{field}.numeric_expressions", "true or false", shown(value))
@@ -261,7 +256,6 @@ def _number(value: Any) -> bool:
 
 def check_against_bank(assignment: Assignment, bank: Mapping[str, Template]) -> None:
     """Every problem's template exists; fixed and narrowed parameters exist and lie in the domain."""
-    import difflib
 
     for index, problem in enumerate(assignment.problems):
         key = f"problems[{index}]"

@@ -36,7 +36,7 @@ from fractions import Fraction
 from functools import lru_cache
 from typing import Any
 
-from grader.base.errors import TemplateError, shown
+from grader.base.errors import TemplateError, refuse_unknown_fields, shown
 
 DEFAULT_ZONE = "UTC"
 PER = {"day": timedelta(days=1), "hour": timedelta(hours=1)}
@@ -97,12 +97,7 @@ def late_from(raw: Any, where: str, field: str = "late") -> LatePolicy:
     refused with the nearest known one, a value that does not read with what it takes."""
     if not isinstance(raw, Mapping):
         raise TemplateError(where, field, "a mapping {" + ", ".join(LATE_FIELDS) + "}", shown(raw))
-    for name in raw:
-        if name not in LATE_FIELDS:
-            close = difflib.get_close_matches(str(name), list(LATE_FIELDS), n=1, cutoff=0.6)
-            hint = f" (did you mean {close[0]}?)" if close else ""
-            raise TemplateError(where, f"{field}.{shown(name, 40) if not isinstance(name, str) else name}",
-                                f"one of {', '.join(LATE_FIELDS)}{hint}", "an unknown field")
+    refuse_unknown_fields(raw, LATE_FIELDS, where, field)
     if "deduct" not in raw:
         raise TemplateError(where, f"{field}.deduct", LATE_FIELDS["deduct"], "none")
     per = raw.get("per", "day")

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import re
 import reprlib
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from typing import Any
 
 _SHOWN = reprlib.Repr()  # keyword arguments need Python 3.12
@@ -106,6 +106,20 @@ def close_matches(name: str, choices: Iterable[str]) -> list[str]:
     import difflib
 
     return difflib.get_close_matches(name, list(choices), n=3, cutoff=0.5)
+
+
+def refuse_unknown_fields(raw: Mapping[Any, Any], known: Iterable[str], where: str, field: str) -> None:
+    """Refuse the first entry of the mapping ``raw`` (the ``field`` of file ``where``) whose name is not one of
+    ``known``, with the nearest known name (``grading.max_tolerence``: did you mean max_tolerance?)."""
+    import difflib
+
+    names = list(known)
+    for name in raw:
+        if name not in names:
+            close = difflib.get_close_matches(str(name), names, n=1, cutoff=0.6)
+            hint = f" (did you mean {close[0]}?)" if close else ""
+            raise TemplateError(where, f"{field}.{name if isinstance(name, str) else shown(name, 40)}",
+                                f"one of {', '.join(names)}{hint}", "an unknown field")
 
 
 class GraderError(Exception):

@@ -183,6 +183,9 @@ def build_parser() -> argparse.ArgumentParser:
     grading.add_argument("--canvas", type=Path, metavar="EXPORT.csv",
                          help="a Canvas gradebook export (Grades > Export): canvas.csv then has its students, names "
                               "and ids, and its 'Title (id)' column of the assignment")
+    grading.add_argument("--missing", choices=("zero", "blank"),
+                         help="what canvas.csv gives a student who submitted nothing: 0, or no score (the export's "
+                              "cell, or an empty one); by default 0 unless the --canvas export shows a grade, kept")
     grading.add_argument("--force", action="store_true",
                          help="replace an output folder an earlier run of this command wrote (as its "
                               ".grader-manifest.json says)")
@@ -644,7 +647,7 @@ def _grade(arguments: argparse.Namespace) -> int:
     from grader.grade.run import run as run_grading
 
     summary = run_grading(arguments.key, arguments.submissions, arguments.out, arguments.format, arguments.force,
-                          arguments.canvas, _lazy_bank(arguments))
+                          arguments.canvas, _lazy_bank(arguments), arguments.missing)
     print(_graded_line(summary), file=sys.stderr)
     if summary.ignored_columns:
         print(f"columns ignored: {some(list(summary.ignored_columns))}", file=sys.stderr)

@@ -20,8 +20,8 @@ EXPORT = Path("export.csv")  # relative, as a user types it: problems.csv names 
 # (id, name, email, answers given to 1a and 1b: correct 6.26 and 0.5, or nothing)
 KEY_STUDENTS = [
     ("00123", "Jane Doe", "jane.doe@uni.edu", {"1a": "6.26", "1b": "0.5"}),  # 10 points; by SIS User ID
-    ("s2002", "Li Wei", "li.wei@uni.edu", {"1a": "6.26"}),  # 4 points; by SIS Login ID, in other case
-    ("s2003", "Ana Ruiz", "ana.ruiz@uni.edu", {}),  # 0 points; by email (the SIS Login ID is the email)
+    ("s2002", "Li Wei", "li.wei@uni.edu", {"1a": "6.26"}),  # 4 points; by name (the login is in other case)
+    ("s2003", "Ana Ruiz", "ana.ruiz@uni.edu", {}),  # 0 points; by name (the login is the email in other case)
     ("00126", "Eve Adams", "eve.adams@uni.edu", {"1b": "0.5"}),  # 6 points; SIS User ID lost its zeros
     ("s2004", "Omar Haddad", "omar.haddad@uni.edu", {"1a": "6.26"}),  # not in the export
 ]
@@ -39,10 +39,15 @@ EXPORT_TEXT = (
 )
 
 CANVAS_HEADER = ["Student", "ID", "SIS User ID", "SIS Login ID", "Section", "Homework 3 (12345)"]
-NOT_IN_KEY = ("Canvas student 'Stranger, Sam' is not in the key (by SIS User ID, SIS Login ID or email): "
-              "no score written, the export's score kept")
-NOT_IN_EXPORT = ("in the key but not in the Canvas export: no score can be imported for them (dropped the course, "
-                 "or enrolled under another id?)")
+BY = "(by ID, SIS User ID, SIS Login ID or a name of one key student)"
+NOT_IN_KEY = f"Canvas student 'Stranger, Sam' is not in the key {BY}: no score written, the export's cell kept"
+NOT_IN_EXPORT = (f"in the key but not in the Canvas export {BY}: no score can be imported for them (dropped the "
+                 "course, or enrolled under another id?)")
+
+
+def by_name(name: str, key_name: str) -> str:
+    return (f"matched by name, '{name}' is the key's {key_name}: no ID, SIS User ID or SIS Login ID of the row is "
+            "the key's; check it is the same student")
 
 
 def key_document() -> dict[str, object]:
@@ -83,9 +88,10 @@ def cells(path: Path) -> list[list[str]]:
 @pytest.mark.parametrize("encoding", ["utf-8-sig", "utf-16"])  # Canvas writes a BOM; Excel's "Unicode text"
 def test_canvas_csv_has_the_exports_students_ids_and_assignment_column(folder: Path, capsys: pytest.CaptureFixture[str],
                                                                        encoding: str) -> None:
-    """Matched by SIS User ID, by login (any case), by email, and by an id whose zeros a spreadsheet ate;
-    a name that is a formula is guarded; the Canvas student not in the key keeps the export's 7.50; the
-    points-possible, manual-posting and test-student rows are not students."""
+    """Matched by SIS User ID, by an id whose zeros a spreadsheet ate, and by name where the login is the
+    key's in another case (Canvas compares logins exactly); a name that is a formula is written exactly
+    (Canvas matches on it); the Canvas student not in the key keeps the export's 7.50, as a plain number;
+    the points-possible, manual-posting and test-student rows are not students."""
     EXPORT.write_bytes(EXPORT_TEXT.encode(encoding))
     code, out, err = grade(capsys, "g", "--json")
     assert code == 0, err  # caveats only: every submission row was graded
@@ -95,19 +101,23 @@ def test_canvas_csv_has_the_exports_students_ids_and_assignment_column(folder: P
         ["Doe, Jane", "4321", "00123", "jdoe", "Section 1", "10"],
         ["Wei, Li", "4322", "", "S2002", "Section 1", "4"],
         ["Ruiz, Ana", "4323", "", "Ana.Ruiz@UNI.edu", "Section 2", "0"],
-        ["'=HYPERLINK(\"http://x\"), Eve", "4325", "126", "eadams", "Section 2", "6"],
+        ["=HYPERLINK(\"http://x\"), Eve", "4325", "126", "eadams", "Section 2", "6"],
         ["Stranger, Sam", "4330", "99999", "sstranger", "Section 2", "7.5"],
     ]
     assert cells(folder / "g" / "problems.csv") == [
         ["file", "line", "student_id", "label", "reason"],
+        ["export.csv", "5", "s2002", "", by_name("Wei, Li", "Li Wei")],
+        ["export.csv", "6", "s2003", "", by_name("Ruiz, Ana", "Ana Ruiz")],
         ["export.csv", "7", "00126", "", "leading zeros restored: 126 -> 00126"],
         ["export.csv", "8", "99999", "", NOT_IN_KEY],
         ["export.csv", "", "s2004", "", NOT_IN_EXPORT],
     ]
     summary = json.loads(out)
     assert summary["rows_not_graded"] == 0
-    assert "export.csv: 5 Canvas students, 4 scored from the key; key students not in the export: 1 " \
+    assert "export.csv: 5 Canvas students, 4 matched to the key (2 by name); key students not in the export: 1 " \
            "(see problems.csv)" in summary["notes"]
+    assert ("export.csv: of the key's students who submitted nothing, 1 got 0 (the export shows no grade for "
+            "them)") in summary["notes"]
     assert "note: export.csv: 5 Canvas students" in err
 
 
@@ -120,13 +130,14 @@ def test_reruns_with_an_export_are_byte_identical(folder: Path, capsys: pytest.C
 
 @pytest.mark.parametrize(("header", "written", "note"), [
     ("Quiz 1 (12346)", "Homework 3", "export.csv: no column 'Homework 3 (id)'; canvas.csv's column is titled "
-                                     "'Homework 3': Canvas updates the assignment of exactly that title, or "
-                                     "creates one"),
+                                     "'Homework 3': Canvas updates the published assignment of exactly that "
+                                     "title, or creates one"),
     ("homework  3 (12345)", "homework  3 (12345)", "export.csv: the column 'homework  3 (12345)' taken as the key's "
                                                    "assignment 'Homework 3' (the titles differ in case or spacing)"),
     ("Homework 3 (12345)", "Homework 3 (12345)", "export.csv: Canvas gives 'Homework 3 (12345)' 20 points possible, "
-                                                 "the key's students can earn 10: change the assignment's points in "
-                                                 "Canvas, or the scores read as a fraction of 20"),
+                                                 "the key's students can earn 10: canvas.csv keeps Canvas' 20; change "
+                                                 "the assignment's points in Canvas, or the scores read as a fraction "
+                                                 "of 20"),
 ])
 def test_the_assignment_column_and_its_points_are_noted_when_they_do_not_fit(
         folder: Path, capsys: pytest.CaptureFixture[str], header: str, written: str, note: str) -> None:
@@ -155,7 +166,7 @@ def test_an_excused_student_and_a_second_row_of_one_student_keep_the_exports_cel
     reasons = [(row[1], row[2], row[4]) for row in cells(folder / "g" / "problems.csv")[1:3]]
     assert reasons == [("2", "00123", "excused (EX) in Canvas: EX kept, the key's score not written"),
                        ("4", "s2002", "names the key student s2002, as line 3 does: no score written, the export's "
-                                      "score kept")]
+                                      "cell kept")]
 
 
 def test_scores_of_400_digits_are_kept_as_text_never_infinite(folder: Path, capsys: pytest.CaptureFixture[str]) -> None:
@@ -180,7 +191,7 @@ def test_a_row_with_more_cells_than_the_header_is_left_out_and_said_so(folder: P
                       '"Stranger; Sam";4330;99999;sstranger;Section 2;7,50\n', encoding="utf-8")
     assert grade(capsys)[0] == 0
     assert [row[0] for row in cells(folder / "g" / "canvas.csv")[2:]] == ["Doe, Jane", "Stranger; Sam"]
-    assert cells(folder / "g" / "canvas.csv")[-1][-1] == "7,50"  # a decimal comma Canvas' import reads
+    assert cells(folder / "g" / "canvas.csv")[-1][-1] == "7.5"  # the decimal comma read as Canvas' import reads it
     assert cells(folder / "g" / "problems.csv")[1] == [
         "export.csv", "3", "s2002", "", "7 cells, but the header has 6 columns; expected one cell per column: left "
                                         "out of canvas.csv"]
@@ -211,8 +222,8 @@ def test_the_exports_own_student_columns_are_written_in_canvas_order(
     ("Student,ID,SIS User ID,SIS Login ID,Section,Homework 3 (12345)\n    Points Possible,,,,,10\n",
      "export.csv: no student rows; expected a Canvas gradebook export"),
     ('Student,ID,SIS User ID,SIS Login ID,Section,Homework 3 (12345)\n"Roe, Al",7,555,aroe,S1,\n',
-     "export.csv: none of its 1 students is in the key key.json (by SIS User ID, SIS Login ID or email); "
-     "expected the Canvas gradebook export of this assignment's course"),
+     "export.csv: none of its 1 students is in the key key.json (by ID, SIS User ID, SIS Login ID or a name of one "
+     "key student); expected the Canvas gradebook export of this assignment's course"),
     ('Student,ID,SIS User ID,SIS Login ID,Section,Homework 3 (1),Homework 3 (2)\n"Doe, Jane",1,00123,jdoe,S1,,\n',
      "export.csv: line 1: the columns 'Homework 3 (1)' and 'Homework 3 (2)' both have the key's assignment title "
      "'Homework 3'; expected one"),

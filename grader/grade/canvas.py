@@ -1,23 +1,25 @@
 """A Canvas gradebook export (Grades > Export), read for ``grader grade --canvas``: its students matched
 to the key's and the key's assignment found among its columns, so that ``canvas.csv`` carries Canvas'
-own rows, names and ids and updates the assignment that already exists.
+own rows, names and ids and updates the assignment that already exists (:mod:`grader.grade.canvas_file`
+decides each cell).
 
 Canvas writes the student columns ``Student, ID, SIS User ID, SIS Login ID, Section`` (``LastName,
 FirstName`` for ``Student`` where a course shows names so; ``SIS User ID``, ``Integration ID`` and
 ``Root Account`` only for some users and accounts), then custom columns, a ``Title (id)`` column per
 assignment and the totals. Then come rows that are no students (``    Points Possible``; a row of
-``Manual Posting`` or ``Muted`` marks), the students, and the test student (``Student, Test``) last.
-Its import finds a row's student by ``ID`` (then SIS User ID, SIS Login ID, name) and reads the student
-columns by position, so ``canvas.csv`` writes the ones the export has, in Canvas' order; it finds the
-assignment by the id in ``Title (id)``, else by the exact title, else creates one.
+``Manual Posting`` marks), the students, and the test student (``Student, Test``) last. Its import
+(``lib/gradebook_importer.rb``) reads the student columns by position, so ``canvas.csv`` writes the ones
+the export has, in Canvas' order; it finds the assignment by the id in ``Title (id)``, else by the exact
+title among published assignments, else creates one.
 
-A row's student in the key is the one whose id is the row's SIS User ID (exactly, or once leading zeros
-a spreadsheet ate are restored: a caveat), else whose id or email is its SIS Login ID (ignoring case),
-else whose email is in an ``Email`` column. A Canvas student who is nobody in the key keeps the export's
-own score, so that the import changes nothing for them (Canvas reads an empty cell as "remove the
-grade" when there is one). That, a key student absent from the export, and an excused (``EX``) student
-whose ``EX`` is kept are caveats in ``problems.csv``: every submission row was still graded, and students
-who dropped or joined late are routine, so they do not change the exit code.
+A row's student in the key is found as Canvas' import finds its own (``process_student``): by ``ID``
+(a key made from Canvas ids), then ``SIS User ID`` (exactly, or once leading zeros a spreadsheet ate are
+restored: a caveat), then ``SIS Login ID`` (the key's id or email, exactly: Canvas compares logins with
+their case), and last by name or sortable name (``Raman, Priya`` for Priya Raman), only where the name is
+one key student's and one unmatched row's: a caveat says so. A Canvas student who is nobody in the key,
+a second row of one key student, and a key student absent from the export are caveats in
+``problems.csv``: every submission row was still graded, and students who dropped or joined late are
+routine, so they do not change the exit code.
 
 >>> import pathlib, tempfile
 >>> from grader.grade.key import Key, KeyStudent
@@ -26,68 +28,73 @@ who dropped or joined late are routine, so they do not change the exit code.
 >>> path = pathlib.Path(tempfile.mkdtemp()) / "export.csv"
 >>> _ = path.write_text("Student,ID,SIS User ID,SIS Login ID,Section,Homework 3 (12345),Current Score\\n"
 ...                     "    Points Possible,,,,,10.00,(read only)\\n"
-...                     '"Doe, Jane",4321,123,jdoe,Sec 1,,\\n"Roe, Sam",4322,,sroe,Sec 1,7.50,75\\n')
+...                     '"Doe, Jane",4321,123,jdoe,Sec 1,,\\n"Wei, Li",4322,,lwei,Sec 1,7.50,75\\n')
 >>> export = read_export(path, key)
->>> export.columns, export.assignment
-(('Student', 'ID', 'SIS User ID', 'SIS Login ID', 'Section'), 'Homework 3 (12345)')
->>> [(row.identity[0], row.key_id, row.kept) for row in export.rows]
-[('Doe, Jane', '00123', None), ('Roe, Sam', None, 7.5)]
->>> [(p.line, p.student_id, p.reason.split(" (")[0]) for p in export.problems]  # doctest: +NORMALIZE_WHITESPACE
-[(3, '00123', 'leading zeros restored: 123 -> 00123'), (4, 'sroe', "Canvas student 'Roe, Sam' is not in the key"),
- (0, 's2', 'in the key but not in the Canvas export: no score can be imported for them')]
+>>> export.columns, export.assignment, export.points
+(('Student', 'ID', 'SIS User ID', 'SIS Login ID', 'Section'), 'Homework 3 (12345)', '10.00')
+>>> [(row.identity[0], row.key_id, row.current, row.by_name) for row in export.rows]
+[('Doe, Jane', '00123', '', False), ('Wei, Li', 's2', '7.50', True)]
+>>> [(p.line, p.student_id, p.reason.split(":")[0]) for p in export.problems]
+[(3, '00123', 'leading zeros restored'), (4, 's2', "matched by name, 'Wei, Li' is the key's Li Wei")]
 """
 
 from __future__ import annotations
 
-import math
 import re
-from collections import defaultdict
+from collections import Counter, defaultdict
 from collections.abc import Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from grader.base.errors import GraderError, shown
 from grader.base.files import shown_path
-from grader.base.inputs import CsvRow, CsvStream, open_csv
-from grader.grade.columns import EMAIL, normalized
+from grader.base.inputs import CsvStream, open_csv
+from grader.grade.columns import normalized
 from grader.grade.key import Key
 from grader.grade.submissions import TEST_STUDENTS, Roster, RowProblem, StudentRef
 
 STUDENT_COLUMNS = ("Student", "LastName", "FirstName", "ID", "SIS User ID", "SIS Login ID", "Integration ID",
-                   "Root Account", "Section")  # in the order Canvas' import reads them
+                   "Root Account", "Section")  # in the order Canvas' export writes and its import reads them
 _REQUIRED = ("ID", "SIS Login ID", "Section")
-_TITLE_ID = re.compile(r"(?P<title>.*)\s\((?P<id>\d+)\)")  # Canvas' own pattern for "Title (id)"
+TITLE_ID = re.compile(r"(?P<title>.*)\s\((?P<id>\d+)\)")  # Canvas' Assignment.title_and_id: "Title (id)"
 _POSTING = re.compile(r"\s*(?:muted|manual posting.*)?\s*", re.I)  # every cell of Canvas' posting row
-_SCORE = re.compile(r"-?\d+(?:\.\d+)?")  # a score as Canvas exports it; "7,50" (decimal comma) stays text
 _EXPECTED = ("a Canvas gradebook export (Grades > Export) with the columns Student (or LastName and FirstName), "
              "ID, SIS Login ID and Section")
-_KEPT = "no score written, the export's score kept"
+_KEPT = "no score written, the export's cell kept"
+_BY = "by ID, SIS User ID, SIS Login ID or a name of one key student"
 MAX_ROWS = 100_000
 """Rows an export may have: more than any course has students (tens of thousands at most). The rows kept
 take a few hundred bytes a student; a 64 MiB file of short rows would be millions of them."""
+_SUFFIXES = re.compile(r"(Sn?r\.?|Senior|Jn?r\.?|Junior|II|III|IV|V|VI|Esq\.?|Esquire)", re.I)  # Canvas' User
 
 
 @dataclass(frozen=True, slots=True)
 class CanvasRow:
-    """A student row of the export: its student columns as exported, and the key student whose score
-    it takes, or (``key_id`` None) the export's own score ``kept``: a number, text such as ``EX``, or
-    None when empty."""
+    """A student row of the export: its student columns as exported, its cell of the assignment as
+    exported (``current``: stripped, as Canvas' import strips it; "" without a column), and the key
+    student whose score it may take (None: nobody's, its cell stays as exported); ``by_name``: matched by
+    name, as Canvas' import matches last."""
 
     line: int
     identity: tuple[str, ...]
     key_id: str | None
-    kept: float | str | None = None
+    current: str = ""
+    by_name: bool = False
 
 
 @dataclass(frozen=True)
 class CanvasExport:
     """What ``canvas.csv`` takes from an export: the student columns (Canvas' names, in its order),
     the assignment column's header (the export's ``Title (id)``, or the key's title when it has
-    none), the student rows in export order, the caveats for ``problems.csv`` and notes."""
+    none) and its cells of Canvas' points-possible and posting rows (None without the row or the column),
+    the student rows in export order, the caveats for ``problems.csv`` and notes."""
 
     path: Path
     columns: tuple[str, ...]
     assignment: str
+    found: bool  # whether the export has the assignment's column
+    points: str | None
+    posting: str | None
     rows: tuple[CanvasRow, ...]
     problems: tuple[RowProblem, ...]
     notes: tuple[str, ...]
@@ -106,29 +113,34 @@ def read_export(path: Path, key: Key) -> CanvasExport:
     stream = open_csv(path, exports=True)
     columns = _student_columns(stream)
     assignment = _assignment_column(stream, key.title)
-    finder = _Finder(key, next((h for h in stream.header if normalized(h) in EMAIL), None))
+    finder = _Finder(key)
     read = _read_rows(stream, columns, assignment, finder)
+    _match_by_name(read, finder, shown_path(path))
     if not read.taken:
         raise _unrelated(path, key, len(read.rows))
-    missing = [s.id for s in key.students if s.id not in read.taken]
-    problems = [*read.problems, *(RowProblem(shown_path(path), 0, student_id, "", "in the key but not in the Canvas "
-                                             "export: no score can be imported for them (dropped the course, or "
-                                             "enrolled under another id?)", caveat=True) for student_id in missing)]
-    notes = [*_assignment_notes(stream, assignment, key), *_points_notes(stream, assignment, read.points, key),
-             f"{path}: {len(read.rows)} Canvas students, {sum(r.key_id is not None for r in read.rows)} scored from "
-             f"the key; key students not in the export: {len(missing)} (see problems.csv)"]
-    return CanvasExport(path, tuple(columns), assignment or key.title, tuple(read.rows), tuple(problems), tuple(notes))
+    missing = [s for s in key.students if s.id not in read.taken]
+    problems = sorted((*read.problems, *(_absent(shown_path(path), s.id, finder.lines_named(s.name, read))
+                                         for s in missing)), key=lambda p: (p.line == 0, p.line))
+    by_name = sum(row.by_name for row in read.rows)
+    notes = [*_assignment_notes(stream, assignment, key),
+             f"{path}: {len(read.rows)} Canvas students, {sum(r.key_id is not None for r in read.rows)} matched to "
+             f"the key ({by_name} by name); key students not in the export: {len(missing)} (see problems.csv)"]
+    return CanvasExport(path, tuple(columns), assignment or key.title, assignment is not None, read.points,
+                        read.posting, tuple(read.rows), tuple(problems), tuple(notes))
 
 
 @dataclass(slots=True)
 class _Read:
     """What the rows of an export gave: its student rows and caveats, the key students taken (and the
-    line that took each), and the assignment's cell of Canvas' points-possible row (None without one)."""
+    line that took each), the assignment's cells of Canvas' points-possible and posting rows (None without
+    one), and each unmatched row's name and shown id (by its place in ``rows``), for the match by name."""
 
     rows: list[CanvasRow] = field(default_factory=list)
     problems: list[RowProblem] = field(default_factory=list)
     taken: dict[str, int] = field(default_factory=dict)
     points: str | None = None
+    posting: str | None = None
+    unmatched: dict[int, tuple[str, str]] = field(default_factory=dict)
 
 
 def _read_rows(stream: CsvStream, columns: Mapping[str, str], assignment: str | None, finder: _Finder) -> _Read:
@@ -138,35 +150,78 @@ def _read_rows(stream: CsvStream, columns: Mapping[str, str], assignment: str | 
         if count > MAX_ROWS:
             raise GraderError(f"{stream.path}: line {row.line}: more than {MAX_ROWS:,} rows; expected a Canvas "
                               "gradebook export, a row per student of one course (tens of thousands at most)")
-        if read.points is None and "points possible" in row.cells[first].lower():
-            read.points = row.cells[assignment] if assignment else ""
+        if "Points Possible" in row.cells[first]:  # as Canvas' import tells the row
+            read.points = row.cells[assignment] if assignment and read.points is None else read.points
+            continue
+        if all(_POSTING.fullmatch(cell) for cell in row.cells.values()):
+            read.posting = row.cells[assignment] if assignment else None
+            continue
         who = {name: row.cells[header] for name, header in columns.items()}
-        name = who.get("Student") or f"{who.get('LastName', '')}, {who.get('FirstName', '')}"
-        if not _is_student(row, name):
+        if not _is_student(who):
             continue
         if row.problem is not None:
             read.problems.append(RowProblem(file, row.line, _canvas_id(who), "",
                                             f"{row.problem.split(': ', 1)[-1]}: left out of canvas.csv", caveat=True))
             continue
         current = row.cells[assignment] if assignment else ""
-        key_id, caveat = finder.find(who, row.cells)
-        reason = _not_scored(key_id, name, read.taken, current)
-        if key_id is not None:
-            read.taken.setdefault(key_id, row.line)
-        if reason or caveat:
-            read.problems.append(RowProblem(file, row.line, key_id or _canvas_id(who), "", reason or caveat,
-                                            caveat=True))
-        read.rows.append(CanvasRow(row.line, tuple(who.values()), None if reason else key_id,
-                                   _kept(current) if reason else None))
+        key_id, caveat = finder.by_id(who)
+        if key_id is not None and key_id in read.taken:
+            read.problems.append(RowProblem(file, row.line, key_id, "", f"names the key student {key_id}, as line "
+                                            f"{read.taken[key_id]} does: {_KEPT}", caveat=True))
+            key_id = None
+        elif key_id is not None:
+            read.taken[key_id] = row.line
+            if caveat:
+                read.problems.append(RowProblem(file, row.line, key_id, "", caveat, caveat=True))
+        else:
+            read.unmatched[len(read.rows)] = (_name(who), _canvas_id(who))
+        read.rows.append(CanvasRow(row.line, tuple(who.values()), key_id, current))
     return read
+
+
+def _match_by_name(read: _Read, finder: _Finder, file: str) -> None:
+    """Match the rows no id matched by name (Canvas' import: ``s.name == name || s.sortable_name == name``),
+    where the name is one key student's, not taken by an id, and no other unmatched row's."""
+    rows_named = Counter(name for name, _ in read.unmatched.values())
+    for index, (name, canvas_id) in read.unmatched.items():
+        row, fits = read.rows[index], finder.named(name)
+        if len(fits) == 1 and fits[0] not in read.taken and rows_named[name] == 1:
+            read.taken[fits[0]] = row.line
+            read.rows[index] = replace(row, key_id=fits[0], by_name=True)
+            read.problems.append(RowProblem(file, row.line, fits[0], "", f"matched by name, {shown(name)} is the key's "
+                                            f"{finder.names[fits[0]]}: no ID, SIS User ID or SIS Login ID of the row "
+                                            "is the key's; check it is the same student", caveat=True))
+        else:
+            read.problems.append(RowProblem(file, row.line, canvas_id, "", f"Canvas student {shown(name)} is not in "
+                                            f"the key ({_BY}){_why_not(fits, rows_named[name], read.taken)}: {_KEPT}",
+                                            caveat=True))
+
+
+def _why_not(fits: list[str], rows_named: int, taken: Mapping[str, int]) -> str:
+    """Why a row whose name is a key student's is not matched by it ("" when no key student has it)."""
+    if len(fits) > 1:
+        return f"; its name is {len(fits)} key students' ({', '.join(fits[:5])}), so it is not matched by name"
+    if fits and rows_named > 1:
+        return f"; {rows_named} rows of the export have its name, so none is matched by name"
+    if fits:
+        return f"; the key student of its name, {fits[0]}, is line {taken[fits[0]]}'s by id"
+    return ""
+
+
+def _absent(file: str, student_id: str, lines: list[int]) -> RowProblem:
+    """The caveat of a key student no row of the export matched (``lines``: unmatched rows of their name)."""
+    named = f"; line {', '.join(map(str, lines[:5]))} has their name, not matched by it (see that line)" if lines \
+        else ""
+    return RowProblem(file, 0, student_id, "", f"in the key but not in the Canvas export ({_BY}){named}: no score "
+                      "can be imported for them (dropped the course, or enrolled under another id?)", caveat=True)
 
 
 def _unrelated(path: Path, key: Key, students: int) -> GraderError:
     """The refusal of an export none of whose students is in the key."""
     if not students:
         return GraderError(f"{path}: no student rows; expected {_EXPECTED}, and a row per student")
-    return GraderError(f"{path}: none of its {students} students is in the key {key.where} (by SIS User ID, SIS "
-                       "Login ID or email); expected the Canvas gradebook export of this assignment's course")
+    return GraderError(f"{path}: none of its {students} students is in the key {key.where} ({_BY}); expected the "
+                       "Canvas gradebook export of this assignment's course")
 
 
 def _student_columns(stream: CsvStream) -> dict[str, str]:
@@ -185,7 +240,7 @@ def _student_columns(stream: CsvStream) -> dict[str, str]:
 def _assignment_column(stream: CsvStream, title: str) -> str | None:
     """The export's ``Title (id)`` column of the key's assignment: its title exactly, else ignoring
     case and spacing; None when there is none. Two are refused: the import would update one of them."""
-    titled = [(header, match["title"]) for header in stream.header if (match := _TITLE_ID.fullmatch(header))]
+    titled = [(header, match["title"]) for header in stream.header if (match := TITLE_ID.fullmatch(header))]
     found = ([header for header, text in titled if text == title]
              or [header for header, text in titled if _folded(text) == _folded(title)])
     if len(found) > 1:
@@ -199,48 +254,68 @@ def _folded(title: str) -> str:
     return " ".join(title.split()).casefold()
 
 
-def _is_student(row: CsvRow, name: str) -> bool:
-    """Whether a row is a student's: not Canvas' points-possible or posting row, nor its test student."""
-    if "points possible" in name.lower() or all(_POSTING.fullmatch(cell) for cell in row.cells.values()):
-        return False
+def _is_student(who: Mapping[str, str]) -> bool:
+    """Whether a row is a student's, not Canvas' test student."""
+    name = who.get("Student") or f"{who.get('LastName', '')}, {who.get('FirstName', '')}"
     return " ".join(name.split()).lower() not in TEST_STUDENTS
 
 
-class _Finder:
-    """The key student a Canvas row names: by SIS User ID, then SIS Login ID, then email."""
+def _name(who: Mapping[str, str]) -> str:
+    """The name Canvas' import matches a row by: ``Student``, or ``FirstName LastName``."""
+    return who["Student"] if "Student" in who else f"{who['FirstName']} {who['LastName']}".strip()
 
-    def __init__(self, key: Key, email_column: str | None) -> None:
+
+def sortable_name(name: str) -> str:
+    """A name as Canvas sorts it (``User.last_name_first``): the surname first, then a comma; a suffix
+    stays with the given names; a name with a comma already is one.
+
+    >>> sortable_name("Priya Raman"), sortable_name("John Doe Jr."), sortable_name("Raman, Priya")
+    ('Raman, Priya', 'Doe, John Jr.', 'Raman, Priya')
+    """
+    words = name.split()
+    if "," in name or len(words) < 2:
+        return name.strip()
+    suffix = [words.pop()] if len(words) > 2 and _SUFFIXES.fullmatch(words[-1]) else []
+    surname = words.pop()
+    return f"{surname}, {' '.join(words + suffix)}"
+
+
+class _Finder:
+    """The key student a Canvas row names, in the order Canvas' import finds its own: by ID, SIS User ID,
+    SIS Login ID (the key's id or email, exactly); and the key students a name fits."""
+
+    def __init__(self, key: Key) -> None:
+        self.ids = {s.id for s in key.students}
         self.roster = Roster([StudentRef(s.id, s.email) for s in key.students])
         self.logins: dict[str, list[str]] = defaultdict(list)
+        self.named_as: dict[str, list[str]] = defaultdict(list)
+        self.names = {s.id: s.name for s in key.students}
         for student in key.students:
-            self.logins[student.id.casefold()].append(student.id)
-        self.email_column = email_column
+            for login in dict.fromkeys(filter(None, (student.id, student.email.strip()))):
+                self.logins[login].append(student.id)
+            for name in dict.fromkeys(filter(None, (student.name.strip(), sortable_name(student.name)))):
+                self.named_as[name].append(student.id)
 
-    def find(self, who: Mapping[str, str], cells: Mapping[str, str]) -> tuple[str | None, str]:
+    def by_id(self, who: Mapping[str, str]) -> tuple[str | None, str]:
         """The key student's id, or None; and a caveat ("" if none)."""
+        if who["ID"] in self.ids:
+            return who["ID"], ""
         if who.get("SIS User ID"):
             found, why, _ = self.roster.find(who["SIS User ID"], by_email=False)
-            if found is not None:
+            if found is not None and (found == who["SIS User ID"] or why.startswith("leading zeros")):
                 return found, why
-        login = who["SIS Login ID"]
-        if len(self.logins.get(login.casefold(), [])) == 1:
-            return self.logins[login.casefold()][0], ""
-        for text in (login, cells[self.email_column] if self.email_column else ""):
-            found = self.roster.find(text, by_email=True)[0] if text else None
-            if found is not None:
-                return found, ""
-        return None, ""
+        found_by_login = self.logins.get(who["SIS Login ID"], []) if who["SIS Login ID"] else []
+        return (found_by_login[0], "") if len(found_by_login) == 1 else (None, "")
 
+    def named(self, name: str) -> list[str]:
+        """The key students whose name or sortable name is ``name``."""
+        return self.named_as.get(name, []) if name else []
 
-def _not_scored(key_id: str | None, name: str, taken: Mapping[str, int], current: str) -> str:
-    """Why a student row gets no score from the key, or ""."""
-    if key_id is None:
-        return f"Canvas student {shown(name)} is not in the key (by SIS User ID, SIS Login ID or email): {_KEPT}"
-    if key_id in taken:
-        return f"names the key student {key_id}, as line {taken[key_id]} does: {_KEPT}"
-    if current.upper() == "EX":
-        return "excused (EX) in Canvas: EX kept, the key's score not written"
-    return ""
+    def lines_named(self, name: str, read: _Read) -> list[int]:
+        """The lines of unmatched rows whose name is ``name``'s or its sortable form."""
+        forms = {name.strip(), sortable_name(name)}
+        return [read.rows[index].line for index, (text, _) in read.unmatched.items()
+                if text in forms and read.rows[index].key_id is None]
 
 
 def _canvas_id(who: Mapping[str, str]) -> str:
@@ -248,40 +323,13 @@ def _canvas_id(who: Mapping[str, str]) -> str:
     return who.get("SIS User ID") or who["SIS Login ID"] or who["ID"]
 
 
-def _kept(text: str) -> float | str | None:
-    """An export's score as ``canvas.csv`` writes it back: a number stays a number (so ``-1.5`` is not
-    guarded as if it were a formula), other text stays text (a number of 400 digits too: as a float
-    it would be infinite), empty is None."""
-    score = _score(text)
-    return text or None if score is None else score
-
-
-def _score(text: str) -> float | None:
-    """A score as Canvas exports it, as a finite number; None for any other text."""
-    if not _SCORE.fullmatch(text):
-        return None
-    score = float(text)
-    return score if math.isfinite(score) else None
-
-
 def _assignment_notes(stream: CsvStream, column: str | None, key: Key) -> list[str]:
     if column is None:
         return [f"{stream.path}: no column {shown(key.title + ' (id)')}; canvas.csv's column is titled "
-                f"{shown(key.title)}: Canvas updates the assignment of exactly that title, or creates one"]
-    match = _TITLE_ID.fullmatch(column)
+                f"{shown(key.title)}: Canvas updates the published assignment of exactly that title, or creates one"]
+    match = TITLE_ID.fullmatch(column)
     if match and match["title"] != key.title:
         return [f"{stream.path}: the column {shown(column)} taken as the key's assignment {shown(key.title)} "
                 "(the titles differ in case or spacing)"]
     return []
 
-
-def _points_notes(stream: CsvStream, column: str | None, points_cell: str | None, key: Key) -> list[str]:
-    """A note when Canvas' points possible for the assignment (``points_cell``: its cell of Canvas'
-    points-possible row) are not what the key's students can earn (the import does not change an existing
-    assignment's points: scores would read as a fraction of Canvas' points)."""
-    points = _score(points_cell.replace(",", ".")) if points_cell and column else None
-    if points is None or math.isclose(points, key.possible):
-        return []
-    return [f"{stream.path}: Canvas gives {shown(column)} {points:g} points possible, the key's students can "
-            f"earn {key.possible:g}: change the assignment's points in Canvas, or the scores read as a fraction of "
-            f"{points:g}"]

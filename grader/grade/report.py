@@ -1,7 +1,8 @@
 """The files a grading run writes: ``grades.csv``, ``details.csv``, ``problems.csv``, ``canvas.csv``, and
 the class report ``report.html`` (:mod:`grader.grade.class_report`).
 
-Every text cell is guarded against formula injection (:func:`grader.base.spreadsheet.safe_cell`), and
+Every text cell is guarded against formula injection (:func:`grader.base.spreadsheet.safe_cell`), but
+``canvas.csv``'s, which Canvas matches on and writes back exactly (:mod:`grader.grade.canvas_file`); and
 what came from a student or an input file shows its control characters as escapes
 (:func:`grader.base.errors.visible`: an escape sequence a student typed is not run by the terminal that
 prints the file); numbers stay numbers and are never NaN or infinite. Rows come in the key's order, so two runs on
@@ -18,7 +19,7 @@ from pathlib import Path
 from grader.base.errors import visible
 from grader.base.files import write_atomic
 from grader.base.spreadsheet import csv_pieces, number_cell, safe_cell
-from grader.grade.canvas import CanvasExport
+from grader.grade.canvas_file import CanvasFile
 from grader.grade.class_report import REPORT, class_report
 from grader.grade.compare import number_text
 from grader.grade.grading import Graded, final_scores, lateness, totals
@@ -26,11 +27,10 @@ from grader.grade.grading import Graded, final_scores, lateness, totals
 GRADES, DETAILS, PROBLEMS, CANVAS = "grades.csv", "details.csv", "problems.csv", "canvas.csv"
 
 
-def write_reports(graded: Graded, folder: Path, export: CanvasExport | None = None) -> list[Path]:
-    """Write the five files into ``folder`` (``canvas.csv`` after a Canvas ``export`` when one is
-    given); returns their paths."""
-    files = {GRADES: grades_csv(graded), DETAILS: details_csv(graded), PROBLEMS: problems_csv(graded, export),
-             CANVAS: canvas_csv(graded, export), REPORT: class_report(graded)}
+def write_reports(graded: Graded, folder: Path, canvas: CanvasFile) -> list[Path]:
+    """Write the five files into ``folder`` (``canvas.csv`` as ``canvas`` says); returns their paths."""
+    files = {GRADES: grades_csv(graded), DETAILS: details_csv(graded), PROBLEMS: problems_csv(graded, canvas),
+             CANVAS: canvas_csv(canvas), REPORT: class_report(graded)}
     for name, text in files.items():
         write_atomic(folder / name, text)
     return [folder / name for name in files]
@@ -85,33 +85,30 @@ def details_csv(graded: Graded, students_per_piece: int = 2000) -> Iterator[str]
     return csv_pieces(rows(), students_per_piece * max(1, len(columns)))
 
 
-def problems_csv(graded: Graded, export: CanvasExport | None = None) -> Iterator[str]:
+def problems_csv(graded: Graded, canvas: CanvasFile | None = None) -> Iterator[str]:
     """Every input row not graded, or graded with a caveat, with the reason; then the Canvas
     export's caveats (line empty: a key student the export lacks). In pieces, as :func:`_csv_pieces`."""
     header = [["file", "line", "student_id", "label", "reason"]]
     rows = ([p.file, p.line or None, p.student_id, p.label, p.reason]
-            for p in (*graded.problems, *(export.problems if export else ())))
+            for p in (*graded.problems, *(canvas.problems if canvas else ())))
     return _csv_pieces(itertools.chain(header, rows))
 
 
-def canvas_csv(graded: Graded, export: CanvasExport | None = None) -> Iterator[str]:
-    """A Canvas gradebook import: the student columns Canvas wants, one column of the assignment (each
-    score after the late policy's deduction), and its ``Points Possible`` row. Without an ``export``, a row
-    per student of the key, named as the key
-    names them; with one, its student rows and columns as exported, and its ``Title (id)`` header. In
-    pieces, as :func:`_csv_pieces` (an export may have 100,000 students)."""
-    key = graded.key
-    scores = final_scores(graded)
-    columns: tuple[str, ...]
-    body: Iterable[Sequence[object]]
-    if export is None:
-        columns, title = ("Student", "ID", "SIS User ID", "SIS Login ID", "Section"), key.title
-        body = ([s.name, "", s.id, s.email, s.section, scores[s.id]] for s in key.students)
-    else:
-        columns, title = export.columns, export.assignment
-        body = ([*row.identity, row.kept if row.key_id is None else scores[row.key_id]] for row in export.rows)
-    head: list[list[object]] = [[*columns, title], ["Points Possible", *[""] * (len(columns) - 1), key.possible]]
-    return _csv_pieces(itertools.chain(head, body))
+def canvas_csv(canvas: CanvasFile) -> Iterator[str]:
+    """A Canvas gradebook import: the student columns, one column of the assignment, and its ``Points
+    Possible`` row, every cell exactly as :class:`CanvasFile` has it (no formula guard: Canvas matches on
+    the text), numbers as their shortest text. In pieces (an export may have 100,000 students)."""
+    head: list[Sequence[object]] = [[*canvas.columns, canvas.title],
+                                    ["Points Possible", *[""] * (len(canvas.columns) - 1), canvas.points]]
+    body = ([*identity, cell] for identity, cell in zip(canvas.identities, canvas.cells, strict=True))
+    return csv_pieces([_exact(value) for value in row] for row in itertools.chain(head, body))
+
+
+def _exact(value: object) -> str:
+    """A ``canvas.csv`` cell: text as it is, a number as its shortest exact text, None as empty."""
+    if value is None:
+        return ""
+    return number_cell(value) if isinstance(value, float) else str(value)
 
 
 def _csv(rows: Iterable[Sequence[object]]) -> str:

@@ -19,8 +19,9 @@ from grader.bank.template import Template
 from grader.base.files import output_folder, write_manifest
 from grader.base.heap import collector_paused
 from grader.grade.canvas import CanvasExport, read_export
+from grader.grade.canvas_file import CanvasFile, canvas_file
 from grader.grade.diagnosis import physics_for
-from grader.grade.grading import Graded, counts, grade
+from grader.grade.grading import Graded, counts, final_scores, grade
 from grader.grade.key import Key, load_key
 from grader.grade.report import write_reports
 from grader.grade.submissions import StudentRef, read_submissions
@@ -53,11 +54,12 @@ class GradeSummary:
 
 def run(key_path: Path, paths: Sequence[Path], out: Path, fmt: Literal["auto", "long", "wide"] = "auto",
         force: bool = False, canvas: Path | None = None,
-        bank: Path | Mapping[str, Template] | None = None) -> GradeSummary:
+        bank: Path | Mapping[str, Template] | None = None, missing: str | None = None) -> GradeSummary:
     """Grade the submission files against the key into ``out``; ``canvas``: a Canvas gradebook export
     whose students, names and ids ``canvas.csv`` then carries; ``bank``: the templates the key was made
     from (a folder, or a mapping of templates; by default the shipped bank), for error carried forward
-    and diagnosed mistakes.
+    and diagnosed mistakes; ``missing``: what ``canvas.csv`` gives a student who submitted nothing
+    (:func:`grader.grade.canvas_file.canvas_file`).
 
     ``rows_not_graded`` counts submission rows only: the export's mismatches are caveats (see
     :mod:`grader.grade.canvas`).
@@ -70,8 +72,9 @@ def run(key_path: Path, paths: Sequence[Path], out: Path, fmt: Literal["auto", "
         key = load_key(key_path)
         export = read_export(canvas, key) if canvas is not None else None
         graded = _graded(key, paths, fmt, (), bank)
-        write_reports(graded, staging, export)
-    return _summary(graded, out, started, export)
+        made = _canvas(graded, export, missing)
+        write_reports(graded, staging, made)
+    return _summary(graded, out, started, made)
 
 
 def grade_into(folder: Path, key_path: Path, paths: Sequence[Path], out: Path, names: Sequence[str],
@@ -83,9 +86,10 @@ def grade_into(folder: Path, key_path: Path, paths: Sequence[Path], out: Path, n
     started = time.perf_counter()
     with collector_paused():
         graded = _graded(load_key(key_path), paths, "auto", names, bank, now)
-        write_reports(graded, folder)
+        made = _canvas(graded, None, None)
+        write_reports(graded, folder, made)
         write_manifest(folder, COMMAND)
-    return _summary(graded, out, started, None)
+    return _summary(graded, out, started, made)
 
 
 def _graded(key: Key, paths: Sequence[Path], fmt: Literal["auto", "long", "wide"], names: Sequence[str],
@@ -95,11 +99,19 @@ def _graded(key: Key, paths: Sequence[Path], fmt: Literal["auto", "long", "wide"
     return grade(key, submissions, physics_for(key, bank))
 
 
-def _summary(graded: Graded, out: Path, started: float, export: CanvasExport | None) -> GradeSummary:
+def _canvas(graded: Graded, export: CanvasExport | None, missing: str | None) -> CanvasFile:
+    """``canvas.csv`` of a run: who submitted anything is who has an answer to any part."""
+    columns = graded.columns.values()
+    submitted = {student.id for index, student in enumerate(graded.key.students)
+                 if any(rows[index].submitted is not None for rows in columns)}
+    return canvas_file(graded.key, final_scores(graded), submitted, export, missing)
+
+
+def _summary(graded: Graded, out: Path, started: float, canvas: CanvasFile) -> GradeSummary:
     students, columns = range(len(graded.key.students)), graded.columns.values()
     answered = sum(any(rows[index].submitted is not None for rows in columns) for index in students)
     return GradeSummary(out, len(students), answered, len(students) * len(graded.columns),
                         sum(problem.rows for problem in graded.problems if problem.not_graded),
                         sum(problem.rows for problem in graded.problems if problem.routine), counts(graded),
-                        graded.ignored_columns, (*graded.notes, *(export.notes if export else ())),
+                        graded.ignored_columns, (*graded.notes, *canvas.notes),
                         time.perf_counter() - started)

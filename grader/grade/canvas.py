@@ -57,6 +57,7 @@ STUDENT_COLUMNS = ("Student", "LastName", "FirstName", "ID", "SIS User ID", "SIS
                    "Root Account", "Section")  # in the order Canvas' export writes and its import reads them
 _REQUIRED = ("ID", "SIS Login ID", "Section")
 TITLE_ID = re.compile(r"(?P<title>.*)\s\((?P<id>\d+)\)")  # Canvas' Assignment.title_and_id: "Title (id)"
+_SKIPPED = frozenset(";, ")  # what a line Canvas' import skips is made of
 _POSTING = re.compile(r"\s*(?:muted|manual posting.*)?\s*", re.I)  # every cell of Canvas' posting row
 _EXPECTED = ("a Canvas gradebook export (Grades > Export) with the columns Student (or LastName and FirstName), "
              "ID, SIS Login ID and Section")
@@ -152,6 +153,8 @@ def _read_rows(stream: CsvStream, columns: Mapping[str, str], assignment: str | 
                               "gradebook export, a row per student of one course (tens of thousands at most)")
         if "Points Possible" in row.cells[first]:  # as Canvas' import tells the row
             read.points = row.cells[assignment] if assignment and read.points is None else read.points
+            continue
+        if all(_SKIPPED.issuperset(cell) for cell in row.cells.values()):  # Canvas' skip_lines: /^[;, ]+$/
             continue
         if all(_POSTING.fullmatch(cell) for cell in row.cells.values()):
             read.posting = row.cells[assignment] if assignment else None

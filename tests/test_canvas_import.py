@@ -249,3 +249,17 @@ def test_a_malformed_export_exits_2_with_a_clear_message(folder: Path, capsys: p
     code, _, err = grade(capsys, "--canvas", "export.csv")
     assert code == 2 and message in err and "Traceback" not in err, err
     assert not Path("g").exists()
+
+
+def test_a_key_of_canvas_ids_matches_by_id_first(tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
+                                                 capsys: pytest.CaptureFixture[str]) -> None:
+    """``process_student`` looks a row up by ``ID`` before anything else: a roster of Canvas ids matches
+    by it, whatever the SIS columns say (here another key student's SIS User ID, on a later row)."""
+    monkeypatch.chdir(tmp_path)
+    write_key(tmp_path, [("101", "Jane Doe", "jane.doe@uni.edu", {"1a": "6.26"}),
+                         ("102", "Li Wei", "li.wei@uni.edu", {"1b": "0.5"})])
+    Path("export.csv").write_text('Student,ID,SIS User ID,SIS Login ID,Section,@Home Lab 7: Impact (555)\n'
+                                  '"Doe, Jane",101,102,jdoe,S1,\n"Wei, Li",102,,lwei,S1,\n', encoding="utf-8")
+    assert grade(capsys, "--canvas", "export.csv")[0] == 0
+    assert [row[-1] for row in table(Path("g/canvas.csv"))[2:]] == ["4", "6"]
+    assert table(Path("g/problems.csv"))[1:] == []

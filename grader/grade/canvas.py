@@ -120,8 +120,10 @@ def read_export(path: Path, key: Key) -> CanvasExport:
     if not read.taken:
         raise _unrelated(path, key, len(read.rows))
     missing = [s for s in key.students if s.id not in read.taken]
-    problems = sorted((*read.problems, *(_absent(shown_path(path), s.id, finder.lines_named(s.name, read))
-                                         for s in missing)), key=lambda p: (p.line == 0, p.line))
+    named = _unmatched_lines(read)
+    problems = sorted((*read.problems, *(_absent(shown_path(path), s.id, named.get(s.name.strip(), []) or
+                                                 named.get(sortable_name(s.name), [])) for s in missing)),
+                      key=lambda p: (p.line == 0, p.line))
     by_name = sum(row.by_name for row in read.rows)
     notes = [*_assignment_notes(stream, assignment, key),
              f"{path}: {len(read.rows)} Canvas students, {sum(r.key_id is not None for r in read.rows)} matched to "
@@ -198,6 +200,15 @@ def _match_by_name(read: _Read, finder: _Finder, file: str) -> None:
             read.problems.append(RowProblem(file, row.line, canvas_id, "", f"Canvas student {shown(name)} is not in "
                                             f"the key ({_BY}){_why_not(fits, rows_named[name], read.taken)}: {_KEPT}",
                                             caveat=True))
+
+
+def _unmatched_lines(read: _Read) -> dict[str, list[int]]:
+    """The lines of the rows still matched to nobody, by their name."""
+    lines: dict[str, list[int]] = defaultdict(list)
+    for index, (name, _) in read.unmatched.items():
+        if read.rows[index].key_id is None:
+            lines[name].append(read.rows[index].line)
+    return lines
 
 
 def _why_not(fits: list[str], rows_named: int, taken: Mapping[str, int]) -> str:
@@ -313,12 +324,6 @@ class _Finder:
     def named(self, name: str) -> list[str]:
         """The key students whose name or sortable name is ``name``."""
         return self.named_as.get(name, []) if name else []
-
-    def lines_named(self, name: str, read: _Read) -> list[int]:
-        """The lines of unmatched rows whose name is ``name``'s or its sortable form."""
-        forms = {name.strip(), sortable_name(name)}
-        return [read.rows[index].line for index, (text, _) in read.unmatched.items()
-                if text in forms and read.rows[index].key_id is None]
 
 
 def _canvas_id(who: Mapping[str, str]) -> str:

@@ -9,7 +9,7 @@ nothing behind and a previous output untouched.
 from __future__ import annotations
 
 import time
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from datetime import datetime
 from pathlib import Path
@@ -26,6 +26,7 @@ from grader.grade.report import write_reports
 from grader.grade.submissions import StudentRef, read_submissions
 
 COMMAND = "grader grade"
+Extra = Callable[[Graded, Path], object]  # more files a run writes from its verdicts (each student's feedback)
 
 
 @dataclass(frozen=True)
@@ -53,11 +54,12 @@ class GradeSummary:
 
 def run(key_path: Path, paths: Sequence[Path], out: Path, fmt: Literal["auto", "long", "wide"] = "auto",
         force: bool = False, canvas: Path | None = None,
-        bank: Path | Mapping[str, Template] | None = None) -> GradeSummary:
+        bank: Path | Mapping[str, Template] | None = None, feedback: Extra | None = None) -> GradeSummary:
     """Grade the submission files against the key into ``out``; ``canvas``: a Canvas gradebook export
     whose students, names and ids ``canvas.csv`` then carries; ``bank``: the templates the key was made
     from (a folder, or a mapping of templates; by default the shipped bank), for error carried forward
-    and diagnosed mistakes.
+    and diagnosed mistakes; ``feedback``: called with the verdicts and the folder being written, to add
+    each student's feedback files (:func:`grader.handback.feedback_writer`).
 
     ``rows_not_graded`` counts submission rows only: the export's mismatches are caveats (see
     :mod:`grader.grade.canvas`).
@@ -71,11 +73,14 @@ def run(key_path: Path, paths: Sequence[Path], out: Path, fmt: Literal["auto", "
         export = read_export(canvas, key) if canvas is not None else None
         graded = _graded(key, paths, fmt, (), bank)
         write_reports(graded, staging, export)
+        if feedback is not None:
+            feedback(graded, staging)
     return _summary(graded, out, started, export)
 
 
 def grade_into(folder: Path, key_path: Path, paths: Sequence[Path], out: Path, names: Sequence[str],
-               bank: Path | Mapping[str, Template] | None = None, now: datetime | None = None) -> GradeSummary:
+               bank: Path | Mapping[str, Template] | None = None, now: datetime | None = None,
+               feedback: Extra | None = None) -> GradeSummary:
     """Grade into ``folder``, a part of an output folder still being written (the demo's ``grades/``), as
     ``grader grade --out out`` would, with the files named as in ``names`` (where they will be) and the
     manifest ``grader grade`` writes, so that ``grader grade --out out --force`` may replace it later;
@@ -84,6 +89,8 @@ def grade_into(folder: Path, key_path: Path, paths: Sequence[Path], out: Path, n
     with collector_paused():
         graded = _graded(load_key(key_path), paths, "auto", names, bank, now)
         write_reports(graded, folder)
+        if feedback is not None:
+            feedback(graded, folder)
         write_manifest(folder, COMMAND)
     return _summary(graded, out, started, None)
 

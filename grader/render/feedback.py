@@ -19,6 +19,7 @@ are inline SVG typeset by Typst.
 
 from __future__ import annotations
 
+import concurrent.futures
 import html
 import tempfile
 from collections.abc import Callable, Mapping, Sequence
@@ -40,7 +41,7 @@ from grader.render.documents import (
     file_names,
     key_source,
 )
-from grader.render.joining import join, read_part
+from grader.render.joining import Part, join, read_part
 from grader.render.typeset import compile_typst, font_paths, one_pdf, release_memory
 from grader.render.typst_text import Typ, string
 
@@ -144,22 +145,22 @@ class Feedback:
             assignment=_assignment_view(assignment), sheet=self.view(back), paper=PAPER,
             document_title=f"{assignment.title}: {back.name}, graded")
 
-    def pdf(self, back: Returned, target: Path, scratch: Path) -> None:
-        """Write the student's PDF: the marked pages, then their worked solutions as in the answer key."""
-        parts = []
-        for number, source in enumerate((self.marked_source(back), key_source(self.documents, people=[back.index]))):
-            path = scratch / f"{number}.pdf"
-            path.write_bytes(one_pdf(compile_typst(source, tagged=False, fonts=self.fonts)))
-            parts.append(read_part(path))
+    def pdf(self, back: Returned, target: Path, scratch: Path, pool: concurrent.futures.Executor) -> None:
+        """Write the student's PDF: the marked pages, then their worked solutions as in the answer key (the
+        two typeset at once in ``pool``)."""
+        sources = (self.marked_source(back), key_source(self.documents, people=[back.index]))
+        parts = [pool.submit(_typeset_part, source, scratch / f"{number}.pdf", self.fonts)
+                 for number, source in enumerate(sources)]
         assignment = self.documents.assignment
-        join(parts, target, title=f"{assignment.title}: {back.name}, graded", author=assignment.course, lang="en")
+        join([part.result() for part in parts], target, title=f"{assignment.title}: {back.name}, graded",
+             author=assignment.course, lang="en")
 
-    def page(self, back: Returned) -> str:
-        """The student's self-contained HTML page."""
+    def page(self, back: Returned, pool: concurrent.futures.Executor) -> str:
+        """The student's self-contained HTML page (its figures and worked solutions typeset at once in ``pool``)."""
         view = self.view(back)
-        figures = _svg_pages(compile_typst(_figures_source(view), "svg", fonts=self.fonts))
-        worked = _svg_pages(compile_typst(key_source(self.documents, people=[back.index]), "svg", fonts=self.fonts))
-        return _html(self.documents.assignment, view, figures, worked)
+        figures, worked = (pool.submit(_svg_pages, source, self.fonts)
+                           for source in (_figures_source(view), key_source(self.documents, people=[back.index])))
+        return _html(self.documents.assignment, view, figures.result(), worked.result())
 
     def forget(self, back: Returned) -> None:
         """Drop what was built for this student."""
@@ -177,13 +178,14 @@ def write_feedback(assignment: Assignment, generation: Generation, bank: Mapping
     feedback = Feedback(assignment, generation, bank, font_paths(tuple(font_dirs)))
     names = file_names([back.id for back in returned])
     written = []
-    with tempfile.TemporaryDirectory(prefix=".feedback-", dir=out) as scratch:
+    with tempfile.TemporaryDirectory(prefix=".feedback-", dir=out) as scratch, \
+            concurrent.futures.ThreadPoolExecutor(max_workers=2) as pool:  # Typst lets go of the GIL
         for count, (back, name) in enumerate(zip(returned, names, strict=True), start=1):
             target = out / f"{name}.{fmt}"
             if fmt == "pdf":
-                feedback.pdf(back, target, Path(scratch))
+                feedback.pdf(back, target, Path(scratch), pool)
             else:
-                write_atomic(target, feedback.page(back))
+                write_atomic(target, feedback.page(back, pool))
             feedback.forget(back)
             written.append(target)
             if count % RELEASE_EVERY == 0:
@@ -232,7 +234,14 @@ def _e(value: object) -> str:
     return html.escape(str(value), quote=True)
 
 
-def _svg_pages(result: bytes | list[bytes]) -> list[str]:
+def _typeset_part(source: str, path: Path, fonts: tuple[str, ...]) -> Part:
+    path.write_bytes(one_pdf(compile_typst(source, tagged=False, fonts=fonts)))
+    return read_part(path)
+
+
+def _svg_pages(source: str, fonts: tuple[str, ...]) -> list[str]:
+    """A source typeset as SVG, a page each."""
+    result = compile_typst(source, "svg", fonts=fonts)
     pages = [result] if isinstance(result, bytes) else result
     return [page.decode("utf-8") for page in pages]
 

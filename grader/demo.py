@@ -23,11 +23,10 @@ from grader.bank.template import Template
 from grader.base.files import output_folder, write_atomic
 from grader.base.resources import sample_dir
 from grader.grade.run import GradeSummary, grade_into
-from grader.handback import FOLDER as FEEDBACK
-from grader.handback import feedback_writer
+from grader.handback import FOLDER, feedback_writer
 from grader.render.generate import Job, Summary, load_inputs, write_outputs
 
-SUBMISSIONS, GRADES, KEY = "submissions.csv", "grades", "key.json"
+SUBMISSIONS, GRADES, KEY, FEEDBACK = "submissions.csv", "grades", "key.json", FOLDER
 
 
 @dataclass(frozen=True)

@@ -31,7 +31,8 @@ from tests.demo_output import DemoRun
 from tests.documents import all_text
 
 DOCS = all_text()  # README.md and docs/*.md
-REGRADE = "grader grade --key grader-demo/key.json grader-demo/submissions.csv --out grader-demo/grades --feedback --force"
+REGRADE = ("grader grade --key grader-demo/key.json grader-demo/submissions.csv --out grader-demo/grades --feedback "
+           "--force")
 
 
 @pytest.fixture(scope="module")

@@ -23,8 +23,8 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
-from grader.assign.returned import MarkedPart, Returned, key_variants
 from grader.assign.assignment import Assignment
+from grader.assign.returned import MarkedPart, Returned, key_variants
 from grader.assign.variants import Generation
 from grader.bank.template import Template
 from grader.base.errors import GraderError, visible
@@ -49,9 +49,10 @@ def returned(graded: Graded) -> list[Returned]:
                                     _with_unit(visible(row.parsed), row.unit), row.verdict, row.credit, row.points,
                                     visible(row.feedback), _with_unit(row.expected, row.unit), row.tolerance,
                                     shares or 0.0))
+        late_by = minutes[index]
         back.append(Returned(index, student.id, student.name, student.email, student.section, tuple(parts),
-                             _lateness(late_by) if (late_by := minutes[index]) else "", graded.deductions.get(student.id, 0.0), final[student.id],
-                             student.possible))
+                             _lateness(late_by) if late_by else "", graded.deductions.get(student.id, 0.0),
+                             final[student.id], student.possible))
     return back
 
 

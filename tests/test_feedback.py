@@ -162,6 +162,26 @@ def test_the_html_pages_hold_nothing_of_another_student(hostile: Path, demo_run:
     assert leaks(hostile, people, page_text) == []
 
 
+def test_html_pages_are_the_same_bytes_when_graded_again(hostile: Path) -> None:
+    before = {path.name: path.read_bytes() for path in hostile.iterdir()}
+    folder = hostile.parent.parent
+    assert main(["grade", "--key", str(folder / "key.json"), str(folder / "answers.csv"), "--out",
+                 str(folder / "grades"), "--feedback-format", "html", "--force"]) == 0
+    assert {path.name: path.read_bytes() for path in hostile.iterdir()} == before
+
+
+def test_a_key_whose_template_cannot_be_found_is_refused_and_nothing_is_written(
+        demo_run: DemoRun, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    key = json.loads((demo_run.out / "key.json").read_text(encoding="utf-8"))
+    key["templates"]["drop-rebound"]["sha256"] = "0" * 64
+    (tmp_path / "key.json").write_text(json.dumps(key), encoding="utf-8")
+    assert main(["grade", "--key", str(tmp_path / "key.json"), str(demo_run.out / "submissions.csv"), "--out",
+                 str(tmp_path / "grades"), "--feedback"]) == 2
+    assert "problem 1: template drop-rebound in the problem bank has changed since the key was written" in \
+        capsys.readouterr().err
+    assert not (tmp_path / "grades").exists()
+
+
 @pytest.mark.skipif(shutil.which("chromium") is None, reason="no chromium")
 def test_a_browser_draws_the_html_page(hostile: Path, tmp_path: Path) -> None:
     """Headless Chromium opens a page offline and draws it: the screenshot is not blank."""

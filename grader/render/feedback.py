@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import concurrent.futures
 import html
+import re
 import tempfile
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
@@ -263,6 +264,7 @@ def _html(assignment: Assignment, view: SheetView, figures: Sequence[str], worke
     if not view.submitted:
         head.append("<p class=\"notice\"><strong>No answers were received.</strong> Each part below shows what was "
                     "expected; your worked solutions follow.</p>")
+    figures, worked = _shared_glyphs([*figures, *worked], len(figures))
     body = [*head, *(_problem_html(problem, figure) for problem, figure in zip(view.problems, figures, strict=True))]
     body.append("<h2 id=\"worked\">Your worked solutions</h2>\n" +
                 "\n".join(f"<div class=\"page\" role=\"img\" aria-label=\"worked solutions, page {n}\">{svg}</div>"
@@ -272,6 +274,26 @@ def _html(assignment: Assignment, view: SheetView, figures: Sequence[str], worke
             "<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n"
             f"<title>{_e(title)}</title>\n<style>{_STYLE}</style>\n</head>\n<body>\n<main>\n" + "\n".join(body)
             + "\n</main>\n</body>\n</html>\n")
+
+
+_SYMBOL = re.compile(r'<symbol id="([^"]+)"[^>]*>.*?</symbol>', re.S)
+
+
+def _shared_glyphs(pages: Sequence[str], split: int) -> tuple[list[str], list[str]]:
+    """The SVG pages with each glyph defined once in the page: Typst names a glyph's ``<symbol>`` by a hash of
+    it, and a page uses a symbol by its id anywhere in the document, so a later definition that is the same
+    text is dropped (a third of the size of the worked solutions); the pages are split again at ``split``."""
+    seen: dict[str, str] = {}
+
+    def once(match: re.Match[str]) -> str:
+        whole, name = match.group(0), match.group(1)
+        if name not in seen:
+            seen[name] = whole
+            return whole
+        return "" if seen[name] == whole else whole
+
+    kept = [_SYMBOL.sub(once, page) for page in pages]
+    return kept[:split], kept[split:]
 
 
 def _problem_html(problem: ProblemView, figure: str) -> str:

@@ -17,6 +17,7 @@ from grader.bank.template import Template
 from grader.grade.feedback_rows import key_generation, key_templates, returned
 from grader.grade.grading import Graded
 from grader.render.feedback import FOLDER, Format, write_feedback
+from grader.render.generate import _progress as progress_bar
 
 __all__ = ["FOLDER", "feedback_writer"]
 
@@ -29,6 +30,8 @@ def feedback_writer(fmt: Format = "pdf", bank: Path | Mapping[str, Template] | N
     def write(graded: Graded, folder: Path) -> list[Path]:
         templates = key_templates(graded.key, bank)
         assignment, generation = key_generation(graded.key, templates)
-        return write_feedback(assignment, generation, templates, returned(graded), folder, fmt, font_dirs)
+        with progress_bar(len(generation.students), "feedback") as advance:  # a bar on a terminal only
+            return write_feedback(assignment, generation, templates, returned(graded), folder, fmt, font_dirs,
+                                  advance)
 
     return write

@@ -121,10 +121,13 @@ def test_who_submitted_nothing_gets_the_sheet_the_expected_values_and_the_worked
 
 
 def test_the_late_resubmission_says_how_late(feedback: Path, demo_run: DemoRun) -> None:
-    details = roster(demo_run.out / "grades" / "details.csv")
-    late = {row["student_id"] for row in details if row["late"] not in ("", "0")}
-    for student in late:
-        assert "late" in pdf_text(feedback / f"{student}.pdf")
+    """Zoë Keller (2027025) resubmitted 1a 309 minutes after the due time; the demo has no late policy."""
+    late = {row["student_id"]: row["late"] for row in roster(demo_run.out / "grades" / "grades.csv")
+            if row["late"] not in ("", "0")}
+    assert late == {"2027025": "309"}
+    said = [row["id"] for row in index_rows(feedback) if "Your answers came" in pdf_text(feedback / row["file"])]
+    assert said == ["2027025"]
+    assert "Your answers came 5 h 9 min late." in pdf_text(feedback / "2027025.pdf")
 
 
 @pytest.fixture(scope="module")

@@ -32,6 +32,7 @@ from grader.assign.assignment import Assignment
 from grader.assign.returned import MarkedPart, Returned
 from grader.assign.variants import Generation
 from grader.bank.template import Template
+from grader.base.errors import visible
 from grader.base.files import write_atomic
 from grader.base.spreadsheet import csv_text, number_cell, safe_cell
 from grader.render.documents import (
@@ -106,6 +107,18 @@ def _credit(part: MarkedPart) -> str:
     return f"{_points(part.score)} of {_points(part.points)} point{'' if part.points == 1 else 's'}"
 
 
+def _late(back: Returned) -> str:
+    """How late the student's answers came, and what the late policy took, in a sentence (empty: on time).
+
+    >>> _late(Returned(0, "7", "Ana", "", "", (), "2 h 5 min", 1.5, 10.0, 12.0))
+    'Your answers came 2 h 5 min late: the late policy took 1.5 points.'
+    """
+    if not back.late:
+        return ""
+    taken = f": the late policy took {_points(back.deduction)} point{'' if back.deduction == 1 else 's'}"
+    return f"Your answers came {back.late} late{taken if back.deduction else ''}."
+
+
 class Feedback:
     """The feedback files of one graded class."""
 
@@ -124,11 +137,7 @@ class Feedback:
             score = f"{_points(sum(p.score for p in parts))} of {_points(sum(p.points for p in parts))} points"
             problems.append(ProblemView(shown.key, shown.title, score, worked.given, shown.figure, views))
         total = f"{_points(back.total)} of {_points(back.possible)} points"
-        late = (f"Your answers came {back.late} late" + (f": the late policy took {_points(back.deduction)} "
-                                                         f"point{'' if back.deduction == 1 else 's'}"
-                                                         if back.deduction else "") + ".") if back.late else ""
-        return SheetView(back.name, back.id, self.documents.generation.students[back.index].student.section,
-                         total, late, back.submitted, tuple(problems))
+        return SheetView(back.name, back.id, back.section, total, _late(back), back.submitted, tuple(problems))
 
     @staticmethod
     def _mark(part: MarkedPart, description: str) -> MarkView:
@@ -194,7 +203,8 @@ def write_feedback(assignment: Assignment, generation: Generation, bank: Mapping
             if progress:
                 progress(1)
     rows: list[list[object]] = [["id", "name", "email", "file", "total"]]
-    rows += [[safe_cell(b.id), safe_cell(b.name), safe_cell(b.email), safe_cell(path.name), number_cell(b.total)]
+    rows += [[safe_cell(visible(b.id)), safe_cell(visible(b.name)), safe_cell(visible(b.email)), safe_cell(path.name),
+              number_cell(b.total)]
              for b, path in zip(returned, written, strict=True)]
     write_atomic(out / INDEX, csv_text(rows))
     return [*written, out / INDEX]

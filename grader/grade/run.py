@@ -84,7 +84,8 @@ def grade_into(folder: Path, key_path: Path, paths: Sequence[Path], out: Path, n
     """Grade into ``folder``, a part of an output folder still being written (the demo's ``grades/``), as
     ``grader grade --out out`` would, with the files named as in ``names`` (where they will be) and the
     manifest ``grader grade`` writes, so that ``grader grade --out out --force`` may replace it later;
-    ``now``: the time the grading is as at (a timestamp after it is a caveat), by default the clock's."""
+    ``now``: the time the grading is as at (a timestamp after it is a caveat), by default the clock's;
+    ``feedback``: as for :func:`run`."""
     started = time.perf_counter()
     with collector_paused():
         graded = _graded(load_key(key_path), paths, "auto", names, bank, now)

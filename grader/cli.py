@@ -186,6 +186,11 @@ def build_parser() -> argparse.ArgumentParser:
     grading.add_argument("--missing", choices=("zero", "blank"),
                          help="what canvas.csv gives a student who submitted nothing: 0, or no score (the export's "
                               "cell, or an empty one); by default 0 unless the --canvas export shows a grade, kept")
+    grading.add_argument("--feedback", action="store_true",
+                         help="also write each student's graded sheet with their worked solutions: "
+                              "DIR/feedback/ID.pdf, and DIR/feedback/index.csv (id, name, email, file, total)")
+    grading.add_argument("--feedback-format", choices=("pdf", "html"), default=None,
+                         help="pdf (default), or html: a self-contained page per student (implies --feedback)")
     grading.add_argument("--force", action="store_true",
                          help="replace an output folder an earlier run of this command wrote (as its "
                               ".grader-manifest.json says)")
@@ -609,7 +614,7 @@ def _generate(arguments: argparse.Namespace) -> int:
 
 
 def _demo(arguments: argparse.Namespace) -> int:
-    from grader.demo import GRADES, KEY, SUBMISSIONS, demo
+    from grader.demo import FEEDBACK, GRADES, KEY, SUBMISSIONS, demo
 
     _check_jobs(arguments.jobs)
     summary = demo(arguments.out, _bank(arguments), jobs=arguments.jobs, force=arguments.force,
@@ -617,11 +622,12 @@ def _demo(arguments: argparse.Namespace) -> int:
     _print_summary(summary.generated)
     out = summary.generated.out
     print(f"{SUBMISSIONS} (simulated answers) graded: {_graded_line(summary.graded)}")
+    print(f"Each student's graded sheet, with their worked solutions: {out / GRADES / FEEDBACK}")
     print(f"The assignment and roster it used are in {out}: edit them and run\n"
           f"  grader generate {_quoted(out / 'assignment.yaml')} --roster {_quoted(out / 'roster.csv')} --out OTHER\n"
           f"Grade the submissions again, or your own file, with\n"
           f"  grader grade --key {_quoted(out / KEY)} {_quoted(out / SUBMISSIONS)} --out {_quoted(out / GRADES)} "
-          "--force")
+          "--feedback --force")
     return EXIT_OK
 
 
@@ -646,9 +652,16 @@ def _print_summary(summary: Any) -> None:
 def _grade(arguments: argparse.Namespace) -> int:
     from grader.grade.run import run as run_grading
 
+    feedback = None
+    if arguments.feedback or arguments.feedback_format:
+        from grader.handback import FOLDER, feedback_writer
+
+        feedback = feedback_writer(arguments.feedback_format or "pdf", _lazy_bank(arguments))
     summary = run_grading(arguments.key, arguments.submissions, arguments.out, arguments.format, arguments.force,
-                          arguments.canvas, _lazy_bank(arguments), arguments.missing)
+                          arguments.canvas, _lazy_bank(arguments), arguments.missing, feedback)
     print(_graded_line(summary), file=sys.stderr)
+    if feedback is not None:
+        print(f"each student's graded sheet -> {arguments.out / FOLDER} (index.csv lists them)", file=sys.stderr)
     if summary.ignored_columns:
         print(f"columns ignored: {some(list(summary.ignored_columns))}", file=sys.stderr)
     for note in summary.notes:

@@ -2,7 +2,8 @@
 
 It generates the sample assignment for the sample roster (:mod:`grader.render.generate`), plays the
 class (``submissions.csv``: answers as students type them, :mod:`grader.assign.sample_answers`) and
-grades them into ``grades/`` as ``grader grade`` would (:func:`grader.grade.run.grade_into`). All of it
+grades them into ``grades/`` as ``grader grade --feedback`` would (:func:`grader.grade.run.grade_into`), each
+student's graded sheet in ``grades/feedback/``. All of it
 is one output folder (:func:`grader.base.files.output_folder`): a failure leaves nothing behind, and
 ``--force`` replaces a previous demo whole. ``grades/`` has a manifest of its own, so that
 ``grader grade --key DIR/key.json DIR/submissions.csv --out DIR/grades --force`` can grade again.
@@ -22,9 +23,10 @@ from grader.bank.template import Template
 from grader.base.files import output_folder, write_atomic
 from grader.base.resources import sample_dir
 from grader.grade.run import GradeSummary, grade_into
+from grader.handback import FOLDER, feedback_writer
 from grader.render.generate import Job, Summary, load_inputs, write_outputs
 
-SUBMISSIONS, GRADES, KEY = "submissions.csv", "grades", "key.json"
+SUBMISSIONS, GRADES, KEY, FEEDBACK = "submissions.csv", "grades", "key.json", FOLDER
 
 
 @dataclass(frozen=True)
@@ -50,7 +52,8 @@ def demo(out: Path, bank: Mapping[str, Template], jobs: int = 1, force: bool = F
         # Graded as at a day after the due date, by which the simulated class submitted, its late resubmission
         # (within 12 hours) included: no row is after the run's time.
         graded = grade_into(staging / GRADES, staging / KEY, [staging / SUBMISSIONS], out / GRADES,
-                            [str(out / SUBMISSIONS)], bank, now=due_time(assignment.due) + timedelta(days=1))
+                            [str(out / SUBMISSIONS)], bank, now=due_time(assignment.due) + timedelta(days=1),
+                            feedback=feedback_writer("pdf", bank, font_dirs))
         files = sum(path.is_file() for path in staging.rglob("*"))
     generated = Summary(out, len(roster), len(assignment.problems), generation.collisions, files,
                         time.perf_counter() - started)

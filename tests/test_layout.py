@@ -22,7 +22,7 @@ PACKAGE = Path(__file__).resolve().parent.parent / "grader"
 RANKS = {"base": 0, "model": 1, "physics": 2, "bank": 3, "solve": 4, "simulate": 4, "assign": 5,
          "render": 6, "grade": 6, "cli": 7}
 TOP_LEVEL = {"grader": "base", "grader.cli": "cli", "grader.__main__": "cli", "grader.demo": "cli",
-             "grader.bankcheck": "cli"}
+             "grader.handback": "cli", "grader.bankcheck": "cli"}
 MAX_TOP_LEVEL = 8
 """Modules at the top of ``grader/`` (``__init__`` and ``__main__`` counted): the rest stand in their stage."""
 

@@ -92,14 +92,20 @@ def physics_for(key: Key, bank: Path | Mapping[str, Template] | None = None) -> 
     return Physics(problems, tuple(notes))
 
 
-def _problem_physics(key: Key, problem: KeyProblem, bank: Path | Mapping[str, Template]) -> ProblemPhysics | str:
-    """The problem's physics, or why there is none."""
+def template_of(key: Key, problem: KeyProblem, bank: Path | Mapping[str, Template] | None = None) -> Template | str:
+    """The template a problem of the key was made from, found in ``bank`` (by default the shipped bank) or
+    the bank folder the key records, when it is the very file the key records; else why not."""
     if not problem.template:
         return "the key does not name its template"
     recorded = key.templates.get(problem.template)
     if not recorded:
         return f"the key does not record which file of template {problem.template} it was made from"
-    found = _template(key, problem.template, recorded, bank)
+    return _template(key, problem.template, recorded, bank_dir() if bank is None else bank)
+
+
+def _problem_physics(key: Key, problem: KeyProblem, bank: Path | Mapping[str, Template]) -> ProblemPhysics | str:
+    """The problem's physics, or why there is none."""
+    found = template_of(key, problem, bank)
     if isinstance(found, str):
         return found
     template = found

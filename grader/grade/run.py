@@ -9,7 +9,7 @@ nothing behind and a previous output untouched.
 from __future__ import annotations
 
 import time
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from datetime import datetime
 from pathlib import Path
@@ -27,6 +27,7 @@ from grader.grade.report import write_reports
 from grader.grade.submissions import StudentRef, read_submissions
 
 COMMAND = "grader grade"
+Extra = Callable[[Graded, Path], object]  # more files a run writes from its verdicts (each student's feedback)
 
 
 @dataclass(frozen=True)
@@ -54,12 +55,14 @@ class GradeSummary:
 
 def run(key_path: Path, paths: Sequence[Path], out: Path, fmt: Literal["auto", "long", "wide"] = "auto",
         force: bool = False, canvas: Path | None = None,
-        bank: Path | Mapping[str, Template] | None = None, missing: str | None = None) -> GradeSummary:
+        bank: Path | Mapping[str, Template] | None = None, missing: str | None = None,
+        feedback: Extra | None = None) -> GradeSummary:
     """Grade the submission files against the key into ``out``; ``canvas``: a Canvas gradebook export
     whose students, names and ids ``canvas.csv`` then carries; ``bank``: the templates the key was made
     from (a folder, or a mapping of templates; by default the shipped bank), for error carried forward
     and diagnosed mistakes; ``missing``: what ``canvas.csv`` gives a student who submitted nothing
-    (:func:`grader.grade.canvas_file.canvas_file`).
+    (:func:`grader.grade.canvas_file.canvas_file`); ``feedback``: called with the verdicts and the folder
+    being written, to add each student's feedback files (:func:`grader.handback.feedback_writer`).
 
     ``rows_not_graded`` counts submission rows only: the export's mismatches are caveats (see
     :mod:`grader.grade.canvas`).
@@ -74,20 +77,26 @@ def run(key_path: Path, paths: Sequence[Path], out: Path, fmt: Literal["auto", "
         graded = _graded(key, paths, fmt, (), bank)
         made = _canvas(graded, export, missing)
         write_reports(graded, staging, made)
+        if feedback is not None:
+            feedback(graded, staging)
     return _summary(graded, out, started, made)
 
 
 def grade_into(folder: Path, key_path: Path, paths: Sequence[Path], out: Path, names: Sequence[str],
-               bank: Path | Mapping[str, Template] | None = None, now: datetime | None = None) -> GradeSummary:
+               bank: Path | Mapping[str, Template] | None = None, now: datetime | None = None,
+               feedback: Extra | None = None) -> GradeSummary:
     """Grade into ``folder``, a part of an output folder still being written (the demo's ``grades/``), as
     ``grader grade --out out`` would, with the files named as in ``names`` (where they will be) and the
     manifest ``grader grade`` writes, so that ``grader grade --out out --force`` may replace it later;
-    ``now``: the time the grading is as at (a timestamp after it is a caveat), by default the clock's."""
+    ``now``: the time the grading is as at (a timestamp after it is a caveat), by default the clock's;
+    ``feedback``: as for :func:`run`."""
     started = time.perf_counter()
     with collector_paused():
         graded = _graded(load_key(key_path), paths, "auto", names, bank, now)
         made = _canvas(graded, None, None)
         write_reports(graded, folder, made)
+        if feedback is not None:
+            feedback(graded, folder)
         write_manifest(folder, COMMAND)
     return _summary(graded, out, started, made)
 

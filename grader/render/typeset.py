@@ -85,7 +85,7 @@ def font_paths(font_dirs: tuple[Path, ...] = ()) -> tuple[str, ...]:
 _LOCAL = threading.local()
 
 
-def compile_typst(source: str, fmt: Literal["pdf", "png"] = "pdf", ppi: float | None = None,
+def compile_typst(source: str, fmt: Literal["pdf", "png", "svg"] = "pdf", ppi: float | None = None,
                   tagged: bool = True, fonts: tuple[str, ...] = ()) -> bytes | list[bytes]:
     """Compile a source with the embedded fonts and those in the ``fonts`` folders (see
     :func:`font_paths`), the fixed timestamp, and an empty private root (one compiler per thread

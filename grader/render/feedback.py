@@ -1,0 +1,328 @@
+"""Each student's graded sheet, handed back: ``feedback/ID.pdf`` (or ``ID.html``) and ``feedback/index.csv``.
+
+A student's file shows their sheet's header and total, then per problem their numbers, the figure and each
+part marked (what they typed, what it was read as, the verdict with its credit, the sentence that explains
+it, the expected value within its tolerance, the late deduction), then the worked solutions of their own
+variants exactly as the answer key has them: the key's part for that student
+(:func:`~grader.render.documents.key_source`), typeset on its own and joined after the marked pages
+(:mod:`grader.render.joining`). A student who sent nothing gets the same, saying that no answers were received.
+
+Only that student's record (:class:`~grader.assign.returned.Returned`) and their own variants go into a
+file: nothing of another student, and none of the run's notes for the instructor. Sources are made from
+``templates/feedback.typ.j2`` as the other documents are (every value shown as text unless marked as Typst
+source), compiled with the fixed timestamp: two runs write the same bytes.
+
+The HTML page is one self-contained file, as the class report is: no script, nothing loaded (its content
+security policy allows only its own inline style), every text escaped; the figures and the worked solutions
+are inline SVG typeset by Typst.
+"""
+
+from __future__ import annotations
+
+import concurrent.futures
+import html
+import re
+import tempfile
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Literal
+
+from grader.assign.assignment import Assignment
+from grader.assign.returned import MarkedPart, Returned
+from grader.assign.variants import Generation
+from grader.bank.template import Template
+from grader.base.errors import visible
+from grader.base.files import write_atomic
+from grader.base.spreadsheet import csv_text, number_cell, safe_cell
+from grader.render.documents import (
+    PAPER,
+    Documents,
+    _assignment_view,
+    _environment,
+    file_names,
+    key_source,
+)
+from grader.render.joining import Part, join, read_part
+from grader.render.typeset import compile_typst, font_paths, one_pdf, release_memory
+from grader.render.typst_text import Typ, string
+
+FOLDER, INDEX = "feedback", "index.csv"
+Format = Literal["pdf", "html"]
+RELEASE_EVERY = 8  # students between letting Typst's memo go: memory stays flat over a class
+
+VERDICT_WORDS = {"correct": "correct", "ecf": "correct for your earlier answer (error carried forward)",
+                 "mistake": "a common mistake", "incorrect": "incorrect", "invalid": "could not be read",
+                 "missing": "not answered"}
+
+
+@dataclass(frozen=True)
+class MarkView:
+    """A marked part as the template shows it."""
+
+    kind: str
+    label: str
+    description: str
+    verdict: str
+    credit: str
+    typed: Typ
+    typed_text: str | None  # as the student typed it (None: nothing came)
+    read: str
+    said: str
+    expected: str
+    tolerance: str
+    late: str
+
+
+@dataclass(frozen=True)
+class ProblemView:
+    """A problem of the graded sheet: its score, the student's numbers, the figure, the marked parts."""
+
+    key: str
+    title: str
+    score: str
+    given: Typ
+    figure: Typ
+    parts: tuple[MarkView, ...]
+
+
+@dataclass(frozen=True)
+class SheetView:
+    """The graded sheet's header, total and problems."""
+
+    name: str
+    id: str
+    section: str
+    total: str
+    late: str
+    submitted: bool
+    problems: tuple[ProblemView, ...]
+
+
+def _points(value: float) -> str:
+    return number_cell(value, 6)
+
+
+def _credit(part: MarkedPart) -> str:
+    return f"{_points(part.score)} of {_points(part.points)} point{'' if part.points == 1 else 's'}"
+
+
+def _late(back: Returned) -> str:
+    """How late the student's answers came, and what the late policy took, in a sentence (empty: on time).
+
+    >>> _late(Returned(0, "7", "Ana", "", "", (), "2 h 5 min", 1.5, 10.0, 12.0))
+    'Your answers came 2 h 5 min late: the late policy took 1.5 points.'
+    """
+    if not back.late:
+        return ""
+    taken = f": the late policy took {_points(back.deduction)} point{'' if back.deduction == 1 else 's'}"
+    return f"Your answers came {back.late} late{taken if back.deduction else ''}."
+
+
+class Feedback:
+    """The feedback files of one graded class."""
+
+    def __init__(self, assignment: Assignment, generation: Generation, bank: Mapping[str, Template],
+                 fonts: tuple[str, ...] = ()) -> None:
+        self.documents, self.fonts = Documents(assignment, generation, bank), fonts
+
+    def view(self, back: Returned) -> SheetView:
+        """What the graded sheet shows for one student."""
+        sheet, person = self.documents.sheet(back.index), self.documents.person(back.index)
+        marks = {part.label: part for part in back.parts}
+        problems = []
+        for shown, worked in zip(sheet.problems, person.problems, strict=True):
+            parts = [marks[blank.label] for blank in shown.blanks]
+            views = tuple(self._mark(part, blank.description) for part, blank in zip(parts, shown.blanks, strict=True))
+            score = f"{_points(sum(p.score for p in parts))} of {_points(sum(p.points for p in parts))} points"
+            problems.append(ProblemView(shown.key, shown.title, score, worked.given, shown.figure, views))
+        total = f"{_points(back.total)} of {_points(back.possible)} points"
+        return SheetView(back.name, back.id, back.section, total, _late(back), back.submitted, tuple(problems))
+
+    @staticmethod
+    def _mark(part: MarkedPart, description: str) -> MarkView:
+        typed = Typ("#text(fill: luma(90))[nothing]") if part.typed is None else \
+            Typ(f'#text(font: "DejaVu Sans Mono", size: 8.5pt, {string(part.typed)})')
+        late = f"late: the late policy took {_points(part.deduction)} of its points" if part.deduction else ""
+        return MarkView(part.verdict, part.label, description, VERDICT_WORDS.get(part.verdict, part.verdict),
+                        _credit(part), typed, part.typed, part.read_as if part.typed is not None else "", part.feedback,
+                        part.expected, part.tolerance, late)
+
+    def marked_source(self, back: Returned) -> str:
+        """The Typst source of the marked pages."""
+        assignment = self.documents.assignment
+        return _environment().get_template("feedback.typ.j2").render(
+            assignment=_assignment_view(assignment), sheet=self.view(back), paper=PAPER,
+            document_title=f"{assignment.title}: {back.name}, graded")
+
+    def pdf(self, back: Returned, target: Path, scratch: Path, pool: concurrent.futures.Executor) -> None:
+        """Write the student's PDF: the marked pages, then their worked solutions as in the answer key (the
+        two typeset at once in ``pool``)."""
+        sources = (self.marked_source(back), key_source(self.documents, people=[back.index]))
+        parts = [pool.submit(_typeset_part, source, scratch / f"{number}.pdf", self.fonts)
+                 for number, source in enumerate(sources)]
+        assignment = self.documents.assignment
+        join([part.result() for part in parts], target, title=f"{assignment.title}: {back.name}, graded",
+             author=assignment.course, lang="en")
+
+    def page(self, back: Returned, pool: concurrent.futures.Executor) -> str:
+        """The student's self-contained HTML page (its figures and worked solutions typeset at once in ``pool``)."""
+        view = self.view(back)
+        figures, worked = (pool.submit(_svg_pages, source, self.fonts)
+                           for source in (_figures_source(view), key_source(self.documents, people=[back.index])))
+        return _html(self.documents.assignment, view, figures.result(), worked.result())
+
+    def forget(self, back: Returned) -> None:
+        """Drop what was built for this student."""
+        self.documents.forget([back.index])
+
+
+def write_feedback(assignment: Assignment, generation: Generation, bank: Mapping[str, Template],
+                   returned: Sequence[Returned], folder: Path, fmt: Format = "pdf", font_dirs: Sequence[Path] = (),
+                   progress: Callable[[int], None] | None = None) -> list[Path]:
+    """Write ``folder/feedback/<file name>.pdf`` (or ``.html``) per student of ``returned`` (file names as
+    the students' sheets have them, :func:`~grader.render.documents.file_names`), then ``index.csv``;
+    returns the paths written."""
+    out = folder / FOLDER
+    out.mkdir(parents=True, exist_ok=True)
+    feedback = Feedback(assignment, generation, bank, font_paths(tuple(font_dirs)))
+    names = file_names([back.id for back in returned])
+    written = []
+    with tempfile.TemporaryDirectory(prefix=".feedback-", dir=out) as scratch, \
+            concurrent.futures.ThreadPoolExecutor(max_workers=2) as pool:  # Typst lets go of the GIL
+        for count, (back, name) in enumerate(zip(returned, names, strict=True), start=1):
+            target = out / f"{name}.{fmt}"
+            if fmt == "pdf":
+                feedback.pdf(back, target, Path(scratch), pool)
+            else:
+                write_atomic(target, feedback.page(back, pool))
+            feedback.forget(back)
+            written.append(target)
+            if count % RELEASE_EVERY == 0:
+                release_memory()
+            if progress:
+                progress(1)
+    rows: list[list[object]] = [["id", "name", "email", "file", "total"]]
+    rows += [[safe_cell(visible(b.id)), safe_cell(visible(b.name)), safe_cell(visible(b.email)), safe_cell(path.name),
+              number_cell(b.total)]
+             for b, path in zip(returned, written, strict=True)]
+    write_atomic(out / INDEX, csv_text(rows))
+    return [*written, out / INDEX]
+
+
+# --- HTML ---------------------------------------------------------------------------------------
+
+_STYLE = """
+:root { --ink: #222; --muted: #5f6b7a; --line: #dde2ea; --soft: #f5f7fa; --accent: #1f4e99; --good: #1b5e20;
+        --bad: #b71c1c; --odd: #e65100; }
+* { box-sizing: border-box; }
+body { margin: 0; color: var(--ink); background: #fff;
+       font: 15px/1.45 system-ui, -apple-system, "Segoe UI", Roboto, "DejaVu Sans", sans-serif; }
+main { max-width: 900px; margin: 0 auto; padding: 24px 28px 48px; }
+header { border-bottom: 3px solid var(--accent); padding-bottom: 10px; margin-bottom: 8px; }
+h1 { font-size: 24px; margin: 0 0 4px; }
+h2 { font-size: 19px; margin: 28px 0 6px; padding-top: 6px; border-top: 1px solid var(--line); }
+.muted { color: var(--muted); }
+.total { font-size: 18px; font-weight: 600; margin: 10px 0; }
+.notice { background: var(--soft); border: 1px solid var(--line); border-radius: 6px; padding: 8px 12px; }
+.late { color: var(--bad); }
+table { border-collapse: collapse; margin: 8px 0; font-size: 14px; width: 100%; }
+th, td { text-align: left; padding: 4px 8px; border-bottom: 1px solid var(--line); vertical-align: top; }
+th { background: var(--soft); font-weight: 600; }
+code { background: var(--soft); padding: 0 3px; border-radius: 3px; word-break: break-all; }
+.correct, .ecf { color: var(--good); font-weight: 600; }
+.mistake, .incorrect { color: var(--bad); font-weight: 600; }
+.invalid { color: var(--odd); font-weight: 600; }
+.missing { color: var(--muted); font-weight: 600; }
+figure { margin: 8px 0; }
+svg { max-width: 100%; height: auto; display: block; }
+.page { border: 1px solid var(--line); margin: 12px 0; }
+"""
+
+
+def _e(value: object) -> str:
+    """Text as HTML shows it, quotes included (the class report's rule)."""
+    return html.escape(str(value), quote=True)
+
+
+def _typeset_part(source: str, path: Path, fonts: tuple[str, ...]) -> Part:
+    path.write_bytes(one_pdf(compile_typst(source, tagged=False, fonts=fonts)))
+    return read_part(path)
+
+
+def _svg_pages(source: str, fonts: tuple[str, ...]) -> list[str]:
+    """A source typeset as SVG, a page each."""
+    result = compile_typst(source, "svg", fonts=fonts)
+    pages = [result] if isinstance(result, bytes) else result
+    return [page.decode("utf-8") for page in pages]
+
+
+def _figures_source(view: SheetView) -> str:
+    """A Typst document of the student's numbers and figure of each problem, one problem a page."""
+    return _environment().get_template("feedback-figures.typ.j2").render(problems=view.problems)
+
+
+def _html(assignment: Assignment, view: SheetView, figures: Sequence[str], worked: Sequence[str]) -> str:
+    title = f"{assignment.title}: {view.name}, graded"
+    head = [f"<header>\n<h1>{_e(assignment.title)}</h1>\n<p class=\"muted\">{_e(assignment.course)}"
+            + (f" · due {_e(assignment.due)}" if assignment.due else "") + "</p>\n"
+            f"<p>{_e(view.name)} <span class=\"muted\">({_e(view.id)}"
+            + (f", section {_e(view.section)}" if view.section else "") + ")</span></p>\n</header>",
+            f"<p class=\"total\">Total: {_e(view.total)}</p>"]
+    if view.late:
+        head.append(f"<p class=\"late\">{_e(view.late)}</p>")
+    if not view.submitted:
+        head.append("<p class=\"notice\"><strong>No answers were received.</strong> Each part below shows what was "
+                    "expected; your worked solutions follow.</p>")
+    figures, worked = _shared_glyphs([*figures, *worked], len(figures))
+    body = [*head, *(_problem_html(problem, figure) for problem, figure in zip(view.problems, figures, strict=True))]
+    body.append("<h2 id=\"worked\">Your worked solutions</h2>\n" +
+                "\n".join(f"<div class=\"page\" role=\"img\" aria-label=\"worked solutions, page {n}\">{svg}</div>"
+                          for n, svg in enumerate(worked, start=1)))
+    return ("<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
+            "<meta http-equiv=\"Content-Security-Policy\" content=\"default-src 'none'; style-src 'unsafe-inline'\">\n"
+            "<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n"
+            f"<title>{_e(title)}</title>\n<style>{_STYLE}</style>\n</head>\n<body>\n<main>\n" + "\n".join(body)
+            + "\n</main>\n</body>\n</html>\n")
+
+
+_SYMBOL = re.compile(r'<symbol id="([^"]+)"[^>]*>.*?</symbol>', re.S)
+
+
+def _shared_glyphs(pages: Sequence[str], split: int) -> tuple[list[str], list[str]]:
+    """The SVG pages with each glyph defined once in the page: Typst names a glyph's ``<symbol>`` by a hash of
+    it, and a page uses a symbol by its id anywhere in the document, so a later definition that is the same
+    text is dropped (a third of the size of the worked solutions); the pages are split again at ``split``."""
+    seen: dict[str, str] = {}
+
+    def once(match: re.Match[str]) -> str:
+        whole, name = match.group(0), match.group(1)
+        if name not in seen:
+            seen[name] = whole
+            return whole
+        return "" if seen[name] == whole else whole
+
+    kept = [_SYMBOL.sub(once, page) for page in pages]
+    return kept[:split], kept[split:]
+
+
+def _problem_html(problem: ProblemView, figure: str) -> str:
+    rows = "\n".join(_mark_html(mark) for mark in problem.parts)
+    return (f"<h2>Problem {_e(problem.key)}: {_e(problem.title)} <span class=\"muted\">— {_e(problem.score)}"
+            f"</span></h2>\n<figure role=\"img\" aria-label=\"figure of problem {_e(problem.key)}\">{figure}</figure>\n"
+            "<table>\n<tr><th>Part</th><th>Asked</th><th>You typed</th><th>Verdict</th><th>Why</th>"
+            f"<th>Expected</th></tr>\n{rows}\n</table>")
+
+
+def _mark_html(mark: MarkView) -> str:
+    read = f"<br><span class=\"muted\">read as</span> {_e(mark.read)}" if mark.read else ""
+    late = f"<br><span class=\"late\">{_e(mark.late)}</span>" if mark.late else ""
+    return (f"<tr><th>{_e(mark.label)}</th><td>{_e(mark.description)}</td><td>{_typed(mark)}{read}</td>"
+            f"<td><span class=\"{_e(mark.kind)}\">{_e(mark.verdict)}</span><br>{_e(mark.credit)}</td>"
+            f"<td>{_e(mark.said)}{late}</td>"
+            f"<td>{_e(mark.expected)}<br><span class=\"muted\">accepted {_e(mark.tolerance)}</span></td></tr>")
+
+
+def _typed(mark: MarkView) -> str:
+    """What was typed, or that nothing was."""
+    return "<span class=\"muted\">nothing</span>" if mark.typed_text is None else f"<code>{_e(mark.typed_text)}</code>"

@@ -28,7 +28,7 @@ _ADDING = {"+": "add", "-": "sub"}
 _MULTIPLYING = {"*": "mul", "/": "div"}
 
 
-class _Unusual(Exception):
+class _UnusualError(Exception):
     """Tokens outside the common shapes (or wrong): parse reads them."""
 
 
@@ -40,7 +40,7 @@ def read_tokens(tokens: Sequence[str]) -> Node | None:
     reader = _Reader(tokens)
     try:
         tree, height = reader.sum()
-    except _Unusual:
+    except _UnusualError:
         return None
     # parse refuses a tree deeper than MAX_DEPTH, counting a unary plus (not in the tree) as a level.
     return tree if reader.at == len(tokens) and height <= MAX_DEPTH else None
@@ -50,14 +50,14 @@ class _Reader:
     """Python's grammar for ``sum``, ``term``, ``factor``, ``power`` and ``primary``, over tokens; each returns a
     tree and its height in Python's syntax tree."""
 
-    __slots__ = ("tokens", "at", "nested")
+    __slots__ = ("at", "nested", "tokens")
 
     def __init__(self, tokens: Sequence[str]) -> None:
         self.tokens, self.at, self.nested = [*tokens, ""], 0, 0  # "": the end, never a token
 
     def take(self, token: str) -> None:
         if self.tokens[self.at] != token:
-            raise _Unusual
+            raise _UnusualError
         self.at += 1
 
     def sum(self) -> tuple[Node, int]:
@@ -91,7 +91,7 @@ class _Reader:
         self.at += 1
         exponent, exponent_height = self.factor()
         if isinstance(exponent, Num) and abs(float(exponent.value)) > MAX_EXPONENT:
-            raise _Unusual
+            raise _UnusualError
         return Op("pow", (base, exponent)), max(height, exponent_height) + 1
 
     def primary(self) -> tuple[Node, int]:
@@ -103,17 +103,17 @@ class _Reader:
         if first == "(":
             self.nested += 1
             if self.nested > _NESTED:
-                raise _Unusual
+                raise _UnusualError
             tree, height = self.sum()
             self.take(")")
             self.nested -= 1
             return tree, height
         if not (first.isalpha() or first == "_") or keyword.iskeyword(token):
-            raise _Unusual
+            raise _UnusualError
         if self.tokens[self.at] != "(":
             return _symbol(token), 0
         if token not in FUNCTIONS:
-            raise _Unusual
+            raise _UnusualError
         self.at += 1
         args, height = [], 0
         for index in range(FUNCTIONS[token]):
@@ -134,8 +134,8 @@ def _symbol(name: str) -> Sym:
 @lru_cache(maxsize=4096)  # a class writes the same numbers, an answer often one number twice
 def _number(token: str) -> Num:
     if token[:1] == "0" and token[1:2].isdigit():
-        raise _Unusual  # leading zeros: Python refuses them in an integer
+        raise _UnusualError  # leading zeros: Python refuses them in an integer
     try:
         return literal(token)
     except (ExpressionError, ValueError):
-        raise _Unusual from None
+        raise _UnusualError from None

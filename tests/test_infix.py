@@ -10,9 +10,9 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from grader.base.errors import ExpressionError
+from grader.grade.infix import read_tokens
 from grader.grade.notation import ReadError, _written
 from grader.model.expr import MAX_DEPTH, parse
-from grader.model.infix import read_tokens
 
 
 def _parsed(tokens: list[str]) -> str:
@@ -31,7 +31,7 @@ SHAPES = [  # (text, tokens) that the reader reads as parse does
 
 GIVEN_UP = [  # shapes left to parse (which reads them, or says what is wrong)
     "p**65", "p**65.5", "0123*p", "00*p", "1e999*p", "p**", "p*", "*p", "(p", "p)", "Max(p)", "Max(p,v,)",
-    "sqrt(p,v)", "foo(p)", "None*p", "p*lambda", "(p,v)", "p//v", "p%v", "", "p<v",
+    "sqrt(p,v)", "foo(p)", "None*p", "p*lambda", "(p,v)", "p//v", "p%v", "", "p<v", "٣*p", "３*p",
     "+".join(["p"] * (MAX_DEPTH + 2)), "(" * 60 + "p" + ")" * 60,
 ]
 

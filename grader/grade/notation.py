@@ -21,8 +21,8 @@ from collections.abc import Callable, Sequence
 import numpy as np
 
 from grader.base.errors import ExpressionError
+from grader.grade.infix import read_tokens
 from grader.model.expr import CONSTANTS, FUNCTIONS, MAX_EXPONENT, Node, Num, Op, Sym, names, parse, to_text
-from grader.model.infix import read_tokens
 from grader.model.kernel import OPERATIONS
 
 MAX_NODES = 200

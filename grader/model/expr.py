@@ -23,7 +23,6 @@ import ast
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from fractions import Fraction
-from functools import lru_cache
 from typing import Any
 
 from grader.base.errors import ExpressionError
@@ -170,16 +169,6 @@ def _number(value: Any) -> Num:
     return Num(Fraction(value))
 
 
-def literal(text: str) -> Num:
-    """The number :func:`parse` reads from a Python number literal without ``_`` or a base (``2``, ``.5``,
-    ``1e-3``).
-
-    >>> literal("0.10"), literal("3")
-    (Num(value=Fraction(1, 10)), Num(value=Fraction(3, 1)))
-    """
-    return _number(float(text) if "." in text or "e" in text or "E" in text else int(text))
-
-
 def _decimal_fraction(text: str) -> Fraction:
     """The exact value of a float's ``repr`` (``Fraction(text)`` does the same, four times slower).
 
@@ -297,11 +286,6 @@ def format_number(value: Fraction | float) -> str:
     """
     if isinstance(value, float):
         return repr(value)
-    return _exact_text(value)
-
-
-@lru_cache(maxsize=4096)  # a class writes the same numbers, an answer often one number twice
-def _exact_text(value: Fraction) -> str:
     if value.denominator == 1:
         return str(value.numerator)
     denominator, twos, fives = value.denominator, 0, 0

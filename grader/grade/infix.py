@@ -17,11 +17,12 @@ True
 from __future__ import annotations
 
 import keyword
+import math
 from collections.abc import Sequence
+from fractions import Fraction
 from functools import lru_cache
 
-from grader.base.errors import ExpressionError
-from grader.model.expr import FUNCTIONS, MAX_DEPTH, MAX_EXPONENT, MAX_LENGTH, Node, Num, Op, Sym, literal
+from grader.model.expr import FUNCTIONS, MAX_DEPTH, MAX_EXPONENT, MAX_LENGTH, Node, Num, Op, Sym
 
 _NESTED = 50  # parentheses inside each other beyond which parse decides (Python's own limit is 200)
 _ADDING = {"+": "add", "-": "sub"}
@@ -133,9 +134,13 @@ def _symbol(name: str) -> Sym:
 
 @lru_cache(maxsize=4096)  # a class writes the same numbers, an answer often one number twice
 def _number(token: str) -> Num:
-    if token[:1] == "0" and token[1:2].isdigit():
-        raise _UnusualError  # leading zeros: Python refuses them in an integer
-    try:
-        return literal(token)
-    except (ExpressionError, ValueError):
-        raise _UnusualError from None
+    """The number parse reads from a literal: an integer exactly, any other as float64 then the exact value of its
+    shortest text (``0.1`` is 1/10)."""
+    if not token.isascii() or (token[:1] == "0" and token[1:2].isdigit()):
+        raise _UnusualError  # Python reads ASCII digits only, and no leading zeros in an integer
+    if token.isdigit():
+        return Num(Fraction(int(token)))
+    value = float(token)
+    if not math.isfinite(value):
+        raise _UnusualError
+    return Num(Fraction(repr(value)))

@@ -280,11 +280,17 @@ def _survey(tree: Node) -> _Survey:
             return _NONE if node.name in CONSTANTS else _named(node.name)
         if isinstance(node, Num):
             return _NONE
-        uses = [visit(arg) for arg in node.args]
+        args = node.args
+        if len(args) == 2:  # most operations: no list, no loop
+            left, right = visit(args[0]), visit(args[1])
+            uses: tuple[frozenset[str], ...] = (left, right)
+            used = left if right <= left else right if left <= right else left | right
+        else:
+            uses = tuple(visit(arg) for arg in args)
+            used = uses[0] if len(uses) == 1 else _union(uses)
         op = node.op
         if op in _TRANSCENDENTAL:
             functions.add(op)
-        used = uses[0] if len(uses) == 1 else _union(uses)
         if not used:
             return used
         if op == "div" and uses[1]:
@@ -309,7 +315,7 @@ def _named(name: str) -> frozenset[str]:
     return frozenset((name,))
 
 
-def _union(uses: list[frozenset[str]]) -> frozenset[str]:
+def _union(uses: tuple[frozenset[str], ...]) -> frozenset[str]:
     first, *rest = uses
     for other in rest:
         if not other <= first:  # mostly a sub-term's names are its sibling's: no new set then
@@ -369,7 +375,7 @@ def _tame(kind: str, node: Node, used: frozenset[str], domains: Domains) -> bool
     if len(used) != 1:
         return False  # in two names or more the scans may pass beside the place: search it
     name = next(iter(used))
-    low, high = dict(domains)[name]
+    low, high = next(bounds for other, bounds in domains if other == name)
     values = _values(node, {name: _grid(low, high)})
     least, most = float(values.min()), float(values.max())  # NaN if any value is
     if not (math.isfinite(least) and math.isfinite(most)):

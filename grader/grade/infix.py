@@ -22,7 +22,17 @@ from collections.abc import Sequence
 from fractions import Fraction
 from functools import lru_cache
 
-from grader.model.expr import FUNCTIONS, MAX_DEPTH, MAX_EXPONENT, MAX_LENGTH, Node, Num, Op, Sym
+from grader.model.expr import (
+    FUNCTIONS,
+    MAX_DEPTH,
+    MAX_EXPONENT,
+    MAX_LENGTH,
+    Node,
+    Num,
+    Op,
+    Sym,
+    _decimal_fraction,  # parse's own reading of a float's text: one place
+)
 
 _NESTED = 50  # parentheses inside each other beyond which parse decides (Python's own limit is 200)
 _ADDING = {"+": "add", "-": "sub"}
@@ -40,91 +50,101 @@ def read_tokens(tokens: Sequence[str]) -> Node | None:
         return None
     reader = _Reader(tokens)
     try:
-        tree, height = reader.sum()
+        tree = reader.sum()
     except _UnusualError:
         return None
-    # parse refuses a tree deeper than MAX_DEPTH, counting a unary plus (not in the tree) as a level.
-    return tree if reader.at == len(tokens) and height <= MAX_DEPTH else None
+    if reader.at != len(tokens):
+        return None
+    # parse refuses a tree deeper than MAX_DEPTH. Each level of Python's tree has a token of its own (an operator,
+    # a sign, a function's name), so only a longer list can be too deep; there, a unary plus (a level of Python's
+    # tree, not of ours) is left to parse.
+    if len(tokens) > MAX_DEPTH and (reader.plus or _height(tree) > MAX_DEPTH):
+        return None
+    return tree
 
 
 class _Reader:
-    """Python's grammar for ``sum``, ``term``, ``factor``, ``power`` and ``primary``, over tokens; each returns a
-    tree and its height in Python's syntax tree."""
+    """Python's grammar for ``sum``, ``term``, ``factor`` (with ``power``) and ``primary``, over tokens."""
 
-    __slots__ = ("at", "nested", "tokens")
+    __slots__ = ("at", "nested", "plus", "tokens")
 
     def __init__(self, tokens: Sequence[str]) -> None:
-        self.tokens, self.at, self.nested = [*tokens, ""], 0, 0  # "": the end, never a token
+        self.tokens, self.at, self.nested, self.plus = [*tokens, ""], 0, 0, False  # "": the end, never a token
 
     def take(self, token: str) -> None:
         if self.tokens[self.at] != token:
             raise _UnusualError
         self.at += 1
 
-    def sum(self) -> tuple[Node, int]:
-        tree, height = self.term()
+    def sum(self) -> Node:
+        tree = self.term()
         while (op := _ADDING.get(self.tokens[self.at])) is not None:
             self.at += 1
-            right, right_height = self.term()
-            tree, height = Op(op, (tree, right)), max(height, right_height) + 1
-        return tree, height
+            tree = Op(op, (tree, self.term()))
+        return tree
 
-    def term(self) -> tuple[Node, int]:
-        tree, height = self.factor()
+    def term(self) -> Node:
+        tree = self.factor()
         while (op := _MULTIPLYING.get(self.tokens[self.at])) is not None:
             self.at += 1
-            right, right_height = self.factor()
-            tree, height = Op(op, (tree, right)), max(height, right_height) + 1
-        return tree, height
+            tree = Op(op, (tree, self.factor()))
+        return tree
 
-    def factor(self) -> tuple[Node, int]:
+    def factor(self) -> Node:
         sign = self.tokens[self.at]
-        if sign == "-" or sign == "+":
+        if sign == "-":
             self.at += 1
-            operand, height = self.factor()
-            return (Op("neg", (operand,)) if sign == "-" else operand), height + 1
-        return self.power()
-
-    def power(self) -> tuple[Node, int]:
-        base, height = self.primary()
+            return Op("neg", (self.factor(),))
+        if sign == "+":
+            self.at, self.plus = self.at + 1, True
+            return self.factor()
+        base = self.primary()
         if self.tokens[self.at] != "**":
-            return base, height
+            return base
         self.at += 1
-        exponent, exponent_height = self.factor()
+        exponent = self.factor()  # Python's power: a primary, '**', a factor (-p**2 is -(p**2), p**-2 is p**(-2))
         if isinstance(exponent, Num) and abs(float(exponent.value)) > MAX_EXPONENT:
             raise _UnusualError
-        return Op("pow", (base, exponent)), max(height, exponent_height) + 1
+        return Op("pow", (base, exponent))
 
-    def primary(self) -> tuple[Node, int]:
-        token = self.tokens[self.at]
+    def primary(self) -> Node:
+        tokens = self.tokens
+        token = tokens[self.at]
         self.at += 1
         first = token[:1]  # "" at the end
         if first.isdigit() or first == ".":
-            return _number(token), 0
-        if first == "(":
-            self.nested += 1
-            if self.nested > _NESTED:
-                raise _UnusualError
-            tree, height = self.sum()
-            self.take(")")
-            self.nested -= 1
-            return tree, height
-        if not (first.isalpha() or first == "_") or keyword.iskeyword(token):
+            return _number(token)
+        if first.isalpha() or first == "_":
+            if tokens[self.at] != "(":
+                if keyword.iskeyword(token):
+                    raise _UnusualError
+                return _symbol(token)
+            return self.call(token)
+        if first != "(":
             raise _UnusualError
-        if self.tokens[self.at] != "(":
-            return _symbol(token), 0
-        if token not in FUNCTIONS:
+        self.nested += 1
+        if self.nested > _NESTED:
+            raise _UnusualError
+        tree = self.sum()
+        self.take(")")
+        self.nested -= 1
+        return tree
+
+    def call(self, name: str) -> Node:
+        if name not in FUNCTIONS:
             raise _UnusualError
         self.at += 1
-        args, height = [], 0
-        for index in range(FUNCTIONS[token]):
+        args = []
+        for index in range(FUNCTIONS[name]):
             if index:
                 self.take(",")
-            arg, arg_height = self.sum()
-            args.append(arg)
-            height = max(height, arg_height)
+            args.append(self.sum())
         self.take(")")
-        return Op(token, tuple(args)), height + 1
+        return Op(name, tuple(args))
+
+
+def _height(tree: Node) -> int:
+    return 1 + max(map(_height, tree.args)) if isinstance(tree, Op) else 0
 
 
 @lru_cache(maxsize=4096)
@@ -143,4 +163,4 @@ def _number(token: str) -> Num:
     value = float(token)
     if not math.isfinite(value):
         raise _UnusualError
-    return Num(Fraction(repr(value)))
+    return Num(_decimal_fraction(repr(value)))  # as parse makes it (Fraction(text) is four times slower)

@@ -42,14 +42,15 @@ _CALLED = re.compile(r"\s*\(")  # after a name: it is called
 def tree_of(text: str, symbols: tuple[str, ...]) -> Node:
     """Parse with the allow-list parser after writing out implicit products; bounded in size."""
     parts = _written(text, symbols)
-    tree = read_tokens(parts)
+    tree = read = read_tokens(parts)
     if tree is None:  # not a common shape: parse reads it, and says what is wrong
         written = "".join(parts)
         try:
             tree = parse(written)
         except ExpressionError as error:
             raise ReadError(str(error).replace(written, cut(text, 60))) from None
-    if _count(tree) > MAX_NODES:
+    # Each node read from the tokens has a token of its own: a short list needs no count.
+    if (len(parts) > MAX_NODES or tree is not read) and _count(tree) > MAX_NODES:
         raise ReadError(f"more than {MAX_NODES} numbers, names and operations; simplify the answer")
     return tree
 
@@ -76,8 +77,11 @@ def _written(text: str, symbols: tuple[str, ...]) -> list[str]:
             _check_underflow(token)
             kind = "num"
         elif group == "name":
-            kind, parts = _name(token, symbols, text[position:position + 1] == "(" or
-                                _CALLED.match(text, position) is not None)
+            if token in symbols or token in CONSTANTS:  # as _name says, sooner
+                kind = "name"
+            else:
+                kind, parts = _name(token, symbols, text[position:position + 1] == "(" or
+                                    _CALLED.match(text, position) is not None)
         else:
             kind, token = token, _WRITTEN.get(token, token)
             if kind == "(":

@@ -136,7 +136,7 @@ def _equivalent(student: Node, expected: _Form, domains: Domains, seed: str, rto
     values = _values(student, fixed if probes is None else _joined([fixed, probes]))
     a = values[:b.size]
     finite = np.isfinite(a)
-    if not finite.all():
+    if not np.logical_and.reduce(finite):  # finite.all(), without its Python wrapper
         return False if finite.any() else "the expression cannot be evaluated at any test point (division by zero?)"
     floor = 1e-3 * rtol * largest
     if not _agree(a, b, rtol, floor):
@@ -161,7 +161,7 @@ def _agree(a: np.ndarray, b: np.ndarray, rtol: float, floor: float) -> bool:
     np.maximum(bound, np.abs(b), out=bound)
     bound *= rtol
     bound += floor
-    return bool(np.less_equal(error, bound).all())
+    return bool(np.logical_and.reduce(np.less_equal(error, bound)))
 
 
 Points = dict[str, np.ndarray]
@@ -377,7 +377,7 @@ def _tame(kind: str, node: Node, used: frozenset[str], domains: Domains) -> bool
     name = next(iter(used))
     low, high = next(bounds for other, bounds in domains if other == name)
     values = _values(node, {name: _grid(low, high)})
-    least, most = float(values.min()), float(values.max())  # NaN if any value is
+    least, most = float(np.minimum.reduce(values)), float(np.maximum.reduce(values))  # NaN if any value is
     if not (math.isfinite(least) and math.isfinite(most)):
         return False
     if kind == "large":

@@ -136,7 +136,7 @@ def _equivalent(student: Node, expected: _Form, domains: Domains, seed: str, rto
     values = _values(student, fixed if probes is None else _joined([fixed, probes]))
     a = values[:b.size]
     finite = np.isfinite(a)
-    if not finite.all():
+    if not np.logical_and.reduce(finite):  # finite.all(), without its Python wrapper
         return False if finite.any() else "the expression cannot be evaluated at any test point (division by zero?)"
     floor = 1e-3 * rtol * largest
     if not _agree(a, b, rtol, floor):
@@ -153,8 +153,15 @@ def _equivalent(student: Node, expected: _Form, domains: Domains, seed: str, rto
 
 
 def _agree(a: np.ndarray, b: np.ndarray, rtol: float, floor: float) -> bool:
+    """``|a - b| <= rtol max(|a|, |b|) + floor`` everywhere (in place: a few numpy calls on short arrays)."""
     # The floor lets a value that cancels to near zero at one point agree to the size of the others.
-    return bool(np.all(np.abs(a - b) <= rtol * np.maximum(np.abs(a), np.abs(b)) + floor))
+    error = np.subtract(a, b)
+    np.abs(error, out=error)
+    bound = np.abs(a)
+    np.maximum(bound, np.abs(b), out=bound)
+    bound *= rtol
+    bound += floor
+    return bool(np.logical_and.reduce(np.less_equal(error, bound)))
 
 
 Points = dict[str, np.ndarray]
@@ -273,11 +280,17 @@ def _survey(tree: Node) -> _Survey:
             return _NONE if node.name in CONSTANTS else _named(node.name)
         if isinstance(node, Num):
             return _NONE
-        uses = [visit(arg) for arg in node.args]
+        args = node.args
+        if len(args) == 2:  # most operations: no list, no loop
+            left, right = visit(args[0]), visit(args[1])
+            uses: tuple[frozenset[str], ...] = (left, right)
+            used = left if right <= left else right if left <= right else left | right
+        else:
+            uses = tuple(visit(arg) for arg in args)
+            used = uses[0] if len(uses) == 1 else _union(uses)
         op = node.op
         if op in _TRANSCENDENTAL:
             functions.add(op)
-        used = uses[0] if len(uses) == 1 else _union(uses)
         if not used:
             return used
         if op == "div" and uses[1]:
@@ -302,7 +315,7 @@ def _named(name: str) -> frozenset[str]:
     return frozenset((name,))
 
 
-def _union(uses: list[frozenset[str]]) -> frozenset[str]:
+def _union(uses: tuple[frozenset[str], ...]) -> frozenset[str]:
     first, *rest = uses
     for other in rest:
         if not other <= first:  # mostly a sub-term's names are its sibling's: no new set then
@@ -362,9 +375,9 @@ def _tame(kind: str, node: Node, used: frozenset[str], domains: Domains) -> bool
     if len(used) != 1:
         return False  # in two names or more the scans may pass beside the place: search it
     name = next(iter(used))
-    low, high = dict(domains)[name]
+    low, high = next(bounds for other, bounds in domains if other == name)
     values = _values(node, {name: _grid(low, high)})
-    least, most = float(values.min()), float(values.max())  # NaN if any value is
+    least, most = float(np.minimum.reduce(values)), float(np.maximum.reduce(values))  # NaN if any value is
     if not (math.isfinite(least) and math.isfinite(most)):
         return False
     if kind == "large":

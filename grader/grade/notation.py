@@ -21,6 +21,7 @@ from collections.abc import Callable, Sequence
 import numpy as np
 
 from grader.base.errors import ExpressionError
+from grader.grade.infix import read_tokens
 from grader.model.expr import CONSTANTS, FUNCTIONS, MAX_EXPONENT, Node, Num, Op, Sym, names, parse, to_text
 from grader.model.kernel import OPERATIONS
 
@@ -35,51 +36,54 @@ class ReadError(ValueError):
 _TOKEN = re.compile(r"\s*(?:(?P<num>(?>\d+(?:\.\d*)?|\.\d+)(?>[eE][-+]?\d+)?)|(?P<name>[A-Za-z_][A-Za-z_0-9]*)"
                     r"|(?P<op>\*\*|[-+*/^×·(),]))")
 _TOKEN_NO_E = re.compile(_TOKEN.pattern.replace(r"(?>[eE][-+]?\d+)?", ""))
+_CALLED = re.compile(r"\s*\(")  # after a name: it is called
 
 
 def tree_of(text: str, symbols: tuple[str, ...]) -> Node:
     """Parse with the allow-list parser after writing out implicit products; bounded in size."""
-    written = _with_products(text, symbols)
-    try:
-        tree = parse(written)
-    except ExpressionError as error:
-        raise ReadError(str(error).replace(written, cut(text, 60))) from None
-    if _count(tree) > MAX_NODES:
+    parts = _written(text, symbols)
+    tree = read = read_tokens(parts)
+    if tree is None:  # not a common shape: parse reads it, and says what is wrong
+        written = "".join(parts)
+        try:
+            tree = parse(written)
+        except ExpressionError as error:
+            raise ReadError(str(error).replace(written, cut(text, 60))) from None
+    # Each node read from the tokens has a token of its own: a short list needs no count.
+    if (len(parts) > MAX_NODES or tree is not read) and _count(tree) > MAX_NODES:
         raise ReadError(f"more than {MAX_NODES} numbers, names and operations; simplify the answer")
     return tree
 
 
-def _with_products(text: str, symbols: tuple[str, ...]) -> str:
-    """Text :func:`parse` accepts: ``2v(1+p)`` becomes ``2*v*(1+p)``; names outside ``symbols``,
-    the functions and ``pi`` are refused, and so are characters outside the allow-list."""
+def _written(text: str, symbols: tuple[str, ...]) -> list[str]:
+    """The tokens of text :func:`parse` accepts, one Python token each: ``2v(1+p)`` becomes
+    ``2 * v * ( 1 + p )``; names outside ``symbols``, the functions and ``pi`` are refused, and so are
+    characters outside the allow-list."""
     tokenizer = _TOKEN_NO_E if "e" in symbols or "E" in symbols else _TOKEN
     out: list[str] = []
     previous = ""  # kind of the last token: num, name, func, ( , ) or op
     calls: list[bool] = []  # for each open parenthesis: does it hold a function's arguments?
-    position, end = 0, len(text)
-    while position < end:
-        match = tokenizer.match(text, position)
-        if match is None:
-            rest = text[position:].lstrip()
-            if not rest:
-                break
-            if rest[0] == "∞":
-                raise ReadError("infinity is not a finite number")
-            raise ReadError(f"unexpected character '{rest[0]}'" if rest[0].isprintable() else
-                              f"unexpected character U+{ord(rest[0]):04X}")
+    position = 0
+    for match in tokenizer.finditer(text):
+        if match.start() != position:  # not a token where the last one ended
+            break
         position = match.end()
         group = match.lastgroup or "op"  # the one of num, name, op that matched
         token = match[group]
+        parts = None  # the token, unless written as several
         if group == "num":
             if previous == "num":
                 raise ReadError(f"two numbers side by side ({cut(text, 40)}); give one answer")
             _check_underflow(token)
-            kind, parts = "num", [token]
+            kind = "num"
         elif group == "name":
-            kind, parts = _name(token, symbols, text[position:position + 1] == "(" or
-                                text[position:].lstrip()[:1] == "(")
+            if token in symbols or token in CONSTANTS:  # as _name says, sooner
+                kind = "name"
+            else:
+                kind, parts = _name(token, symbols, text[position:position + 1] == "(" or
+                                    _CALLED.match(text, position) is not None)
         else:
-            kind, parts = token, [_WRITTEN.get(token, token)]
+            kind, token = token, _WRITTEN.get(token, token)
             if kind == "(":
                 calls.append(previous == "func")
             elif kind == ")" and calls:
@@ -88,11 +92,20 @@ def _with_products(text: str, symbols: tuple[str, ...]) -> str:
                 _check_comma(calls, previous, text[position:])
         if previous in _BEFORE_PRODUCT and kind in _AFTER_PRODUCT:
             out.append("*")
-        out += parts
+        if parts is None:
+            out.append(token)
+        else:
+            out += parts
         previous = kind
         if len(out) > 3 * MAX_NODES:  # bounded work a cell: refused before it is parsed (parentheses counted)
             raise ReadError(f"more than {MAX_NODES} numbers, names and operations; simplify the answer")
-    return "".join(out)
+    rest = text[position:].lstrip()
+    if rest:
+        if rest[0] == "∞":
+            raise ReadError("infinity is not a finite number")
+        raise ReadError(f"unexpected character '{rest[0]}'" if rest[0].isprintable() else
+                          f"unexpected character U+{ord(rest[0]):04X}")
+    return out
 
 
 _WRITTEN = {"^": "**", "×": "*", "·": "*"}

@@ -377,6 +377,7 @@ def _environment() -> jinja2.Environment:
         autoescape=False)  # noqa: S701
     environment.filters["str"] = string
     environment.filters["int"] = lambda value: Typ(str(int(value)))
+    environment.filters["bool"] = lambda value: Typ("true" if value else "false")
     return environment
 
 
@@ -395,12 +396,13 @@ def student_source(documents: Documents, indices: Iterable[int]) -> str:
 
 
 def key_source(documents: Documents, *, cover: Cover | None = None, glances: Sequence[Glance] = (),
-               people: Sequence[int] = ()) -> str:
+               people: Sequence[int] = (), numbers: int = 0) -> str:
     """The Typst source of a part of the answer key: the cover, tables of answers at a glance, the
-    worked solutions of the listed students (roster positions), or any of them in this order."""
+    worked solutions of the listed students (roster positions), or any of them in this order; with
+    ``numbers``, that many pages of the key's page numbers alone (stamped on the joined key's pages)."""
     assignment = documents.assignment
     return _environment().get_template("key.typ.j2").render(
-        assignment=_assignment_view(assignment), paper=PAPER, cover=cover, glances=glances,
+        assignment=_assignment_view(assignment), paper=PAPER, cover=cover, glances=glances, numbers=numbers,
         people=[(i + 1, documents.person(i)) for i in people], document_title=f"{assignment.title}: answer key")
 
 

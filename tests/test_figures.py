@@ -7,20 +7,19 @@ stranger ones)."""
 
 from __future__ import annotations
 
-import dataclasses
 import re
 from pathlib import Path
 
 import pytest
 
-from grader.assign.assignment import Assignment, ProblemSpec, load_assignment, load_roster
-from grader.assign.variants import generate
+from grader.assign.variants import ProblemVariant
 from grader.bank.template import Template, load_bank, load_template
-from grader.base.resources import sample_dir
 from grader.physics.effects import CATALOGUE
-from grader.render.documents import Documents
 from grader.render.figures import figure_record
 from grader.render.panels import ANNOTATIONS, FigureRecord, panel_groups
+from grader.render.preview import example_printed
+from grader.render.worked import chain_values, si_parameters
+from grader.solve.cache import compiled_for
 
 TEST_BANK = Path(__file__).parent / "data" / "figures"
 
@@ -35,21 +34,27 @@ def _bank() -> dict[str, Template]:
 BANK = _bank()
 
 
+def example_variant(template: Template) -> ProblemVariant:
+    """The template's example (its ``example:`` values, printed as a sheet prints them)."""
+    printed = example_printed(template)
+    return ProblemVariant("1", template.id, "example", {n: float(v) for n, v in printed.items()}, printed, ())
+
+
 @pytest.fixture(scope="module")
 def figures() -> dict[str, tuple[str, FigureRecord, dict[str, str]]]:
-    """Each template's figure (Typst), its record and the printed values, for three students."""
-    assignment: Assignment = load_assignment(sample_dir() / "assignment.yaml")
-    ids = sorted(BANK)
-    problems = tuple(ProblemSpec(str(n + 1), t, {"*": 1.0}, {}, {}, {}) for n, t in enumerate(ids))
-    every = dataclasses.replace(assignment, problems=problems)
-    generation = generate(every, load_roster(sample_dir() / "roster.csv")[:3], BANK)
-    documents = Documents(every, generation, BANK)
+    """Each template's figure (Typst), its record and the printed values, at its example's values."""
     found = {}
-    for student, entry in enumerate(generation.students):
-        for position, variant in enumerate(entry.problems):
-            typst, record = figure_record(BANK[variant.template], variant, documents.solution(student, position).values)
-            found[f"{variant.template}/{student}"] = (str(typst), record, dict(variant.printed))
+    for template_id, template in BANK.items():
+        variant = example_variant(template)
+        typst, record = figure_record(template, variant, _values(template, variant))
+        found[f"{template_id}/0"] = (str(typst), record, dict(variant.printed))
     return found
+
+
+def _values(template: Template, variant: ProblemVariant) -> dict[str, float]:
+    """Every quantity's value (SI, symbols at 1), as the worked solution gives the figure."""
+    given = {**si_parameters(template, variant), **dict.fromkeys(template.symbols, 1.0)}
+    return chain_values(compiled_for(template), given)
 
 
 def _bodies(stage_fields: dict[str, object]) -> set[str]:
@@ -137,3 +142,76 @@ def test_a_scene_of_stages_no_panel_claims_has_a_panel_per_stage() -> None:
     assert [[s.effect for s in g] for g in panel_groups(BANK["skid"].scene.stages)] == [["impact", "slide"]]
     pendulum = panel_groups(BANK["ballistic-pendulum"].scene.stages)
     assert [[s.effect for s in g] for g in pendulum] == [["impact", "swing"]]
+
+
+# --- the author decides: figure: none, {panels: ...}, {file: ...} --------------------------------
+
+def _variant_of(template: Template) -> tuple[Template, ProblemVariant, dict[str, float]]:
+    variant = example_variant(template)
+    return template, variant, _values(template, variant)
+
+
+def _with_figure(tmp_path: Path, template_id: str, figure: object, files: dict[str, str] | None = None) -> Template:
+    import yaml
+
+    source = TEST_BANK / f"{template_id}.yaml"
+    raw = yaml.safe_load(source.read_text(encoding="utf-8")) if source.exists() else \
+        yaml.safe_load((Path(BANK[template_id].where)).read_text(encoding="utf-8"))
+    raw["figure"] = figure
+    for name, text in (files or {}).items():
+        (tmp_path / name).write_text(text, encoding="utf-8")
+    path = tmp_path / f"{template_id}.yaml"
+    path.write_text(yaml.safe_dump(raw, allow_unicode=True), encoding="utf-8")
+    return load_template(path)
+
+
+def test_figure_none_draws_nothing(tmp_path: Path) -> None:
+    template, variant, values = _variant_of(_with_figure(tmp_path, "cord-pendulum", "none"))
+    typst, record = figure_record(template, variant, values)
+    assert str(typst) == "none" and record.panels == ()
+
+
+def test_figure_panels_choose_and_merge_the_stages_shown(tmp_path: Path) -> None:
+    """`panels: [[1, 2], 3]`: A's swing and the impact in one panel, B's swing in the next."""
+    template, variant, values = _variant_of(_with_figure(tmp_path, "cord-pendulum", {"panels": [[2, 1], 3]}))
+    _, record = figure_record(template, variant, values)
+    assert [p.stages for p in record.panels] == [(0, 1), (2,)]
+    assert [set(p.bodies) for p in record.panels] == [{"A"}, {"B"}]  # a merged panel draws its first stage's panel
+
+
+def test_a_figure_of_the_authors_own_gets_the_variants_values(tmp_path: Path) -> None:
+    """A .typ figure beside the template, `{{ L }}` replaced by the printed value, typeset in the
+    sheet; an .svg likewise, as an image."""
+    from grader.render.typeset import compile_typst
+
+    drawing = '#rect(width: 3cm, height: 1cm)[A on a cord $L = {{ L }}$ m]'
+    template, variant, values = _variant_of(_with_figure(tmp_path, "cord-pendulum", {"file": "mine.typ"},
+                                                         {"mine.typ": drawing}))
+    typst, _ = figure_record(template, variant, values)
+    assert f"$L = {variant.printed['L']}$" in str(typst)
+    compile_typst(f"#{typst}\n", tagged=False)
+    svg = ('<svg xmlns="http://www.w3.org/2000/svg" width="100" height="40"><text x="5" y="20">'
+           'L = {{ L }} m</text></svg>')
+    template, variant, values = _variant_of(_with_figure(tmp_path, "cord-pendulum", {"file": "mine.svg"},
+                                                         {"mine.svg": svg}))
+    typst, _ = figure_record(template, variant, values)
+    compile_typst(f"#{typst}\n", tagged=False)
+
+
+@pytest.mark.parametrize(("figure", "files", "message"), [
+    ({"panel": [1]}, {}, "figure.panel: expected one of file, panels (did you mean panels?)"),
+    ({"panels": [1, 4]}, {}, "figure.panels[2]: expected a list of panels, each a stage's number (1 to 3)"),
+    ({"panels": [1, [1, 2]]}, {}, "figure.panels[2]: expected each stage in one panel at most, got stage 1 again"),
+    ({"file": "missing.typ"}, {}, "figure.file: expected a UTF-8 file"),
+    ({"file": "../x.typ"}, {}, "figure.file: expected the name of a .typ or .svg file beside the template"),
+    ({"file": "a.typ"}, {"a.typ": "$x = {{ nope }}$"}, "expected {{ name }} of parameters only, got {{ nope }}"),
+    ({"file": "a.typ"}, {"a.typ": '#read("/etc/passwd")'}, "expected a drawing that reads no file"),
+    ("a picture", {}, "figure: expected none, {file: FILE.typ or FILE.svg} or {panels: [1, [2, 3]]}"),
+])
+def test_a_figure_field_that_cannot_be_used_is_refused_saying_why(
+        tmp_path: Path, figure: object, files: dict[str, str], message: str) -> None:
+    from grader.base.errors import TemplateError
+
+    with pytest.raises(TemplateError) as refused:
+        _with_figure(tmp_path, "cord-pendulum", figure, files)
+    assert message in str(refused.value)

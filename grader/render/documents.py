@@ -427,8 +427,8 @@ def cover(documents: Documents, contents: Sequence[tuple[Typ, int]]) -> Cover:
 
 def check_statements(assignment: Assignment, generation: Generation, bank: Mapping[str, Template],
                      fonts: tuple[str, ...] = ()) -> None:
-    """Typeset each problem's statement alone once, so that a statement Typst cannot read is
-    reported with its template's file, not as a failure of a whole document."""
+    """Typeset each problem's statement (and the template's own figure, if it has one) alone once, so
+    that one Typst cannot read is reported with its template's file, not as a failure of a whole document."""
     if not generation.students:
         return
     for variant in generation.students[0].problems:
@@ -437,6 +437,12 @@ def check_statements(assignment: Assignment, generation: Generation, bank: Mappi
             compile_typst(f"#set page(width: 12cm, height: auto)\n{statement(template, variant)}\n", fonts=fonts)
         except GraderError as error:
             raise GraderError(f"{template.where}: statement: {error}") from None
+        if template.figure.kind == "file":  # the author's own figure, alone: its errors name its template
+            try:
+                compile_typst(f"#set page(width: auto, height: auto)\n#{figure(template, variant, {})}\n",
+                              fonts=fonts)
+            except GraderError as error:
+                raise GraderError(f"{template.where}: figure: {error}") from None
 
 
 def sources(assignment: Assignment, generation: Generation, bank: Mapping[str, Template],

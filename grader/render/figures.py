@@ -14,7 +14,7 @@ from grader.assign.variants import ProblemVariant
 from grader.bank.template import Template
 from grader.render.panels import PANELS, FigureRecord, panels_figure
 from grader.render.scene_view import SceneView
-from grader.render.typst_text import Typ
+from grader.render.typst_text import Typ, string
 
 STAGE_FIGURES: Mapping[str, str] = {
     **{name: kind.drawn for name, kind in PANELS.items()},
@@ -36,5 +36,17 @@ def figure(template: Template, variant: ProblemVariant, values: Mapping[str, flo
 
 def figure_record(template: Template, variant: ProblemVariant,
                   values: Mapping[str, float]) -> tuple[Typ, FigureRecord]:
-    """The figure and the record of what it drew (its panels, their stages and bodies)."""
-    return panels_figure(SceneView(template, variant, values))
+    """The figure and the record of what it drew (its panels, their stages and bodies): the scene's
+    panels, the panels the template chose, none, or the template's own figure (``figure:``,
+    :mod:`grader.bank.figure_field`)."""
+    spec = template.figure
+    if spec.kind == "none":
+        return Typ("none"), FigureRecord(())
+    if spec.kind == "file":
+        filled = spec.filled(variant.printed)
+        if spec.suffix == ".svg":
+            return Typ(f"image(bytes({string(filled)}), format: \"svg\", width: 6cm)"), FigureRecord(())
+        return Typ(f"box(width: 7.6cm, [\n{filled}\n])"), FigureRecord(())
+    stages = template.scene.stages
+    groups = [[stages[i] for i in panel] for panel in spec.panels] if spec.kind == "panels" else None
+    return panels_figure(SceneView(template, variant, values), groups)

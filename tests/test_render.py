@@ -142,21 +142,24 @@ def test_the_key_has_worked_steps_with_each_students_numbers(rendered: tuple[Pat
 
 
 def footers(reader: PdfReader) -> list[tuple[str, int, int]]:
-    """Each page's footer: the section it names, and "page x of y"."""
+    """Each page's footer: the section it names (its own, the left), and "page x of y" (stamped
+    over it as the key's parts are joined, the last line)."""
     found = []
     for page in reader.pages:
-        last = page.extract_text().strip().splitlines()[-1]
-        match = re.fullmatch(r"(.*) · answer key\s*page (\d+) of (\d+)", last)
-        assert match is not None, last
-        found.append((match.group(1), int(match.group(2)), int(match.group(3))))
+        *_, left, right = page.extract_text().strip().splitlines()
+        named = re.fullmatch(r"(.*) · answer key", left.strip())
+        number = re.fullmatch(r"page (\d+) of (\d+)", right.strip())
+        assert named is not None and number is not None, (left, right)
+        found.append((named.group(1), int(number.group(1)), int(number.group(2))))
     return found
 
 
 def test_a_key_typeset_in_many_parts_numbers_its_pages_and_contents_rightly(
         tmp_path: Path, monkeypatch: pytest.MonkeyPatch, assignment: Assignment, bank: dict[str, Template],
         few: Generation) -> None:
-    """Parts of 2 students and tables of 3 rows: every section's footer counts 1..y within it, the
-    contents give the page each student and table starts on, and the bookmarks point there too."""
+    """Parts of 2 students and tables of 3 rows: the pages are numbered 1..y through the whole key
+    (issue 26: they were numbered per student, "page 1 of 2" in a file of 127), the contents give
+    the page each student and table starts on, and the bookmarks point there too."""
     import grader.render.pdfs
 
     monkeypatch.setattr(grader.render.pdfs, "STUDENTS_PER_PART", 2)
@@ -164,24 +167,23 @@ def test_a_key_typeset_in_many_parts_numbers_its_pages_and_contents_rightly(
     render_all(assignment, few, bank, tmp_path, jobs=2)
     reader = PdfReader(tmp_path / "answer-key.pdf")
     pages = footers(reader)
-    for page, (section, number, count) in enumerate(pages):  # sections run 1..y, one after another
-        assert number == 1 or pages[page - 1][:2] == (section, number - 1), (page, pages[page - 1])
-        assert number < count or page + 1 == len(pages) or pages[page + 1][1] == 1
-    starts = {}  # each section's first page, from 1
-    for page, (section, number, _) in enumerate(pages):
-        if number == 1:
-            starts.setdefault(section, page + 1)
-    assert {"Answers at a glance (problem 1, students 1–3)", "Answers at a glance (problem 1, student 4)"} \
-        <= set(starts)
-    cover = "\n".join(reader.pages[i].extract_text() for i, (s, _, _) in enumerate(pages) if "class overview" in s)
+    assert [(number, count) for _, number, count in pages] == [(n, len(pages)) for n in range(1, len(pages) + 1)]
+    texts = [page.extract_text() for page in reader.pages]
+    covered = sum(1 for section, _, _ in pages if "class overview" in section)
+    cover = "\n".join(texts[:covered])
     listed = {line.rsplit(maxsplit=1)[0]: int(line.split()[-1]) for line in cover.splitlines()
               if re.search(r"\(\d+\)|^Answers at a glance", line)}
+
+    def first_page(words: str) -> int:
+        return next(page for page in range(covered, len(texts)) if words in texts[page]) + 1
+
     for entry in few.students:
         shown = next(page for title, page in listed.items() if f"({entry.student.id})" in title)
-        assert shown == starts[f"{entry.student.name} ({entry.student.id})"], entry.student.name
+        assert shown == first_page(f"({entry.student.id})"), entry.student.name
     for key in "12345":
         shown = next(page for title, page in listed.items() if title.startswith(f"Answers at a glance, problem {key}:"))
-        assert shown == starts[f"Answers at a glance (problem {key}, students 1–3)"]
+        assert shown == first_page(f"Answers at a glance, problem {key}:")
+    assert sum("(continued)" in text for text in texts) >= 1  # a table goes on in the next part
     marks = [(o.title, reader.get_destination_page_number(o) + 1) for o in reader.outline if not isinstance(o, list)]
     assert sorted(page for _, page in marks) == sorted(listed.values())
 
@@ -557,3 +559,36 @@ def test_the_line_of_centres_is_drawn_at_the_variants_angle(assignment: Assignme
     (x1, y1, r1), (x2, y2, r2) = [tuple(map(float, found)) for found in circles]
     assert abs(((x2 - x1) ** 2 + (y2 - y1) ** 2) ** 0.5 - (r1 + r2)) < 0.02
     assert abs((y1 - y2) / (r1 + r2) - sine) < 0.02  # Typst's y points down
+
+
+def test_a_given_is_printed_in_the_unit_it_was_given(bank: dict[str, Template], few: Generation) -> None:
+    """Issue 26: a given `k = 651 N/m` was printed `= 651 kg/s²`. A unit of factor 1 that is not
+    the SI name (here the ram's mass in N·s²/m) is shown as given, with no conversion; one of
+    another factor (mm) is still converted."""
+    raw = yaml.safe_load((Path(bank["pile-driver"].where)).read_text(encoding="utf-8"))
+    raw["parameters"]["m_ram"]["unit"] = "N*s^2/m"
+    template = parse_template(raw, "pile-driver (N*s^2/m)", "test")
+    variant = next(v for s in few.students for v in s.problems if v.template == "pile-driver")
+    given = worked(template, dataclasses.replace(variant, template=template.id)).given
+    ram = next(line for line in given if line.startswith('m_"ram"'))
+    assert "N" in ram and "kg" not in ram and ram.count("=") == 1, ram
+    drop = worked(bank["drop-rebound"], few.students[0].problems[0]).given[0]
+    assert '"mm"' in drop and drop.count("=") == 2, drop
+
+
+def test_every_pdf_is_clean_for_pdfinfo_and_qpdf(rendered: tuple[Path, list[Path], list[int]]) -> None:
+    """Issue 26: Typst's `/Suspects false` made poppler's pdfinfo warn "Suspects object is wrong type
+    (boolean)" on every sheet. Every PDF written (sheets, class file, key) now reads without a word
+    on stderr from pdfinfo, and `qpdf --check` finds nothing; a tool not installed is skipped."""
+    import shutil
+    import subprocess
+
+    tools = [command for command in (["pdfinfo"], ["qpdf", "--check"]) if shutil.which(command[0])]
+    if not tools:
+        pytest.skip("neither pdfinfo (poppler-utils) nor qpdf is installed")
+    _, paths, _ = rendered
+    for path in (p for p in paths if p.suffix == ".pdf"):
+        for command in tools:
+            run = subprocess.run([*command, str(path)], capture_output=True, text=True, check=False)
+            assert run.returncode == 0 and not run.stderr.strip(), (command, path.name, run.stderr)
+            assert "warning" not in run.stdout.lower(), (command, path.name, run.stdout)

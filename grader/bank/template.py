@@ -17,6 +17,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from grader.bank.figure_field import SCENE_FIGURE, FigureSpec, parse_figure
 from grader.bank.folders import NAME, TEMPLATE_ID, TOPICS, bank_folders, one_line, template_files, template_paths
 from grader.bank.scene_parser import parse_scene
 from grader.base.errors import ExpressionError, GraderError, TemplateError, UsageError, close_matches, shown
@@ -42,7 +43,7 @@ RESERVED = {"g", "pi"}
 _BOUND = r"(-?inf|[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)"
 _INTERVAL = re.compile(rf"^\s*([\[(])\s*{_BOUND}\s*,\s*{_BOUND}\s*([\])])\s*$")
 _TOP_KEYS = {"id", "title", "topic", "version", "gravity", "bodies", "stages", "symbols", "parameters",
-             "constraints", "answers", "tolerance", "statement", "example"}
+             "constraints", "answers", "tolerance", "statement", "example", "figure"}
 
 @dataclass(frozen=True)
 class Interval:
@@ -180,6 +181,7 @@ class Template:
     answers: Mapping[str, AnswerSpec]
     statement: str
     example: Mapping[str, float]
+    figure: FigureSpec = SCENE_FIGURE  # what the sheets draw: the scene's panels unless the template says
 
 
 def load_bank(directory: Path | None = None) -> dict[str, Template]:
@@ -326,6 +328,7 @@ def parse_template(raw: Mapping[str, Any], where: str, source_hash: str, stem: s
         constraints=tuple(_constraint(i, c, where) for i, c in enumerate(_list(raw, "constraints", where))),
         answers=answers, statement=_text(raw, "statement", where),
         example=_example(raw.get("example") or {}, parameters, where),
+        figure=parse_figure(raw.get("figure"), where, len(scene.stages), parameters),
     )
     _check_names(template)
     return template

@@ -377,6 +377,7 @@ def _environment() -> jinja2.Environment:
         autoescape=False)  # noqa: S701
     environment.filters["str"] = string
     environment.filters["int"] = lambda value: Typ(str(int(value)))
+    environment.filters["bool"] = lambda value: Typ("true" if value else "false")
     return environment
 
 
@@ -395,12 +396,13 @@ def student_source(documents: Documents, indices: Iterable[int]) -> str:
 
 
 def key_source(documents: Documents, *, cover: Cover | None = None, glances: Sequence[Glance] = (),
-               people: Sequence[int] = ()) -> str:
+               people: Sequence[int] = (), numbers: int = 0) -> str:
     """The Typst source of a part of the answer key: the cover, tables of answers at a glance, the
-    worked solutions of the listed students (roster positions), or any of them in this order."""
+    worked solutions of the listed students (roster positions), or any of them in this order; with
+    ``numbers``, that many pages of the key's page numbers alone (stamped on the joined key's pages)."""
     assignment = documents.assignment
     return _environment().get_template("key.typ.j2").render(
-        assignment=_assignment_view(assignment), paper=PAPER, cover=cover, glances=glances,
+        assignment=_assignment_view(assignment), paper=PAPER, cover=cover, glances=glances, numbers=numbers,
         people=[(i + 1, documents.person(i)) for i in people], document_title=f"{assignment.title}: answer key")
 
 
@@ -425,8 +427,8 @@ def cover(documents: Documents, contents: Sequence[tuple[Typ, int]]) -> Cover:
 
 def check_statements(assignment: Assignment, generation: Generation, bank: Mapping[str, Template],
                      fonts: tuple[str, ...] = ()) -> None:
-    """Typeset each problem's statement alone once, so that a statement Typst cannot read is
-    reported with its template's file, not as a failure of a whole document."""
+    """Typeset each problem's statement (and the template's own figure, if it has one) alone once, so
+    that one Typst cannot read is reported with its template's file, not as a failure of a whole document."""
     if not generation.students:
         return
     for variant in generation.students[0].problems:
@@ -435,6 +437,12 @@ def check_statements(assignment: Assignment, generation: Generation, bank: Mappi
             compile_typst(f"#set page(width: 12cm, height: auto)\n{statement(template, variant)}\n", fonts=fonts)
         except GraderError as error:
             raise GraderError(f"{template.where}: statement: {error}") from None
+        if template.figure.kind == "file":  # the author's own figure, alone: its errors name its template
+            try:
+                compile_typst(f"#set page(width: auto, height: auto)\n#{figure(template, variant, {})}\n",
+                              fonts=fonts)
+            except GraderError as error:
+                raise GraderError(f"{template.where}: figure: {error}") from None
 
 
 def sources(assignment: Assignment, generation: Generation, bank: Mapping[str, Template],

@@ -39,6 +39,8 @@ class Drawing:
     labels: list[tuple[Point, tuple[float, float, float, float]]] = field(default_factory=list)
     occupied: list[tuple[float, float, float, float]] = field(default_factory=list)
     strokes: list[tuple[Point, Point]] = field(default_factory=list)
+    bodies: list[str] = field(default_factory=list)  # the scene's bodies named, in the order drawn: the record
+
 
     def _add(self, kind: str, points: Sequence[Point], options: str = "", radius: float = 0.0) -> None:
         for x, y in points:
@@ -94,6 +96,12 @@ class Drawing:
         body = ", ".join(f"${line}$" for line in lines)
         self.calls.append(("fig-label", [at], 0.0, f"{string(anchor)}, ({body},)"))
 
+    def name(self, at: Point, anchor: str, body: str, more: Sequence[str] = ()) -> None:
+        """A body's name (and ``more`` lines, its mass), placed as :meth:`label` places lines, and
+        kept in :attr:`bodies`, the record of the scene's bodies this drawing shows."""
+        self.bodies.append(body)
+        self.label(at, anchor, [str(string(body)), *more])
+
     def arrow(self, tail: Point, tip: Point, width: float = 0.9, head: float = 0.22) -> None:
         """An arrow: a line and a triangular head."""
         dx, dy = tip[0] - tail[0], tip[1] - tail[1]
@@ -148,11 +156,11 @@ class Drawing:
         ys = [y * scale for _, y in self.points] + [a[1] * scale + d for a, box in self.labels for d in box[1::2]]
         return (min(xs), min(ys), max(xs), max(ys)) if xs else (0.0, 0.0, 0.0, 0.0)
 
-    def typst(self) -> Typ:
+    def typst(self, max_width: float = MAX_WIDTH) -> Typ:
         """A ``fig-canvas`` call drawing everything, shifted to start at the origin; a drawing wider
-        than ``MAX_WIDTH`` has its geometry (not its labels) scaled down until it fits."""
+        than ``max_width`` has its geometry (not its labels) scaled down until it fits."""
         scale = 1.0
-        while scale > 0.5 and self._extent(scale)[2] - self._extent(scale)[0] + 2 * PAD > MAX_WIDTH:
+        while scale > 0.5 and self._extent(scale)[2] - self._extent(scale)[0] + 2 * PAD > max_width:
             scale -= 0.05
         x0, y0, x1, y1 = self._extent(scale)
 

@@ -7,7 +7,9 @@ its pages and bookmarks use (content, fonts, images, outline entries; not its ta
 which describes that document alone) are copied as bytes with their references renumbered, and
 the part is let go. What stays in memory is an offset per object written.
 
-Each part's bookmarks follow the previous part's at the top level of the joined outline.
+Each part's bookmarks follow the previous part's at the top level of the joined outline. A page may
+be stamped with a page of another PDF drawn over it (the answer key's page numbers, which no part
+knows: each page's own content and the stamp become two form XObjects the page draws in turn).
 
 >>> _text_string("Ana (TA)"), _text_string("李华")
 (b'(Ana \\\\(TA\\\\))', b'<FEFF674E534E>')
@@ -60,12 +62,32 @@ def read_part(path: Path) -> Part:
     return Part(path, len(source.pages), tuple(index[source.destination(item)] for item in source.top_bookmarks()))
 
 
-def join(parts: Sequence[Part], target: Path, *, title: str = "", author: str = "", lang: str = "") -> None:
+def join(parts: Sequence[Part], target: Path, *, title: str = "", author: str = "", lang: str = "",
+         stamps: Part | None = None) -> None:
     """Write ``parts`` in order as one PDF at ``target``, with their bookmarks and the given
-    title, author and language. Nothing in it depends on when it was made: the same parts give
-    the same bytes."""
+    title, author and language; with ``stamps`` (a PDF of as many pages as the parts together),
+    each page with the stamp's page of the same number drawn over it. Nothing in it depends on
+    when it was made: the same parts give the same bytes."""
     with target.open("wb") as stream:
-        _Joiner(stream, parts).write(title, author, lang)
+        _Joiner(stream, parts, stamps).write(title, author, lang)
+
+
+_MARK_INFO = re.compile(rb"/Suspects\s*false")
+
+
+def without_false_suspects(data: bytes) -> bytes:
+    """A PDF as Typst writes it, without the ``/Suspects false`` of its catalog's mark information
+    (blanked, so every offset stays): false is the default, and poppler (``pdfinfo``, 22.x) warns
+    "Suspects object is wrong type (boolean)" at any Suspects entry that is not true.
+
+    >>> without_false_suspects(b"<</MarkInfo<</Marked true/Suspects false>>>>")
+    b'<</MarkInfo<</Marked true               >>>>'
+    """
+    at = data.find(b"/MarkInfo")
+    found = _MARK_INFO.search(data, at, data.find(b">>", at) + 2) if at >= 0 else None
+    if found is None:
+        return data
+    return data[:found.start()] + b" " * (found.end() - found.start()) + data[found.end():]
 
 
 # --- reading a part -----------------------------------------------------------------------------
@@ -190,7 +212,7 @@ class _Joiner:
 
     CATALOG, PAGES, OUTLINES, FIRST = 1, 2, 3, 4
 
-    def __init__(self, stream: BinaryIO, parts: Sequence[Part]) -> None:
+    def __init__(self, stream: BinaryIO, parts: Sequence[Part], stamps: Part | None = None) -> None:
         self.stream, self.parts = stream, parts
         self.offsets: dict[int, int] = {}
         total = sum(part.pages for part in parts)
@@ -200,6 +222,10 @@ class _Joiner:
         self.first_bookmark: int | None = None
         self.last_bookmark: int | None = None
         self.next_bookmark: int | None = None  # the number the next part's first bookmark takes
+        self.stamps = None if stamps is None else _Source(stamps.path)
+        if self.stamps is not None and len(self.stamps.pages) != total:
+            raise PdfFormatError(f"{self.stamps.path}: {len(self.stamps.pages)} pages of stamps for {total} pages")
+        self.stamp_numbers: dict[int, int] = {}  # the stamps' objects written, by their number there
 
     def write(self, title: str, author: str, lang: str) -> None:
         self.stream.write(b"%PDF-1.7\n%\x80\x80\x80\x80\n")
@@ -246,6 +272,7 @@ class _Joiner:
             count = re.search(rb"/Count\s*(\d+)", source.outline or b"")
             self.bookmarks += int(count.group(1)) if count else len(top)
         pending = [*top[::-1], *source.pages[::-1]]
+        forms: dict[int, bytes] = {}
         done: set[int] = set()
         while pending:
             old = pending.pop()
@@ -255,10 +282,54 @@ class _Joiner:
             body = self._renumbered(source.body(old), numbers, pending, parents.get(old))
             if old in added:
                 body = body[:body.rindex(b">>")] + added[old] + b">>"
+            if old in forms:  # a page's content, drawn as a form
+                body = body.replace(b"<<", b"<<" + forms[old], 1)
+            if self.stamps is not None and old in parents and parents[old] == self.PAGES:
+                body = self._stamped(source, old, body, first_page + source.pages.index(old), numbers, pending, forms)
             self._object(numbers[old], body.strip())
         if top:
             self.first_bookmark = self.first_bookmark or numbers[top[0]]
             self.last_bookmark = numbers[top[-1]]
+
+    def _stamped(self, source: _Source, page: int, body: bytes, position: int, numbers: dict[int, int],
+                 pending: list[int], forms: dict[int, bytes]) -> bytes:
+        """A page's (renumbered) dictionary drawing its content, then the stamp of its position; its
+        content and resources become a form's (``forms``, written as the content is copied)."""
+        content, resources = (source.ref(key, _masked(source.body(page))) for key in (b"/Contents", b"/Resources"))
+        box = re.search(rb"/MediaBox\s*\[([^\]]*)\]", body)
+        if box is None:
+            raise PdfFormatError(f"{source.path}: page {page} has no media box")
+        if resources not in numbers:
+            numbers[resources] = self._new()
+            pending.append(resources)
+        forms[content] = b"/Type/XObject/Subtype/Form/BBox[%s]/Resources %d 0 R" % (box.group(1), numbers[resources])
+        stamp = self._stamp(position, box.group(1))
+        drawn = self._new()
+        draw = b"/Page Do /Stamp Do"
+        self._object(drawn, b"<</Length %d>>\nstream\n%s\nendstream" % (len(draw), draw))
+        body = re.sub(rb"/Contents\s*\d+\s+\d+\s+R", b"/Contents %d 0 R" % drawn, body, count=1)
+        return re.sub(rb"/Resources\s*\d+\s+\d+\s+R", b"/Resources<</XObject<</Page %d 0 R/Stamp %d 0 R>>>>"
+                      % (numbers[content], stamp), body, count=1)
+
+    def _stamp(self, position: int, box: bytes) -> int:
+        """Write the stamps' page ``position`` as a form (with what it uses, once); returns its number."""
+        assert self.stamps is not None
+        source, numbers = self.stamps, self.stamp_numbers
+        page = _masked(source.body(source.pages[position]))
+        content, resources = source.ref(b"/Contents", page), source.ref(b"/Resources", page)
+        pending = [resources]
+        for old in (content, resources):
+            if old not in numbers:
+                numbers[old] = self._new()
+        while pending:
+            old = pending.pop()
+            self._object(numbers[old], self._renumbered(source.body(old), numbers, pending, None).strip())
+        body = self._renumbered(source.body(content), numbers, pending, None).strip()
+        self._object(numbers[content], body.replace(b"<<", b"<</Type/XObject/Subtype/Form/BBox[%s]/Resources %d 0 R"
+                                                    % (box, numbers[resources]), 1))
+        for old in pending:  # a content stream refers to nothing, but were it to, it is written too
+            raise PdfFormatError(f"{source.path}: a page's content refers to object {old}")
+        return numbers[content]
 
     def _renumbered(self, body: bytes, numbers: dict[int, int], pending: list[int], parent: int | None) -> bytes:
         """An object's text with its references renumbered (new objects queued to copy), its

@@ -103,7 +103,7 @@ def surface(canvas: Drawing, scene: SceneView, impact: Stage) -> bool:
     radius = 0.28
     center = (0.0, radius)
     canvas.rect((-3.0, -0.3), (3.0, 0.0), fill="luma(215)")
-    canvas.label((2.9, -0.35), "ne", [str(string(impact.fields["bodies"][1]))])
+    canvas.name((2.9, -0.35), "ne", impact.fields["bodies"][1], [])
     canvas.line((-2.9, radius), (2.9, radius), width=0.4, dash="dashed", gray=True)
     canvas.circle(center, radius)
     stages = scene.template.scene.stages
@@ -125,6 +125,8 @@ def surface(canvas: Drawing, scene: SceneView, impact: Stage) -> bool:
         if stage is not None:
             _angle_mark(canvas, center, ray, [_axis(stage, n, t)], 0.95, _angle_label(scene, stage))
     _axes(canvas, (3.4, 1.6), n, t)
+    spots = [((0.0, 2 * radius + 0.12), "s"), ((0.0, -0.35), "n")]  # above the body, or under the surface
+    canvas.name(*next((s for s in spots if canvas.fits(*s, [str(string(first))])), spots[-1]), first)
     return True
 
 
@@ -142,7 +144,7 @@ def spheres(canvas: Drawing, scene: SceneView, impact: Stage) -> bool:
     canvas.label((radius, radius + 1.0), "s", ["t"])
     for body, center in centers.items():
         canvas.circle(center, radius)
-        canvas.label(center, "c", [str(string(body)), *scene.mass_value(body)])
+        canvas.name(center, "c", body, [*scene.mass_value(body)])
     stages = scene.template.scene.stages
     for body, velocity in impact.fields["before"].items():
         vector = _screen(velocity, scene, n, t)
@@ -179,7 +181,7 @@ def incline(canvas: Drawing, scene: SceneView, impact: Stage) -> bool:
     corner = (top[0], bottom[1])
     canvas.polygon([top, bottom, corner], fill="luma(215)")
     canvas.path([corner, top, bottom, corner], width=0.6)
-    canvas.label(((corner[0] + bottom[0]) / 2, bottom[1] - 0.1), "n", [str(string(surface))])
+    canvas.name(((corner[0] + bottom[0]) / 2, bottom[1] - 0.1), "n", surface, [])
     stages = scene.template.scene.stages
     center = (radius * out[0], radius * out[1])
     release = (center[0], center[1] + drop)
@@ -190,7 +192,7 @@ def incline(canvas: Drawing, scene: SceneView, impact: Stage) -> bool:
                     _angle_label(scene, incoming))
     canvas.circle(center, radius)
     canvas.circle(release, radius, "dashed", fill=False)
-    canvas.label((release[0], release[1] + radius + 0.1), "s", [str(string(first)), *scene.mass(first)])
+    canvas.name((release[0], release[1] + radius + 0.1), "s", first, [*scene.mass(first)])
     canvas.line(center, release, width=0.4, dash="dashed", gray=True)
     canvas.arrow((center[0], center[1] + 0.55 * drop), (center[0], center[1] + 0.45 * drop), width=0.4, head=0.16)
     fall = find_stage(stages, "free_fall", before=impact.index, body=first)
@@ -250,11 +252,11 @@ def offset_spheres(canvas: Drawing, scene: SceneView, geometry: Stage, impact: S
     canvas.line(at(contact, t, -0.8), at(contact, t, 0.8), width=0.4, dash="dashed", gray=True)
     canvas.arrow(at(contact, t, 0.8), at(contact, t, 1.2), width=0.5, head=0.15)
     canvas.label(at(contact, t, 1.3), _anchor(_m.atan2(t[1], t[0])), ["t"])
-    canvas.label((one[0], -drawn[0] - 0.1), "n", [str(string(first)), *scene.mass_value(first)])
+    canvas.name((one[0], -drawn[0] - 0.1), "n", first, [*scene.mass_value(first)])
     if n[1] < 0.7:  # above sphere 2, or left of it where the line of centres leaves it upward
-        canvas.label((0.0, across + drawn[1] + 0.1), "s", [str(string(second)), *scene.mass_value(second)])
+        canvas.name((0.0, across + drawn[1] + 0.1), "s", second, [*scene.mass_value(second)])
     else:
-        canvas.label((-drawn[1] - 0.1, across + 0.5 * drawn[1]), "e", [str(string(second)), *scene.mass_value(second)])
+        canvas.name((-drawn[1] - 0.1, across + 0.5 * drawn[1]), "e", second, [*scene.mass_value(second)])
     tip = at(one, (1.0, 0.0), -drawn[0] - 0.1)
     tail = at(tip, (1.0, 0.0), -1.8)
     canvas.arrow(tail, tip)

@@ -35,12 +35,12 @@ from grader.render.documents import (
     person_title,
     student_source,
 )
-from grader.render.joining import Part, join, read_part
+from grader.render.joining import Part, join, read_part, without_false_suspects
 from grader.render.typeset import compile_typst, font_paths, one_pdf, release_memory
 from grader.render.typst_text import Typ
 
-STUDENTS_PER_PART = 4  # of the key: about 16 pages, some 25 MiB of Typst's memo while it compiles
-ROWS_PER_PART = 50  # of a table of answers at a glance: a page or two, some 15 MiB
+STUDENTS_PER_PART = 6  # of the key: about 15 pages, some 35 MiB of Typst's memo while it compiles
+ROWS_PER_PART = 150  # of the tables of answers at a glance, which flow on: some three pages, some 45 MiB
 AHEAD = 2  # groups of students whose sources may wait for a thread: bounds the memory they take
 
 
@@ -87,8 +87,30 @@ def _ranges(count: int, size: int) -> list[range]:
     return [range(start, min(count, start + size)) for start in range(0, count, size)]
 
 
+def _table_parts(problems: int, students: int, rows: int) -> list[list[tuple[int, range]]]:
+    """The tables of answers at a glance (a row a student, a table a problem) in parts of at most
+    ``rows`` rows: each part a list of (problem position, students), a table split where a part is full.
+
+    >>> _table_parts(3, 2, 5)
+    [[(0, range(0, 2)), (1, range(0, 2)), (2, range(0, 1))], [(2, range(1, 2))]]
+    """
+    parts: list[list[tuple[int, range]]] = [[]]
+    room = rows
+    for position in range(problems):
+        start = 0
+        while start < students:
+            if room == 0:
+                parts.append([])
+                room = rows
+            stop = min(students, start + room)
+            parts[-1].append((position, range(start, stop)))
+            room -= stop - start
+            start = stop
+    return [part for part in parts if part]
+
+
 def _typeset(source: str, path: Path, fonts: tuple[str, ...], tagged: bool = True) -> Path:
-    path.write_bytes(one_pdf(compile_typst(source, tagged=tagged, fonts=fonts)))
+    path.write_bytes(without_false_suspects(one_pdf(compile_typst(source, tagged=tagged, fonts=fonts))))
     return path
 
 
@@ -107,8 +129,7 @@ class _Run:
         self.sheets = [out / "students" / f"{name}.pdf" for name in self.names]
         self.kept: list[Path] | None = [] if keep_source else None
         self.groups = _ranges(len(students), STUDENTS_PER_PART)
-        self.tables = [(position, rows) for position in range(len(documents.assignment.problems))
-                       for rows in _ranges(len(students), ROWS_PER_PART)]
+        self.tables = _table_parts(len(documents.assignment.problems), len(students), ROWS_PER_PART)
 
     def write(self, pool: concurrent.futures.ThreadPoolExecutor, scratch: Path) -> list[Path]:
         key_parts = self._submit(pool, scratch)
@@ -120,8 +141,10 @@ class _Run:
         contents = self._contents(parts)
         first = _typeset_part(self._keep(key_source(self.documents, cover=cover(self.documents, contents)), 0),
                               scratch / "0000.pdf", self.fonts)
+        pages = first.pages + sum(part.pages for part in parts)
+        numbers = _typeset_part(key_source(self.documents, numbers=pages), scratch / "numbers.pdf", self.fonts)
         join([first, *parts], self.out / "answer-key.pdf", title=f"{self.documents.assignment.title}: answer key",
-             author=self.documents.assignment.course, lang="en")
+             author=self.documents.assignment.course, lang="en", stamps=numbers)
         self.progress(1)
         return [*self.sheets, self.out / "class.pdf", self.out / "answer-key.pdf", *(self.kept or [])]
 
@@ -140,15 +163,15 @@ class _Run:
                 sheets.append(pool.submit(_typeset, source, self.sheets[index], self.fonts))
             parts[number] = self._part(pool, scratch, number, key_source(self.documents, people=group))
             self.documents.forget(group)
-            for table, (position, rows) in itertools.islice(tables, 1):
-                parts[table] = self._part(pool, scratch, table, self._table_source(position, rows))
+            for table, pieces in itertools.islice(tables, 1):
+                parts[table] = self._part(pool, scratch, table, self._table_source(pieces))
             ahead.append(parts[number])
             if len(ahead) > AHEAD:
                 ahead.popleft().result()
                 release_memory()
             sheets = self._report(sheets)
-        for table, (position, rows) in tables:
-            parts[table] = self._part(pool, scratch, table, self._table_source(position, rows))
+        for table, pieces in tables:
+            parts[table] = self._part(pool, scratch, table, self._table_source(pieces))
         for future in concurrent.futures.as_completed(sheets):
             future.result()
             self.progress(1)
@@ -169,20 +192,27 @@ class _Run:
                 waiting.append(future)
         return waiting
 
-    def _table_source(self, position: int, rows: range) -> str:
-        part = f"problem {self.documents.assignment.problems[position].key}"
-        if len(self.documents.generation.students) > ROWS_PER_PART:
-            part += f", students {rows.start + 1}–{rows.stop}" if len(rows) > 1 else f", student {rows.stop}"
-        return key_source(self.documents, glances=[self.documents.glance(position, rows, part, rows.start > 0)])
+    def _table_source(self, pieces: Sequence[tuple[int, range]]) -> str:
+        glances = []
+        for position, rows in pieces:
+            part = f"problem {self.documents.assignment.problems[position].key}"
+            if len(rows) < len(self.documents.generation.students):
+                part += f", students {rows.start + 1}–{rows.stop}" if len(rows) > 1 else f", student {rows.stop}"
+            glances.append(self.documents.glance(position, rows, part, rows.start > 0))
+        return key_source(self.documents, glances=glances)
 
     def _contents(self, parts: Sequence[Part]) -> list[tuple[Typ, int]]:
         """The cover's contents: each table's first part and each student, with the page it starts
         on, counted from the first page after the cover."""
         contents, later = [], 1
         students = self.documents.generation.students
-        for (position, rows), part in zip(self.tables, parts[:len(self.tables)], strict=True):
-            if rows.start == 0:
-                contents.append((self.documents.glance_title(position), later))
+        for pieces, part in zip(self.tables, parts[:len(self.tables)], strict=True):
+            firsts = [position for position, rows in pieces if rows.start == 0]
+            if len(part.bookmarks) != len(firsts):
+                raise GraderError(f"a part of the answer key has {len(part.bookmarks)} tables' headings, "
+                                  f"expected {len(firsts)}")
+            contents += [(self.documents.glance_title(position), later + page)
+                         for position, page in zip(firsts, part.bookmarks, strict=True)]
             later += part.pages
         for group, part in zip(self.groups, parts[len(self.tables):], strict=True):
             if len(part.bookmarks) != len(group):

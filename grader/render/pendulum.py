@@ -15,10 +15,10 @@ from grader.model.scene import Stage
 from grader.render.drawing import Drawing
 from grader.render.scene_view import SceneView
 from grader.render.typst_math import math
-from grader.render.typst_text import string
 
 CORD = 3.6  # cm: the cord's length on the page
 HALF_WIDTH, HALF_HEIGHT = 0.42, 0.3  # cm: the block hanging from it
+ASKED_ANGLE = _m.radians(35)  # how an asked angle is drawn
 
 
 def swing_figure(canvas: Drawing, scene: SceneView, swing: Stage, impact: Stage | None) -> bool:
@@ -28,6 +28,8 @@ def swing_figure(canvas: Drawing, scene: SceneView, swing: Stage, impact: Stage 
     theta = scene.value(swing.fields["angle"])
     if not (_m.isfinite(theta) and 0 <= theta <= _m.pi / 2):
         return False
+    if not scene.is_given(swing.fields["angle"]):
+        theta = ASKED_ANGLE  # an asked angle is drawn, not to scale: the figure must not give it away
     canvas.ground(-0.9, 0.9, 0.0, below=False)  # short: at 90 degrees the block reaches the pivot's height
     canvas.circle((0.0, 0.0), 0.06)
     low = (0.0, -CORD)
@@ -37,7 +39,7 @@ def swing_figure(canvas: Drawing, scene: SceneView, swing: Stage, impact: Stage 
                 "none")
     canvas.line((0.0, 0.0), high, width=0.6)
     canvas.rect((high[0] - HALF_WIDTH, high[1] - HALF_HEIGHT), (high[0] + HALF_WIDTH, high[1] + HALF_HEIGHT))
-    canvas.label((high[0] + HALF_WIDTH + 0.12, high[1]), "w", [str(string(body)), *scene.mass(body)])
+    canvas.name((high[0] + HALF_WIDTH + 0.12, high[1]), "w", body, [*scene.mass(body)])
     steps = max(6, int(theta / 0.05))
     canvas.path([(CORD * _m.sin(theta * i / steps), -CORD * _m.cos(theta * i / steps)) for i in range(steps + 1)],
                 width=0.4, dash="dashed")
@@ -60,7 +62,7 @@ def _striker(canvas: Drawing, scene: SceneView, impact: Stage, target: tuple[flo
     first = impact.fields["bodies"][0]
     x = target[0] - HALF_WIDTH - 1.9
     canvas.rect((x - 0.2, target[1] - 0.06), (x + 0.2, target[1] + 0.06), fill="luma(120)")
-    canvas.label((x, target[1] - 0.15), "n", [str(string(first)), *scene.mass(first)])
+    canvas.name((x, target[1] - 0.15), "n", first, [*scene.mass(first)])
     canvas.arrow((x + 0.35, target[1]), (x + 1.35, target[1]), width=0.7, head=0.18)
     velocity = impact.fields["before"].get(first)
     if velocity is not None:

@@ -13,7 +13,6 @@ from grader.model.scene import Stage
 from grader.render.drawing import Drawing
 from grader.render.scene_view import SceneView
 from grader.render.typst_math import math
-from grader.render.typst_text import string
 
 TALL, WIDE = 3.8, 6.4  # cm: the drop height, and the time until the last arc drawn
 SMALLEST = 0.04  # arcs lower than this share of the drop height are left out (they would be a line)
@@ -35,7 +34,7 @@ def bounce_series(canvas: Drawing, scene: SceneView, stage: Stage) -> bool:
     x_scale, y_scale = WIDE / span, TALL / h0
     x0, radius = 0.9, 0.18
     canvas.circle((x0, TALL + radius), radius)
-    canvas.label((x0, TALL + 2 * radius + 0.12), "s", [str(string(body))])
+    canvas.name((x0, TALL + 2 * radius + 0.12), "s", body, [])
     canvas.dimension((0.3, 0.0), (0.3, TALL), scene.given(stage.fields["height"]), "left")
     fall = _m.sqrt(h0) * x_scale
     canvas.path([(x0 + fall * (i / 16), TALL * (1 - (i / 16) ** 2)) for i in range(17)], width=0.5, dash="dashed")
@@ -52,6 +51,6 @@ def bounce_series(canvas: Drawing, scene: SceneView, stage: Stage) -> bool:
             canvas.label((x, -0.12), "n", [str(number)])
         x += width
     canvas.ground(0.0, max(x, x0 + fall) + 0.4, 0.0)
-    canvas.label((x + 0.55, -0.05), "w", [str(string(floor))])  # past the floor's end: clear of the arcs
+    canvas.name((x + 0.55, -0.05), "w", floor, [])  # past the floor's end: clear of the arcs
     canvas.label((x0 + fall + 0.15, TALL * 0.75), "w", scene.given(stage.fields["restitution"]))
     return True

@@ -54,7 +54,7 @@ def skid(canvas: Drawing, scene: SceneView, impact: Stage, slide: Stage) -> bool
     canvas.label((a / 2, height + 0.35), "s", scene.given(before.n) if before is not None else ["v"])
     canvas.label((a + b / 2, height + 0.1), "s", ["v = 0"])
     for x, body in ((a / 2, first), (a + b / 2, second)):
-        canvas.label((x, ROW + 0.2 + tall / 2), "c", [str(string(body))])
+        canvas.name((x, ROW + 0.2 + tall / 2), "c", body, [])
     canvas.label((-0.3, ROW + tall + 1.3), "w", [str(string("at the impact"))])
     given = [*scene.mass(first), *scene.mass(second), *scene.given(slide.fields["friction"])]
     canvas.label((a + b + 0.4, ROW + 0.15), "sw", given)
@@ -66,7 +66,7 @@ def skid(canvas: Drawing, scene: SceneView, impact: Stage, slide: Stage) -> bool
     _car(canvas, d, d + a, 0.0, tall, None)
     _car(canvas, d + a, d + a + b, 0.0, tall, None)
     for x, body in ((d + a / 2, first), (d + a + b / 2, second)):
-        canvas.label((x, 0.2 + tall / 2), "c", [str(string(body))])
+        canvas.name((x, 0.2 + tall / 2), "c", body, [])
     canvas.label((-0.3, tall + 0.9), "w", [str(string("at rest"))])
     horizontal_dimension(canvas, a, a + d, -0.55, scene.given(slide.fields["distance"]))
     return True

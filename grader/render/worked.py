@@ -147,7 +147,7 @@ def given_lines(template: Template, variant: ProblemVariant, compiled: Compiled)
         shown = f"{name(parameter_name)} = {printed}"
         if unit.text == "deg":
             shown += f" degree = {number(float(printed) * unit.to_si)}{_unit_math('rad')}"
-        elif unit.to_si != 1.0 or unit.text not in ("", si_unit(unit.dimension)):
+        elif unit.to_si != 1.0:
             shown += f"{_unit_math(unit.text)} = {_shown_parameter(printed, unit.to_si)}" \
                      f"{_unit_math(si_unit(unit.dimension))}"
         else:

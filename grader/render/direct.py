@@ -1,0 +1,82 @@
+"""The panels of direct impacts of bodies on a line (see :mod:`grader.render.panels`), and of bodies
+side by side, named: blocks whose areas follow the masses, each with its velocity before as an arrow
+the way it moves, lengths in the ratio of the speeds.
+"""
+
+from __future__ import annotations
+
+import math as _m
+from collections.abc import Sequence
+
+from grader.model.scene import Stage, Velocity
+from grader.render.drawing import Drawing, Point
+from grader.render.scene_view import SceneView
+from grader.render.typst_text import string
+
+
+def _line_of_bodies(impacts: Sequence[Stage]) -> list[str]:
+    """The bodies of direct impacts in the order they are struck: ``[1, 2]`` then ``[2, 3]`` is 1, 2, 3."""
+    order: list[str] = []
+    for stage in impacts:
+        order += [body for body in stage.fields["bodies"] if body not in order]
+    return order
+
+
+def direct(canvas: Drawing, scene: SceneView, impacts: Sequence[Stage]) -> bool:
+    """Bodies on a line in the order they are struck, blocks whose areas follow the masses (a fixed
+    one a wall); above each its velocity before it is first struck, an arrow the way it moves with
+    lengths in the ratio of the speeds, or ``v = 0``."""
+    bodies = _line_of_bodies(impacts)
+    before = {body: stage.fields["before"].get(body) for stage in reversed(impacts) for body in stage.fields["bodies"]}
+    masses = {b: scene.value(scene.template.scene.bodies[b].mass) for b in bodies
+              if scene.template.scene.bodies[b].mass is not None}
+    finite = [m for m in masses.values() if _m.isfinite(m) and m > 0]
+    mean = _m.exp(sum(_m.log(m) for m in finite) / len(finite)) if finite else 1.0
+    # Sides clamped to 0.77..2.2 cm: the smallest still holds its name, the largest fits the column.
+    sides = {b: 1.1 * min(2.0, max(0.7, _m.sqrt(m / mean))) if _m.isfinite(m) and m > 0 else 1.1
+             for b, m in masses.items()}
+    speeds = [abs(scene.value(v.n)) for v in before.values() if v is not None]
+    fastest = max((v for v in speeds if _m.isfinite(v)), default=0.0)
+    gap = 2.2 if len(bodies) < 3 else 1.9
+    x = 0.0
+    for index, body in enumerate(bodies):
+        if index:
+            x += gap
+        if body not in masses:  # a wall, hatched on its far side
+            canvas.line((x, 0.0), (x, 1.8), width=1.0)
+            for y in (0.15, 0.4, 0.65, 0.9, 1.15, 1.4, 1.65):
+                canvas.line((x, y), (x + 0.16, y + 0.16), width=0.4)
+            canvas.name((x + 0.3, 1.0), "w", body, [])
+            continue
+        side = sides[body]
+        canvas.rect((x, 0.0), (x + side, side))
+        canvas.name((x + side / 2, side / 2), "c", body, [])
+        canvas.label((x + side / 2, -0.12), "n", scene.mass(body))
+        _horizontal_velocity(canvas, scene, (x + side / 2, side + 0.3), before[body], fastest)
+        x += side
+    canvas.line((-0.3, 0.0), (x + 0.3, 0.0), width=1.0)
+    return True
+
+
+def _horizontal_velocity(canvas: Drawing, scene: SceneView, at: Point, velocity: Velocity | None,
+                         fastest: float) -> None:
+    """Above a body: an arrow centred on ``at`` the way it moves, 1.6 cm for the fastest body of the
+    figure (at least 0.5 cm), labelled with its velocity as given; ``v = 0`` for a body at rest."""
+    given = velocity.n if velocity is not None else None
+    value = scene.value(given) if given is not None else 0.0
+    if given is None or not (_m.isfinite(value) and value != 0 and fastest > 0):
+        canvas.label((at[0], at[1] - 0.2), "s", ["v = 0"] if given is None else scene.given(given))
+        return
+    half = max(0.25, 0.8 * abs(value) / fastest) * (1 if value > 0 else -1)
+    canvas.arrow((at[0] - half, at[1]), (at[0] + half, at[1]))
+    canvas.label((at[0], at[1] + 0.2), "s", scene.given(given))
+
+
+def row(canvas: Drawing, scene: SceneView, bodies: Sequence[str]) -> None:
+    """Bodies side by side, named, with their masses: the panel of stages that cannot be drawn otherwise."""
+    x = 0.0
+    for body in bodies:
+        canvas.circle((x + 0.5, 0.5), 0.5)
+        canvas.name((x + 0.5, 0.5), "c", body, [])
+        canvas.label((x + 0.5, -0.1), "n", scene.mass(body) or [str(string("(fixed)"))])
+        x += 1.8

@@ -406,3 +406,18 @@ def test_the_grading_sections_rounding_settings_are_read_with_their_defaults(tmp
                     "problems:\n  - template: drop-rebound\n", encoding="utf-8")
     grading = load_assignment(path).grading
     assert (grading.intermediate_sig_figs, grading.max_tolerance) == (5, 0.1)
+
+
+@pytest.mark.parametrize("path", [("problems", 0), ("students", 0), ("problems", 0, "answers", 0)])
+def test_a_key_with_null_in_place_of_an_object_is_refused(tmp_path: Path, capsys: pytest.CaptureFixture[str],
+                                                          key_path: Path, path: tuple[Any, ...]) -> None:
+    """A problem, a student or an answer written as ``null`` is refused naming it (it was a TypeError)."""
+    document = key_document(key_path)
+    holder = document
+    for step in path[:-1]:
+        holder = holder[step]
+    holder[path[-1]] = None
+    (tmp_path / "key.json").write_text(json.dumps(document), encoding="utf-8")
+    (tmp_path / "a.csv").write_text("student_id,label,answer\n", encoding="utf-8")
+    code, _, err = run(capsys, "grade", "--key", tmp_path / "key.json", tmp_path / "a.csv", "--out", tmp_path / "g")
+    assert code == 2 and "expected an object, got None" in err and not (tmp_path / "g").exists()

@@ -248,6 +248,8 @@ def _array(value: Any, what: str) -> list[Any]:
 
 def _field(raw: Mapping[str, Any], name: str, what: str) -> Any:
     """The entry ``name`` of the object ``raw`` (``what``, for the message)."""
+    if type(raw) is not dict:
+        raise _MalformedError(f"{what}: expected an object, got {shown(raw)}")
     if name not in raw:
         raise _MalformedError(f"{what}: no entry {name!r}")
     return raw[name]

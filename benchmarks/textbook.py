@@ -191,6 +191,24 @@ def wall_throw(xp: Any, h0: Any, D: Any, v0: Any, alpha: Any, e: Any) -> dict[st
             "x_land": e * v_x * t2}
 
 
+def bullet_spring(xp: Any, m_b: Any, m_blk: Any, v_b: Any, k: Any) -> dict[str, Any]:
+    """Momentum, then 1/2 (m_b + m_blk) V^2 = 1/2 k x^2 (issue 25's trial template, tests/data)."""
+    m_b, k = m_b / 1000, k * 1000  # g, kN/m
+    common = m_b * v_b / (m_b + m_blk)
+    x = xp.sqrt((m_b + m_blk) * common**2 / k)
+    return {"V": common, "x_max": 1000 * x, "E_max": k * x**2 / 2}
+
+
+def package_platform(xp: Any, m: Any, m_p: Any, h: Any, k: Any) -> dict[str, Any]:
+    """Fall, momentum, then 1/2 M V^2 + M g (x - delta) = 1/2 k (x^2 - delta^2), the quadratic's root."""
+    k = k * 1000
+    common = m * xp.sqrt(2 * G * h) / (m + m_p)
+    mass, delta = m + m_p, m_p * G / k
+    constant = mass * common**2 / 2 - mass * G * delta + k * delta**2 / 2
+    x = (mass * G + xp.sqrt((mass * G) ** 2 + 2 * k * constant)) / k
+    return {"delta": 1000 * delta, "x_max": 1000 * x, "extra": 1000 * (x - delta)}
+
+
 FORMS: dict[str, Callable[..., dict[str, Any]]] = {
     "drop-rebound": drop_rebound, "pile-driver": pile_driver, "car-collision": car_collision,
     "ball-plate": ball_plate, "oblique-spheres": oblique_spheres, "head-on": head_on,
@@ -198,5 +216,6 @@ FORMS: dict[str, Callable[..., dict[str, Any]]] = {
     "incline-bounce": incline_bounce, "billiards": billiards, "offset-spheres": offset_spheres,
     "three-balls": three_balls, "two-rebounds": two_rebounds, "successive-bounces": successive_bounces,
     "ballistic-pendulum": ballistic_pendulum, "skid": skid, "wall-throw": wall_throw,
+    "bullet-spring": bullet_spring, "package-platform": package_platform,
 }
 """Template id -> its textbook answers."""

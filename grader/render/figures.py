@@ -78,6 +78,8 @@ STAGE_FIGURES: Mapping[str, str] = {
              "of impact dimensioned; without an impact, the bodies in a row",
     "flight": "a flight to a wall before an impact: the path to scale, solid to the wall, dashed from the wall to "
               "the ground (the flight after the impact); in no other scene",
+    "spring": "not drawn yet: a scene with a spring is drawn by the figure its other stages choose (an impact's), "
+              "or as its bodies in a row",
 }
 """How a stage of each effect is drawn today, one sentence each (``grader effects`` shows them): the figure
 is chosen for the whole scene by :func:`figure`, so a stage is drawn only in the scenes it lists. A scene

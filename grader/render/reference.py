@@ -92,6 +92,13 @@ EXAMPLES: Mapping[str, tuple[Example, ...]] = {
     "slide": (
         Example("a body slides to rest", _ONE, {"body": "A", "speed": "v", "distance": "d", "friction": "mu_k"}),
     ),
+    "spring": (
+        Example("a body stuck to another compresses a horizontal spring", _TWO,
+                {"body": "A", "with": "B", "stiffness": "k", "speed": "v", "compression": "x", "energy": "E"}),
+        Example("a body dropped on a platform the vertical spring supports", {**_TWO, "P": {"mass": "m_P"}},
+                {"body": "P", "with": "A", "stiffness": "k", "speed": "v", "compression": "x", "vertical": True,
+                 "supports": "P", "static_deflection": "delta"}),
+    ),
     "flight": (
         Example("a flight to a wall", _ONE,
                 {"body": "A", "until": "wall", "horizontal": "v_x", "vertical": "v_y", "height": "y_0",

@@ -27,7 +27,7 @@ from scipy.optimize import brentq
 
 from grader.bank.template import Template
 from grader.base.errors import GraderError
-from grader.model.expr import Sym, names, parse
+from grader.model.expr import Op, Sym, names, parse
 from grader.model.scene import Stage, Velocity
 from grader.physics.effects import CATALOGUE
 from grader.physics.integrate import MAX_STEPS, Budget, SimulationError
@@ -135,7 +135,8 @@ SEARCH_PASSES = 25
 _SEARCHABLE = {("impact", "restitution"): ("coefficient of restitution", 0.0, 1.0),
                ("free_fall", "height"): ("fall height", 0.0, math.inf),
                ("impact", "before"): ("velocity before the impact", 0.0, math.inf),
-               ("slide", "speed"): ("speed at the start of the slide", 0.0, math.inf)}
+               ("slide", "speed"): ("speed at the start of the slide", 0.0, math.inf),
+               ("spring", "stiffness"): ("spring constant", 0.0, math.inf)}
 _PROBE = 0.5  # a value of the unknown that shows which outcome it leads to
 _GROWTH, _MAX_GROWTH = 4.0, 120  # an open upper end grows 4x at a time, at most 120 times (4**120 ~ 1e72)
 
@@ -213,9 +214,10 @@ def _next_unknown(template: Template, options: Options, values: dict[str, float]
 
 def _names(field: object, name: str) -> bool:
     """Whether a stage field is the quantity ``name`` itself: the field, or a body's velocity along n
-    alone (a bullet's or a car's speed before it strikes, found from what happens after)."""
-    if isinstance(field, Mapping):
-        return any(isinstance(v, Velocity) and v.n == Sym(name) and v.t is None for v in field.values())
+    (or its negative) alone (a bullet's or a car's speed before it strikes, found from what happens after)."""
+    if isinstance(field, Mapping):  # the velocity, or its negative (a bullet coming in along -n)
+        return any(isinstance(v, Velocity) and v.n in (Sym(name), Op("neg", (Sym(name),))) and v.t is None
+                   for v in field.values())
     return field == Sym(name)
 
 

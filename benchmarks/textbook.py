@@ -209,6 +209,19 @@ def package_platform(xp: Any, m: Any, m_p: Any, h: Any, k: Any) -> dict[str, Any
     return {"delta": 1000 * delta, "x_max": 1000 * x, "extra": 1000 * (x - delta)}
 
 
+def ramp_and_floor(xp: Any, h: Any, v0: Any, mu_k: Any) -> dict[str, Any]:
+    """Energy down a smooth ramp, then friction's work mu_k m g d takes the kinetic energy."""
+    v_foot = xp.sqrt(v0**2 + 2 * G * h)
+    return {"v_B": v_foot, "d": v_foot**2 / (2 * mu_k * G)}
+
+
+def incline_up_and_back(xp: Any, v0: Any, beta: Any, mu_k: Any) -> dict[str, Any]:
+    """Up to rest against gravity's component and friction, then down from rest through the same distance."""
+    sine, cosine = xp.sin(xp.radians(beta)), xp.cos(xp.radians(beta))
+    d = v0**2 / (2 * G * (sine + mu_k * cosine))
+    return {"d": d, "v_back": xp.sqrt(2 * G * (sine - mu_k * cosine) * d)}
+
+
 FORMS: dict[str, Callable[..., dict[str, Any]]] = {
     "drop-rebound": drop_rebound, "pile-driver": pile_driver, "car-collision": car_collision,
     "ball-plate": ball_plate, "oblique-spheres": oblique_spheres, "head-on": head_on,
@@ -216,6 +229,7 @@ FORMS: dict[str, Callable[..., dict[str, Any]]] = {
     "incline-bounce": incline_bounce, "billiards": billiards, "offset-spheres": offset_spheres,
     "three-balls": three_balls, "two-rebounds": two_rebounds, "successive-bounces": successive_bounces,
     "ballistic-pendulum": ballistic_pendulum, "skid": skid, "wall-throw": wall_throw,
-    "bullet-spring": bullet_spring, "package-platform": package_platform,
+    "bullet-spring": bullet_spring, "package-platform": package_platform, "ramp-and-floor": ramp_and_floor,
+    "incline-up-and-back": incline_up_and_back,
 }
 """Template id -> its textbook answers."""

@@ -178,7 +178,7 @@ def test_a_support_needs_a_vertical_spring() -> None:
         compiled_for(template)
 
 
-TRIALS = ("bullet-spring", "package-platform")
+TRIALS = ("bullet-spring", "package-platform", "ramp-and-floor", "incline-up-and-back")
 """Issue 25's trial templates in tests/data, until the bank carries templates of these effects."""
 
 
@@ -191,3 +191,117 @@ def test_check_bank_passes_every_trial_template(tmp_path: Path, capsys: pytest.C
     out = capsys.readouterr().out
     assert code == 0, out
     assert out.count(" ok ") == len(TRIALS), out
+
+
+# --- slope -------------------------------------------------------------------------------------------
+
+RAMP = trial("ramp-and-floor")
+INCLINE = trial("incline-up-and-back")
+
+
+def ref_ramp_and_floor(h: Any, v0: Any, mu_k: Any) -> dict[str, Any]:
+    """Energy down the smooth ramp, then the friction force mu_k m g's work takes the kinetic energy."""
+    v_foot = mp.sqrt(v0**2 + 2 * G * h)
+    return {"v_B": v_foot, "d": v_foot**2 / (2 * mu_k * G)}
+
+
+def ref_incline(v0: Any, beta: Any, mu_k: Any) -> dict[str, Any]:
+    """Up: gravity's component and friction decelerate it; down from rest: gravity's component less friction."""
+    beta = beta * mp.pi / 180
+    up = G * (mp.sin(beta) + mu_k * mp.cos(beta))
+    down = G * (mp.sin(beta) - mu_k * mp.cos(beta))
+    d = v0**2 / (2 * up)
+    return {"d": d, "v_back": mp.sqrt(2 * down * d)}
+
+
+SLOPE_CASES = [
+    (RAMP, {"h": 1.2, "v0": 1, "mu_k": 0.3}, ref_ramp_and_floor),
+    (RAMP, {"h": 1e-12, "v0": 0, "mu_k": 1e-9}, ref_ramp_and_floor),
+    (RAMP, {"h": 1e-9, "v0": 1e3, "mu_k": 0.5}, ref_ramp_and_floor),  # the ramp adds a hair to a fast block
+    (INCLINE, {"v0": 5, "beta": 30, "mu_k": 0.2}, ref_incline),
+    (INCLINE, {"v0": 1e-150, "beta": 89.9, "mu_k": 0}, ref_incline),
+    (INCLINE, {"v0": 7, "beta": 1e-6, "mu_k": 1e-12}, ref_incline),
+]
+
+
+@pytest.mark.parametrize(("template", "params", "reference"), SLOPE_CASES,
+                         ids=[f"{t.id}-{i}" for i, (t, _, _) in enumerate(SLOPE_CASES)])
+def test_slope_answers_match_a_50_digit_reference(template: Template, params: dict[str, float],
+                                                  reference: Callable[..., Mapping[str, Any]]) -> None:
+    assert_matches_reference(template, params, reference)
+
+
+@pytest.mark.parametrize(("template", "params"), [(RAMP, {"h": 1.2, "v0": 1, "mu_k": 0.3}),
+                                                  (RAMP, {"h": 2.5, "v0": 0, "mu_k": 0.55}),
+                                                  (INCLINE, {"v0": 5, "beta": 30, "mu_k": 0.2})])
+def test_slope_scenes_are_re_derived_by_gravity_and_friction(template: Template, params: dict[str, float]) -> None:
+    assert_simulated(template, params)
+
+
+def test_the_ramp_is_a_descent_not_a_fall() -> None:
+    """The key says the block descends the ramp, and no step of it says it falls."""
+    steps = [step.relation for step in compiled_for(RAMP).steps]
+    assert any("descends a smooth ramp" in label for label in steps), steps
+    assert not any("falls" in label for label in steps), steps
+
+
+def test_friction_asked_from_the_slide_is_found_by_the_simulation_too() -> None:
+    """mu_k from the distance slid along the floor: the closed form, and the simulation's search."""
+    raw = yaml.safe_load((DATA / "ramp-and-floor.yaml").read_text(encoding="utf-8"))
+    raw["parameters"]["d"] = {"unit": "m", "domain": "(0, inf)", "sample": {"uniform": [2, 8]}, "decimals": 2}
+    del raw["parameters"]["mu_k"], raw["answers"]["d"], raw["example"]
+    raw["answers"]["mu_k"] = {"value": "mu_k", "unit": "", "description": "coefficient of kinetic friction"}
+    raw["statement"] = "Given {{ h }}, {{ v0 }} and {{ d }}."
+    template = parse_template(raw, "test:ramp-and-floor-friction", "ramp-and-floor-friction")
+    params = {"h": 1.2, "v0": 1, "d": 4.17}
+    assert answers(template, params)["mu_k"] == pytest.approx((1 + 2 * 9.81 * 1.2) / (2 * 9.81 * 4.17), rel=1e-12)
+    assert_simulated(template, params)
+
+
+def test_a_body_that_does_not_stay_at_rest_is_refused() -> None:
+    """With mu_s given, a block come to rest on a slope steeper than atan(mu_s) is refused, with the reason."""
+    raw = yaml.safe_load((DATA / "incline-up-and-back.yaml").read_text(encoding="utf-8"))
+    raw["stages"] = raw["stages"][:1]
+    raw["stages"][0]["static"] = "mu_s"
+    raw["parameters"]["mu_s"] = {"unit": "", "domain": "[0, inf)", "sample": {"uniform": [0.9, 1.2]}, "decimals": 2}
+    raw["answers"] = {"d": raw["answers"]["d"]}
+    raw["statement"] = "Given {{ v0 }}, {{ beta }}, {{ mu_k }} and {{ mu_s }}."
+    raw["example"] = {"v0": 5, "beta": 30, "mu_k": 0.2, "mu_s": 0.9}
+    template = parse_template(raw, "test:incline-stays", "incline-stays")
+    assert answers(template, {"v0": 5, "beta": 30, "mu_k": 0.2, "mu_s": 0.9})["d"] == pytest.approx(1.8928, rel=1e-4)
+    refused = solve_one(template, compiled_for(template), {"v0": 5, "beta": 45, "mu_k": 0.2, "mu_s": 0.9})
+    assert refused.answers is None and "slides off again" in str(refused.error)
+
+
+def incline_up() -> Template:
+    """The incline's first stage alone: how far up the block slides."""
+    raw = yaml.safe_load((DATA / "incline-up-and-back.yaml").read_text(encoding="utf-8"))
+    raw["stages"], raw["answers"] = raw["stages"][:1], {"d": raw["answers"]["d"]}
+    raw["statement"] = "Given {{ v0 }}, {{ beta }} and {{ mu_k }}."
+    return parse_template(raw, "test:incline-up", "incline-up")
+
+
+SLOPE_MISTAKES = [
+    # mu_k m g for mu_k m g cos(beta): d = v0^2 / (2 g (sin beta + mu_k))
+    (INCLINE, {"v0": 5, "beta": 30, "mu_k": 0.2}, "d", "slope.friction_without_cos",
+     25 / (2 * 9.81 * (0.5 + 0.2))),
+    # gravity's component helping the block up: d = v0^2 / (2 g (mu_k cos beta - sin beta))
+    (incline_up(), {"v0": 5, "beta": 20, "mu_k": 0.8}, "d", "slope.gravity_sign",
+     25 / (2 * 9.81 * (0.8 * math.cos(math.radians(20)) - math.sin(math.radians(20))))),
+    # no friction: d = v0^2 / (2 g sin beta)
+    (INCLINE, {"v0": 5, "beta": 30, "mu_k": 0.2}, "d", "slope.friction_left_out", 25 / (2 * 9.81 * 0.5)),
+]
+
+
+@pytest.mark.parametrize(("template", "params", "answer", "mistake", "by_hand"), SLOPE_MISTAKES,
+                         ids=[m[3] for m in SLOPE_MISTAKES])
+def test_slope_mistakes_are_diagnosed(template: Template, params: dict[str, float], answer: str, mistake: str,
+                                      by_hand: float) -> None:
+    assert mistake_value(alternatives_for(template), params, answer, mistake) == pytest.approx(by_hand, rel=1e-9)
+    verdict = graded_alone(template, params, answer, f"{by_hand:.3g}")
+    assert (verdict.verdict, verdict.diagnosis) == ("mistake", mistake), verdict
+
+
+def test_the_slope_is_listed_with_its_fields(capsys: pytest.CaptureFixture[str]) -> None:
+    listed(capsys, "slope", {"body", "with", "speed", "end_speed", "distance", "angle", "direction", "height",
+                             "friction", "static"})

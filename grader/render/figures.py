@@ -78,6 +78,8 @@ STAGE_FIGURES: Mapping[str, str] = {
              "of impact dimensioned; without an impact, the bodies in a row",
     "flight": "a flight to a wall before an impact: the path to scale, solid to the wall, dashed from the wall to "
               "the ground (the flight after the impact); in no other scene",
+    "slope": "not drawn yet: a scene with a slope is drawn by the figure its other stages choose (an impact's), "
+             "or as its bodies in a row",
     "spring": "not drawn yet: a scene with a spring is drawn by the figure its other stages choose (an impact's), "
               "or as its bodies in a row",
 }

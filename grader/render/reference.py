@@ -92,6 +92,15 @@ EXAMPLES: Mapping[str, tuple[Example, ...]] = {
     "slide": (
         Example("a body slides to rest", _ONE, {"body": "A", "speed": "v", "distance": "d", "friction": "mu_k"}),
     ),
+    "slope": (
+        Example("a body slides down a rough slope to rest", _ONE,
+                {"body": "A", "speed": "v", "distance": "d", "angle": "beta", "friction": "mu_k", "static": "mu_s"}),
+        Example("a body descends a smooth ramp of height h", _ONE,
+                {"body": "A", "speed": "v_0", "end_speed": "v", "height": "h"}),
+        Example("a body slides up a rough slope from v_0 to v", _ONE,
+                {"body": "A", "speed": "v_0", "end_speed": "v", "distance": "d", "angle": "beta",
+                 "direction": "up", "friction": "mu_k"}),
+    ),
     "spring": (
         Example("a body stuck to another compresses a horizontal spring", _TWO,
                 {"body": "A", "with": "B", "stiffness": "k", "speed": "v", "compression": "x", "energy": "E"}),

@@ -136,7 +136,9 @@ _SEARCHABLE = {("impact", "restitution"): ("coefficient of restitution", 0.0, 1.
                ("free_fall", "height"): ("fall height", 0.0, math.inf),
                ("impact", "before"): ("velocity before the impact", 0.0, math.inf),
                ("slide", "speed"): ("speed at the start of the slide", 0.0, math.inf),
-               ("spring", "stiffness"): ("spring constant", 0.0, math.inf)}
+               ("spring", "stiffness"): ("spring constant", 0.0, math.inf),
+               ("slope", "speed"): ("speed at the start of the path", 0.0, math.inf),
+               ("slope", "friction"): ("coefficient of kinetic friction", 0.0, math.inf)}
 _PROBE = 0.5  # a value of the unknown that shows which outcome it leads to
 _GROWTH, _MAX_GROWTH = 4.0, 120  # an open upper end grows 4x at a time, at most 120 times (4**120 ~ 1e72)
 

@@ -222,6 +222,14 @@ def incline_up_and_back(xp: Any, v0: Any, beta: Any, mu_k: Any) -> dict[str, Any
     return {"d": d, "v_back": xp.sqrt(2 * G * (sine - mu_k * cosine) * d)}
 
 
+def intersection(xp: Any, m_A: Any, m_B: Any, v_A: Any, v_B: Any) -> dict[str, Any]:  # noqa: N803 (its names)
+    """Momentum east and north; the loss as T - T'."""
+    east, north = m_B * v_B / (m_A + m_B), m_A * v_A / (m_A + m_B)
+    before = (m_A * v_A**2 + m_B * v_B**2) / 2
+    return {"v": xp.hypot(east, north), "theta": xp.degrees(xp.atan2(north, east)),
+            "loss_pct": _loss_pct(before, (m_A + m_B) * (east**2 + north**2) / 2)}
+
+
 FORMS: dict[str, Callable[..., dict[str, Any]]] = {
     "drop-rebound": drop_rebound, "pile-driver": pile_driver, "car-collision": car_collision,
     "ball-plate": ball_plate, "oblique-spheres": oblique_spheres, "head-on": head_on,
@@ -230,6 +238,6 @@ FORMS: dict[str, Callable[..., dict[str, Any]]] = {
     "three-balls": three_balls, "two-rebounds": two_rebounds, "successive-bounces": successive_bounces,
     "ballistic-pendulum": ballistic_pendulum, "skid": skid, "wall-throw": wall_throw,
     "bullet-spring": bullet_spring, "package-platform": package_platform, "ramp-and-floor": ramp_and_floor,
-    "incline-up-and-back": incline_up_and_back,
+    "incline-up-and-back": incline_up_and_back, "intersection": intersection,
 }
 """Template id -> its textbook answers."""

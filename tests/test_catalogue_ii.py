@@ -178,7 +178,8 @@ def test_a_support_needs_a_vertical_spring() -> None:
         compiled_for(template)
 
 
-TRIALS = ("bullet-spring", "package-platform", "ramp-and-floor", "incline-up-and-back")
+TRIALS = ("bullet-spring", "package-platform", "ramp-and-floor", "incline-up-and-back", "intersection",
+          "intersection-reconstruction")
 """Issue 25's trial templates in tests/data, until the bank carries templates of these effects."""
 
 
@@ -305,3 +306,88 @@ def test_slope_mistakes_are_diagnosed(template: Template, params: dict[str, floa
 def test_the_slope_is_listed_with_its_fields(capsys: pytest.CaptureFixture[str]) -> None:
     listed(capsys, "slope", {"body", "with", "speed", "end_speed", "distance", "angle", "direction", "height",
                              "friction", "static"})
+
+
+# --- stick -------------------------------------------------------------------------------------------
+
+CARS = trial("intersection")
+RECONSTRUCTION = trial("intersection-reconstruction")
+KMH = mp.mpf(1000) / 3600
+
+
+def ref_intersection(m_A: Any, m_B: Any, v_A: Any, v_B: Any) -> dict[str, Any]:  # noqa: N803 (its names)
+    """Momentum east and north; the kinetic energies before and after as sums of 1/2 m v^2."""
+    east, north = m_B * v_B / (m_A + m_B), m_A * v_A / (m_A + m_B)
+    before = (m_A * v_A**2 + m_B * v_B**2) / 2
+    after = (m_A + m_B) * (east**2 + north**2) / 2
+    return {"v": mp.hypot(east, north), "theta": mp.degrees(mp.atan2(north, east)),
+            "loss_pct": 100 * (before - after) / before}
+
+
+def ref_reconstruction(m_A: Any, m_B: Any, v_B: Any, theta: Any) -> dict[str, Any]:  # noqa: N803 (its names)
+    """East from B's momentum, north from the wreck's direction, car A's speed from the momentum north."""
+    east = m_B * v_B / (m_A + m_B)
+    north = east * mp.tan(mp.radians(theta))
+    return {"v_A": (m_A + m_B) * north / m_A, "v": mp.hypot(east, north)}
+
+
+STICK_CASES = [
+    (CARS, {"m_A": 1500, "m_B": 1200, "v_A": 50, "v_B": 60}, ref_intersection),
+    (CARS, {"m_A": 1e-9, "m_B": 1e3, "v_A": 1e170, "v_B": 1e-150}, ref_intersection),
+    (CARS, {"m_A": 1e12, "m_B": 1, "v_A": 30, "v_B": 80}, ref_intersection),
+    (RECONSTRUCTION, {"m_A": 1500, "m_B": 1200, "v_B": 60, "theta": 40}, ref_reconstruction),
+    (RECONSTRUCTION, {"m_A": 1e-6, "m_B": 2000, "v_B": 60, "theta": 1e-9}, ref_reconstruction),
+    (RECONSTRUCTION, {"m_A": 1500, "m_B": 1200, "v_B": 60, "theta": 89.9}, ref_reconstruction),  # tan near its pole
+]
+
+
+@pytest.mark.parametrize(("template", "params", "reference"), STICK_CASES,
+                         ids=[f"{t.id}-{i}" for i, (t, _, _) in enumerate(STICK_CASES)])
+def test_stick_answers_match_a_50_digit_reference(template: Template, params: dict[str, float],
+                                                  reference: Callable[..., Mapping[str, Any]]) -> None:
+    assert_matches_reference(template, params, reference)
+
+
+@pytest.mark.parametrize(("template", "params"), [(CARS, {"m_A": 1500, "m_B": 1200, "v_A": 50, "v_B": 60}),
+                                                  (CARS, {"m_A": 900, "m_B": 2000, "v_A": 80, "v_B": 30}),
+                                                  (RECONSTRUCTION, {"m_A": 1500, "m_B": 1200, "v_B": 60,
+                                                                    "theta": 40})])
+def test_stick_scenes_are_re_derived_by_a_plastic_contact(template: Template, params: dict[str, float]) -> None:
+    """Forward, and asked backward (the simulation searches for car A's speed that sends the wreck off at
+    the given direction)."""
+    assert_simulated(template, params)
+
+
+def test_a_wreck_that_does_not_move_has_no_direction() -> None:
+    """Equal and opposite momenta: the direction is undefined, with the reason, not an angle of 0."""
+    raw = yaml.safe_load((DATA / "intersection.yaml").read_text(encoding="utf-8"))
+    raw["stages"][0]["before"] = {"A": {"n": "-v_A", "t": 0}, "B": {"n": "v_B", "t": 0}}
+    template = parse_template(raw, "test:head-on-lock", "head-on-lock")
+    solution = solve_one(template, compiled_for(template), {"m_A": 1500, "m_B": 1000, "v_A": 40, "v_B": 60})
+    assert solution.answers is not None and solution.answers["v"].value == 0
+    assert solution.answers["theta"].value is None and "no direction" in str(solution.answers["theta"].undefined)
+
+
+STICK_MISTAKES = [
+    # (m_A |u_A| + m_B |u_B|)/(m_A + m_B) = (1500 * 50 + 1200 * 60)/2700 km/h
+    (CARS, {"m_A": 1500, "m_B": 1200, "v_A": 50, "v_B": 60}, "v", "stick.speeds_added", (1500 * 50 + 1200 * 60) / 2700),
+    # from north instead of east: atan(east/north)
+    (CARS, {"m_A": 1500, "m_B": 1200, "v_A": 50, "v_B": 60}, "theta", "stick.angle_other_axis",
+     math.degrees(math.atan2(1200 * 60, 1500 * 50))),
+    # the direction from the other axis turns the reconstruction: north = east / tan(theta)
+    (RECONSTRUCTION, {"m_A": 1500, "m_B": 1200, "v_B": 60, "theta": 40}, "v_A", "stick.angle_other_axis",
+     1200 * 60 / math.tan(math.radians(40)) / 1500),
+]
+
+
+@pytest.mark.parametrize(("template", "params", "answer", "mistake", "by_hand"), STICK_MISTAKES,
+                         ids=[f"{m[0].id}-{m[3]}" for m in STICK_MISTAKES])
+def test_stick_mistakes_are_diagnosed(template: Template, params: dict[str, float], answer: str, mistake: str,
+                                      by_hand: float) -> None:
+    assert mistake_value(alternatives_for(template), params, answer, mistake) == pytest.approx(by_hand, rel=1e-9)
+    verdict = graded_alone(template, params, answer, f"{by_hand:.3g}")
+    assert (verdict.verdict, verdict.diagnosis) == ("mistake", mistake), verdict
+
+
+def test_stick_is_listed_with_its_fields(capsys: pytest.CaptureFixture[str]) -> None:
+    listed(capsys, "stick", {"bodies", "before", "common", "speed", "angle", "from", "energy_lost", "loss_fraction"})

@@ -108,6 +108,12 @@ EXAMPLES: Mapping[str, tuple[Example, ...]] = {
                 {"body": "P", "with": "A", "stiffness": "k", "speed": "v", "compression": "x", "vertical": True,
                  "supports": "P", "static_deflection": "delta"}),
     ),
+    "stick": (
+        Example("two bodies moving at right angles lock together", _TWO,
+                {"bodies": ["A", "B"], "before": {"A": {"n": "0", "t": "u_A"}, "B": {"n": "u_B", "t": "0"}},
+                 "common": {"n": "v_n", "t": "v_t"}, "speed": "v", "angle": "theta", "energy_lost": "E_lost",
+                 "loss_fraction": "f_loss"}),
+    ),
     "flight": (
         Example("a flight to a wall", _ONE,
                 {"body": "A", "until": "wall", "horizontal": "v_x", "vertical": "v_y", "height": "y_0",

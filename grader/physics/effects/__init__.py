@@ -1,7 +1,7 @@
 """The catalogue of physical effects a scene's stages are made of, one module per effect.
 
 >>> print(*sorted(CATALOGUE))
-angle_between bounces flight free_fall impact impact_geometry rise slide slope spring swing velocity
+angle_between bounces flight free_fall impact impact_geometry rise slide slope spring stick swing velocity
 """
 
 from grader.physics.effects.base import Condition, Effect, Field, Mistake, Relation, Route, Stable
@@ -13,11 +13,12 @@ from grader.physics.effects.projectile import FLIGHT
 from grader.physics.effects.slide import SLIDE
 from grader.physics.effects.slope import SLOPE
 from grader.physics.effects.spring import SPRING
+from grader.physics.effects.stick import STICK
 from grader.physics.effects.swing import SWING
 from grader.physics.effects.velocity import ANGLE_BETWEEN, VELOCITY
 
 CATALOGUE: dict[str, Effect] = {effect.name: effect for effect in (FREE_FALL, RISE, IMPACT_GEOMETRY, IMPACT, VELOCITY,
                                                                    ANGLE_BETWEEN, BOUNCES, SWING, SLIDE, FLIGHT,
-                                                                   SPRING, SLOPE)}
+                                                                   SPRING, SLOPE, STICK)}
 
 __all__ = ["CATALOGUE", "Condition", "Effect", "Field", "Mistake", "Relation", "Route", "Stable"]

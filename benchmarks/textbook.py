@@ -230,6 +230,18 @@ def intersection(xp: Any, m_A: Any, m_B: Any, v_A: Any, v_B: Any) -> dict[str, A
             "loss_pct": _loss_pct(before, (m_A + m_B) * (east**2 + north**2) / 2)}
 
 
+def ball_wall_impulse(xp: Any, m: Any, v: Any, e: Any, dt: Any) -> dict[str, Any]:
+    """The rebound at e v the other way: impulse m (v + e v) (m in g), average force over dt (in ms)."""
+    impulse = m / 1000 * (v + e * v)
+    return {"J": impulse, "F": impulse / (dt / 1000)}
+
+
+def cushion(xp: Any, m: Any, h: Any, d: Any) -> dict[str, Any]:
+    """Fall, then (F - m g) d = 1/2 m v^2 over the cushion's d (in mm); F in kN."""
+    v = xp.sqrt(2 * G * h)
+    return {"J": m * v, "F": (m * v**2 / 2 / (d / 1000) + m * G) / 1000}
+
+
 FORMS: dict[str, Callable[..., dict[str, Any]]] = {
     "drop-rebound": drop_rebound, "pile-driver": pile_driver, "car-collision": car_collision,
     "ball-plate": ball_plate, "oblique-spheres": oblique_spheres, "head-on": head_on,
@@ -238,6 +250,7 @@ FORMS: dict[str, Callable[..., dict[str, Any]]] = {
     "three-balls": three_balls, "two-rebounds": two_rebounds, "successive-bounces": successive_bounces,
     "ballistic-pendulum": ballistic_pendulum, "skid": skid, "wall-throw": wall_throw,
     "bullet-spring": bullet_spring, "package-platform": package_platform, "ramp-and-floor": ramp_and_floor,
-    "incline-up-and-back": incline_up_and_back, "intersection": intersection,
+    "incline-up-and-back": incline_up_and_back, "intersection": intersection, "ball-wall-impulse": ball_wall_impulse,
+    "cushion": cushion,
 }
 """Template id -> its textbook answers."""

@@ -179,7 +179,7 @@ def test_a_support_needs_a_vertical_spring() -> None:
 
 
 TRIALS = ("bullet-spring", "package-platform", "ramp-and-floor", "incline-up-and-back", "intersection",
-          "intersection-reconstruction")
+          "intersection-reconstruction", "ball-wall-impulse", "cushion")
 """Issue 25's trial templates in tests/data, until the bank carries templates of these effects."""
 
 
@@ -391,3 +391,90 @@ def test_stick_mistakes_are_diagnosed(template: Template, params: dict[str, floa
 
 def test_stick_is_listed_with_its_fields(capsys: pytest.CaptureFixture[str]) -> None:
     listed(capsys, "stick", {"bodies", "before", "common", "speed", "angle", "from", "energy_lost", "loss_fraction"})
+
+
+# --- impulse -----------------------------------------------------------------------------------------
+
+WALL = trial("ball-wall-impulse")
+CUSHION = trial("cushion")
+
+
+def ref_ball_wall(m: Any, v: Any, e: Any, dt: Any) -> dict[str, Any]:
+    """The rebound at e v the other way: the impulse m (v + e v), over the contact time."""
+    impulse = m / 1000 * (v + e * v)
+    return {"J": impulse, "F": impulse / (dt / 1000)}
+
+
+def ref_cushion(m: Any, h: Any, d: Any) -> dict[str, Any]:
+    """Fall: v = sqrt(2 g h); the cushion takes m v; work-energy over d with the weight: (F - m g) d = 1/2 m v^2."""
+    v = mp.sqrt(2 * G * h)
+    return {"J": m * v, "F": (m * v**2 / 2 / (d / 1000) + m * G) / 1000}
+
+
+IMPULSE_CASES = [
+    (WALL, {"m": 200, "v": 12, "e": 0.6, "dt": 8}, ref_ball_wall),
+    (WALL, {"m": 1e-9, "v": 1e170, "e": 1 - 1e-12, "dt": 1e-9}, ref_ball_wall),
+    (WALL, {"m": 50, "v": 1e-150, "e": 0, "dt": 20}, ref_ball_wall),
+    (CUSHION, {"m": 10, "h": 1.5, "d": 80}, ref_cushion),
+    (CUSHION, {"m": 1e6, "h": 1e-12, "d": 1e9}, ref_cushion),  # the weight all but alone
+]
+
+
+@pytest.mark.parametrize(("template", "params", "reference"), IMPULSE_CASES,
+                         ids=[f"{t.id}-{i}" for i, (t, _, _) in enumerate(IMPULSE_CASES)])
+def test_impulse_answers_match_a_50_digit_reference(template: Template, params: dict[str, float],
+                                                    reference: Callable[..., Mapping[str, Any]]) -> None:
+    assert_matches_reference(template, params, reference)
+
+
+@pytest.mark.parametrize(("template", "params"), [(WALL, {"m": 200, "v": 12, "e": 0.6, "dt": 8}),
+                                                  (CUSHION, {"m": 10, "h": 1.5, "d": 80})])
+def test_impulse_scenes_are_re_derived_by_the_simulation(template: Template, params: dict[str, float]) -> None:
+    assert_simulated(template, params)
+
+
+def rebound_given() -> Template:
+    """The ball's rebound speed given instead of e: the impulse stage alone (with e, the impact's own
+    "rebound's sign turned" mistake gives the same number first)."""
+    raw = yaml.safe_load((DATA / "ball-wall-impulse.yaml").read_text(encoding="utf-8"))
+    raw["stages"] = raw["stages"][1:]
+    raw["stages"][0]["velocity_after"] = {"n": "-v2", "t": 0}
+    raw["parameters"]["v2"] = {**raw["parameters"].pop("e"), "unit": "m/s", "domain": "[0, inf)",
+                               "sample": {"uniform": [2, 5]}}
+    raw["statement"], raw["example"] = "Given {{ m }}, {{ v }}, {{ v2 }} and {{ dt }}.", {"m": 200, "v": 12, "v2": 7.2,
+                                                                                        "dt": 8}
+    return parse_template(raw, "test:rebound-given", "rebound-given")
+
+
+IMPULSE_MISTAKES = [
+    # m (|v'| - |v|) = 0.2 (7.2 - 12): the magnitude 0.96 N s
+    (rebound_given(), {"m": 200, "v": 12, "v2": 7.2, "dt": 8}, "J", "impulse.speeds_for_velocities",
+     0.2 * (12 - 7.2)),
+    # the weight left out, which the scene declares: m v^2 / (2 d) in kN
+    (CUSHION, {"m": 10, "h": 1.5, "d": 80}, "F", "impulse.weight", 10 * 2 * 9.81 * 1.5 / (2 * 0.08) / 1000),
+]
+
+
+@pytest.mark.parametrize(("template", "params", "answer", "mistake", "by_hand"), IMPULSE_MISTAKES,
+                         ids=[m[3] for m in IMPULSE_MISTAKES])
+def test_impulse_mistakes_are_diagnosed(template: Template, params: dict[str, float], answer: str, mistake: str,
+                                        by_hand: float) -> None:
+    assert mistake_value(alternatives_for(template), params, answer, mistake) == pytest.approx(by_hand, rel=1e-9)
+    verdict = graded_alone(template, params, answer, f"{by_hand:.3g}")
+    assert (verdict.verdict, verdict.diagnosis) == ("mistake", mistake), verdict
+
+
+@pytest.mark.parametrize(("template", "params", "answer", "typed"), [
+    (WALL, {"m": 200, "v": 12, "e": 0.6, "dt": 8}, "J", "3.84 N*s"),
+    (WALL, {"m": 200, "v": 12, "e": 0.6, "dt": 8}, "J", "0.863 lb·s"),
+    (WALL, {"m": 200, "v": 12, "e": 0.6, "dt": 8}, "F", "0.48 kN"),
+    (CUSHION, {"m": 10, "h": 1.5, "d": 80}, "F", "1937.5 N"),
+])
+def test_impulse_and_force_in_other_units_are_correct(template: Template, params: dict[str, float], answer: str,
+                                                      typed: str) -> None:
+    assert graded_alone(template, params, answer, typed).verdict == "correct"
+
+
+def test_the_impulse_is_listed_with_its_fields(capsys: pytest.CaptureFixture[str]) -> None:
+    listed(capsys, "impulse", {"body", "velocity", "velocity_after", "components", "impulse", "angle", "time",
+                               "distance", "force", "weight"})

@@ -80,6 +80,8 @@ STAGE_FIGURES: Mapping[str, str] = {
               "the ground (the flight after the impact); in no other scene",
     "slope": "not drawn yet: a scene with a slope is drawn by the figure its other stages choose (an impact's), "
              "or as its bodies in a row",
+    "impulse": "not drawn yet: a scene with an impulse is drawn by the figure its other stages choose (an "
+               "impact's or a fall's), or as its bodies in a row",
     "stick": "not drawn yet: a scene with bodies that stick in a plane is drawn as its bodies in a row",
     "spring": "not drawn yet: a scene with a spring is drawn by the figure its other stages choose (an impact's), "
               "or as its bodies in a row",

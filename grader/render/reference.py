@@ -108,6 +108,15 @@ EXAMPLES: Mapping[str, tuple[Example, ...]] = {
                 {"body": "P", "with": "A", "stiffness": "k", "speed": "v", "compression": "x", "vertical": True,
                  "supports": "P", "static_deflection": "delta"}),
     ),
+    "impulse": (
+        Example("a body's impulse and the average force over a contact time", _ONE,
+                {"body": "A", "velocity": {"n": "u_n", "t": "u_t"}, "velocity_after": {"n": "v_n", "t": "v_t"},
+                 "components": {"n": "J_n", "t": "J_t"}, "impulse": "J", "angle": "phi", "time": "dt",
+                 "force": "F"}),
+        Example("a falling body stopped by a cushion, the weight included", _ONE,
+                {"body": "A", "velocity": {"n": "-v", "t": "0"}, "velocity_after": {"n": "0", "t": "0"}, "impulse": "J",
+                 "distance": "d", "force": "F", "weight": True}),
+    ),
     "stick": (
         Example("two bodies moving at right angles lock together", _TWO,
                 {"bodies": ["A", "B"], "before": {"A": {"n": "0", "t": "u_A"}, "B": {"n": "u_B", "t": "0"}},

@@ -242,6 +242,23 @@ def cushion(xp: Any, m: Any, h: Any, d: Any) -> dict[str, Any]:
     return {"J": m * v, "F": (m * v**2 / 2 / (d / 1000) + m * G) / 1000}
 
 
+def recoil(xp: Any, m_gun: Any, m_b: Any, u: Any) -> dict[str, Any]:
+    """From rest: m_gun v_gun + m_b v_b = 0 with v_b - v_gun = u (m_b in g); the energy as a sum of 1/2 m v^2."""
+    m_b = m_b / 1000
+    v_b = m_gun * u / (m_gun + m_b)
+    v_gun = v_b - u
+    return {"v_recoil": -v_gun, "v_b": v_b, "E": (m_gun * v_gun**2 + m_b * v_b**2) / 2 / 1000}
+
+
+def explosion(xp: Any, m1: Any, m2: Any, V: Any, E: Any) -> dict[str, Any]:  # noqa: N803 (its names)
+    """Momentum and energy, 1/2 m1 v1^2 + 1/2 m2 v2^2 = 1/2 (m1 + m2) V^2 + E (E in kJ), the quadratic in v2."""
+    released, total = E * 1000, m1 + m2
+    a, b = m2 + m2**2 / m1, -2 * total * V * m2 / m1
+    c = total**2 * V**2 / m1 - total * V**2 - 2 * released
+    v2 = (-b + xp.sqrt(b**2 - 4 * a * c)) / (2 * a)
+    return {"v1": (total * V - m2 * v2) / m1, "v2": v2}
+
+
 FORMS: dict[str, Callable[..., dict[str, Any]]] = {
     "drop-rebound": drop_rebound, "pile-driver": pile_driver, "car-collision": car_collision,
     "ball-plate": ball_plate, "oblique-spheres": oblique_spheres, "head-on": head_on,
@@ -251,6 +268,6 @@ FORMS: dict[str, Callable[..., dict[str, Any]]] = {
     "ballistic-pendulum": ballistic_pendulum, "skid": skid, "wall-throw": wall_throw,
     "bullet-spring": bullet_spring, "package-platform": package_platform, "ramp-and-floor": ramp_and_floor,
     "incline-up-and-back": incline_up_and_back, "intersection": intersection, "ball-wall-impulse": ball_wall_impulse,
-    "cushion": cushion,
+    "cushion": cushion, "recoil": recoil, "explosion": explosion,
 }
 """Template id -> its textbook answers."""

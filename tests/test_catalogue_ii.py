@@ -179,7 +179,7 @@ def test_a_support_needs_a_vertical_spring() -> None:
 
 
 TRIALS = ("bullet-spring", "package-platform", "ramp-and-floor", "incline-up-and-back", "intersection",
-          "intersection-reconstruction", "ball-wall-impulse", "cushion")
+          "intersection-reconstruction", "ball-wall-impulse", "cushion", "recoil", "explosion")
 """Issue 25's trial templates in tests/data, until the bank carries templates of these effects."""
 
 
@@ -478,3 +478,73 @@ def test_impulse_and_force_in_other_units_are_correct(template: Template, params
 def test_the_impulse_is_listed_with_its_fields(capsys: pytest.CaptureFixture[str]) -> None:
     listed(capsys, "impulse", {"body", "velocity", "velocity_after", "components", "impulse", "angle", "time",
                                "distance", "force", "weight"})
+
+
+# --- separation --------------------------------------------------------------------------------------
+
+RECOIL = trial("recoil")
+EXPLOSION = trial("explosion")
+
+
+def ref_recoil(m_gun: Any, m_b: Any, u: Any) -> dict[str, Any]:
+    """Momentum from rest, m_gun v_gun + m_b v_b = 0, with v_b - v_gun = u; energy as the sum of 1/2 m v^2."""
+    m_b = m_b / 1000
+    v_b = m_gun * u / (m_gun + m_b)
+    v_gun = v_b - u
+    return {"v_recoil": -v_gun, "v_b": v_b, "E": (m_gun * v_gun**2 + m_b * v_b**2) / 2 / 1000}
+
+
+def ref_explosion(m1: Any, m2: Any, V: Any, E: Any) -> dict[str, Any]:  # noqa: N803 (its names)
+    """Momentum (m1 + m2) V = m1 v1 + m2 v2 and energy 1/2 m1 v1^2 + 1/2 m2 v2^2 = 1/2 (m1 + m2) V^2 + E, solved
+    as a quadratic for v2 (the front fragment faster)."""
+    released, total = E * 1000, m1 + m2
+    # v1 = (total V - m2 v2)/m1 into the energy: a v2^2 + b v2 + c = 0
+    a = m2 + m2**2 / m1
+    b = -2 * total * V * m2 / m1
+    c = total**2 * V**2 / m1 - total * V**2 - 2 * released
+    v2 = (-b + mp.sqrt(b**2 - 4 * a * c)) / (2 * a)
+    return {"v1": (total * V - m2 * v2) / m1, "v2": v2}
+
+
+SEPARATION_CASES = [
+    (RECOIL, {"m_gun": 4, "m_b": 20, "u": 600}, ref_recoil),
+    (RECOIL, {"m_gun": 1e9, "m_b": 1e-6, "u": 1e3}, ref_recoil),
+    (EXPLOSION, {"m1": 4, "m2": 6, "V": 200, "E": 24}, ref_explosion),
+    (EXPLOSION, {"m1": 4, "m2": 6, "V": 200, "E": 1e-20}, ref_explosion),  # a puff: the fragments barely part
+]
+
+
+@pytest.mark.parametrize(("template", "params", "reference"), SEPARATION_CASES,
+                         ids=[f"{t.id}-{i}" for i, (t, _, _) in enumerate(SEPARATION_CASES)])
+def test_separation_answers_match_a_50_digit_reference(template: Template, params: dict[str, float],
+                                                       reference: Callable[..., Mapping[str, Any]]) -> None:
+    assert_matches_reference(template, params, reference)
+
+
+@pytest.mark.parametrize(("template", "params"), [(RECOIL, {"m_gun": 4, "m_b": 20, "u": 600}),
+                                                  (EXPLOSION, {"m1": 4, "m2": 6, "V": 200, "E": 24}),
+                                                  (EXPLOSION, {"m1": 9, "m2": 2.5, "V": -150, "E": 40})])
+def test_separation_scenes_are_re_derived_by_a_spring_between_the_parts(template: Template,
+                                                                        params: dict[str, float]) -> None:
+    assert_simulated(template, params)
+
+
+SEPARATION_MISTAKES = [
+    # each fragment's speed relative to the shell sqrt(2 E/(m1 + m2)): v2 = 200 + sqrt(48000/10)
+    (EXPLOSION, {"m1": 4, "m2": 6, "V": 200, "E": 24}, "v2", "separation.mass_ratio", 200 + math.sqrt(48000 / 10)),
+    # a heavy shot leaves at u itself (a bullet of 20 g would be within the tolerance of it)
+    (RECOIL, {"m_gun": 4, "m_b": 2000, "u": 600}, "v_b", "separation.relative_as_absolute", 600.0),
+]
+
+
+@pytest.mark.parametrize(("template", "params", "answer", "mistake", "by_hand"), SEPARATION_MISTAKES,
+                         ids=[m[3] for m in SEPARATION_MISTAKES])
+def test_separation_mistakes_are_diagnosed(template: Template, params: dict[str, float], answer: str, mistake: str,
+                                           by_hand: float) -> None:
+    assert mistake_value(alternatives_for(template), params, answer, mistake) == pytest.approx(by_hand, rel=1e-9)
+    verdict = graded_alone(template, params, answer, f"{by_hand:.4g}")
+    assert (verdict.verdict, verdict.diagnosis) == ("mistake", mistake), verdict
+
+
+def test_the_separation_is_listed_with_its_fields(capsys: pytest.CaptureFixture[str]) -> None:
+    listed(capsys, "separation", {"bodies", "whole", "after", "energy", "relative"})

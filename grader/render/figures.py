@@ -82,6 +82,7 @@ STAGE_FIGURES: Mapping[str, str] = {
              "or as its bodies in a row",
     "impulse": "not drawn yet: a scene with an impulse is drawn by the figure its other stages choose (an "
                "impact's or a fall's), or as its bodies in a row",
+    "separation": "not drawn yet: a scene where a body separates in two is drawn as its bodies in a row",
     "stick": "not drawn yet: a scene with bodies that stick in a plane is drawn as its bodies in a row",
     "spring": "not drawn yet: a scene with a spring is drawn by the figure its other stages choose (an impact's), "
               "or as its bodies in a row",

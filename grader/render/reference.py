@@ -117,6 +117,13 @@ EXAMPLES: Mapping[str, tuple[Example, ...]] = {
                 {"body": "A", "velocity": {"n": "-v", "t": "0"}, "velocity_after": {"n": "0", "t": "0"}, "impulse": "J",
                  "distance": "d", "force": "F", "weight": True}),
     ),
+    "separation": (
+        Example("a body at rest splits in two, the energy released given", _TWO,
+                {"bodies": ["A", "B"], "after": {"A": "v_A", "B": "v_B"}, "energy": "E"}),
+        Example("a recoil: B leaves A at a relative velocity, from a whole moving at V", _TWO,
+                {"bodies": ["A", "B"], "whole": {"n": "V", "t": "0"}, "after": {"A": "v_A", "B": "v_B"},
+                 "relative": "u"}),
+    ),
     "stick": (
         Example("two bodies moving at right angles lock together", _TWO,
                 {"bodies": ["A", "B"], "before": {"A": {"n": "0", "t": "u_A"}, "B": {"n": "u_B", "t": "0"}},

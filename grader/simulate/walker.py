@@ -139,7 +139,9 @@ _SEARCHABLE = {("impact", "restitution"): ("coefficient of restitution", 0.0, 1.
                ("spring", "stiffness"): ("spring constant", 0.0, math.inf),
                ("slope", "speed"): ("speed at the start of the path", 0.0, math.inf),
                ("slope", "friction"): ("coefficient of kinetic friction", 0.0, math.inf),
-               ("stick", "before"): ("speed before the collision", 0.0, math.inf)}
+               ("stick", "before"): ("speed before the collision", 0.0, math.inf),
+               ("separation", "relative"): ("relative velocity of separation", 0.0, math.inf),
+               ("separation", "energy"): ("energy released", 0.0, math.inf)}
 _PROBE = 0.5  # a value of the unknown that shows which outcome it leads to
 _GROWTH, _MAX_GROWTH = 4.0, 120  # an open upper end grows 4x at a time, at most 120 times (4**120 ~ 1e72)
 

@@ -54,7 +54,8 @@ from grader.solve.solver import compile_template
 RESULTS = Path(__file__).resolve().parent / "results"
 TRIALS_DIR = Path(__file__).resolve().parent.parent / "tests" / "data"
 TRIALS = ("bullet-spring", "package-platform", "ramp-and-floor", "incline-up-and-back", "intersection",
-          "intersection-reconstruction", "ball-wall-impulse", "cushion", "recoil", "explosion")
+          "intersection-reconstruction", "ball-wall-impulse", "cushion", "recoil", "explosion",
+          "oblique-both-moving")
 """Issue 25's trial templates of new effects (tests/data), swept beside the bank's until the bank carries them."""
 REFERENCE_RTOL = 1e-13
 PANEL_RTOL = 1e-12

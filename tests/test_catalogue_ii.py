@@ -179,7 +179,8 @@ def test_a_support_needs_a_vertical_spring() -> None:
 
 
 TRIALS = ("bullet-spring", "package-platform", "ramp-and-floor", "incline-up-and-back", "intersection",
-          "intersection-reconstruction", "ball-wall-impulse", "cushion", "recoil", "explosion")
+          "intersection-reconstruction", "ball-wall-impulse", "cushion", "recoil", "explosion",
+          "oblique-both-moving")
 """Issue 25's trial templates in tests/data, until the bank carries templates of these effects."""
 
 
@@ -548,3 +549,46 @@ def test_separation_mistakes_are_diagnosed(template: Template, params: dict[str,
 
 def test_the_separation_is_listed_with_its_fields(capsys: pytest.CaptureFixture[str]) -> None:
     listed(capsys, "separation", {"bodies", "whole", "after", "energy", "relative"})
+
+
+# --- oblique impact of two moving bodies, the separation given in place of e -------------------------
+
+OBLIQUE = trial("oblique-both-moving")
+
+
+def ref_oblique_both_moving(m_A: Any, m_B: Any, v_A: Any, alpha: Any, v_B: Any, beta: Any,  # noqa: N803
+                            s: Any) -> dict[str, Any]:
+    """Components along the line of centres n and the tangent t; e = separation/approach; along n momentum and
+    the separation give the velocities after; along t nothing changes (smooth); energies as 1/2 m v^2."""
+    a_n, a_t = v_A * mp.cos(mp.radians(alpha)), v_A * mp.sin(mp.radians(alpha))
+    b_n, b_t = -v_B * mp.cos(mp.radians(beta)), v_B * mp.sin(mp.radians(beta))
+    e = s / (a_n - b_n)
+    # m_A a_n + m_B b_n = m_A x + m_B (x + s)
+    after_a = (m_A * a_n + m_B * b_n - m_B * s) / (m_A + m_B)
+    after_b = after_a + s
+    before = (m_A * (a_n**2 + a_t**2) + m_B * (b_n**2 + b_t**2)) / 2
+    after = (m_A * (after_a**2 + a_t**2) + m_B * (after_b**2 + b_t**2)) / 2
+    return {"e": e, "vB_n": after_b, "vA_out": mp.hypot(after_a, a_t), "loss_pct": 100 * (before - after) / before}
+
+
+@pytest.mark.parametrize("params", [
+    {"m_A": 2, "m_B": 1.5, "v_A": 6, "alpha": 30, "v_B": 2, "beta": 45, "s": 2.4},
+    {"m_A": 1e-6, "m_B": 1e6, "v_A": 6, "alpha": 89, "v_B": 2, "beta": 0, "s": 1e-9},
+    {"m_A": 2, "m_B": 3, "v_A": 5, "alpha": 0, "v_B": 5, "beta": 0, "s": 10},  # head-on, elastic
+])
+def test_two_moving_spheres_match_a_50_digit_reference(params: dict[str, float]) -> None:
+    assert_matches_reference(OBLIQUE, params, ref_oblique_both_moving)
+
+
+def test_two_moving_spheres_are_re_derived_by_the_simulation_searching_for_e() -> None:
+    """e is not given: the simulation finds the e whose contact separates the spheres at the given speed."""
+    params = {"m_A": 2, "m_B": 1.5, "v_A": 6, "alpha": 30, "v_B": 2, "beta": 45, "s": 2.4}
+    assert_simulated(OBLIQUE, params)
+    assert "e" in simulate(OBLIQUE, params, ADAPTIVE).fitted
+
+
+def test_the_separation_in_place_of_e_keeps_the_impacts_mistakes() -> None:
+    """1/e for e (approach over separation): e = (approach)/s."""
+    params = {"m_A": 2, "m_B": 1.5, "v_A": 6, "alpha": 30, "v_B": 2, "beta": 45, "s": 2.4}
+    approach = 6 * math.cos(math.radians(30)) + 2 * math.cos(math.radians(45))
+    assert mistake_value(alternatives_for(OBLIQUE), params, "e", "impact.e_inverse") == pytest.approx(approach / 2.4)

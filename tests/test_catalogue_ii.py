@@ -148,15 +148,6 @@ SPRING_MISTAKES = [
 ]
 
 
-@pytest.mark.parametrize(("template", "params", "answer", "mistake", "by_hand"), SPRING_MISTAKES,
-                         ids=[m[3] for m in SPRING_MISTAKES])
-def test_spring_mistakes_are_diagnosed(template: Template, params: dict[str, float], answer: str, mistake: str,
-                                       by_hand: float) -> None:
-    assert mistake_value(alternatives_for(template), params, answer, mistake) == pytest.approx(by_hand, rel=1e-9)
-    verdict = graded_alone(template, params, answer, f"{by_hand:.3g}")
-    assert (verdict.verdict, verdict.diagnosis) == ("mistake", mistake), verdict
-
-
 def test_spring_energy_in_another_unit_is_correct() -> None:
     """E_max = 6.2189 J typed in kJ, and the compression in m where the sheet asks mm."""
     params = {"m_b": 10, "m_blk": 2, "v_b": 500, "k": 5}
@@ -295,15 +286,6 @@ SLOPE_MISTAKES = [
 ]
 
 
-@pytest.mark.parametrize(("template", "params", "answer", "mistake", "by_hand"), SLOPE_MISTAKES,
-                         ids=[m[3] for m in SLOPE_MISTAKES])
-def test_slope_mistakes_are_diagnosed(template: Template, params: dict[str, float], answer: str, mistake: str,
-                                      by_hand: float) -> None:
-    assert mistake_value(alternatives_for(template), params, answer, mistake) == pytest.approx(by_hand, rel=1e-9)
-    verdict = graded_alone(template, params, answer, f"{by_hand:.3g}")
-    assert (verdict.verdict, verdict.diagnosis) == ("mistake", mistake), verdict
-
-
 def test_the_slope_is_listed_with_its_fields(capsys: pytest.CaptureFixture[str]) -> None:
     listed(capsys, "slope", {"body", "with", "speed", "end_speed", "distance", "angle", "direction", "height",
                              "friction", "static"})
@@ -381,15 +363,6 @@ STICK_MISTAKES = [
 ]
 
 
-@pytest.mark.parametrize(("template", "params", "answer", "mistake", "by_hand"), STICK_MISTAKES,
-                         ids=[f"{m[0].id}-{m[3]}" for m in STICK_MISTAKES])
-def test_stick_mistakes_are_diagnosed(template: Template, params: dict[str, float], answer: str, mistake: str,
-                                      by_hand: float) -> None:
-    assert mistake_value(alternatives_for(template), params, answer, mistake) == pytest.approx(by_hand, rel=1e-9)
-    verdict = graded_alone(template, params, answer, f"{by_hand:.3g}")
-    assert (verdict.verdict, verdict.diagnosis) == ("mistake", mistake), verdict
-
-
 def test_stick_is_listed_with_its_fields(capsys: pytest.CaptureFixture[str]) -> None:
     listed(capsys, "stick", {"bodies", "before", "common", "speed", "angle", "from", "energy_lost", "loss_fraction"})
 
@@ -454,15 +427,6 @@ IMPULSE_MISTAKES = [
     # the weight left out, which the scene declares: m v^2 / (2 d) in kN
     (CUSHION, {"m": 10, "h": 1.5, "d": 80}, "F", "impulse.weight", 10 * 2 * 9.81 * 1.5 / (2 * 0.08) / 1000),
 ]
-
-
-@pytest.mark.parametrize(("template", "params", "answer", "mistake", "by_hand"), IMPULSE_MISTAKES,
-                         ids=[m[3] for m in IMPULSE_MISTAKES])
-def test_impulse_mistakes_are_diagnosed(template: Template, params: dict[str, float], answer: str, mistake: str,
-                                        by_hand: float) -> None:
-    assert mistake_value(alternatives_for(template), params, answer, mistake) == pytest.approx(by_hand, rel=1e-9)
-    verdict = graded_alone(template, params, answer, f"{by_hand:.3g}")
-    assert (verdict.verdict, verdict.diagnosis) == ("mistake", mistake), verdict
 
 
 @pytest.mark.parametrize(("template", "params", "answer", "typed"), [
@@ -538,15 +502,6 @@ SEPARATION_MISTAKES = [
 ]
 
 
-@pytest.mark.parametrize(("template", "params", "answer", "mistake", "by_hand"), SEPARATION_MISTAKES,
-                         ids=[m[3] for m in SEPARATION_MISTAKES])
-def test_separation_mistakes_are_diagnosed(template: Template, params: dict[str, float], answer: str, mistake: str,
-                                           by_hand: float) -> None:
-    assert mistake_value(alternatives_for(template), params, answer, mistake) == pytest.approx(by_hand, rel=1e-9)
-    verdict = graded_alone(template, params, answer, f"{by_hand:.4g}")
-    assert (verdict.verdict, verdict.diagnosis) == ("mistake", mistake), verdict
-
-
 def test_the_separation_is_listed_with_its_fields(capsys: pytest.CaptureFixture[str]) -> None:
     listed(capsys, "separation", {"bodies", "whole", "after", "energy", "relative"})
 
@@ -592,3 +547,19 @@ def test_the_separation_in_place_of_e_keeps_the_impacts_mistakes() -> None:
     params = {"m_A": 2, "m_B": 1.5, "v_A": 6, "alpha": 30, "v_B": 2, "beta": 45, "s": 2.4}
     approach = 6 * math.cos(math.radians(30)) + 2 * math.cos(math.radians(45))
     assert mistake_value(alternatives_for(OBLIQUE), params, "e", "impact.e_inverse") == pytest.approx(approach / 2.4)
+
+
+# --- every effect's diagnosed mistakes -----------------------------------------------------------------
+
+MISTAKES = SPRING_MISTAKES + SLOPE_MISTAKES + STICK_MISTAKES + IMPULSE_MISTAKES + SEPARATION_MISTAKES
+
+
+@pytest.mark.parametrize(("template", "params", "answer", "mistake", "by_hand"), MISTAKES,
+                         ids=[f"{m[0].id}-{m[3]}" for m in MISTAKES])
+def test_a_new_effects_mistake_is_diagnosed(template: Template, params: dict[str, float], answer: str,
+                                            mistake: str, by_hand: float) -> None:
+    """The solver's chain under the mistake, against the variant worked by hand with it; and that answer typed
+    to 4 significant figures is graded ``mistake`` with the mistake's id."""
+    assert mistake_value(alternatives_for(template), params, answer, mistake) == pytest.approx(by_hand, rel=1e-9)
+    verdict = graded_alone(template, params, answer, f"{by_hand:.4g}")
+    assert (verdict.verdict, verdict.diagnosis) == ("mistake", mistake), verdict

@@ -82,10 +82,7 @@ class _Impulse:
 
         check_fields(stage, ctx.scene.where)
         fields = stage.fields
-        mass = ctx.scene.bodies[fields["body"]].mass
-        if mass is None:
-            raise TemplateError(ctx.scene.where, f"stages[{stage.index}].body", "a body with a mass",
-                                f"{fields['body']}, which is fixed")
+        mass = ctx.mass(stage, fields["body"], "body")
         named = fields.get("components")
         direct = all(ctx.sym(fields[key].t) == 0 for key in ("velocity", "velocity_after"))
         components = (ctx.sym(named.n), ctx.sym(named.t)) if named is not None else (
@@ -93,7 +90,7 @@ class _Impulse:
             sp.Integer(0) if direct else ctx.symbol(ctx.unused_name("J_t", stage)))  # direct: no t-impulse
         g = ctx.gravity_symbol(stage) if fields.get("weight", False) else sp.Integer(0)
         before, after = fields["velocity"], fields["velocity_after"]
-        return cls(stage, ctx.sym(mass), (ctx.sym(before.n), ctx.sym(before.t)), (ctx.sym(after.n), ctx.sym(after.t)),
+        return cls(stage, mass, (ctx.sym(before.n), ctx.sym(before.t)), (ctx.sym(after.n), ctx.sym(after.t)),
                    components, g)
 
     def relations(self, ctx: Context) -> list[Relation]:

@@ -24,7 +24,6 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from grader.base.errors import TemplateError
 from grader.model.expr import Sym
 from grader.model.quantities import ENERGY, SPEED
 from grader.physics.effects.base import Condition, Effect, Field, Mistake, Relation, Stable
@@ -68,9 +67,7 @@ class _Separation:
         fields = stage.fields
         bodies = tuple(fields["bodies"])
         for body in bodies:
-            if ctx.scene.bodies[body].mass is None:
-                raise TemplateError(ctx.scene.where, f"stages[{stage.index}].bodies", "two parts with a mass",
-                                    f"{body}, which is fixed")
+            ctx.mass(stage, body, "bodies")
         whole = fields.get("whole")
         before = (ctx.sym(whole.n), ctx.sym(whole.t)) if whole is not None else (sp.Integer(0), sp.Integer(0))
         plane = before[1] != 0 or any(v.t is not None for v in fields.get("after", {}).values())

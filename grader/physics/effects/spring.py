@@ -101,14 +101,14 @@ class _Spring:
         """The spring a stage describes."""
         check_fields(stage, ctx.scene.where)
         fields = stage.fields
-        mass = _mass(ctx, stage, fields["body"])
+        mass = ctx.mass(stage, fields["body"], "body")
         if "with" in fields:
-            mass += _mass(ctx, stage, fields["with"])
+            mass += ctx.mass(stage, fields["with"], "with")
         g = ctx.gravity_symbol(stage) if fields.get("vertical", False) else 0
         k = ctx.sym(fields["stiffness"])
         if "supports" in fields:
             x0 = ctx.quantity(stage, "static_deflection", _DEFAULT_NAMES)
-            x0_value = _mass(ctx, stage, fields["supports"]) * g / k
+            x0_value = ctx.mass(stage, fields["supports"], "supports") * g / k
         else:
             x0 = x0_value = ctx.sym(fields["initial"]) if "initial" in fields else 0
         return cls(stage, mass, k, ctx.sym(fields["speed"]), ctx.sym(fields["compression"]), x0, g, x0_value)
@@ -152,7 +152,7 @@ class _Spring:
         import sympy as sp
 
         supported = self.stage.fields["supports"]
-        weight = _mass(ctx, self.stage, supported) * ctx.gravity_symbol(self.stage)
+        weight = ctx.mass(self.stage, supported, "supports") * ctx.gravity_symbol(self.stage)
         delta = ctx.quantity(self.stage, "static_deflection", _DEFAULT_NAMES)
         solutions = {delta: weight / self.k, self.k: weight / delta} if isinstance(self.k, sp.Symbol) else \
             {delta: weight / self.k}
@@ -214,14 +214,6 @@ def _hypot(a: Any, b: Any) -> Any:
     return hypot(a, b)
 
 
-def _mass(ctx: Context, stage: Stage, body: str) -> Any:
-    mass = ctx.scene.bodies[body].mass
-    if mass is None:
-        raise TemplateError(ctx.scene.where, f"stages[{stage.index}]", "a movable body (one with a mass) on the "
-                            "spring", f"{body}, which is fixed")
-    return ctx.sym(mass)
-
-
 def _who(stage: Stage) -> str:
     together = stage.fields.get("with")
     return f"{stage.fields['body']} (with {together} stuck to it)" if together else str(stage.fields["body"])
@@ -236,7 +228,7 @@ def _mistakes(stage: Stage, ctx: Context) -> list[Mistake]:
     mistakes = [Mistake("spring.half_k_x", "½kx instead of ½kx² for the energy stored in the spring",
                         tuple(replace(real, law="x").relations(ctx)))]
     if "with" in stage.fields:
-        alone = _mass(ctx, stage, stage.fields["body"])
+        alone = ctx.mass(stage, stage.fields["body"], "body")
         mistakes.append(Mistake("spring.mass_before_stuck", f"the mass of {stage.fields['body']} alone, as before "
                                 f"{stage.fields['with']} stuck to it", tuple(replace(real, mass=alone).relations(ctx))))
     if "supports" in stage.fields:

@@ -24,7 +24,6 @@ import math
 from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING, Any
 
-from grader.base.errors import TemplateError
 from grader.model.expr import Sym, to_text
 from grader.model.quantities import ANGLE, ENERGY, PURE, SPEED
 from grader.physics.effects.base import Condition, Effect, Field, Mistake, Relation, Stable
@@ -72,9 +71,7 @@ class _Stick:
 
         first, second = stage.fields["bodies"]
         for body in (first, second):
-            if ctx.scene.bodies[body].mass is None:
-                raise TemplateError(ctx.scene.where, f"stages[{stage.index}].bodies", "two bodies with a mass (a "
-                                    "fixed surface does not move on with a body)", f"{body}, which is fixed")
+            ctx.mass(stage, body, "bodies")  # a fixed surface does not move on with a body
 
         def component(body: str, axis: str) -> Any:
             given = stage.fields.get("before", {}).get(body)

@@ -563,3 +563,21 @@ def test_a_new_effects_mistake_is_diagnosed(template: Template, params: dict[str
     assert mistake_value(alternatives_for(template), params, answer, mistake) == pytest.approx(by_hand, rel=1e-9)
     verdict = graded_alone(template, params, answer, f"{by_hand:.4g}")
     assert (verdict.verdict, verdict.diagnosis) == ("mistake", mistake), verdict
+
+
+# --- the units that come with them ---------------------------------------------------------------------
+
+LBF, INCH, FOOT = 4.4482216152605, 0.0254, 0.3048  # N, m, m: the international pound-force, inch and foot
+
+
+@pytest.mark.parametrize(("typed", "key", "factor"), [
+    ("kN", "N", 1000), ("N/m", "kN/m", 1e-3), ("kN/m", "N/m", 1000), ("lb/in", "N/m", LBF / INCH),
+    ("N·s", "N*s", 1), ("N s", "N·s", 1), ("lb·s", "N·s", LBF), ("kJ", "J", 1000), ("ft·lb", "J", FOOT * LBF),
+    ("ft-lb", "J", FOOT * LBF), ("lbf", "N", LBF),
+])
+def test_the_new_effects_units_read_in_templates_and_in_students_cells(typed: str, key: str, factor: float) -> None:
+    """Each unit a template may print (parse_unit) and a student may type (unit_factor), against the definitions."""
+    from grader.model.quantities import parse_unit, unit_factor
+
+    assert float(parse_unit(typed).factor) / float(parse_unit(key).factor) == pytest.approx(factor, rel=1e-12)
+    assert unit_factor(typed, key) == pytest.approx(factor, rel=1e-12)

@@ -205,7 +205,6 @@ def _simulate_stick(stage: Stage, run: Run) -> None:
         c, s = (before[0] - before[2]) / relative, (before[1] - before[3]) / relative
         turned = [before[0] * c + before[1] * s, before[1] * c - before[0] * s,
                   before[2] * c + before[3] * s, before[3] * c - before[2] * s]
-        run.uses("perfectly plastic contact (Kelvin-Voigt, e = 0) along the relative velocity")
         moved = simulate_contact(stage, run, (first, second), inverse, 0.0, turned,  # type: ignore[arg-type]
                                  f"{first} and {second} collide and lock")
         after = [moved[0] * c - moved[1] * s, moved[1] * c + moved[0] * s,

@@ -52,6 +52,11 @@ from grader.solve.evaluate import solve_one
 from grader.solve.solver import compile_template
 
 RESULTS = Path(__file__).resolve().parent / "results"
+TRIALS_DIR = Path(__file__).resolve().parent.parent / "tests" / "data"
+TRIALS = ("bullet-spring", "package-platform", "ramp-and-floor", "incline-up-and-back", "intersection",
+          "intersection-reconstruction", "ball-wall-impulse", "cushion", "recoil", "explosion",
+          "oblique-both-moving")
+"""Issue 25's trial templates of new effects (tests/data), swept beside the bank's until the bank carries them."""
 REFERENCE_RTOL = 1e-13
 PANEL_RTOL = 1e-12
 TARGET_ERROR = 1e-8
@@ -127,6 +132,8 @@ def parse_args(argv: Sequence[str] | None = None) -> argparse.Namespace:
     parser.add_argument("--shifts", type=int, default=8, help="onset positions per point (default 8)")
     parser.add_argument("--repeat", type=int, default=3, help="timed runs per onset position (default 3)")
     parser.add_argument("--out", type=Path, default=RESULTS, help=f"output folder (default {RESULTS})")
+    parser.add_argument("--only", action="append", default=[], metavar="ID",
+                        help="sweep only this template (repeatable; the stiffness panel's drop-rebound is kept)")
     args = parser.parse_args(argv)
     if args.quick:
         args.max_steps, args.points, args.shifts, args.repeat = 400, 6, 2, 1
@@ -199,6 +206,15 @@ def textbook_exact(template_id: str) -> Exact | None:
     if form is None:
         return None
     return lambda params: form(MPMATH, **params)
+
+
+def trials() -> dict[str, Template]:
+    """The trial templates of :data:`TRIALS`, read as the bank's are."""
+    found = {}
+    for name in TRIALS:
+        raw = yaml.safe_load((TRIALS_DIR / f"{name}.yaml").read_text(encoding="utf-8"))
+        found[name] = parse_template(raw, f"tests/data/{name}.yaml", name)
+    return found
 
 
 def classify(bank: Mapping[str, Template]) -> tuple[list[Template], list[Template], list[str]]:
@@ -598,8 +614,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     args = parse_args(argv)
     load_at_start = os.getloadavg()[0]
     started = time.perf_counter()
-    ahead, backward, skipped = classify(load_bank())
+    ahead, backward, skipped = classify({**load_bank(), **trials()})
     forward, points = scenes(ahead), []
+    if args.only:  # and the last scene, the stiffness panel's drop-rebound
+        forward = [s for s in forward[:-1] if s.name in args.only] + forward[-1:]
     names = [s.name for s in forward]
     for reason in skipped:
         print(f"not simulated: {reason}", file=sys.stderr)

@@ -191,6 +191,74 @@ def wall_throw(xp: Any, h0: Any, D: Any, v0: Any, alpha: Any, e: Any) -> dict[st
             "x_land": e * v_x * t2}
 
 
+def bullet_spring(xp: Any, m_b: Any, m_blk: Any, v_b: Any, k: Any) -> dict[str, Any]:
+    """Momentum, then 1/2 (m_b + m_blk) V^2 = 1/2 k x^2 (issue 25's trial template, tests/data)."""
+    m_b, k = m_b / 1000, k * 1000  # g, kN/m
+    common = m_b * v_b / (m_b + m_blk)
+    x = xp.sqrt((m_b + m_blk) * common**2 / k)
+    return {"V": common, "x_max": 1000 * x, "E_max": k * x**2 / 2}
+
+
+def package_platform(xp: Any, m: Any, m_p: Any, h: Any, k: Any) -> dict[str, Any]:
+    """Fall, momentum, then 1/2 M V^2 + M g (x - delta) = 1/2 k (x^2 - delta^2), the quadratic's root."""
+    k = k * 1000
+    common = m * xp.sqrt(2 * G * h) / (m + m_p)
+    mass, delta = m + m_p, m_p * G / k
+    constant = mass * common**2 / 2 - mass * G * delta + k * delta**2 / 2
+    x = (mass * G + xp.sqrt((mass * G) ** 2 + 2 * k * constant)) / k
+    return {"delta": 1000 * delta, "x_max": 1000 * x, "extra": 1000 * (x - delta)}
+
+
+def ramp_and_floor(xp: Any, h: Any, v0: Any, mu_k: Any) -> dict[str, Any]:
+    """Energy down a smooth ramp, then friction's work mu_k m g d takes the kinetic energy."""
+    v_foot = xp.sqrt(v0**2 + 2 * G * h)
+    return {"v_B": v_foot, "d": v_foot**2 / (2 * mu_k * G)}
+
+
+def incline_up_and_back(xp: Any, v0: Any, beta: Any, mu_k: Any) -> dict[str, Any]:
+    """Up to rest against gravity's component and friction, then down from rest through the same distance."""
+    sine, cosine = xp.sin(xp.radians(beta)), xp.cos(xp.radians(beta))
+    d = v0**2 / (2 * G * (sine + mu_k * cosine))
+    return {"d": d, "v_back": xp.sqrt(2 * G * (sine - mu_k * cosine) * d)}
+
+
+def intersection(xp: Any, m_A: Any, m_B: Any, v_A: Any, v_B: Any) -> dict[str, Any]:  # noqa: N803 (its names)
+    """Momentum east and north; the loss as T - T'."""
+    east, north = m_B * v_B / (m_A + m_B), m_A * v_A / (m_A + m_B)
+    before = (m_A * v_A**2 + m_B * v_B**2) / 2
+    return {"v": xp.hypot(east, north), "theta": xp.degrees(xp.atan2(north, east)),
+            "loss_pct": _loss_pct(before, (m_A + m_B) * (east**2 + north**2) / 2)}
+
+
+def ball_wall_impulse(xp: Any, m: Any, v: Any, e: Any, dt: Any) -> dict[str, Any]:
+    """The rebound at e v the other way: impulse m (v + e v) (m in g), average force over dt (in ms)."""
+    impulse = m / 1000 * (v + e * v)
+    return {"J": impulse, "F": impulse / (dt / 1000)}
+
+
+def cushion(xp: Any, m: Any, h: Any, d: Any) -> dict[str, Any]:
+    """Fall, then (F - m g) d = 1/2 m v^2 over the cushion's d (in mm); F in kN."""
+    v = xp.sqrt(2 * G * h)
+    return {"J": m * v, "F": (m * v**2 / 2 / (d / 1000) + m * G) / 1000}
+
+
+def recoil(xp: Any, m_gun: Any, m_b: Any, u: Any) -> dict[str, Any]:
+    """From rest: m_gun v_gun + m_b v_b = 0 with v_b - v_gun = u (m_b in g); the energy as a sum of 1/2 m v^2."""
+    m_b = m_b / 1000
+    v_b = m_gun * u / (m_gun + m_b)
+    v_gun = v_b - u
+    return {"v_recoil": -v_gun, "v_b": v_b, "E": (m_gun * v_gun**2 + m_b * v_b**2) / 2 / 1000}
+
+
+def explosion(xp: Any, m1: Any, m2: Any, V: Any, E: Any) -> dict[str, Any]:  # noqa: N803 (its names)
+    """Momentum and energy, 1/2 m1 v1^2 + 1/2 m2 v2^2 = 1/2 (m1 + m2) V^2 + E (E in kJ), the quadratic in v2."""
+    released, total = E * 1000, m1 + m2
+    a, b = m2 + m2**2 / m1, -2 * total * V * m2 / m1
+    c = total**2 * V**2 / m1 - total * V**2 - 2 * released
+    v2 = (-b + xp.sqrt(b**2 - 4 * a * c)) / (2 * a)
+    return {"v1": (total * V - m2 * v2) / m1, "v2": v2}
+
+
 FORMS: dict[str, Callable[..., dict[str, Any]]] = {
     "drop-rebound": drop_rebound, "pile-driver": pile_driver, "car-collision": car_collision,
     "ball-plate": ball_plate, "oblique-spheres": oblique_spheres, "head-on": head_on,
@@ -198,5 +266,8 @@ FORMS: dict[str, Callable[..., dict[str, Any]]] = {
     "incline-bounce": incline_bounce, "billiards": billiards, "offset-spheres": offset_spheres,
     "three-balls": three_balls, "two-rebounds": two_rebounds, "successive-bounces": successive_bounces,
     "ballistic-pendulum": ballistic_pendulum, "skid": skid, "wall-throw": wall_throw,
+    "bullet-spring": bullet_spring, "package-platform": package_platform, "ramp-and-floor": ramp_and_floor,
+    "incline-up-and-back": incline_up_and_back, "intersection": intersection, "ball-wall-impulse": ball_wall_impulse,
+    "cushion": cushion, "recoil": recoil, "explosion": explosion,
 }
 """Template id -> its textbook answers."""

@@ -252,6 +252,14 @@ class Context:
         mass = self.scene.bodies[body].mass
         return sp.Integer(0) if mass is None else 1 / self.sym(mass)
 
+    def mass(self, stage: Stage, body: str, key: str) -> Any:
+        """A body's mass where the stage's field ``key`` needs one that moves; a fixed body is refused."""
+        mass = self.scene.bodies[body].mass
+        if mass is None:
+            raise TemplateError(self.scene.where, f"stages[{stage.index}].{key}", "a body with a mass (one that "
+                                "moves)", f"{body}, which is fixed")
+        return self.sym(mass)
+
     def radius(self, body: str) -> Any:
         """A sphere's radius (the parser makes sure a stage that needs one has it)."""
         radius = self.scene.bodies[body].radius

@@ -27,7 +27,7 @@ from scipy.optimize import brentq
 
 from grader.bank.template import Template
 from grader.base.errors import GraderError
-from grader.model.expr import Sym, names, parse
+from grader.model.expr import Num, Op, Sym, names, parse
 from grader.model.scene import Stage, Velocity
 from grader.physics.effects import CATALOGUE
 from grader.physics.integrate import MAX_STEPS, Budget, SimulationError
@@ -64,7 +64,7 @@ def simulate(template: Template, params: Mapping[str, float], options: Options |
         # A found e is reported as the contact produced it (separation over approach), not as the
         # value the contact law was calibrated to: that is the time-domain answer.
         for contact in run.contacts:
-            restitution = template.scene.stages[contact.stage].fields["restitution"]
+            restitution = template.scene.stages[contact.stage].fields.get("restitution")  # none: bodies that stick
             if isinstance(restitution, Sym) and restitution.name in fitted:
                 run.values[restitution.name] = contact.measured_e
         if run.problems:
@@ -135,7 +135,13 @@ SEARCH_PASSES = 25
 _SEARCHABLE = {("impact", "restitution"): ("coefficient of restitution", 0.0, 1.0),
                ("free_fall", "height"): ("fall height", 0.0, math.inf),
                ("impact", "before"): ("velocity before the impact", 0.0, math.inf),
-               ("slide", "speed"): ("speed at the start of the slide", 0.0, math.inf)}
+               ("slide", "speed"): ("speed at the start of the slide", 0.0, math.inf),
+               ("spring", "stiffness"): ("spring constant", 0.0, math.inf),
+               ("slope", "speed"): ("speed at the start of the path", 0.0, math.inf),
+               ("slope", "friction"): ("coefficient of kinetic friction", 0.0, math.inf),
+               ("stick", "before"): ("speed before the collision", 0.0, math.inf),
+               ("separation", "relative"): ("relative velocity of separation", 0.0, math.inf),
+               ("separation", "energy"): ("energy released", 0.0, math.inf)}
 _PROBE = 0.5  # a value of the unknown that shows which outcome it leads to
 _GROWTH, _MAX_GROWTH = 4.0, 120  # an open upper end grows 4x at a time, at most 120 times (4**120 ~ 1e72)
 
@@ -212,10 +218,13 @@ def _next_unknown(template: Template, options: Options, values: dict[str, float]
 
 
 def _names(field: object, name: str) -> bool:
-    """Whether a stage field is the quantity ``name`` itself: the field, or a body's velocity along n
-    alone (a bullet's or a car's speed before it strikes, found from what happens after)."""
-    if isinstance(field, Mapping):
-        return any(isinstance(v, Velocity) and v.n == Sym(name) and v.t is None for v in field.values())
+    """Whether a stage field is the quantity ``name`` itself: the field, or a body's velocity along one axis
+    alone, or its negative, the other component a given number (a bullet's or a car's speed before it strikes,
+    found from what happens after: a car driving north, ``{n: 0, t: v_A}``)."""
+    if isinstance(field, Mapping):  # the velocity, or its negative (a bullet coming in along -n)
+        alone = (Sym(name), Op("neg", (Sym(name),)))
+        return any(isinstance(v, Velocity) and ((v.n in alone and (v.t is None or isinstance(v.t, Num))) or
+                                                (v.t in alone and isinstance(v.n, Num))) for v in field.values())
     return field == Sym(name)
 
 

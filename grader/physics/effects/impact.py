@@ -56,6 +56,8 @@ _FIELDS = (
     Field("energy_lost", "name", required=False, doc="name for the energy lost", dimension=ENERGY, default="E_lost"),
     Field("loss_fraction", "name", required=False, doc="name for the fraction of energy lost", dimension=PURE,
           default="f_loss"),
+    Field("separation", "expr", required=False, doc="relative velocity of separation along n, v2' - v1', given in "
+          "place of e (then name e as a quantity to find)", dimension=SPEED, default="v2' - v1' from e"),
     Field("weight_during_contact", "flag", required=False,
           doc="simulate the weight during contact (the closed form neglects it)", default="false"),
 )
@@ -99,7 +101,9 @@ class _Impact:
         impulse = ctx.quantity(self.stage, "impulse", _DEFAULT_NAMES)
         (u1, u2), (a1, a2) = (self.before[0][0], self.before[1][0]), (self.after[0][0], self.after[1][0])
         approach, separation = u1 - u2, a2 - a1
-        ratio = separation / approach
+        # A measured separation (given in place of e) makes e its ratio to the approach: one unknown.
+        measured = self.stage.fields.get("separation")
+        ratio = (separation if measured is None else ctx.sym(measured)) / approach
         centre = (w2 * u1 + w1 * u2) / (w1 + w2)
         e_text = self.stage.text("restitution")
 
@@ -312,6 +316,8 @@ def _simulate_impact(stage: Stage, run: Run) -> None:
             if given.t is not None:
                 run.output(given.t, after[2 * index + 1])
     _output_energies(stage, run, (w1, w2), before, after)
+    if "separation" in stage.fields:  # given: an observation a search for e matches
+        run.output(stage.fields["separation"], after[2] - after[0])
 
 
 def simulate_contact(stage: Stage, run: Run, bodies: tuple[str, str], inverse: tuple[float, float], e: float,

@@ -125,7 +125,8 @@ ROSTER_TEXT = ROSTER.read_text(encoding="utf-8")
     ({}, "id,name,email,section\n1,A,a@x,L1\n1,B,b@x,L1\n", "line 3: student id '1' appears twice"),
     ({}, "id,name,email,section\n1,A,a@x,L1\n,B,b@x,L1\n", "line 3: empty student id"),
     ({}, "id,name,email,section\n", "the roster has no students"),
-    ({}, "id,name\n1,A\n", "missing column(s) email, section"),
+    ({}, "id,email\n1,a@x\n", "missing column(s) name; expected a header with id, name, and optionally email, "
+                                "section and due (got id, email)"),
 ], ids=["unknown-template", "fixed-outside-domain", "unknown-parameter", "infeasible-constraint", "duplicate-id",
         "empty-id", "empty-roster", "missing-columns"])
 def test_bad_input_exits_2_and_leaves_nothing_behind(tmp_path: Path, capsys: pytest.CaptureFixture[str],
@@ -530,3 +531,14 @@ def test_a_full_stdout_is_one_line_on_stderr_not_a_traceback(command: list[str])
     assert result.returncode == 2
     assert result.stderr == ("grader: error: cannot write to standard output (No space left on device); free some "
                              "space, or send the output to a file or program that takes it\n")
+
+
+def test_a_roster_of_ids_and_names_only_is_enough(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """An LMS export often has no email or section: those columns may be left out (empty for everyone)."""
+    assignment = _assignment(tmp_path, {})
+    roster_path = _write(tmp_path / "roster.csv", "id,name\n1,Ann Lee\n2,Bo Chan\n")
+    code, _, err = run(capsys, "generate", assignment, "--roster", roster_path, "--out", tmp_path / "out", "--no-pdf")
+    assert code == 0, err
+    students = json.loads((tmp_path / "out" / "key.json").read_text(encoding="utf-8"))["students"]
+    assert [(s["id"], s["name"], s["email"], s["section"]) for s in students] == [("1", "Ann Lee", "", ""),
+                                                                                  ("2", "Bo Chan", "", "")]

@@ -36,6 +36,7 @@ from grader.model.tolerance import ANSWER_SIG_FIGS, FORMS
 
 _KEY = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_-]{0,15}$")
 _ROSTER_COLUMNS = ("id", "name", "email", "section")
+_ROSTER_REQUIRED = ("id", "name")  # email and section may be left out: empty for everyone
 MAX_POINTS = 1_000_000  # per answer part: any class's totals stay exact in float64
 _NUMBER_WORDS = ("zero", "one", "two", "three", "four", "five", "six", "seven", "eight", "nine", "ten")
 
@@ -298,19 +299,20 @@ def _admitted(parameter: Parameter, value: float, where: str, key: str) -> None:
 
 
 def load_roster(path: Path) -> tuple[Student, ...]:
-    """Read a roster: columns id, name, email, section, and optionally due, a student's extension (UTF-8
-    with or without BOM; , ; or tab)."""
+    """Read a roster: columns id and name, and optionally email, section and due, a student's extension
+    (UTF-8 with or without BOM; , ; or tab)."""
     table = read_csv(path)
     columns = {name.lower(): name for name in table.header}
-    missing = [c for c in _ROSTER_COLUMNS if c not in columns]
+    missing = [c for c in _ROSTER_REQUIRED if c not in columns]
     if missing:
         raise GraderError(f"{path}: missing column(s) {', '.join(missing)}; expected a header with "
-                          f"{', '.join(_ROSTER_COLUMNS)} (got {', '.join(table.header)})")
+                          f"{', '.join(_ROSTER_REQUIRED)}, and optionally {', '.join(_ROSTER_COLUMNS[2:])} and due "
+                          f"(got {', '.join(table.header)})")
     students, seen = [], set()
     for row in table.rows:
         if row.problem is not None:
             raise GraderError(f"{path}: {row.problem}")
-        values = {c: row.cells[columns[c]] for c in _ROSTER_COLUMNS}
+        values = {c: row.cells[columns[c]] if c in columns else "" for c in _ROSTER_COLUMNS}
         _check_id(values["id"], f"{path}: line {row.line}")
         _check_name(values["name"], f"{path}: line {row.line}")
         due = row.cells[columns["due"]].strip() if "due" in columns else ""

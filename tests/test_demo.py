@@ -63,7 +63,7 @@ def test_the_demo_exits_0_and_says_how_the_class_graded_and_how_to_grade_again(d
                         "(superseded or not a student), 0 rows not graded (see problems.csv) -> grader-demo/grades")
     assert lines[-2:] == ["Grade the submissions again, or your own file, with", f"  {REGRADE}"]
     assert sorted(p.name for p in (demo_run.out / "grades").iterdir()) == [
-        MANIFEST, "canvas.csv", "details.csv", "grades.csv", "problems.csv", "report.html"]
+        MANIFEST, "canvas.csv", "details.csv", "grades.csv", "integrity.csv", "problems.csv", "report.html"]
 
 
 def test_submissions_csv_is_the_simulated_class(demo_run: DemoRun, answers: list[SampleAnswer]) -> None:

@@ -144,7 +144,8 @@ def check(graded: Graded) -> Integrity:
         values = np.array([_number(student.parts[label].value) for student in key.students])
         part = _part(label, values, [student.parts[label].tolerance for student in key.students], first.unit)
         numbers = graded.numbers[label]
-        incorrect = np.array([row.verdict == "incorrect" for row in graded.columns[label]], dtype=bool)
+        rows = graded.columns[label]
+        incorrect = np.fromiter((row.verdict == "incorrect" for row in rows), dtype=bool, count=len(rows))
         wrong[label] = np.flatnonzero(incorrect & np.isfinite(numbers) & np.isfinite(values))
         parts.append(part)
     per_student = np.zeros(students, dtype=np.int64)
@@ -157,11 +158,12 @@ def check(graded: Graded) -> Integrity:
     found = [_found(part, wrong[part.label], graded.numbers[part.label]) for part in parts]
     pairs = _pairs(parts, wrong, graded.numbers, spread, found, per_student, examined)
     matches = _listed(parts, wrong, graded.numbers, found, pairs)
-    for match in matches:  # every listed match has its pair's figures
-        if (match.student, match.partner) not in pairs:
-            pairs[match.student, match.partner] = _figures(parts, wrong, graded.numbers, spread,
-                                                            np.array([match.student]), np.array([match.partner]),
-                                                            per_student, examined)[0]
+    # Every listed match has its pair's figures.
+    others = sorted({(match.student, match.partner) for match in matches} - pairs.keys())
+    if others:
+        owners, partners = np.array(others, dtype=np.int64).T
+        pairs.update(((pair.student, pair.partner), pair) for pair in _figures(
+            parts, wrong, graded.numbers, spread, owners, partners, per_student, examined))
     ranked = sorted(pairs.values(), key=lambda pair: (pair.corrected, pair.chance, pair.student, pair.partner))
     return Integrity(tuple(matches), tuple(ranked), examined, key.integrity_threshold,
                      sum(len(members) for members in wrong.values()),
@@ -291,14 +293,15 @@ def _pairs(parts: Sequence[_Part], wrong: Mapping[str, Ints], numbers: Mapping[s
     pairs = np.unique(np.concatenate(keys))
     return {(pair.student, pair.partner): pair
             for pair in _figures(parts, wrong, numbers, spread, pairs // students, pairs % students, per_student,
-                                 examined)
-            if len(pair.labels) >= 2 and pair.corrected < KEPT}
+                                 examined, 2, KEPT)}
 
 
 def _figures(parts: Sequence[_Part], wrong: Mapping[str, Ints], numbers: Mapping[str, Floats], spread: Spread,
-             owners: Ints, partners: Ints, per_student: Ints, examined: int) -> list[Pair]:
+             owners: Ints, partners: Ints, per_student: Ints, examined: int, least: int = 0,
+             below: float = math.inf) -> list[Pair]:
     """Each pair's matched parts and chances: the Poisson binomial distribution of the number of matches
-    among the owner's wrong parts, built a part at a time."""
+    among the owner's wrong parts, built a part at a time; only the pairs with ``least`` matched parts or
+    more and a corrected chance under ``below``."""
     count = len(owners)
     most = int(per_student[owners].max()) if count else 0
     distribution = np.zeros((count, most + 1))
@@ -316,11 +319,20 @@ def _figures(parts: Sequence[_Part], wrong: Mapping[str, Ints], numbers: Mapping
         distribution[rows] = distribution[rows] * (1 - chance) + shifted * chance
         hits[rows, index] = _accepts(part, owners[rows], partners[rows], numbers[part.label])
     matched = hits.sum(axis=1)
-    tails = np.array([distribution[row, k:].sum() for row, k in enumerate(matched)])
-    labels = [part.label for part in parts]
-    return [Pair(int(owner), int(partner), tuple(label for label, hit in zip(labels, row, strict=True) if hit),
-                 int(per_student[owner]), float(min(1.0, tail)), float(min(1.0, tail * max(examined, 1))))
-            for owner, partner, row, tail in zip(owners, partners, hits, tails, strict=True)]
+    tails = np.cumsum(distribution[:, ::-1], axis=1)[:, ::-1][np.arange(count), np.minimum(matched, most)]
+    tails = np.minimum(tails, 1.0)
+    corrected = np.minimum(tails * max(examined, 1), 1.0)
+    kept = (matched >= least) & (corrected < below)
+    owners, partners, hits, tails, corrected = owners[kept], partners[kept], hits[kept], tails[kept], corrected[kept]
+    # The matched parts' labels, worked out once per pattern of parts (a class has a few hundred patterns).
+    patterns = hits.astype(np.int64) @ (np.int64(1) << np.arange(len(parts), dtype=np.int64))
+    named: dict[int, tuple[str, ...]] = {}
+    for pattern in np.unique(patterns).tolist():
+        named[pattern] = tuple(part.label for index, part in enumerate(parts) if pattern >> index & 1)
+    return [Pair(owner, partner, named[pattern], wrong, chance, fixed)
+            for owner, partner, pattern, wrong, chance, fixed in zip(
+                owners.tolist(), partners.tolist(), patterns.tolist(), per_student[owners].tolist(), tails.tolist(),
+                corrected.tolist(), strict=True)]
 
 
 def _chance(part: _Part, spread: Spread, owners: Ints, partners: Ints) -> Floats:

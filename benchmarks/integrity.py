@@ -153,7 +153,8 @@ def report(run: dict[str, object], big: dict[str, object] | None, seconds: float
              f"{'met' if len(alarms) <= 1 else 'missed'} |",
              f"| planted copies ({COPIED} answers) found | {found} of {planted} ({100 * share:.1f} %) | at least "
              f"95 %: {'met' if share >= 0.95 else 'missed'} |",
-             f"| integrity check, {run['classes']} classes of {run['size']} (in all) | {run['check_seconds']:.2f} s | |"]
+             f"| integrity check, {run['classes']} classes of {run['size']} (in all) | {run['check_seconds']:.2f} s "
+             "| |"]
     if big:
         grading, check = big["grading"], big["check"]
         assert isinstance(grading, float) and isinstance(check, float)

@@ -208,7 +208,7 @@ def test_an_answer_matching_many_students_names_a_bounded_number() -> None:
     typed = {("s12", "1a"): "5.005"}
     result = check(graded(key, typed))
     assert len(result.matches) == LISTED and {m.matches for m in result.matches} == {12}
-    assert [m.partner for m in result.matches][0] == 5  # the nearest value first
+    assert result.matches[0].partner == 5  # the nearest value first
 
 
 def test_an_angle_matches_across_the_turn() -> None:

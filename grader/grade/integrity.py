@@ -363,7 +363,8 @@ def _listed(parts: Sequence[_Part], wrong: Mapping[str, Ints], numbers: Mapping[
         for row, index in enumerate(some):
             student = int(members[index])
             chosen = partners_of.get((student, part.label), [])[:LISTED]
-            chosen += [int(other) for other in nearest[row] if other >= 0 and other not in chosen][:LISTED - len(chosen)]
+            nearer = [int(other) for other in nearest[row] if other >= 0 and other not in chosen]
+            chosen += nearer[:LISTED - len(chosen)]
             matches += [Match(student, part.label, other, float(part.values[other]), int(counts[index]))
                         for other in chosen]
     matches.sort(key=lambda match: (match.student, match.label))

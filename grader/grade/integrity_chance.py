@@ -160,4 +160,5 @@ def _bandwidth(logs: Floats) -> float:
         return 1.0
     quartiles = np.percentile(logs, [25, 75])
     scale = min(float(np.std(logs, ddof=1)), float(quartiles[1] - quartiles[0]) / 1.34) or float(np.std(logs, ddof=1))
-    return max(SMALLEST_WIDTH, 0.9 * scale * len(logs) ** -0.2)
+    width: float = 0.9 * scale * len(logs) ** -0.2
+    return max(SMALLEST_WIDTH, width)

@@ -227,7 +227,7 @@ def test_the_report_lists_flagged_pairs_and_says_when_there_are_none() -> None:
     assert "<h2 id=\"integrity\">" in page and "<td>s0</td><td>Student 0</td><td>s5</td><td>Student 5</td>" in page
     assert "3 of 3" in page
     honest = class_report(graded(key, own_answers(key)))
-    assert "<h2 id=\"integrity\">" in honest and "No pair of students is above the threshold." in honest
+    assert "<h2 id=\"integrity\">" in honest and "No pair of students is flagged." in honest
 
 
 def test_a_threshold_of_0_flags_nothing() -> None:

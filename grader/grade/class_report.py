@@ -299,13 +299,13 @@ def _integrity(graded: Graded, integrity: Integrity) -> str:
             "numbers, so a wrong answer that another student's key accepts (same part, within that student's "
             "tolerance; not a diagnosed mistake of the student's own) is worth a look. "
             f"{integrity.matched:,} of {integrity.wrong:,} wrong answers match some other student's value "
-            "(integrity.csv lists them). A pair is listed here when the chance of so many matches by accident, "
+            "(integrity.csv lists them). A pair is flagged here when the chance of so many matches by accident, "
             f"corrected for the {integrity.examined:,} pairs examined, is at most "
             f"{_e(f'{integrity.threshold:g}')} (the assignment's <code>grading.integrity_threshold</code>; "
             "docs/grading.md says how it is estimated). This is evidence to look at, not proof, and it changes "
             "no grade.</p>"]
     if not flagged:
-        text.append("<p>No pair of students is above the threshold.</p>")
+        text.append("<p>No pair of students is flagged.</p>")
         return "\n".join(text)
     rows = [f"<tr><td>{_e(students[p.student].id)}</td><td>{_e(students[p.student].name)}</td>"
             f"<td>{_e(students[p.partner].id)}</td><td>{_e(students[p.partner].name)}</td>"

@@ -31,6 +31,7 @@ A pair whose corrected chance is at most the assignment's ``grading.integrity_th
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass
@@ -97,15 +98,11 @@ class Integrity:
 
     def pair(self, student: int, partner: int) -> Pair | None:
         """The pair of two students (by index), if it is listed."""
-        return self._pairs.get((student, partner))
+        return self._by_students.get((student, partner))
 
-    @property
-    def _pairs(self) -> dict[tuple[int, int], Pair]:
-        found: dict[tuple[int, int], Pair] = self.__dict__.get("_by_students", {})
-        if not found and self.pairs:
-            found = {(pair.student, pair.partner): pair for pair in self.pairs}
-            object.__setattr__(self, "_by_students", found)
-        return found
+    @functools.cached_property
+    def _by_students(self) -> dict[tuple[int, int], Pair]:
+        return {(pair.student, pair.partner): pair for pair in self.pairs}
 
 
 @dataclass(frozen=True)

@@ -97,11 +97,12 @@ INTEGRITY_HEADER = ("student_id", "label", "submitted", "parsed", "matches_id", 
 def integrity_csv(graded: Graded, integrity: Integrity) -> Iterator[str]:
     """A row per wrong answer and student whose key accepts it (up to
     :data:`~grader.grade.integrity.LISTED` per answer): what was typed and read, whose variant it matches
-    and that variant's value, how many students' values it matches in all; and the pair's figures: how many
-    parts (and which) the student's wrong answers match that student's values in, how many parts the student
-    had wrong, the chance of so many matches by accident and that chance corrected for the pairs examined,
-    and whether the pair is flagged (``yes``: at most the assignment's ``integrity_threshold``). In pieces,
-    as :func:`_csv_pieces`. A report: it changes no grade."""
+    and that variant's value (6 significant figures, as ``details.csv``'s ``expected``), how many students'
+    values it matches in all; and the pair's figures: how many parts (and which) the student's wrong answers
+    match that student's values in, how many parts the student had wrong, the chance of so many matches by
+    accident and that chance corrected for the pairs examined, and whether the pair is flagged (``yes``: at
+    most the assignment's ``integrity_threshold``). In pieces, as :func:`_csv_pieces`. A report: it changes
+    no grade."""
     students = graded.key.students
     flagged = set(integrity.flagged)
 
@@ -114,7 +115,7 @@ def integrity_csv(graded: Graded, integrity: Integrity) -> Iterator[str]:
                 len(pair.labels), " ".join(pair.labels), pair.wrong, _chance(pair.chance), _chance(pair.corrected),
                 "yes" if pair in flagged else "no"]
             yield [students[match.student].id, match.label, row.submitted, row.parsed, students[match.partner].id,
-                   match.value, match.matches, *figures]
+                   number_text(match.value), match.matches, *figures]
 
     return _csv_pieces(rows())
 

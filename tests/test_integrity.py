@@ -260,3 +260,19 @@ def test_the_pair_search_agrees_with_a_comparison_of_every_pair(monkeypatch: pyt
                 expected[a, b] = matched
     assert len(expected) > 10  # the class has pairs to find
     assert {(p.student, p.partner): p.labels for p in check(result).pairs if len(p.labels) >= 2} == expected
+
+
+def test_answers_counted_by_their_search_range_count_as_those_tested_one_by_one(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    from grader.grade import integrity
+
+    rng = np.random.default_rng(7)
+    values = rng.uniform(1, 1.2, size=(200, 2))
+    key = make_key(values.tolist())
+    typed = {(f"s{i}", label): f"{values[i, j] * (1.1 if i % 3 == 0 else 1):.6g}"
+             for i in range(200) for j, label in enumerate(("1a", "1b"))}
+    result = graded(key, typed)
+    tested = [(m.student, m.label, m.matches) for m in check(result).matches]
+    monkeypatch.setattr(integrity, "COUNTED", 0)
+    assert [(m.student, m.label, m.matches) for m in check(result).matches] == tested
+    assert max(matches for _, _, matches in tested) > 5

@@ -51,6 +51,7 @@ Ints = npt.NDArray[np.int64]
 LISTED = 5  # students named per wrong answer in integrity.csv; the rest are counted
 KEPT = 1.0  # pairs with two or more matched parts are kept when their corrected chance is below this
 CHUNK = 1 << 22  # candidate pairs tested at a time: a bounded amount of memory, whatever the class
+COUNTED = 64  # an answer with more candidate bands than this is counted by the size of its search's range
 _PERIOD = {"deg": 360.0, "rad": 2 * math.pi}
 
 
@@ -122,6 +123,7 @@ class _Part:
     sorted_values: Floats
     low: Floats
     high: Floats
+    monotone: bool  # the bands' ends rise with the values: a search's range is exactly the bands holding a number
 
     @property
     def period(self) -> float | None:
@@ -193,8 +195,10 @@ def _part(label: str, values: Floats, tolerances: Sequence[Mapping[str, Any]], u
     bands = reach[order]
     low = np.minimum.accumulate((sorted_values - bands)[::-1])[::-1] if len(order) else sorted_values
     high = np.maximum.accumulate(sorted_values + bands) if len(order) else sorted_values
+    monotone = period is None and not strict.any() and bool(np.array_equal(low, sorted_values - bands)
+                                       and np.array_equal(high, sorted_values + bands))
     return _Part(label, unit, values, reach, strict, class_density(values, reach, order, sorted_values), order,
-                 sorted_values, low, high)
+                 sorted_values, low, high, monotone)
 
 
 def _ranges(part: _Part, numbers: Floats) -> Iterator[tuple[Ints, Ints]]:
@@ -251,35 +255,44 @@ def _matches(part: _Part, owners: Ints, numbers: Floats) -> tuple[Ints, Ints]:
 
 
 def _found(part: _Part, wrong: Ints, numbers: Floats) -> tuple[Ints, list[tuple[Ints, Ints]]]:
-    """Per wrong answer (of ``wrong``), how many students' bands hold it, and its candidate ranges."""
+    """Per wrong answer (of ``wrong``), how many students' bands hold it, and its candidate ranges. Where the
+    bands' ends rise with the values (the search's range is then exactly the bands that hold the number), an
+    answer with more than :data:`COUNTED` candidates is counted by its range's size, not tested one by one
+    (in a class of 100,000 a wrong answer may fall in thousands of bands)."""
     counts = np.zeros(len(wrong), dtype=np.int64)
     ranges = list(_ranges(part, numbers[wrong]))
     for starts, ends in ranges:
-        for which, positions in _expanded(starts, ends):
-            ok = _accepts(part, wrong[which], part.order[positions], numbers)
-            counts += np.bincount(which[ok], minlength=len(wrong))
+        sizes = np.maximum(ends - starts, 0)
+        sized = sizes > COUNTED if part.monotone else np.zeros(len(sizes), dtype=bool)
+        counts[sized] += sizes[sized]
+        tested = np.flatnonzero(~sized)
+        for which, positions in _expanded(starts[tested], ends[tested]):
+            ok = _accepts(part, wrong[tested[which]], part.order[positions], numbers)
+            counts += np.bincount(tested[which[ok]], minlength=len(wrong))
     return counts, ranges
 
 
 def _pairs(parts: Sequence[_Part], wrong: Mapping[str, Ints], numbers: Mapping[str, Floats], spread: Spread,
            found: Sequence[tuple[Ints, list[tuple[Ints, Ints]]]], per_student: Ints,
            examined: int) -> dict[tuple[int, int], Pair]:
-    """Every pair with two or more matched parts whose corrected chance is below 1. A partner that matches
-    two of a student's parts is in the band search of at least one part other than the one that matched
-    the most students: those searches alone are expanded."""
+    """Every pair with two or more matched parts whose corrected chance is below :data:`KEPT`.
+
+    A pair needs as many matched parts as the fewest whose chance could be that small (:func:`_needed`); a
+    partner that matches ``n`` of a student's parts is in the band search of at least one part other than
+    the ``n - 1`` that matched the most students: those searches alone are expanded."""
     students = len(per_student)
-    matched = np.zeros(students, dtype=np.int64)
-    largest = np.zeros(students, dtype=np.int64)  # the most students one wrong answer of theirs matches
-    heaviest = np.full(students, -1, dtype=np.int64)  # which part that was
-    for index, (part, (counts, _)) in enumerate(zip(parts, found, strict=True)):
-        members = wrong[part.label]
-        matched[members] += counts > 0
-        more = counts > largest[members]
-        largest[members[more]], heaviest[members[more]] = counts[more], index
+    counts = np.zeros((students, len(parts)), dtype=np.int64)  # per student and part, the students matched
+    for index, (part, (found_counts, _)) in enumerate(zip(parts, found, strict=True)):
+        counts[wrong[part.label], index] = found_counts
+    matched = np.count_nonzero(counts, axis=1)
+    needed = _needed(parts, wrong, students, examined)
+    # Each part's rank among the student's, most students matched first: the needed - 1 first are not searched.
+    rank = np.argsort(np.argsort(-counts, axis=1, kind="stable"), axis=1, kind="stable")
     keys = []
-    for index, (part, (counts, ranges)) in enumerate(zip(parts, found, strict=True)):
+    for index, (part, (found_counts, ranges)) in enumerate(zip(parts, found, strict=True)):
         members = wrong[part.label]
-        chosen = np.flatnonzero((counts > 0) & (matched[members] >= 2) & (heaviest[members] != index))
+        chosen = np.flatnonzero((found_counts > 0) & (matched[members] >= needed[members])
+                                & (rank[members, index] >= needed[members] - 1))
         for starts, ends in ranges:
             for which, positions in _expanded(starts[chosen], ends[chosen]):
                 owners, partners = members[chosen[which]], part.order[positions]
@@ -291,6 +304,21 @@ def _pairs(parts: Sequence[_Part], wrong: Mapping[str, Ints], numbers: Mapping[s
     return {(pair.student, pair.partner): pair
             for pair in _figures(parts, wrong, numbers, spread, pairs // students, pairs % students, per_student,
                                  examined, 2, KEPT)}
+
+
+def _needed(parts: Sequence[_Part], wrong: Mapping[str, Ints], students: int, examined: int) -> Ints:
+    """Per student, the fewest matched parts (at least 2) whose corrected chance could be under :data:`KEPT`
+    (more than their wrong parts: none could). Each part's chance is at least the unrelated kind's share
+    times the least class density of the part, so ``k`` matches have a chance of at least the product of the
+    ``k`` least of those over the student's wrong parts."""
+    least = np.full((students, max(len(parts), 1)), np.inf)
+    for index, part in enumerate(parts):
+        finite = part.chance[np.isfinite(part.chance)]
+        least[wrong[part.label], index] = UNRELATED * float(finite.min()) if len(finite) else 0.0
+    with np.errstate(divide="ignore"):
+        bound = math.log(max(examined, 1)) + np.cumsum(np.log(np.sort(least, axis=1)), axis=1)
+    possible = (bound < math.log(KEPT)) & (np.arange(least.shape[1]) >= 1)
+    return np.where(possible.any(axis=1), np.argmax(possible, axis=1) + 1, least.shape[1] + 1).astype(np.int64)
 
 
 def _figures(parts: Sequence[_Part], wrong: Mapping[str, Ints], numbers: Mapping[str, Floats], spread: Spread,

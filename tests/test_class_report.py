@@ -281,7 +281,7 @@ def test_the_key_keeps_each_students_printed_parameters(demo_run: DemoRun) -> No
 
 def test_the_demo_report_shows_every_section_and_every_part(demo_run: DemoRun) -> None:
     page = (demo_run.out / "grades" / "report.html").read_text(encoding="utf-8")
-    for section in ("scores", "parts", "mistakes", "difficulty", "invalid", "tolerances"):
+    for section in ("scores", "parts", "mistakes", "difficulty", "invalid", "tolerances", "integrity"):
         assert f"<h2 id=\"{section}\">" in page
     key = load_key(demo_run.out / "key.json")
     assert all(f"<tr><td>{label}</td>" in page for label in key.labels)

@@ -77,10 +77,11 @@ KEYS_REFUSED = [  # (what is changed in the sample key, what the refusal says)
     (_grading(intermediate_sig_figs=0), "assignment.grading.intermediate_sig_figs: expected a whole number of "
                                         "significant figures from 2 to 10, got 0"),
     (_grading(max_tolerence=0.1), "assignment.grading.max_tolerence: expected one of attempts, ecf_credit, "
-                                  "intermediate_sig_figs, max_tolerance, mistake_credit, numeric_expressions (did "
-                                  "you mean max_tolerance?), got an unknown field"),
-    (_grading(partial=1), "assignment.grading.partial: expected one of attempts, ecf_credit, intermediate_sig_figs, "
-                          "max_tolerance, mistake_credit, numeric_expressions, got an unknown field"),
+                                  "integrity_threshold, intermediate_sig_figs, max_tolerance, mistake_credit, "
+                                  "numeric_expressions (did you mean max_tolerance?), got an unknown field"),
+    (_grading(partial=1), "assignment.grading.partial: expected one of attempts, ecf_credit, integrity_threshold, "
+                          "intermediate_sig_figs, max_tolerance, mistake_credit, numeric_expressions, got an "
+                          "unknown field"),
     (lambda d: d["assignment"].update(grading=[1]), "assignment.grading: expected a mapping {numeric_expressions: "
                                                     "true or false, ecf_credit: 0 to 1,"),
 ]
@@ -116,10 +117,14 @@ def test_the_key_written_by_generate_is_still_read(tmp_path: Path, capsys: pytes
 
 
 @pytest.mark.parametrize(("grading", "message"), [
-    ("{max_tolerence: 0.1}", "grading.max_tolerence: expected one of attempts, ecf_credit, intermediate_sig_figs, "
-                             "max_tolerance, mistake_credit, numeric_expressions (did you mean max_tolerance?)"),
-    ("{ecf_credits: 1}", "grading.ecf_credits: expected one of attempts, ecf_credit, intermediate_sig_figs, "
-                         "max_tolerance, mistake_credit, numeric_expressions (did you mean ecf_credit?)"),
+    ("{max_tolerence: 0.1}", "grading.max_tolerence: expected one of attempts, ecf_credit, integrity_threshold, "
+                             "intermediate_sig_figs, max_tolerance, mistake_credit, numeric_expressions (did you "
+                             "mean max_tolerance?)"),
+    ("{ecf_credits: 1}", "grading.ecf_credits: expected one of attempts, ecf_credit, integrity_threshold, "
+                         "intermediate_sig_figs, max_tolerance, mistake_credit, numeric_expressions (did you mean "
+                         "ecf_credit?)"),
+    ("{integrity_threshold: 2}", "grading.integrity_threshold: expected a chance from 0 to 1 (0.05: pairs whose "
+                                 "matches would come about by accident at most 1 time in 20 are flagged), got 2"),
     ("{max_tolerance: -1}", "grading.max_tolerance: expected a relative tolerance from 0.001 to 0.5 (0.05 is ±5 %), "
                             "got -1"),
 ])

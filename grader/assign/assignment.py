@@ -63,7 +63,10 @@ class Grading:
     steps (answers are given to three), from which each variant's rounding allowance is bounded;
     ``max_tolerance``, the widest relative tolerance a variant may get for that allowance (a variant that
     would need more is redrawn); ``attempts``, which of a student's submissions counts when a form allows
-    resubmission (``latest``, ``best`` or ``first``; per submission in a wide file, per part in a long one)."""
+    resubmission (``latest``, ``best`` or ``first``; per submission in a wide file, per part in a long one);
+    ``integrity_threshold``, the chance of so many matches by accident (corrected for the pairs examined) at
+    or below which a pair of students, one's wrong answers matching the other's numbers, is flagged in the
+    class report (:mod:`grader.grade.integrity`; it never changes a grade)."""
 
     numeric_expressions: bool = True
     ecf_credit: float = 1.0
@@ -71,6 +74,7 @@ class Grading:
     intermediate_sig_figs: int = 4
     max_tolerance: float = 0.05
     attempts: str = "latest"
+    integrity_threshold: float = 0.05
 
     @property
     def rounding_rule(self) -> str:
@@ -150,7 +154,7 @@ def load_assignment(path: Path) -> Assignment:
 ATTEMPTS = ("latest", "best", "first")
 GRADING_FIELDS = {"numeric_expressions": "true or false", "ecf_credit": "0 to 1", "mistake_credit": "0 to 1",
                   "intermediate_sig_figs": "2 to 10", "max_tolerance": "0.001 to 0.5",
-                  "attempts": " | ".join(ATTEMPTS)}
+                  "attempts": " | ".join(ATTEMPTS), "integrity_threshold": "0 to 1"}
 """The fields of ``grading`` (in an assignment, and in the key that copies it) and their ranges."""
 
 
@@ -197,8 +201,12 @@ def grading_from(raw: Any, where: str, field: str = "grading") -> Grading:
     if attempts not in ATTEMPTS:
         raise TemplateError(where, f"{field}.attempts", "latest, best or first (which of a student's submissions "
                             "counts)", shown(attempts))
+    threshold = raw.get("integrity_threshold", Grading.integrity_threshold)
+    if not (_number(threshold) and 0 <= threshold <= 1):
+        raise TemplateError(where, f"{field}.integrity_threshold", "a chance from 0 to 1 (0.05: pairs whose "
+                            "matches would come about by accident at most 1 time in 20 are flagged)", shown(threshold))
     return Grading(numeric_expressions=value, **credits, intermediate_sig_figs=figures,
-                   max_tolerance=float(widest), attempts=attempts)
+                   max_tolerance=float(widest), attempts=attempts, integrity_threshold=float(threshold))
 
 
 def _text(raw: Mapping[str, Any], key: str, where: str, required: bool = True) -> str:

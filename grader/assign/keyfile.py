@@ -5,15 +5,16 @@ of the run, so generating twice gives byte-identical files.
 
 Schema ``grader-key`` version 2 (version 1, still read by grading, lacks ``grading``, ``symbols``,
 and the tolerance's ``mode``: its tolerances are ``{"rtol", "atol"}``; a version 2 key from before
-``ecf_credit``, ``mistake_credit`` and ``attempts`` is graded with their defaults, 1, 0 and latest; one
-without ``deadline`` measures no lateness, as before)::
+``ecf_credit``, ``mistake_credit``, ``attempts`` and ``integrity_threshold`` is graded with their defaults,
+1, 0, latest and 0.05; one without ``deadline`` measures no lateness, as before)::
 
     {"schema": "grader-key", "version": 2, "generator": "grader X.Y.Z",
      "assignment": {"title", "course", "seed", "due", "instructions", "source_sha256",
                     "deadline": "2026-12-04T23:59:00-06:00", "timezone": "America/Chicago" (only when
                         due is a date-time), "late": {"grace", "deduct", "per", "lowest", "after"} or null,
                     "grading": {"numeric_expressions": true, "ecf_credit": 1.0, "mistake_credit": 0.0,
-                                "intermediate_sig_figs": 4, "max_tolerance": 0.05, "attempts": "latest"}},
+                                "intermediate_sig_figs": 4, "max_tolerance": 0.05, "attempts": "latest",
+                                "integrity_threshold": 0.05}},
      "templates": {ID: {"version", "sha256", "bank": the folder it came from, relative to the key's folder
                         where possible (only a template from outside the shipped bank; a key before it has none)}},
      "problems": [{"key", "template", "title", "parameters": {NAME: its unit, as printed},
@@ -71,7 +72,8 @@ def key_document(assignment: Assignment, generation: Generation, bank: Mapping[s
                                    "mistake_credit": assignment.grading.mistake_credit,
                                    "intermediate_sig_figs": assignment.grading.intermediate_sig_figs,
                                    "max_tolerance": assignment.grading.max_tolerance,
-                                   "attempts": assignment.grading.attempts}},
+                                   "attempts": assignment.grading.attempts,
+                                   "integrity_threshold": assignment.grading.integrity_threshold}},
         "templates": {t.id: {"version": t.version, "sha256": t.source_hash, **_bank_folder(t, key_folder)}
                       for t in used.values()},
         "problems": [{"key": v.key, "template": v.template, "title": used[v.template].title,

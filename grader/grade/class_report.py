@@ -36,6 +36,7 @@ from grader.grade.class_summary import (
     summarize,
 )
 from grader.grade.grading import Graded, lateness
+from grader.grade.integrity import Integrity, check
 from grader.model.tolerance import Widening
 
 REPORT = "report.html"
@@ -74,12 +75,16 @@ ul.corners li { margin: 2px 0; }
 """
 
 
-def class_report(graded: Graded) -> str:
-    """The page, for a grading run."""
+FLAGGED_SHOWN = 50  # flagged pairs listed in the report; integrity.csv has every one
+
+
+def class_report(graded: Graded, integrity: Integrity | None = None) -> str:
+    """The page, for a grading run (``integrity``: its integrity check, worked out here if not given)."""
     summary = summarize(graded)
     title = f"{summary.key.title}: class report"
     body = "\n".join([_header(summary), _late(graded), _scores(summary), _parts(summary), _mistakes(summary),
-                      _difficulty(summary), _invalid(summary), _tolerances(summary)])
+                      _difficulty(summary), _invalid(summary), _tolerances(summary),
+                      _integrity(graded, check(graded) if integrity is None else integrity)])
     return ("<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
             "<meta http-equiv=\"Content-Security-Policy\" content=\"default-src 'none'; style-src 'unsafe-inline'\">\n"
             "<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n"
@@ -102,7 +107,7 @@ def _header(summary: ClassSummary) -> str:
     notes = [*_not_graded(summary), *summary.notes]
     sections = [("scores", "Scores"), ("parts", "Parts"), ("mistakes", "Diagnosed mistakes"),
                 ("difficulty", "Difficulty per variant"), ("invalid", "Unreadable answers"),
-                ("tolerances", "Tolerances")]
+                ("tolerances", "Tolerances"), ("integrity", "Another student's numbers")]
     return (f"<header>\n<h1>{_e(key.title)}</h1>\n<p class=\"muted\">Class report: how the class did, part by "
             "part and variant by variant</p>\n<div class=\"stats\">"
             + "".join(f"<div class=\"stat\"><b>{_e(value)}</b><span>{_e(name)}</span></div>" for name, value in stats)
@@ -285,6 +290,35 @@ def _tolerances(summary: ClassSummary) -> str:
             f"student's tolerance: {how_many}.</p>\n<table>\n<tr><th>part</th><th>answer</th>"
             "<th class=\"n\">points</th><th>tolerance</th><th>for rounding</th></tr>\n"
             + "\n".join(rows) + "\n</table>")
+
+
+def _integrity(graded: Graded, integrity: Integrity) -> str:
+    """The pairs of students whose wrong answers match each other's numbers too often to be chance."""
+    students, flagged = graded.key.students, integrity.flagged
+    text = ["<h2 id=\"integrity\">Answers from another student's variant</h2>\n<p>Every student has their own "
+            "numbers, so a wrong answer that another student's key accepts (same part, within that student's "
+            "tolerance; not a diagnosed mistake of the student's own) is worth a look. "
+            f"{integrity.matched:,} of {integrity.wrong:,} wrong answers match some other student's value "
+            "(integrity.csv lists them). A pair is flagged here when the chance of so many matches by accident, "
+            f"corrected for the {integrity.examined:,} pairs examined, is at most "
+            f"{_e(f'{integrity.threshold:g}')} (the assignment's <code>grading.integrity_threshold</code>; "
+            "docs/grading.md says how it is estimated). This is evidence to look at, not proof, and it changes "
+            "no grade.</p>"]
+    if not flagged:
+        text.append("<p>No pair of students is flagged.</p>")
+        return "\n".join(text)
+    rows = [f"<tr><td>{_e(students[p.student].id)}</td><td>{_e(students[p.student].name)}</td>"
+            f"<td>{_e(students[p.partner].id)}</td><td>{_e(students[p.partner].name)}</td>"
+            f"<td>{_e(', '.join(p.labels))}</td><td class=\"n\">{len(p.labels)} of {p.wrong}</td>"
+            f"<td class=\"n\">{_e(f'{p.chance:.2g}')}</td><td class=\"n\">{_e(f'{p.corrected:.2g}')}</td></tr>"
+            for p in flagged[:FLAGGED_SHOWN]]
+    text.append("<table>\n<tr><th>student</th><th>name</th><th>answers match the key of</th><th>name</th>"
+                "<th>parts</th><th class=\"n\">of the wrong parts</th><th class=\"n\">chance</th>"
+                "<th class=\"n\">corrected</th></tr>\n" + "\n".join(rows) + "\n</table>")
+    if len(flagged) > FLAGGED_SHOWN:
+        text.append(f"<p class=\"note\">The first {FLAGGED_SHOWN} are listed; {len(flagged) - FLAGGED_SHOWN:,} "
+                    "more: integrity.csv has each (flagged yes).</p>")
+    return "\n".join(text)
 
 
 def _tolerance_words(part: PartSummary) -> str:

@@ -72,6 +72,17 @@ def is_correct(submitted: ArrayLike, expected: ArrayLike, tolerance: Tolerance, 
     return np.asarray(verdict.reshape(finite.shape), dtype=bool)
 
 
+def accepted_distance(expected: ArrayLike, tolerance: Tolerance) -> np.ndarray:
+    """How far from each key value an answer may be and be accepted, as float64 finds it: up to and including
+    it in ``rtol`` mode, strictly less in ``sigfigs`` and ``decimals`` modes (:func:`is_correct` lets the
+    exact rule decide within a rounding of it).
+
+    >>> accepted_distance([6.26, -200.0], Tolerance()).tolist(), accepted_distance(6.26, Tolerance("sigfigs")).item()
+    ([0.0626, 2.0], 0.0051)
+    """
+    return _bound(np.asarray(expected, dtype=float), tolerance)[0]
+
+
 def _finite_pairs(submitted: ArrayLike, expected: ArrayLike) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Both broadcast and flattened, with 0 where either is not finite; and where both are (in shape)."""
     s, t = np.broadcast_arrays(np.asarray(submitted, dtype=float), np.asarray(expected, dtype=float))

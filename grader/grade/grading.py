@@ -122,6 +122,9 @@ class Graded:
     # (label, the mistake's id): the class report says the mistakes, not only their ids.
     mistakes: Mapping[tuple[str, str], str] = field(default_factory=dict)
     late: LateWork | None = None
+    # Per part label, the number each student's answer was read as, in the sheet's unit (NaN: no number):
+    # what the integrity check compares with the other students' keys (:mod:`grader.grade.integrity`).
+    numbers: Mapping[str, np.ndarray] = field(default_factory=dict)
 
     @property
     def deductions(self) -> Mapping[str, float]:
@@ -148,6 +151,7 @@ def grade(key: Key, submissions: Submissions, physics: Physics | None = None) ->
         by_label[answer.label].setdefault(answer.student_id, []).append(answer)
     problems: list[RowProblem] = []
     columns: dict[str, list[Row]] = {}
+    numbers: dict[str, np.ndarray] = {}
     stamps: dict[str, list[datetime | None]] = {}
     everyone = np.arange(len(key.students))
     for problem in key.problems:
@@ -155,11 +159,12 @@ def grade(key: Key, submissions: Submissions, physics: Physics | None = None) ->
         for label in problem.labels:
             answers = _best(key, label, by_label.pop(label), physics.problems.get(problem.key), problems)
             cells = [(student.parts[label], answers.get(student.id)) for student in key.students]
-            columns[label] = _grade_label(cells, key, everyone, physics.problems.get(problem.key), earlier)
+            columns[label], numbers[label] = _grade_label(cells, key, everyone, physics.problems.get(problem.key),
+                                                          earlier)
             stamps[label] = [None if answer is None else answer.timestamp for _, answer in cells]
     late, notes = _late_work(key, columns, stamps)
     return Graded(key, columns, (*submissions.problems, *problems), submissions.ignored_columns,
-                  (*submissions.notes, *physics.notes, *notes), mistake_words(key, physics), late)
+                  (*submissions.notes, *physics.notes, *notes), mistake_words(key, physics), late, numbers)
 
 
 def mistake_words(key: Key, physics: Physics) -> dict[tuple[str, str], str]:
@@ -197,7 +202,7 @@ def _best(key: Key, label: str, answers: Mapping[str, list[Answer]], physics: Pr
         if len(found) > 1:
             cells += [(key.students[positions[student_id]].parts[label], answer) for answer in found]
             students += [positions[student_id]] * len(found)
-    rows = _grade_label(cells, key, np.array(students), physics, [])
+    rows, _ = _grade_label(cells, key, np.array(students), physics, [])
     scored: dict[str, list[tuple[float, Answer]]] = {}
     for (part, answer), index, row in zip(cells, students, rows, strict=True):
         assert answer is not None  # every cell holds an attempt
@@ -282,19 +287,20 @@ def grade_parts(requests: Sequence[Request], key: Key, physics: Physics | None =
         found = physics.problems.get(first.problem) if physics is not None and known else None
         students = np.array([positions.get(requests[index].student_id, 0) for index in members])
         cells = [(requests[index].part, requests[index].answer) for index in members]
-        for index, row in zip(members, _grade_label(cells, key, students, found, []), strict=True):
+        for index, row in zip(members, _grade_label(cells, key, students, found, [])[0], strict=True):
             verdicts[index] = Verdict(requests[index].student_id, requests[index].part.label, *row)
     return verdicts  # type: ignore[return-value]  # every request is in one group
 
 
 def _grade_label(cells: Sequence[tuple[KeyPart, Answer | None]], key: Key, students: np.ndarray,
-                 physics: ProblemPhysics | None, earlier: list[Earlier]) -> list[Row]:
+                 physics: ProblemPhysics | None, earlier: list[Earlier]) -> tuple[list[Row], np.ndarray]:
     """The rows of one part (``students``: each cell's student, by index in the key), the wrong numbers
-    reconsidered by the problem's ``physics``, which then adds the part to ``earlier``."""
+    reconsidered by the problem's ``physics``, which then adds the part to ``earlier``; and the number each
+    cell was read as (NaN: none)."""
     column = _grade_column(cells, key)
     rows = column.rows
     if physics is None or not cells:
-        return rows
+        return rows, column.numbers
     part = cells[0][0]
     for tolerance, wrong in column.wrong:
         if not wrong:
@@ -308,7 +314,7 @@ def _grade_label(cells: Sequence[tuple[KeyPart, Answer | None]], key: Key, stude
             rows[index] = rows[index]._replace(verdict=finding.kind, credit=finding.credit, feedback=finding.feedback,
                                                diagnosis=finding.diagnosis)
     earlier.append(Earlier(part.label, part.name, part.unit, column.numbers, column.right))
-    return rows
+    return rows, column.numbers
 
 
 Outcome = tuple[str, float, str, str]

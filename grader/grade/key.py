@@ -132,6 +132,7 @@ class Key:
     deadline: datetime | None = None  # the assignment's due time (None: lateness is not measured)
     zone: tzinfo = UTC  # of timestamps that give none
     late: LatePolicy | None = None  # None: late work is accepted as on time
+    integrity_threshold: float = 0.05  # pairs whose matches are at most this likely by accident are flagged
 
     @functools.cached_property
     def labels(self) -> tuple[str, ...]:
@@ -385,7 +386,7 @@ def _key(raw: Mapping[str, Any], where: str, version: int) -> Key:
     zone, deadline, late = _deadline(assignment, where)
     return Key(where, version, _text(_field(assignment, "title", "assignment"), "assignment.title"),
                grading.numeric_expressions, problems, students, templates, grading.ecf_credit, grading.mistake_credit,
-               banks, grading.attempts, deadline, zone, late)
+               banks, grading.attempts, deadline, zone, late, grading.integrity_threshold)
 
 
 def _deadline(assignment: Mapping[str, Any], where: str) -> tuple[zoneinfo.ZoneInfo, datetime | None,

@@ -1,5 +1,6 @@
-"""The files a grading run writes: ``grades.csv``, ``details.csv``, ``problems.csv``, ``canvas.csv``, and
-the class report ``report.html`` (:mod:`grader.grade.class_report`).
+"""The files a grading run writes: ``grades.csv``, ``details.csv``, ``problems.csv``, ``canvas.csv``,
+``integrity.csv`` (wrong answers that another student's key accepts, :mod:`grader.grade.integrity`), and the
+class report ``report.html`` (:mod:`grader.grade.class_report`).
 
 Every text cell is guarded against formula injection (:func:`grader.base.spreadsheet.safe_cell`), but
 ``canvas.csv``'s, which Canvas matches on and writes back exactly (:mod:`grader.grade.canvas_file`); and
@@ -23,14 +24,18 @@ from grader.grade.canvas_file import CanvasFile
 from grader.grade.class_report import REPORT, class_report
 from grader.grade.compare import number_text
 from grader.grade.grading import Graded, final_scores, lateness, totals
+from grader.grade.integrity import Integrity, check
 
 GRADES, DETAILS, PROBLEMS, CANVAS = "grades.csv", "details.csv", "problems.csv", "canvas.csv"
+INTEGRITY = "integrity.csv"
 
 
 def write_reports(graded: Graded, folder: Path, canvas: CanvasFile) -> list[Path]:
-    """Write the five files into ``folder`` (``canvas.csv`` as ``canvas`` says); returns their paths."""
+    """Write the six files into ``folder`` (``canvas.csv`` as ``canvas`` says); returns their paths."""
+    integrity = check(graded)
     files = {GRADES: grades_csv(graded), DETAILS: details_csv(graded), PROBLEMS: problems_csv(graded, canvas),
-             CANVAS: canvas_csv(canvas), REPORT: class_report(graded)}
+             CANVAS: canvas_csv(canvas), INTEGRITY: integrity_csv(graded, integrity),
+             REPORT: class_report(graded, integrity)}
     for name, text in files.items():
         write_atomic(folder / name, text)
     return [folder / name for name in files]
@@ -83,6 +88,41 @@ def details_csv(graded: Graded, students_per_piece: int = 2000) -> Iterator[str]
                        numbers[minutes[index]], numbers[shares[index] or 0.0])
 
     return csv_pieces(rows(), students_per_piece * max(1, len(columns)))
+
+
+INTEGRITY_HEADER = ("student_id", "label", "submitted", "parsed", "matches_id", "matches_value", "students_matched",
+                    "pair_parts", "pair_labels", "wrong_parts", "chance", "corrected_chance", "flagged")
+
+
+def integrity_csv(graded: Graded, integrity: Integrity) -> Iterator[str]:
+    """A row per wrong answer and student whose key accepts it (up to
+    :data:`~grader.grade.integrity.LISTED` per answer): what was typed and read, whose variant it matches
+    and that variant's value (6 significant figures, as ``details.csv``'s ``expected``), how many students'
+    values it matches in all; and the pair's figures: how many parts (and which) the student's wrong answers
+    match that student's values in, how many parts the student had wrong, the chance of so many matches by
+    accident and that chance corrected for the pairs examined, and whether the pair is flagged (``yes``: at
+    most the assignment's ``integrity_threshold``). In pieces, as :func:`_csv_pieces`. A report: it changes
+    no grade."""
+    students = graded.key.students
+    flagged = set(integrity.flagged)
+
+    def rows() -> Iterator[Sequence[object]]:
+        yield INTEGRITY_HEADER
+        for match in integrity.matches:
+            row = graded.columns[match.label][match.student]
+            pair = integrity.pair(match.student, match.partner)
+            figures: list[object] = [None] * 6 if pair is None else [
+                len(pair.labels), " ".join(pair.labels), pair.wrong, _chance(pair.chance), _chance(pair.corrected),
+                "yes" if pair in flagged else "no"]
+            yield [students[match.student].id, match.label, row.submitted, row.parsed, students[match.partner].id,
+                   number_text(match.value), match.matches, *figures]
+
+    return _csv_pieces(rows())
+
+
+def _chance(value: float) -> str:
+    """A chance to 3 significant figures (a column for people)."""
+    return number_cell(value, 3)
 
 
 def problems_csv(graded: Graded, canvas: CanvasFile | None = None) -> Iterator[str]:

@@ -1,0 +1,422 @@
+"""Answers that belong to another student's variant: evidence of copying, reported, never graded.
+
+Every student has their own numbers, so a wrong answer that another student's key accepts, for the same part
+and within that student's tolerance, is worth a look. A wrong answer here is one graded ``incorrect`` with a
+number: not the student's own value (that is ``correct``), and not a diagnosed mistake or an error carried
+forward of their own (those are ``mistake`` and ``ecf``). An answer is also not counted against a student
+whose value the answering student's own key accepts (two variants with the same numbers).
+
+The search sorts each part's key values once and finds, for each wrong answer, the students whose accepted
+band holds it by binary search (``numpy.searchsorted``): never all pairs, so a class of 100,000 costs a few
+seconds. A pair (who answered, whose variant) with two or more matched parts gets the chance of so many
+matches by accident (docs/grading.md, *Answers from another student's variant*):
+
+- per part, ``p``: the chance that a wrong answer lands in a given student's accepted band by accident, that
+  band's width times the density of the class's key values around it (counted over the ``√n`` nearest
+  values on each side), and never less than the share of the class's values inside the band;
+- for the pair, the chance of at least ``k`` matches among the answering student's wrong parts, each a
+  coin with its own ``p`` (a Poisson binomial tail);
+- corrected for the pairs examined (Bonferroni): times the number of ordered pairs whose first student has
+  two or more wrong parts (only those can match twice), at most 1.
+
+A pair whose corrected chance is at most the assignment's ``grading.integrity_threshold`` is flagged.
+
+>>> from grader.model.tolerance import Tolerance
+>>> tolerance = Tolerance().to_json()
+>>> part = _part("1a", np.array([2.0, 3.0, 5.0]), [tolerance] * 3, "m/s")
+>>> owners, partners = _matches(part, np.array([0]), np.array([4.98]))
+>>> owners.tolist(), partners.tolist()
+([0], [2])
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+from collections.abc import Iterator, Mapping, Sequence
+from dataclasses import dataclass
+from typing import Any, NamedTuple
+
+import numpy as np
+import numpy.typing as npt
+
+from grader.grade.compare import accepted_distance, errors
+from grader.grade.grading import Graded
+from grader.grade.integrity_chance import UNRELATED, Spread, class_density
+from grader.model.tolerance import Tolerance
+
+Floats = npt.NDArray[np.float64]
+Ints = npt.NDArray[np.int64]
+
+LISTED = 5  # students named per wrong answer in integrity.csv; the rest are counted
+KEPT = 1.0  # pairs with two or more matched parts are kept when their corrected chance is below this
+CHUNK = 1 << 22  # candidate pairs tested at a time: a bounded amount of memory, whatever the class
+COUNTED = 64  # an answer with more candidate bands than this is counted by the size of its search's range
+_PERIOD = {"deg": 360.0, "rad": 2 * math.pi}
+
+
+class Match(NamedTuple):
+    """A wrong answer that another student's key accepts: who answered (index in the key), the part, whose
+    variant it matches (index), that student's value, and how many students' values it matches in all."""
+
+    student: int
+    label: str
+    partner: int
+    value: float
+    matches: int
+
+
+class Pair(NamedTuple):
+    """A student's wrong answers against another student's key: the parts matched, how many of the first
+    student's parts were wrong (and so could match), the chance of so many matches by accident, and that
+    chance corrected for the pairs examined."""
+
+    student: int
+    partner: int
+    labels: tuple[str, ...]
+    wrong: int
+    chance: float
+    corrected: float
+
+
+@dataclass(frozen=True)
+class Integrity:
+    """What the check found: each wrong answer's listed matches, every pair with two or more matched parts
+    (and the pairs of the listed matches), most suspicious first; the number of pairs examined; the
+    threshold; and how many wrong answers were compared (and matched anyone)."""
+
+    matches: tuple[Match, ...]
+    pairs: tuple[Pair, ...]
+    examined: int
+    threshold: float
+    wrong: int
+    matched: int
+
+    @property
+    def flagged(self) -> tuple[Pair, ...]:
+        """The pairs whose corrected chance is at most the threshold."""
+        return tuple(pair for pair in self.pairs if len(pair.labels) >= 2 and pair.corrected <= self.threshold)
+
+    def pair(self, student: int, partner: int) -> Pair | None:
+        """The pair of two students (by index), if it is listed."""
+        return self._by_students.get((student, partner))
+
+    @functools.cached_property
+    def _by_students(self) -> dict[tuple[int, int], Pair]:
+        return {(pair.student, pair.partner): pair for pair in self.pairs}
+
+
+@dataclass(frozen=True)
+class _Part:
+    """A numeric part over the class: each student's key value (NaN: none), accepted distance, whether the
+    bound is strict (sigfigs, decimals), the chance ``p`` of their band; the students with a value sorted
+    by it (angles reduced to one turn), the lowest band start from each sorted position on and the highest
+    band end up to it (a search over them finds a superset of the bands that hold a number)."""
+
+    label: str
+    unit: str
+    values: Floats
+    reach: Floats
+    strict: npt.NDArray[np.bool_]
+    chance: Floats
+    order: Ints
+    sorted_values: Floats
+    low: Floats
+    high: Floats
+    monotone: bool  # the bands' ends rise with the values: a search's range is exactly the bands holding a number
+
+    @property
+    def period(self) -> float | None:
+        return _PERIOD.get(self.unit)
+
+
+def check(graded: Graded) -> Integrity:
+    """The integrity check of a grading run (the key's numeric parts; symbolic ones are left out)."""
+    key = graded.key
+    students = len(key.students)
+    parts: list[_Part] = []
+    wrong: dict[str, Ints] = {}
+    for label in key.labels:
+        first = key.students[0].parts[label] if students else None
+        if first is None or first.symbolic or label not in graded.numbers:
+            continue
+        values = np.array([_number(student.parts[label].value) for student in key.students])
+        part = _part(label, values, [student.parts[label].tolerance for student in key.students], first.unit)
+        numbers = graded.numbers[label]
+        rows = graded.columns[label]
+        incorrect = np.fromiter((row.verdict == "incorrect" for row in rows), dtype=bool, count=len(rows))
+        wrong[label] = np.flatnonzero(incorrect & np.isfinite(numbers) & np.isfinite(values))
+        parts.append(part)
+    per_student = np.zeros(students, dtype=np.int64)
+    for members in wrong.values():
+        per_student[members] += 1
+    spread = Spread.of(np.concatenate([graded.numbers[p.label][wrong[p.label]] for p in parts] or [np.zeros(0)]),
+                       np.concatenate([p.values[wrong[p.label]] for p in parts] or [np.zeros(0)]),
+                       np.concatenate([wrong[p.label] for p in parts] or [np.zeros(0, np.int64)]), students)
+    examined = int(np.count_nonzero(per_student >= 2)) * max(students - 1, 0)
+    found = [_found(part, wrong[part.label], graded.numbers[part.label]) for part in parts]
+    pairs = _pairs(parts, wrong, graded.numbers, spread, found, per_student, examined)
+    matches = _listed(parts, wrong, graded.numbers, found, pairs)
+    # Every listed match has its pair's figures.
+    others = sorted({(match.student, match.partner) for match in matches} - pairs.keys())
+    if others:
+        owners, partners = np.array(others, dtype=np.int64).T
+        pairs.update(((pair.student, pair.partner), pair) for pair in _figures(
+            parts, wrong, graded.numbers, spread, owners, partners, per_student, examined))
+    ranked = sorted(pairs.values(), key=lambda pair: (pair.corrected, pair.chance, pair.student, pair.partner))
+    return Integrity(tuple(matches), tuple(ranked), examined, key.integrity_threshold,
+                     sum(len(members) for members in wrong.values()),
+                     sum(int(np.count_nonzero(counts)) for counts, _ in found))
+
+
+def _number(value: object) -> float:
+    return float(value) if isinstance(value, float | int) and not isinstance(value, bool) else math.nan
+
+
+def _part(label: str, values: Floats, tolerances: Sequence[Mapping[str, Any]], unit: str) -> _Part:
+    """A part's bands: each student's accepted distance (worked out per tolerance: a part has a few)."""
+    reach, strict = np.full(len(values), np.nan), np.zeros(len(values), dtype=bool)
+    groups: dict[tuple[tuple[str, Any], ...], list[int]] = {}
+    mapping: Mapping[str, Any] | None = None
+    written: tuple[tuple[str, Any], ...] = ()
+    for index, tolerance in enumerate(tolerances):
+        if tolerance is not mapping:  # the key shares one mapping between equal rules
+            mapping, written = tolerance, tuple(tolerance.items())
+        groups.setdefault(written, []).append(index)
+    for written, members in groups.items():
+        rule = Tolerance.from_json(dict(written))
+        reach[members] = accepted_distance(values[members], rule)
+        strict[members] = rule.mode != "rtol"
+    period = _PERIOD.get(unit)
+    have = np.flatnonzero(np.isfinite(values) & np.isfinite(reach))
+    placed = values[have] if period is None else np.mod(values[have], period)
+    order = have[np.argsort(placed, kind="stable")]
+    sorted_values = np.sort(placed, kind="stable")
+    bands = reach[order]
+    low = np.minimum.accumulate((sorted_values - bands)[::-1])[::-1] if len(order) else sorted_values
+    high = np.maximum.accumulate(sorted_values + bands) if len(order) else sorted_values
+    monotone = period is None and not strict.any() and bool(np.array_equal(low, sorted_values - bands)
+                                       and np.array_equal(high, sorted_values + bands))
+    return _Part(label, unit, values, reach, strict, class_density(values, reach, order, sorted_values), order,
+                 sorted_values, low, high, monotone)
+
+
+def _ranges(part: _Part, numbers: Floats) -> Iterator[tuple[Ints, Ints]]:
+    """For each number, the positions in the part's sorted order that may hold it in their band: one
+    range, or, for an angle, one for each neighbouring turn."""
+    period = part.period
+    shifts = (0.0,) if period is None else (0.0, -period, period)
+    placed = numbers if period is None else np.mod(numbers, period)
+    for shift in shifts:
+        target = placed + shift
+        yield (np.searchsorted(part.high, target, side="left").astype(np.int64),
+               np.searchsorted(part.low, target, side="right").astype(np.int64))
+
+
+def _accepts(part: _Part, owners: Ints, partners: Ints, numbers: Floats) -> npt.NDArray[np.bool_]:
+    """Whether each partner's band holds the owner's number, the partner being another student whose value
+    the owner's own band does not hold."""
+    unit = part.unit if part.period is not None else None
+    distance = errors(numbers[owners], part.values[partners], angle_unit=unit)[0]
+    reach = part.reach[partners]
+    inside = np.where(part.strict[partners], distance < reach, distance <= reach)
+    own = errors(part.values[partners], part.values[owners], angle_unit=unit)[0]
+    mine = np.where(part.strict[owners], own < part.reach[owners], own <= part.reach[owners])
+    return np.asarray(inside & ~mine & (owners != partners), dtype=bool)
+
+
+def _expanded(starts: Ints, ends: Ints) -> Iterator[tuple[Ints, Ints]]:
+    """Each range's index and the positions in it, in blocks of about :data:`CHUNK` positions."""
+    sizes = np.maximum(ends - starts, 0)
+    begin = 0
+    while begin < len(sizes):
+        total = np.cumsum(sizes[begin:])
+        end = begin + max(1, int(np.searchsorted(total, CHUNK, side="right")))
+        block = sizes[begin:end]
+        owner = np.repeat(np.arange(begin, end), block)
+        offsets = np.arange(int(block.sum())) - np.repeat(np.cumsum(block) - block, block)
+        yield owner, starts[owner] + offsets
+        begin = end
+
+
+def _matches(part: _Part, owners: Ints, numbers: Floats) -> tuple[Ints, Ints]:
+    """Every (owner, partner) whose partner's band holds ``numbers`` (one per owner); for a test's eyes."""
+    full = np.full(len(part.values), np.nan)
+    full[owners] = numbers
+    found_owners, found_partners = [], []
+    for starts, ends in _ranges(part, numbers):
+        for which, positions in _expanded(starts, ends):
+            who, partner = owners[which], part.order[positions]
+            ok = _accepts(part, who, partner, full)
+            found_owners.append(who[ok])
+            found_partners.append(partner[ok])
+    return np.concatenate(found_owners or [np.zeros(0, np.int64)]), np.concatenate(found_partners or
+                                                                                  [np.zeros(0, np.int64)])
+
+
+def _found(part: _Part, wrong: Ints, numbers: Floats) -> tuple[Ints, list[tuple[Ints, Ints]]]:
+    """Per wrong answer (of ``wrong``), how many students' bands hold it, and its candidate ranges. Where the
+    bands' ends rise with the values (the search's range is then exactly the bands that hold the number), an
+    answer with more than :data:`COUNTED` candidates is counted by its range's size, not tested one by one
+    (in a class of 100,000 a wrong answer may fall in thousands of bands)."""
+    counts = np.zeros(len(wrong), dtype=np.int64)
+    ranges = list(_ranges(part, numbers[wrong]))
+    for starts, ends in ranges:
+        sizes = np.maximum(ends - starts, 0)
+        sized = sizes > COUNTED if part.monotone else np.zeros(len(sizes), dtype=bool)
+        counts[sized] += sizes[sized]
+        tested = np.flatnonzero(~sized)
+        for which, positions in _expanded(starts[tested], ends[tested]):
+            ok = _accepts(part, wrong[tested[which]], part.order[positions], numbers)
+            counts += np.bincount(tested[which[ok]], minlength=len(wrong))
+    return counts, ranges
+
+
+def _pairs(parts: Sequence[_Part], wrong: Mapping[str, Ints], numbers: Mapping[str, Floats], spread: Spread,
+           found: Sequence[tuple[Ints, list[tuple[Ints, Ints]]]], per_student: Ints,
+           examined: int) -> dict[tuple[int, int], Pair]:
+    """Every pair with two or more matched parts whose corrected chance is below :data:`KEPT`.
+
+    A pair needs as many matched parts as the fewest whose chance could be that small (:func:`_needed`); a
+    partner that matches ``n`` of a student's parts is in the band search of at least one part other than
+    the ``n - 1`` that matched the most students: those searches alone are expanded."""
+    students = len(per_student)
+    counts = np.zeros((students, len(parts)), dtype=np.int64)  # per student and part, the students matched
+    for index, (part, (found_counts, _)) in enumerate(zip(parts, found, strict=True)):
+        counts[wrong[part.label], index] = found_counts
+    matched = np.count_nonzero(counts, axis=1)
+    needed = _needed(parts, wrong, students, examined)
+    # Each part's rank among the student's, most students matched first: the needed - 1 first are not searched.
+    rank = np.argsort(np.argsort(-counts, axis=1, kind="stable"), axis=1, kind="stable")
+    keys = []
+    for index, (part, (found_counts, ranges)) in enumerate(zip(parts, found, strict=True)):
+        members = wrong[part.label]
+        chosen = np.flatnonzero((found_counts > 0) & (matched[members] >= needed[members])
+                                & (rank[members, index] >= needed[members] - 1))
+        for starts, ends in ranges:
+            for which, positions in _expanded(starts[chosen], ends[chosen]):
+                owners, partners = members[chosen[which]], part.order[positions]
+                ok = _accepts(part, owners, partners, numbers[part.label])
+                keys.append(np.unique(owners[ok] * students + partners[ok]))
+    if not keys:
+        return {}
+    pairs = np.unique(np.concatenate(keys))
+    return {(pair.student, pair.partner): pair
+            for pair in _figures(parts, wrong, numbers, spread, pairs // students, pairs % students, per_student,
+                                 examined, 2, KEPT)}
+
+
+def _needed(parts: Sequence[_Part], wrong: Mapping[str, Ints], students: int, examined: int) -> Ints:
+    """Per student, the fewest matched parts (at least 2) whose corrected chance could be under :data:`KEPT`
+    (more than their wrong parts: none could). Each part's chance is at least the unrelated kind's share
+    times the least class density of the part, so ``k`` matches have a chance of at least the product of the
+    ``k`` least of those over the student's wrong parts."""
+    least = np.full((students, max(len(parts), 1)), np.inf)
+    for index, part in enumerate(parts):
+        finite = part.chance[np.isfinite(part.chance)]
+        least[wrong[part.label], index] = UNRELATED * float(finite.min()) if len(finite) else 0.0
+    with np.errstate(divide="ignore"):
+        bound = math.log(max(examined, 1)) + np.cumsum(np.log(np.sort(least, axis=1)), axis=1)
+    possible = (bound < math.log(KEPT)) & (np.arange(least.shape[1]) >= 1)
+    return np.where(possible.any(axis=1), np.argmax(possible, axis=1) + 1, least.shape[1] + 1).astype(np.int64)
+
+
+def _figures(parts: Sequence[_Part], wrong: Mapping[str, Ints], numbers: Mapping[str, Floats], spread: Spread,
+             owners: Ints, partners: Ints, per_student: Ints, examined: int, least: int = 0,
+             below: float = math.inf) -> list[Pair]:
+    """Each pair's matched parts and chances: the Poisson binomial distribution of the number of matches
+    among the owner's wrong parts, built a part at a time; only the pairs with ``least`` matched parts or
+    more and a corrected chance under ``below``."""
+    count = len(owners)
+    most = int(per_student[owners].max()) if count else 0
+    distribution = np.zeros((count, most + 1))
+    distribution[:, 0] = 1.0
+    hits = np.zeros((count, len(parts)), dtype=bool)
+    for index, part in enumerate(parts):
+        answered = np.zeros(len(part.values), dtype=bool)
+        answered[wrong[part.label]] = True
+        rows = np.flatnonzero(answered[owners])
+        if not len(rows):
+            continue
+        chance = _chance(part, spread, owners[rows], partners[rows])[:, None]
+        shifted = np.zeros((len(rows), most + 1))
+        shifted[:, 1:] = distribution[rows, :-1]
+        distribution[rows] = distribution[rows] * (1 - chance) + shifted * chance
+        hits[rows, index] = _accepts(part, owners[rows], partners[rows], numbers[part.label])
+    matched = hits.sum(axis=1)
+    tails = np.cumsum(distribution[:, ::-1], axis=1)[:, ::-1][np.arange(count), np.minimum(matched, most)]
+    tails = np.minimum(tails, 1.0)
+    corrected = np.minimum(tails * max(examined, 1), 1.0)
+    kept = (matched >= least) & (corrected < below)
+    owners, partners, hits, tails, corrected = owners[kept], partners[kept], hits[kept], tails[kept], corrected[kept]
+    # The matched parts' labels, worked out once per pattern of parts (a class has a few hundred patterns).
+    patterns = hits.astype(np.int64) @ (np.int64(1) << np.arange(len(parts), dtype=np.int64))
+    named: dict[int, tuple[str, ...]] = {}
+    for pattern in np.unique(patterns).tolist():
+        named[pattern] = tuple(part.label for index, part in enumerate(parts) if pattern >> index & 1)
+    return [Pair(owner, partner, named[pattern], wrong, chance, fixed)
+            for owner, partner, pattern, wrong, chance, fixed in zip(
+                owners.tolist(), partners.tolist(), patterns.tolist(), per_student[owners].tolist(), tails.tolist(),
+                corrected.tolist(), strict=True)]
+
+
+def _chance(part: _Part, spread: Spread, owners: Ints, partners: Ints) -> Floats:
+    """The chance that each owner's wrong answer to the part lands in the partner's band by accident
+    (:mod:`grader.grade.integrity_chance`; an angle's answers are all taken as unrelated to their own)."""
+    unrelated = np.nan_to_num(part.chance[partners], nan=0.0)
+    if part.period is not None:
+        return unrelated
+    middle, reach = part.values[partners], part.reach[partners]
+    related = spread.chance(part.values[owners], middle - reach, middle + reach, owners)
+    return np.asarray((1 - UNRELATED) * related + UNRELATED * unrelated)
+
+
+def _listed(parts: Sequence[_Part], wrong: Mapping[str, Ints], numbers: Mapping[str, Floats],
+            found: Sequence[tuple[Ints, list[tuple[Ints, Ints]]]],
+            pairs: Mapping[tuple[int, int], Pair]) -> list[Match]:
+    """Each wrong answer that matches anyone, with up to :data:`LISTED` of the students it matches: the
+    partners of its pairs first, then the nearest values (by distance over the band)."""
+    partners_of: dict[tuple[int, str], list[int]] = {}
+    for pair in sorted(pairs.values(), key=lambda pair: (pair.corrected, pair.chance, pair.partner)):
+        for label in pair.labels:
+            partners_of.setdefault((pair.student, label), []).append(pair.partner)
+    matches = []
+    for part, (counts, _) in zip(parts, found, strict=True):
+        members = wrong[part.label]
+        some = np.flatnonzero(counts > 0)
+        nearest = _nearest(part, members[some], numbers[part.label])
+        for row, index in enumerate(some):
+            student = int(members[index])
+            chosen = partners_of.get((student, part.label), [])[:LISTED]
+            nearer = [int(other) for other in nearest[row] if other >= 0 and other not in chosen]
+            chosen += nearer[:LISTED - len(chosen)]
+            matches += [Match(student, part.label, other, float(part.values[other]), int(counts[index]))
+                        for other in chosen]
+    matches.sort(key=lambda match: (match.student, match.label))
+    return matches
+
+
+def _nearest(part: _Part, owners: Ints, numbers: Floats) -> Ints:
+    """Per owner, up to :data:`LISTED` students whose bands hold the owner's number, nearest first (by
+    distance over the band), among the values sorted next to it (-1: none)."""
+    if not len(owners) or not len(part.order):
+        return np.full((len(owners), LISTED), -1, dtype=np.int64)
+    period = part.period
+    placed = numbers[owners] if period is None else np.mod(numbers[owners], period)
+    middle = np.searchsorted(part.sorted_values, placed)
+    positions = np.clip(middle[:, None] + np.arange(-2 * LISTED, 2 * LISTED)[None, :], 0, len(part.order) - 1)
+    partners = part.order[positions]
+    who = np.repeat(owners, positions.shape[1])
+    ok = _accepts(part, who, partners.ravel(), numbers).reshape(positions.shape)
+    unit = part.unit if period is not None else None
+    with np.errstate(divide="ignore", invalid="ignore"):
+        score = errors(numbers[who], part.values[partners.ravel()], angle_unit=unit)[0].reshape(positions.shape)
+        score = score / part.reach[partners]
+    score = np.where(ok, score, np.inf)
+    # Clipped positions repeat the ends: a repeated partner is listed once (the first of equal scores).
+    first = np.ones(positions.shape, dtype=bool)
+    first[:, 1:] = positions[:, 1:] != positions[:, :-1]
+    score = np.where(first, score, np.inf)
+    best = np.argsort(score, axis=1, kind="stable")[:, :LISTED]
+    chosen = np.take_along_axis(partners, best, axis=1)
+    return np.where(np.isfinite(np.take_along_axis(score, best, axis=1)), chosen, -1)

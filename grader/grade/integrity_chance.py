@@ -1,0 +1,164 @@
+"""How likely a wrong answer is to land in another student's accepted band by accident: the model behind
+the chances of :mod:`grader.grade.integrity` (docs/grading.md, *Answers from another student's variant*).
+
+A wrong answer is taken to be one of two kinds, estimated from how the class's answers spread:
+
+- **related to the student's own value** (a slip, a step done wrong: 6 % low, twice as much), with the
+  share ``1 - UNRELATED``: its ratio to the student's own value is drawn as the class's wrong answers'
+  ratios are (all numeric parts pooled, a Gaussian kernel density of ``log |ratio|``, each sign apart,
+  Silverman's bandwidth), so the chance of landing in a band is that density's mass over the band's
+  ratios to the student's own value (:class:`Spread`);
+- **unrelated** (anything among the class's values), with the share ``UNRELATED``: the band's width times
+  the density of the class's key values around it (:func:`class_density`).
+
+>>> spread = Spread.of(np.array([1.2, 1.2, 0.8, 0.8]), np.ones(4), np.arange(4), 5)
+>>> round(float(spread.chance(np.array([1.0]), np.array([1.19]), np.array([1.21]), np.array([4]))[0]), 3)
+0.022
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import numpy.typing as npt
+
+Floats = npt.NDArray[np.float64]
+Ints = npt.NDArray[np.int64]
+
+UNRELATED = 0.05  # the share of wrong answers taken to land anywhere among the class's values
+SMALLEST_WIDTH = 0.01  # of the kernel, in log |ratio|: a class whose wrong answers are all alike is not sure
+_STEPS = 8  # grid cells per kernel width
+_REACH = 5  # kernel widths the kernel is drawn out to
+
+
+def class_density(values: Floats, reach: Floats, order: Ints, sorted_values: Floats) -> Floats:
+    """Per student, the chance that an unrelated wrong answer lands in their band: the band's width times
+    the density of the class's values around it, over the ``√n`` nearest values on each side, and at least
+    the share of the other students' values inside the band (NaN: no value).
+
+    >>> values = np.array([1.0, 2.0, 3.0, 4.0, 5.0])
+    >>> class_density(values, 0.01 * values, np.arange(5), values).round(6).tolist()
+    [0.005, 0.01, 0.015, 0.02, 0.025]
+    """
+    chance = np.full(len(values), np.nan)
+    count = len(order)
+    if count < 2:
+        return chance
+    side = max(1, math.ceil(math.sqrt(count)))
+    rank = np.arange(count)
+    lowest, highest = np.maximum(rank - side, 0), np.minimum(rank + side, count - 1)
+    width = sorted_values[highest] - sorted_values[lowest]
+    bands = reach[order]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        density = np.where(width > 0, (highest - lowest) / (count - 1) / width, 0.0)
+    inside = (np.searchsorted(sorted_values, sorted_values + bands, side="right")
+              - np.searchsorted(sorted_values, sorted_values - bands, side="left") - 1) / (count - 1)
+    chance[order] = np.clip(np.maximum(density * 2 * bands, inside), 0.0, 1.0)
+    return chance
+
+
+@dataclass(frozen=True)
+class Spread:
+    """The class's wrong answers as ratios to their own values: per sign (the same as the student's own
+    value, or the other), the cumulative distribution of ``log |ratio|`` on a grid (a Gaussian kernel
+    density, binned), as shares of all the answers; and each student's own answers, on the grid, so that the
+    chance of a student's answer is worked out without that student's answers (leave one out: the answers
+    tested do not make themselves likely)."""
+
+    start: float  # the grid's first cell boundary
+    step: float
+    same: Floats  # the cumulative distribution of the answers of the same sign, at each cell boundary
+    other: Floats
+    kernel: Floats  # one answer's cumulative kernel, at the boundaries of the cells around it
+    answers: int
+    cells: npt.NDArray[np.float64]  # per student, the grid cells of their answers (NaN: none), one column each
+    signs: npt.NDArray[np.bool_]  # of the same sign as their own value
+
+    @classmethod
+    def of(cls, answers: Floats, own: Floats, students: Ints, count: int) -> Spread:
+        """From the wrong answers, their students' own values and the students (by index, of ``count``);
+        pairs with a zero are left out."""
+        usable = (answers != 0) & (own != 0) & np.isfinite(answers) & np.isfinite(own)
+        logs = np.log(np.abs(answers[usable] / own[usable]))
+        same = np.sign(answers[usable]) == np.sign(own[usable])
+        width = _bandwidth(logs)
+        start = (float(logs.min()) if len(logs) else 0.0) - _REACH * width
+        stop = (float(logs.max()) if len(logs) else 0.0) + _REACH * width
+        step = width / _STEPS
+        points = int((stop - start) / step) + 2
+        kernel = np.exp(-0.5 * (np.arange(-_REACH * _STEPS, _REACH * _STEPS + 1) / _STEPS) ** 2)
+        kernel /= kernel.sum()
+        where = np.clip((logs - start) / step, 0, points - 2)  # in cells: each answer shared by the two nearest
+        below = where.astype(np.int64)
+        share = where - below
+        tables = []
+        for group in (same, ~same):
+            counts = (np.bincount(below[group], 1 - share[group], minlength=points)
+                      + np.bincount(below[group] + 1, share[group], minlength=points))
+            smooth = np.convolve(counts, kernel, mode="same") / max(len(logs), 1)
+            tables.append(np.concatenate([[0.0], np.cumsum(smooth)]))
+        owners = students[usable]
+        column = _rank_within(owners)
+        cells = np.full((count, int(column.max()) + 1 if len(column) else 1), np.nan)
+        signs = np.zeros(cells.shape, dtype=bool)
+        cells[owners, column], signs[owners, column] = where, same
+        return cls(start - step / 2, step, tables[0], tables[1], np.concatenate([[0.0], np.cumsum(kernel)]),
+                   len(logs), cells, signs)
+
+    def chance(self, own: Floats, low: Floats, high: Floats, owners: Ints) -> Floats:
+        """The chance that a wrong answer of student ``owners`` related to their ``own`` value lands in
+        ``[low, high]``, from the other students' answers; 1 where the band holds zero or ``own`` is zero (no
+        ratio tells)."""
+        with np.errstate(divide="ignore", invalid="ignore"):
+            first, second = low / own, high / own
+            ends = np.log(np.abs(np.stack([first, second])))
+        same = (first > 0) & (second > 0)
+        other = (first < 0) & (second < 0)
+        a, b = np.nanmin(ends, axis=0), np.nanmax(ends, axis=0)
+        whole = np.where(same, self._mass(self.same, a, b), self._mass(self.other, a, b))
+        mine = self.cells[owners]
+        theirs = np.isfinite(mine).sum(axis=1)
+        signed = np.where(np.isfinite(mine), self.signs[owners] == same[:, None], False)
+        # A student's own answers' kernels, over the band: in grid cells, the band's ends from each answer's.
+        low_cell, high_cell = (a - self.start) / self.step - 0.5, (b - self.start) / self.step - 0.5
+        offsets = np.arange(len(self.kernel)) - (len(self.kernel) - 1) / 2
+        with np.errstate(invalid="ignore"):
+            own_mass = (np.interp(high_cell[:, None] - mine, offsets, self.kernel)
+                        - np.interp(low_cell[:, None] - mine, offsets, self.kernel))
+        own_mass = np.where(signed, own_mass, 0.0).sum(axis=1) / max(self.answers, 1)
+        left = self.answers - theirs
+        with np.errstate(divide="ignore", invalid="ignore"):
+            found = np.where(left > 0, (whole - own_mass) * self.answers / left, 0.0)
+        found = np.where(same | other, found, 1.0)
+        return np.asarray(np.clip(np.nan_to_num(found, nan=1.0), 0.0, 1.0))
+
+    def _mass(self, table: Floats, a: Floats, b: Floats) -> Floats:
+        grid = self.start + self.step * np.arange(len(table))
+        return np.asarray(np.interp(b, grid, table) - np.interp(a, grid, table))
+
+
+def _rank_within(owners: Ints) -> Ints:
+    """Each entry's place among the entries of the same owner (0, 1, ...), in order.
+
+    >>> _rank_within(np.array([3, 1, 3, 3, 1])).tolist()
+    [0, 0, 1, 2, 1]
+    """
+    order = np.argsort(owners, kind="stable")
+    ranked = owners[order]
+    starts = np.flatnonzero(np.r_[True, ranked[1:] != ranked[:-1]])
+    places = np.arange(len(owners)) - np.repeat(starts, np.diff(np.r_[starts, len(owners)]))
+    found = np.empty(len(owners), dtype=np.int64)
+    found[order] = places
+    return found
+
+
+def _bandwidth(logs: Floats) -> float:
+    """Silverman's rule of thumb, and never below :data:`SMALLEST_WIDTH`."""
+    if len(logs) < 2:
+        return 1.0
+    quartiles = np.percentile(logs, [25, 75])
+    scale = min(float(np.std(logs, ddof=1)), float(quartiles[1] - quartiles[0]) / 1.34) or float(np.std(logs, ddof=1))
+    width: float = 0.9 * scale * len(logs) ** -0.2
+    return max(SMALLEST_WIDTH, width)

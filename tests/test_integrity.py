@@ -1,0 +1,278 @@
+"""Answers from another student's variant (issue 28 part 3): a copied answer is found with its partner and
+value, an honest class gives no pair, a student's own diagnosed mistake is not counted, the chance of the
+matches by accident is the hand computation of docs/grading.md, and what integrity.csv and report.html show.
+The benchmark (``benchmarks/integrity.py``) measures how often it is right on 200 simulated classes."""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+import math
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from grader.grade.class_report import class_report
+from grader.grade.diagnosis import Physics
+from grader.grade.grading import Graded, grade
+from grader.grade.integrity import check
+from grader.grade.integrity_chance import UNRELATED, Spread, class_density
+from grader.grade.key import Key, KeyPart, KeyProblem, KeyStudent
+from grader.grade.latest import Answer
+from grader.grade.report import integrity_csv
+from grader.grade.submissions import Submissions
+
+TOLERANCE = {"mode": "rtol", "rtol": 0.01, "atol": 0.0}
+
+
+def make_key(values: Sequence[Sequence[float]], threshold: float = 0.01) -> Key:
+    """One problem whose parts 1a, 1b, ... have, for student ``s{i}``, the values ``values[i]``."""
+    labels = tuple(f"1{chr(ord('a') + j)}" for j in range(len(values[0])))
+    students = tuple(KeyStudent(f"s{i}", f"Student {i}", "", "1",
+                                {label: KeyPart("1", f"x{j}", label, float(value), "m/s", 1.0, TOLERANCE, None, {})
+                                 for j, (label, value) in enumerate(zip(labels, row, strict=True))})
+                     for i, row in enumerate(values))
+    return Key("key.json", 2, "HW", True, (KeyProblem("1", "Drop", labels),), students,
+               integrity_threshold=threshold)
+
+
+def graded(key: Key, typed: Mapping[tuple[str, str], str]) -> Graded:
+    """The key graded against ``typed``, by (student id, label); no physics (nothing is diagnosed)."""
+    answers = tuple(Answer("answers.csv", line, student, label, text, ",", None)
+                    for line, ((student, label), text) in enumerate(typed.items(), 2))
+    return grade(key, Submissions(answers, (), (), ()), Physics({}))
+
+
+def own_answers(key: Key) -> dict[tuple[str, str], str]:
+    """Every student's own values, as typed."""
+    return {(s.id, label): f"{part.value:.4g}" for s in key.students for label, part in s.parts.items()}
+
+
+def test_a_copied_answer_is_found_with_the_right_partner_and_value() -> None:
+    # Eight students, three parts, values 2 % and more apart: student 0 types student 5's three answers.
+    key = make_key([[1.0 + i, 10.0 + 2 * i, 100.0 + 5 * i] for i in range(8)])
+    typed = own_answers(key) | {("s0", "1a"): "6", ("s0", "1b"): "20", ("s0", "1c"): "125"}
+    result = check(graded(key, typed))
+    assert [(m.student, m.label, m.partner, m.value, m.matches) for m in result.matches] == [
+        (0, "1a", 5, 6.0, 1), (0, "1b", 5, 20.0, 1), (0, "1c", 5, 125.0, 1)]
+    (pair,) = result.flagged
+    assert (pair.student, pair.partner, pair.labels, pair.wrong) == (0, 5, ("1a", "1b", "1c"), 3)
+    assert result.examined == 7  # one student with two or more wrong parts, against the 7 others
+
+
+def test_an_honest_class_has_no_pair() -> None:
+    # Wrong answers 20 % off the student's own value, where another student's value is at least 5 % away.
+    key = make_key([[1.0 + i, 10.0 + 2 * i] for i in range(10)])
+    typed = own_answers(key) | {(f"s{i}", "1a"): f"{(1.0 + i) * 1.2 + 0.5:.4g}" for i in range(0, 10, 2)}
+    result = check(graded(key, typed))
+    assert result.wrong == 5 and result.flagged == () and result.matched == 0 and result.matches == ()
+
+
+def phi(x: float) -> float:
+    return 0.5 * (1 + math.erf(x / math.sqrt(2)))
+
+
+def kernel_mass(logs: Sequence[float], low: float, high: float) -> float:
+    """A Gaussian kernel density's mass over ``[low, high]`` (of ``log |ratio|``), Silverman's bandwidth:
+    0.9 min(standard deviation, interquartile range / 1.34) n^(-1/5)."""
+    width = kernel_width(np.array(logs))
+    return sum(phi((high - x) / width) - phi((low - x) / width) for x in logs) / len(logs)
+
+
+def test_the_class_density_is_the_hand_computation() -> None:
+    # Values 1 to 5, ±1 %: around 3 the √5 -> 3 nearest values each side span 1 to 5, 4 of the 4 other
+    # students over a width of 4: 0.25 per unit, and the band 3 ± 0.03 holds p = 0.25 * 0.06 = 0.015; at the
+    # edge, 1 ± 0.01: 3 of 4 over 1 to 4, 0.25 per unit, p = 0.005.
+    values = np.array([1.0, 2.0, 3.0, 4.0, 5.0])
+    found = class_density(values, 0.01 * values, np.arange(5), values)
+    assert found[2] == pytest.approx(0.015, rel=1e-12) and found[0] == pytest.approx(0.005, rel=1e-12)
+
+
+def test_the_spread_of_wrong_answers_is_a_kernel_density_of_their_ratios() -> None:
+    """Per sign, the mass over a band of the Gaussian kernels at each answer's log |ratio| (the width from
+    all answers, the mass divided by all of them), as an exact sum of normal distribution functions; the
+    module bins the kernels on a grid, a fraction of their width apart."""
+    rng = np.random.default_rng(5)
+    own = rng.uniform(1, 10, 200)
+    answers = own * rng.choice([0.8, 1.15, 2.0], 200) * rng.uniform(0.98, 1.02, 200)
+    answers[:10] *= -1  # a sign wrong
+    spread = Spread.of(answers, own, np.arange(200), 201)  # each answer a student's; student 200 gave none
+    logs = np.log(np.abs(answers / own))
+    for ratio in (0.8, 1.1, 2.0, 3.0, -2.0):
+        low, high = sorted((ratio * 0.99, ratio * 1.01))
+        mine = logs[10:] if ratio > 0 else logs[:10]
+        width = kernel_width(logs)
+        expected = sum(phi((math.log(abs(high if ratio > 0 else low)) - x) / width)
+                       - phi((math.log(abs(low if ratio > 0 else high)) - x) / width) for x in mine) / len(logs)
+        got = float(spread.chance(np.array([1.0]), np.array([low]), np.array([high]), np.array([200]))[0])
+        assert got == pytest.approx(expected, abs=2e-3)
+
+
+def kernel_width(logs: np.ndarray) -> float:
+    """Silverman's rule of thumb, at least 0.01."""
+    deviation = float(np.std(logs, ddof=1))
+    quartile = float(np.percentile(logs, 75) - np.percentile(logs, 25))
+    return max(0.01, 0.9 * min(deviation, quartile / 1.34) * len(logs) ** -0.2)
+
+
+def test_the_chance_of_the_matches_by_accident_is_the_hand_computation() -> None:
+    # Five students, values 1 to 5 in each of three parts, ±1 %; student 0 types student 2's value (3) in 1a
+    # and 1b, and 100 in 1c; student 4 types 6 (a ratio of 1.2 to their own 5) in 1a and 1b. Per part, for
+    # student 0's answers, p = (1 - u) * (the kernel mass of the other students' wrong log-ratios, student
+    # 4's two ln 1.2, over the band's, ln 2.97 to ln 3.03, the kernel's width from all five answers) + u *
+    # (the class density, 0.015 as above). Two or more matches among three parts with the same p:
+    # 3 p^2 - 2 p^3. Two students have two or more wrong parts: 2 * 4 pairs examined.
+    key = make_key([[1.0 + i] * 3 for i in range(5)])
+    typed = own_answers(key) | {("s0", "1a"): "3", ("s0", "1b"): "3", ("s0", "1c"): "100",
+                                ("s4", "1a"): "6", ("s4", "1b"): "6"}
+    result = check(graded(key, typed))
+    logs = [math.log(3), math.log(3), math.log(100), math.log(1.2), math.log(1.2)]
+    width = kernel_width(np.array(logs))
+    related = sum(phi((math.log(3.03) - x) / width) - phi((math.log(2.97) - x) / width) for x in logs[3:]) / 2
+    p = (1 - UNRELATED) * related + UNRELATED * 0.015
+    assert related > 0.001  # the kernels of student 4's answers reach student 0's
+    (pair,) = [pair for pair in result.pairs if (pair.student, pair.partner) == (0, 2)]
+    assert pair.labels == ("1a", "1b") and pair.wrong == 3
+    assert pair.chance == pytest.approx(3 * p**2 - 2 * p**3, rel=0.05)
+    assert result.examined == 8 and pair.corrected == pytest.approx(8 * pair.chance, rel=1e-12)
+
+
+def test_a_students_own_answers_do_not_make_themselves_likely() -> None:
+    # Student 0's wrong answers are the class's only ones: the chance that they are related to their own
+    # values rests on nobody's, and only the unrelated kind is left: p = u * 0.015 (as above) for each part.
+    key = make_key([[1.0 + i] * 3 for i in range(5)])
+    typed = own_answers(key) | {("s0", "1a"): "3", ("s0", "1b"): "3", ("s0", "1c"): "100"}
+    (pair,) = [pair for pair in check(graded(key, typed)).pairs if (pair.student, pair.partner) == (0, 2)]
+    p = UNRELATED * 0.015
+    assert pair.chance == pytest.approx(3 * p**2 - 2 * p**3, rel=1e-9)
+
+
+def test_a_students_own_diagnosed_mistake_that_is_another_students_value_is_not_counted() -> None:
+    key = make_key([[1.0 + i, 10.0 + 2 * i, 100.0 + 5 * i] for i in range(8)])
+    typed = own_answers(key) | {("s0", "1a"): "6", ("s0", "1b"): "20", ("s0", "1c"): "125"}
+    result = graded(key, typed)
+    # The same answers, graded as diagnosed mistakes of student 0's own (as the physics would find them).
+    columns = {label: list(rows) for label, rows in result.columns.items()}
+    for label in ("1a", "1b", "1c"):
+        columns[label][0] = columns[label][0]._replace(verdict="mistake", diagnosis="impact.masses_swapped")
+    diagnosed = Graded(result.key, columns, (), (), (), numbers=result.numbers)
+    found = check(diagnosed)
+    assert found.wrong == 0 and found.matches == () and found.pairs == ()
+
+
+def test_a_diagnosed_mistake_from_the_shipped_physics_is_not_counted(tmp_path: Path) -> None:
+    """Through the real grading: a drop-rebound student who squares e (a diagnosed mistake) in a class where
+    another student's e is that square."""
+    from grader.base.resources import sample_dir
+    from grader.cli import main
+    from grader.grade.diagnosis import physics_for
+    from grader.grade.key import load_key
+
+    assert main(["generate", str(sample_dir() / "assignment.yaml"), "--roster", str(sample_dir() / "roster.csv"),
+                 "--out", str(tmp_path / "hw"), "--no-pdf"]) == 0
+    document = json.loads((tmp_path / "hw" / "key.json").read_text(encoding="utf-8"))
+    students = document["students"]
+    first, second = students[0]["problems"][0], students[1]["problems"][0]
+    e = first["answers"]["e"]["value"]
+    second["answers"]["e"]["value"] = e * e  # student 1's e is student 0's e squared
+    (tmp_path / "edited.json").write_text(json.dumps(document), encoding="utf-8")
+    key = load_key(tmp_path / "edited.json")
+    label = first["answers"]["e"]["label"]
+    typed = {(students[0]["id"], label): f"{e * e:.6g}"}
+    answers = tuple(Answer("a.csv", 2, who, part, text, ",", None) for (who, part), text in typed.items())
+    result = grade(key, Submissions(answers, (), (), ()), physics_for(key))
+    assert result.columns[label][0].verdict == "mistake"
+    assert check(result).matches == ()
+
+
+def test_integrity_csv_guards_what_a_student_typed_and_names_the_partner() -> None:
+    key = make_key([[1.0 + i, 10.0 + 2 * i, 100.0 + 5 * i] for i in range(8)])
+    typed = own_answers(key) | {("s0", "1a"): "+6", ("s0", "1b"): "20", ("s0", "1c"): "125"}
+    result = graded(key, typed)
+    text = "".join(integrity_csv(result, check(result)))
+    rows = list(csv.DictReader(io.StringIO(text)))
+    assert [(r["student_id"], r["label"], r["submitted"], r["matches_id"], r["matches_value"]) for r in rows] == [
+        ("s0", "1a", "'+6", "s5", "6"), ("s0", "1b", "20", "s5", "20"), ("s0", "1c", "125", "s5", "125")]
+    assert {(r["pair_parts"], r["pair_labels"], r["wrong_parts"], r["flagged"]) for r in rows} == {
+        ("3", "1a 1b 1c", "3", "yes")}
+    assert all(0 < float(r["chance"]) <= float(r["corrected_chance"]) <= 1 for r in rows)
+
+
+def test_an_answer_matching_many_students_names_a_bounded_number() -> None:
+    from grader.grade.integrity import LISTED
+
+    key = make_key([[5.0 + 0.001 * i] for i in range(12)] + [[50.0]])
+    typed = {("s12", "1a"): "5.005"}
+    result = check(graded(key, typed))
+    assert len(result.matches) == LISTED and {m.matches for m in result.matches} == {12}
+    assert result.matches[0].partner == 5  # the nearest value first
+
+
+def test_an_angle_matches_across_the_turn() -> None:
+    students = [KeyStudent(f"s{i}", "", "", "1", {"1a": KeyPart("1", "theta", "1a", value, "deg", 1.0, TOLERANCE,
+                                                                None, {})})
+                for i, value in enumerate([10.0, 90.0, 359.5, 200.0])]
+    key = Key("key.json", 2, "HW", True, (KeyProblem("1", "Spin", ("1a",)),), tuple(students))
+    result = check(graded(key, {("s1", "1a"): "-0.5"}))
+    assert [(m.student, m.partner) for m in result.matches] == [(1, 2)]
+
+
+def test_the_report_lists_flagged_pairs_and_says_when_there_are_none() -> None:
+    key = make_key([[1.0 + i, 10.0 + 2 * i, 100.0 + 5 * i] for i in range(8)])
+    copied = graded(key, own_answers(key) | {("s0", "1a"): "6", ("s0", "1b"): "20", ("s0", "1c"): "125"})
+    page = class_report(copied)
+    assert "<h2 id=\"integrity\">" in page and "<td>s0</td><td>Student 0</td><td>s5</td><td>Student 5</td>" in page
+    assert "3 of 3" in page
+    honest = class_report(graded(key, own_answers(key)))
+    assert "<h2 id=\"integrity\">" in honest and "No pair of students is flagged." in honest
+
+
+def test_a_threshold_of_0_flags_nothing() -> None:
+    key = make_key([[1.0 + i, 10.0 + 2 * i, 100.0 + 5 * i] for i in range(8)], threshold=0.0)
+    result = check(graded(key, own_answers(key) | {("s0", "1a"): "6", ("s0", "1b"): "20", ("s0", "1c"): "125"}))
+    assert result.flagged == () and len(result.pairs) == 1
+
+
+def test_the_pair_search_agrees_with_a_comparison_of_every_pair(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The sort-and-join search finds exactly the pairs with two or more matched parts that comparing every
+    student with every other finds (every such pair kept, whatever its chance)."""
+    from grader.grade import integrity
+
+    monkeypatch.setattr(integrity, "KEPT", 2.0)
+    rng = np.random.default_rng(28)
+    labels = ("1a", "1b", "1c", "1d", "1e")
+    values = rng.uniform(1, 1.5, size=(80, len(labels)))
+    key = make_key(values.tolist())
+    typed = {(f"s{i}", label): f"{values[i, j] * (rng.uniform(0.7, 1.3) if rng.random() < 0.6 else 1):.6g}"
+             for i in range(80) for j, label in enumerate(labels)}
+    result = graded(key, typed)
+    expected = {}
+    for a in range(80):
+        for b in range(80):
+            matched = tuple(label for j, label in enumerate(labels)
+                            if result.columns[label][a].verdict == "incorrect" and a != b
+                            and abs(result.numbers[label][a] - values[b, j]) <= 0.01 * values[b, j]
+                            and abs(values[b, j] - values[a, j]) > 0.01 * values[a, j])
+            if len(matched) >= 2:
+                expected[a, b] = matched
+    assert len(expected) > 10  # the class has pairs to find
+    assert {(p.student, p.partner): p.labels for p in check(result).pairs if len(p.labels) >= 2} == expected
+
+
+def test_answers_counted_by_their_search_range_count_as_those_tested_one_by_one(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    from grader.grade import integrity
+
+    rng = np.random.default_rng(7)
+    values = rng.uniform(1, 1.2, size=(200, 2))
+    key = make_key(values.tolist())
+    typed = {(f"s{i}", label): f"{values[i, j] * (1.1 if i % 3 == 0 else 1):.6g}"
+             for i in range(200) for j, label in enumerate(("1a", "1b"))}
+    result = graded(key, typed)
+    tested = [(m.student, m.label, m.matches) for m in check(result).matches]
+    monkeypatch.setattr(integrity, "COUNTED", 0)
+    assert [(m.student, m.label, m.matches) for m in check(result).matches] == tested
+    assert max(matches for _, _, matches in tested) > 5

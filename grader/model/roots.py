@@ -17,12 +17,16 @@ with exactly one root gets it; a row with none, or more than one, gets NaN, whic
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
+from itertools import pairwise
 
 import numpy as np
 
 TOLERANCE = 1e-15
 """How narrow a bracket is closed, relative to its ends (a few units in the last place of float64)."""
+TOLERANCE_TEXT = "1e−15"
+""":data:`TOLERANCE` as worked solutions and ``grader show`` state it."""
 UNIFORM = 256
 """The intervals of the grid on an interval at most :data:`UNIFORM_WIDTH` wide (an angle, a ratio)."""
 UNIFORM_WIDTH = 100.0
@@ -49,8 +53,8 @@ def grid(low: float, high: float) -> np.ndarray:
     """
     if high - low <= UNIFORM_WIDTH:
         return np.linspace(low, high, UNIFORM + 1)
-    top = np.log10(max(abs(low), abs(high)))
-    magnitudes = 10.0 ** np.linspace(np.log10(SMALLEST), top, int(round((top - np.log10(SMALLEST)) * PER_DECADE)) + 1)
+    bottom, top = math.log10(SMALLEST), math.log10(max(abs(low), abs(high)))
+    magnitudes = 10.0 ** np.linspace(bottom, top, round((top - bottom) * PER_DECADE) + 1)
     points = np.concatenate([-magnitudes[::-1], [0.0], magnitudes, [low, high]])
     return np.unique(points[(points >= low) & (points <= high)])
 
@@ -81,7 +85,7 @@ def _roots(residual: Residual, low: float, high: float, count: int) -> tuple[np.
     every = np.arange(count)
     rows, starts, ends, at_start, at_end = [], [], [], [], []
     before = residual(np.full(count, points[0]), every)
-    for left, right in zip(points[:-1], points[1:], strict=True):
+    for left, right in pairwise(points):
         after = residual(np.full(count, right), every)
         # A zero on the grid is a root of its own (a bracket of width 0); a sign change is a bracket.
         changes = np.flatnonzero((before * after < 0) | ((after == 0) & np.isfinite(before)))

@@ -31,12 +31,13 @@ from grader.bank.template import Template
 from grader.base.errors import SYMPY_FAILURES, TemplateError, shown, unworkable
 from grader.model.expr import Node, Num, Op, names, substitute
 from grader.model.quantities import Unit
+from grader.model.roots import TOLERANCE_TEXT
 from grader.physics.effects import CATALOGUE, Condition, Relation
 from grader.physics.symbolic import INNER as _INNER
 from grader.physics.symbolic import Context, cosd, from_node, sind, to_node
 from grader.solve.compiled import Check, Compiled, CompiledAnswer, Step, Undefined
 from grader.solve.stable import numeric_order, stabilize
-from grader.solve.torn import TOLERANCE_TEXT, identity, interval, root_node, roots_at
+from grader.solve.torn import identity, interval, root_node, roots_at
 
 
 @dataclass(frozen=True)
@@ -81,12 +82,13 @@ def derive(relations: list[Relation], knowns: Iterable[Any], given: Iterable[Any
             return chain
         block = next_block(relations, known, used, points, chain, targets)
         if block is None and numeric:
-            block = torn_block(relations, known, given_set, used, points, chain, targets)
-            if isinstance(block, str):
-                raise TemplateError(_INNER, block, "a scene that tells its solutions apart",
+            torn = torn_block(relations, known, given_set, used, points, chain, targets)
+            if isinstance(torn, str):
+                raise TemplateError(_INNER, torn, "a scene that tells its solutions apart",
                                     "two physical solutions that nothing in it (a sign, a domain, a condition) tells "
                                     "apart: give the quantity that decides between them, or ask the question the "
                                     "other way round")
+            block = torn
         if block is None:
             return chain
         chain += block
@@ -159,7 +161,8 @@ def next_block(relations: list[Relation], known: set[Any], used: set[int],
         if len(members) > MAX_BLOCK or set().union(*(unknowns_of[index] for index in members)) != set(unknowns):
             continue
         found = solve_block([relations[index] for index in members], unknowns, relations, known,
-                            lambda: [(point, _values_at(point, chain or [], i)) for i, point in enumerate(points)], asked)
+                            lambda: [(point, _values_at(point, chain or [], i)) for i, point in enumerate(points)],
+                            asked)
         if isinstance(found, str):
             ambiguous.append(found)
         elif found is not None:
@@ -389,7 +392,8 @@ def torn_block(relations: list[Relation], known: set[Any], given: set[Any], used
             solved.numeric.doit().xreplace(composed)
     open_unknowns = {s for i, r in enumerate(relations) if i not in used for s in r.symbols() - known}
     for tear in sorted(open_unknowns, key=lambda s: (s not in asked, str(s))):
-        trial, inner, have, closing = set(used), [], known | {tear}, None
+        trial, have, closing = set(used), known | {tear}, None
+        inner: list[_Solved] = []
         while True:
             found = {tear} | {step.unknown for step in inner}
             closing = next((i for i, r in enumerate(relations)

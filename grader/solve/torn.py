@@ -23,11 +23,9 @@ import sympy as sp
 
 from grader.model.expr import ROOT, Node, Num, Op, Sym
 from grader.model.kernel import evaluate
-from grader.model.roots import LIMIT, TOLERANCE, every_root, grid
+from grader.model.roots import LIMIT, every_root, grid
 from grader.physics.symbolic import to_node
 
-TOLERANCE_TEXT = f"{TOLERANCE:.0e}".replace("e-", "e−")
-"""The tolerance a worked solution states: ``solved numerically to 1e−15 (relative)``."""
 _TRIGONOMETRIC = (sp.sin, sp.cos, sp.tan)
 
 
@@ -64,7 +62,8 @@ def roots_at(residual: Any, unknown: Any, low: float, high: float, at: Mapping[A
     if fixed.free_symbols - {unknown} or fixed.has(sp.nan, sp.zoo, sp.oo, -sp.oo, sp.I):
         return []
     tree = to_node(fixed)
-    return every_root(lambda x: np.broadcast_to(evaluate(tree, {unknown.name: x}), x.shape), low, high)
+    with np.errstate(all="ignore"):  # a residual outside its domain (a square root of a negative) is no root
+        return every_root(lambda x: np.broadcast_to(evaluate(tree, {unknown.name: x}), x.shape), low, high)
 
 
 def root_node(residual: Node, unknown: str, low: float, high: float) -> Op:

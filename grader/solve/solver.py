@@ -615,8 +615,9 @@ class _Compiler:
         if not tied:
             return "; no stage involves it"
         return (f"; the equations left tie {', '.join(map(self._named, tied))} together (two or more unknowns each) "
-                f"and no set of at most {MAX_BLOCK} of them fixes as many unknowns as it has with one closed-form "
-                "solution (polynomial, of degree at most 4 together): give one of them as a parameter")
+                f"and no set of them fixes as many unknowns as it has, in closed form (at most {MAX_BLOCK}, "
+                "polynomial, of degree at most 4 together) or numerically (one unknown from which the others "
+                "follow, with a root at the sampled values): give one of them as a parameter")
 
     def _named(self, name: str) -> str:
         """A quantity as a message names it: a name the template wrote as is; one the solver gave (the template

@@ -42,7 +42,7 @@ def interval(unknown: Any, residual: Any, conditions: Iterable[Any]) -> tuple[fl
         if not isinstance(condition, sp.Rel) or condition.free_symbols != {unknown}:
             continue
         difference = sp.expand(condition.lhs - condition.rhs)  # holds: difference (rel) 0
-        if sp.degree(difference, unknown) != 1 or not difference.is_polynomial(unknown):
+        if not difference.is_polynomial(unknown) or sp.degree(difference, unknown) != 1:
             continue
         slope, bound = difference.coeff(unknown, 1), -difference.coeff(unknown, 0) / difference.coeff(unknown, 1)
         if not (slope.is_number and bound.is_number):
@@ -73,7 +73,10 @@ def root_node(residual: Node, unknown: str, low: float, high: float) -> Op:
 
 def identity(lhs: Any, rhs: Any, unknown: Any, low: float, high: float, at: Mapping[Any, Any]) -> bool:
     """Whether ``lhs = rhs`` holds for every value of ``unknown`` in ``[low, high]`` with the values ``at``
-    (to 1e-9 of its sides on the grid): an equation the block already satisfies, which fixes nothing."""
+    (to 1e-9 of its sides at 90 % of the grid's points): an equation the block already satisfies, which fixes
+    nothing."""
+    if sp.expand(sp.sympify(lhs) - sp.sympify(rhs)) == 0:  # J = m c (1 - (c - J/m)/c): exact, where floats cancel
+        return True
     sides = []
     for side in (lhs, rhs):
         fixed = sp.sympify(side).xreplace({s: v for s, v in at.items() if s != unknown})
@@ -84,5 +87,8 @@ def identity(lhs: Any, rhs: Any, unknown: Any, low: float, high: float, at: Mapp
             sides.append(np.broadcast_to(evaluate(to_node(fixed), {unknown.name: points}), points.shape))
     left, right = sides
     finite = np.isfinite(left) & np.isfinite(right)
-    return bool(finite.any() and np.all(np.abs(left - right)[finite] <= 1e-9 * np.maximum(
-        np.abs(left), np.abs(right))[finite]))
+    left, right = left[finite], right[finite]
+    agree = np.abs(left - right) <= 1e-9 * np.maximum(np.abs(left), np.abs(right))
+    # Where both sides are near 0 their rounding errors are large beside them: an identity may fail there, at
+    # a few points; an equation that fixes x fails nearly everywhere but at its roots.
+    return bool(agree.size and agree.mean() >= 0.9)

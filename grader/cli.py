@@ -417,6 +417,7 @@ def _show(arguments: argparse.Namespace) -> int:
     import textwrap
 
     from grader.model.expr import to_text
+    from grader.model.roots import TOLERANCE_TEXT
     from grader.render.preview import example_printed, example_statement
     from grader.render.readable import readable
     from grader.render.worked import reader_names
@@ -465,7 +466,9 @@ def _show(arguments: argparse.Namespace) -> int:
         lhs, rhs, solved = (to_text(readable(side, names)) for side in (*step.equation, step.solved))
         lines += [f"  {number}. {step.relation}", f"       {lhs} = {rhs}", f"       => {step.unknown} = {solved}"]
         if step.block and step.unknown == step.block[0]:
-            lines.insert(-3, f"  (steps {number}-{number + len(step.block) - 1}: these equations solved together "
+            how = f" numerically (to {TOLERANCE_TEXT}, relative; the first step's root(...) is found by the kernel)" \
+                if step.numeric else ""
+            lines.insert(-3, f"  (steps {number}-{number + len(step.block) - 1}: these equations solved together{how} "
                              f"for {', '.join(step.block)})")
     print("\n".join(map(visible, lines)))
     return EXIT_OK

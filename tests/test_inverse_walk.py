@@ -22,7 +22,7 @@ from tests.scene_edits import answered, draws, swapped
 
 VARIANTS = 50
 WHY_NOT = {
-    "nothing fixes": "the scene's equations do not fix it in closed form",
+    "nothing fixes": "the scene's equations do not fix it, in closed form or numerically",
     "two physical solutions": "two solutions nothing in the scene tells apart",
     "expected parameters or symbols only": "a mass or a radius is an input of the scene, never a quantity it finds",
     "no step of the solution uses": "with the answer given, another parameter is no longer needed",
@@ -112,7 +112,9 @@ def test_the_head_on_templates_turn_round() -> None:
 
 @pytest.mark.slow
 def test_every_shipped_template_turns_round() -> None:
-    """The whole bank: every pair answered to 1e-9 on 50 variants, or refused saying why."""
+    """The whole bank: every pair answered to 1e-9 on 50 variants, or refused saying why. 86 of the 188 pairs are
+    answered (50 before blocks were solved numerically, when 58 were "nothing fixes"; now none is)."""
     trips = [trip for template in load_bank().values() for trip in round_trips(template)]
     _check(trips)
-    assert sum(trip.refusal is None for trip in trips) >= 49
+    assert sum(trip.refusal is None for trip in trips) >= 86
+    assert not [trip for trip in trips if trip.refusal is not None and "nothing fixes" in trip.refusal]

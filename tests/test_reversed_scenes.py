@@ -48,3 +48,20 @@ def test_the_order_of_bodies_and_stages_changes_nothing(template_id: str) -> Non
 def test_the_order_changes_nothing_in_the_whole_bank() -> None:
     for template in load_bank().values():
         _same_either_way(template)
+
+
+@pytest.mark.parametrize("reverse", [False, True], ids=["bullet first", "block first"])
+def test_the_common_speed_is_worked_out_by_momentum_whichever_body_is_listed_first(reverse: bool) -> None:
+    """Issue 24: ``bodies: [bullet, block]`` showed the block's speed as ``v_b - J/m_b`` (400 - 398 m/s, the
+    digits a student would lose) though the kernel used the stable form; the worked step is now the textbook's
+    conservation of momentum, ``m_b v = (m_b + m_blk) v'``, either way round, with no impulse in it."""
+    from grader.render.worked import worked_form
+    from tests.test_bankcheck import BULLET_BLOCK
+
+    raw = yaml.safe_load(BULLET_BLOCK)
+    template = parse_template(reversed_scene(raw) if reverse else raw, "test:bullet-block", "bullet-block")
+    compiled = compile_template(template)
+    assert [step.unknown for step in compiled.steps] == ["v_block"]
+    step = worked_form(template, compiled).steps[0]
+    assert "conservation of momentum" in str(step.relation)
+    assert step.solved_math == '(m_b v)/(m_b + m_"blk")' and "J" not in step.solved_math

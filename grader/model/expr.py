@@ -39,6 +39,10 @@ FUNCTIONS = {
 
 CONSTANTS = {"pi"}
 
+ROOT = "root"
+"""``root(r, x, low, high)``: the one root ``x`` in ``[low, high]`` of the residual ``r``, in which ``x`` is a bound
+name (the solver's numeric blocks: :mod:`grader.model.roots`). Never parsed from text: only the solver writes it."""
+
 _BINARY = {ast.Add: "add", ast.Sub: "sub", ast.Mult: "mul", ast.Div: "div", ast.Pow: "pow"}
 _COMPARE = {ast.Lt: "lt", ast.LtE: "le", ast.Gt: "gt", ast.GtE: "ge"}
 _BOOLEAN = {ast.And: "and", ast.Or: "or"}
@@ -200,6 +204,9 @@ def names(node: Node) -> set[str]:
     """The names an expression uses (``pi`` excluded)."""
     if isinstance(node, Sym):
         return set() if node.name in CONSTANTS else {node.name}
+    if isinstance(node, Op) and node.op == ROOT:
+        residual, bound, *ends = node.args
+        return (names(residual) - names(bound)).union(*(names(end) for end in ends))
     if isinstance(node, Op):
         return set().union(*(names(a) for a in node.args))
     return set()
@@ -209,6 +216,10 @@ def substitute(node: Node, values: Mapping[str, Node]) -> Node:
     """Replace names by trees."""
     if isinstance(node, Sym):
         return values.get(node.name, node)
+    if isinstance(node, Op) and node.op == ROOT:
+        residual, bound, *ends = node.args
+        inside = {name: value for name, value in values.items() if name not in names(bound)}
+        return Op(ROOT, (substitute(residual, inside), bound, *(substitute(end, values) for end in ends)))
     if isinstance(node, Op):
         return Op(node.op, tuple(substitute(a, values) for a in node.args))
     return node
@@ -258,7 +269,7 @@ def _text(node: Node) -> tuple[str, int]:
     if isinstance(node, Num):
         text = format_number(node.value)
         return text, (6 if text.startswith("-") else 9) if "/" not in text else 5
-    if node.op in FUNCTIONS:
+    if node.op in FUNCTIONS or node.op == ROOT:
         return f"{node.op}({', '.join(_text(a)[0] for a in node.args)})", 9
     level = _PRECEDENCE[node.op]
     if node.op == "neg":
@@ -330,11 +341,14 @@ def from_json(data: Any) -> Node:
     if type(data) is dict:
         return _number_from_json(data)
     if type(data) is list and data and _takes(data[0], len(data) - 1):
-        return Op(data[0], tuple(from_json(a) for a in data[1:]))
+        node = Op(data[0], tuple(from_json(a) for a in data[1:]))
+        if node.op != ROOT or isinstance(node.args[1], Sym):
+            return node
     raise ValueError(f"not an expression tree: {data!r:.80}")
 
 
-_ARGUMENTS = {**FUNCTIONS, **dict.fromkeys(("add", "sub", "mul", "div", "pow", *_COMPARE.values()), 2), "neg": 1}
+_ARGUMENTS = {**FUNCTIONS, **dict.fromkeys(("add", "sub", "mul", "div", "pow", *_COMPARE.values()), 2), "neg": 1,
+              ROOT: 4}
 
 
 def _takes(op: Any, count: int) -> bool:

@@ -32,7 +32,8 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
-from grader.model.expr import Node, Num, Op, Sym
+from grader.model.expr import ROOT, Node, Num, Op, Sym, names
+from grader.model.roots import find_root
 
 _NUMERIC: dict[str, Any] = {
     "add": np.add, "sub": np.subtract, "mul": np.multiply, "div": np.divide, "neg": np.negative,
@@ -218,7 +219,38 @@ def evaluate(node: Node, env: Mapping[str, Any]) -> Any:
             return np.pi
         return env[node.name]
     assert isinstance(node, Op)
+    if node.op == ROOT:
+        residual, bound, low, high = node.args
+        inputs = sorted(names(node))
+        root = _Root(lambda values: evaluate(residual, values), tuple(inputs), _bound(bound))
+        return root(evaluate(low, env), evaluate(high, env), *(env[name] for name in inputs))
     return _apply(node.op, [evaluate(arg, env) for arg in node.args])
+
+
+def _bound(node: Node) -> str:
+    assert isinstance(node, Sym)  # from_json refuses anything else
+    return node.name
+
+
+class _Root:
+    """``root(r, x, low, high)`` as a step: ``residual`` evaluates ``r`` from its inputs (``inputs``' values and
+    ``bound``'s), for the rows :func:`~grader.model.roots.find_root` asks, on every row of the inputs at once."""
+
+    def __init__(self, residual: Callable[[Mapping[str, Any]], Any], inputs: tuple[str, ...], bound: str) -> None:
+        self.residual, self.inputs, self.bound = residual, inputs, bound
+
+    def __call__(self, low: Any, high: Any, *values: Any) -> Any:
+        shape = np.broadcast_shapes(*(np.shape(value) for value in values))
+        columns = [np.broadcast_to(np.asarray(value, dtype=float), shape).reshape(-1) for value in values]
+
+        def at(x: np.ndarray, rows: np.ndarray) -> np.ndarray:
+            found = self.residual({**{name: column[rows] for name, column in zip(self.inputs, columns, strict=True)},
+                                   self.bound: x})
+            return np.broadcast_to(np.asarray(found, dtype=float), x.shape)
+
+        with np.errstate(all="ignore"):
+            root = find_root(at, float(low), float(high), int(np.prod(shape)))
+        return root.reshape(shape) if shape else root[0]
 
 
 def _apply(op: str, args: list[Any]) -> Any:
@@ -421,6 +453,10 @@ class Kernel:
                 self._new(("input", node.name))
             self._slots[node] = self._slots[("input", node.name)]
             return self._slots[node]
+        if node.op == ROOT:
+            slot = self._root(node)
+            self._slots[node] = slot
+            return slot
         args = tuple(self._slot(arg) for arg in node.args)
         if node.op in ("and", "or"):  # two at a time, as evaluate does
             return reduce(lambda left, right: self._call(_TRUTH[node.op], (left, right), floats=False), args)
@@ -433,6 +469,15 @@ class Kernel:
             slot = self._call(OPERATIONS[node.op], args, floats=None if node.op in _NUMERIC else False)
         self._slots[node] = slot
         return slot
+
+    def _root(self, node: Op) -> int:
+        """A numeric block's root: its residual compiled as a kernel of its own, called by one step."""
+        residual, bound, low, high = node.args
+        inner = Kernel({"r": residual}, {name: value for name, value in self._known.items() if name != "pi"})
+        inputs = tuple(name for name in inner.inputs if name != _bound(bound))
+        step = _Root(lambda values: inner(values)["r"], inputs, _bound(bound))
+        return self._call(step, (self._slot(low), self._slot(high), *(self._slot(Sym(name)) for name in inputs)),
+                          floats=True)
 
     def _power(self, args: tuple[int, ...]) -> int:
         base, exponent = args

@@ -25,6 +25,7 @@ from grader.bank.template import Template
 from grader.model.expr import Node, Num, Sym, format_number, names, parse
 from grader.model.kernel import evaluate
 from grader.model.quantities import ACCELERATION, ANGLE, Dimension, dimension_of, si_unit
+from grader.model.roots import TOLERANCE_TEXT
 from grader.render.readable import Names, readable
 from grader.render.typst_math import math, name, number
 from grader.render.typst_text import Typ, string, text
@@ -189,6 +190,7 @@ class StepForm:
     solved: Node
     solved_math: str
     block: tuple[str, ...] = ()  # the unknowns of the block of equations solved together (empty: one equation)
+    numeric: bool = False  # the unknown of a block solved numerically: shown by its value alone
 
 
 @dataclass(frozen=True)
@@ -212,6 +214,11 @@ def worked_form(template: Template, compiled: Compiled | None = None) -> WorkedF
     quantities = set(dimensions) | {s.unknown for s in compiled.steps}
     steps = []
     for step in compiled.steps:
+        if step.numeric:  # its root(...) tree is what the kernel finds, not a form a reader follows
+            lhs, rhs = (readable(side, reader) for side in step.equation)
+            steps.append(StepForm(step.unknown, relation_markup(step.relation, quantities),
+                                  f"{math(lhs)} = {math(rhs)}", Sym(step.unknown), "", step.block, numeric=True))
+            continue
         lhs, rhs, solved = (readable(side, reader) for side in (*step.equation, step.solved))
         # A block's equations are each shown, labelled, before the block's solution.
         shown = step.block or not (lhs == Sym(step.unknown) and rhs == solved)
@@ -254,7 +261,8 @@ def worked(template: Template, variant: ProblemVariant, compiled: Compiled | Non
         if step.block:
             if step.unknown == step.block[0]:
                 steps += _block_equations(form.steps[index:index + len(step.block)])
-            step = replace(step, relation=simultaneous(len(step.block)), equation=None)
+            step = replace(step, relation=(numerically if step.numeric else simultaneous)(len(step.block)),
+                           equation=None)
         scaling = scaled.get(step.unknown)
         steps.append(_step(step, scaling, form.dimensions.get(step.unknown), context))
         if scaling is not None:
@@ -284,14 +292,29 @@ def simultaneous(count: int) -> Typ:
     return text(f"simultaneous solution of {', '.join(letters[:-1])} and {letters[-1]} gives")
 
 
+def numerically(count: int) -> Typ:
+    """What a block solved numerically says before its unknown's value, with the tolerance the root is found to.
+
+    >>> str(numerically(2))
+    '#"(a) and (b) solved together numerically (to 1e−15, relative) give";'
+    """
+    letters = [_letter(index) for index in range(count)]
+    return text(f"{', '.join(letters[:-1])} and {letters[-1]} solved together numerically (to {TOLERANCE_TEXT}, "
+                "relative) give")
+
+
 def quantity_dimensions(template: Template, compiled: Compiled) -> dict[str, Dimension]:
     """The dimension of every parameter, symbol, constant and step quantity whose dimension can be
     told (a step's from its solved form; a bare number, a velocity that stays 0, says nothing)."""
     known: dict[str, Dimension] = {n: p.unit.dimension for n, p in template.parameters.items()}
     known.update({n: s.unit.dimension for n, s in template.symbols.items()})
     known.update({c: ACCELERATION for c in compiled.constants if c == "g"})
+    asked = {spec.value.name: spec.unit.dimension for spec in template.answers.values() if isinstance(spec.value, Sym)}
     for step in compiled.steps:
-        found = None if isinstance(step.solved, Num) else dimension_of(step.solved, known, strict=False)
+        if step.numeric:  # a root has the dimension of the answer that asks for it, if one does
+            found = asked.get(step.unknown)
+        else:
+            found = None if isinstance(step.solved, Num) else dimension_of(step.solved, known, strict=False)
         if found is not None:
             known[step.unknown] = found
     return known
@@ -321,8 +344,8 @@ def _symbol_note(symbol: str, description: str) -> Typ:
 
 def _step(step: StepForm, scaling: Scaling | None, dim: Dimension | None, context: _Context) -> WorkedStep:
     relation, equation = step.relation, step.equation
-    chain = [name(step.unknown), step.solved_math]
-    substituted = math(step.solved, context.shown, context.degrees)
+    chain = [name(step.unknown)] if step.numeric else [name(step.unknown), step.solved_math]
+    substituted = chain[-1] if step.numeric else math(step.solved, context.shown, context.degrees)
     if substituted != chain[-1]:
         chain.append(substituted)
     if step.unknown in context.undefined:

@@ -50,6 +50,7 @@ class Step:
     equation: tuple[Node, Node]
     solved: Node
     block: tuple[str, ...] = ()
+    numeric: bool = False  # solved numerically: ``solved`` is a ``root(...)`` tree (a block's first step)
 
     def __str__(self) -> str:
         lhs, rhs = (to_text(side) for side in self.equation)
@@ -123,6 +124,7 @@ class Compiled:
             "steps": [{"unknown": s.unknown, "relation": s.relation,
                        "equation": [to_json(s.equation[0]), to_json(s.equation[1])],
                        "solved": to_json(s.solved)} | ({"block": list(s.block)} if s.block else {})
+                      | ({"numeric": True} if s.numeric else {})
                       for s in self.steps],
             "checks": [{"holds": to_json(c.holds), "message": c.message, "subject": tree(c.subject)}
                        for c in self.checks],
@@ -143,7 +145,7 @@ class Compiled:
             template_id=data["template"], source_hash=data["source_hash"],
             parameters=tuple(data["parameters"]), constants=dict(data["constants"]),
             steps=tuple(Step(s["unknown"], s["relation"], _sides(s["equation"]), from_json(s["solved"]),
-                             tuple(map(str, s.get("block", ())))) for s in data["steps"]),
+                             tuple(map(str, s.get("block", ()))), s.get("numeric") is True) for s in data["steps"]),
             checks=tuple(Check(from_json(c["holds"]), c["message"], tree(c["subject"])) for c in data["checks"]),
             answers={name: CompiledAnswer(name, a["unit"], tree(a["numeric"]), tree(a["symbolic"]),
                                           tuple(Undefined(from_json(u["when"]), u["reason"]) for u in a["undefined"]))

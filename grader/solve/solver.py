@@ -29,13 +29,15 @@ import sympy as sp
 
 from grader.bank.template import Template
 from grader.base.errors import SYMPY_FAILURES, TemplateError, shown, unworkable
-from grader.model.expr import names
+from grader.model.expr import Node, Num, Op, names, substitute
 from grader.model.quantities import Unit
+from grader.model.roots import TOLERANCE_TEXT
 from grader.physics.effects import CATALOGUE, Condition, Relation
 from grader.physics.symbolic import INNER as _INNER
 from grader.physics.symbolic import Context, cosd, from_node, sind, to_node
 from grader.solve.compiled import Check, Compiled, CompiledAnswer, Step, Undefined
 from grader.solve.stable import numeric_order, stabilize
+from grader.solve.torn import identity, interval, root_node, roots_at
 
 
 @dataclass(frozen=True)
@@ -47,11 +49,14 @@ class _Solved:
     branch: bool = False  # the magnitude only: the sign is the one the unknown has in the scene's own solution
     block: tuple[Any, ...] = ()  # the unknowns solved together with this one (empty: a step of one equation)
     requires: tuple[Condition, ...] = ()  # what the step needs of the values (a block: that it fixes its unknowns)
+    residual: Any = None  # a numeric block's unknown: lhs - rhs of the equation that closes the block (else None)
+    interval: tuple[float, float] = (0.0, 0.0)  # a numeric block's unknown: where its one root is looked for (SI)
+    at_points: tuple[float, ...] = ()  # a numeric block's unknown: its root at each of derive's points (SI)
 
 
 def derive(relations: list[Relation], knowns: Iterable[Any], given: Iterable[Any],
-           branches: bool = False, wanted: Iterable[Any] = (), points: Sequence[Mapping[Any, float]] = ()
-           ) -> list[_Solved]:
+           branches: bool = False, wanted: Iterable[Any] = (), points: Sequence[Mapping[Any, float]] = (),
+           numeric: bool = False) -> list[_Solved]:
     """Solve relations one unknown at a time, earliest relation first, as far as they go; then, while
     something in ``wanted`` is still unknown, the next block of equations solved together
     (:func:`next_block`), and one at a time again.
@@ -61,6 +66,7 @@ def derive(relations: list[Relation], knowns: Iterable[Any], given: Iterable[Any
     known only up to sign (a step marked ``branch``), where no other relation gives it. ``points`` (the
     inputs' values in SI at the template's example and at draws across its sampling) tell apart the roots
     of a block that the scene's conditions select only once the values are known (:func:`solve_block`).
+    With ``numeric``, a block with no closed form is solved numerically (:func:`~grader.solve.torn.torn_block`).
     """
     known, given_set, targets = set(knowns), set(given), set().union(*(sp.sympify(w).free_symbols for w in wanted))
     used: set[int] = set()
@@ -75,6 +81,14 @@ def derive(relations: list[Relation], knowns: Iterable[Any], given: Iterable[Any
         if not targets - known:
             return chain
         block = next_block(relations, known, used, points, chain, targets)
+        if block is None and numeric:
+            torn = torn_block(relations, known, given_set, used, points, chain, targets)
+            if isinstance(torn, str):
+                raise TemplateError(_INNER, torn, "a scene that tells its solutions apart",
+                                    "two physical solutions that nothing in it (a sign, a domain, a condition) tells "
+                                    "apart: give the quantity that decides between them, or ask the question the "
+                                    "other way round")
+            block = torn
         if block is None:
             return chain
         chain += block
@@ -147,7 +161,8 @@ def next_block(relations: list[Relation], known: set[Any], used: set[int],
         if len(members) > MAX_BLOCK or set().union(*(unknowns_of[index] for index in members)) != set(unknowns):
             continue
         found = solve_block([relations[index] for index in members], unknowns, relations, known,
-                            lambda: [(point, _values_at(point, chain or [])) for point in points], asked)
+                            lambda: [(point, _values_at(point, chain or [], i)) for i, point in enumerate(points)],
+                            asked)
         if isinstance(found, str):
             ambiguous.append(found)
         elif found is not None:
@@ -272,6 +287,16 @@ def solve_block(block: list[Relation], unknowns: list[Any], relations: list[Rela
     return [replace(steps[0], requires=_determined(block, numerators, unknowns, roots[0])), *steps[1:]]
 
 
+def _sides(relation: Relation) -> tuple[Any, Any]:
+    """A relation's two sides as a residual takes them: its solved form where it has one (``theta =
+    atan2(v_n, v_t)``, which keeps the quadrant that ``tan(theta) = v_n/v_t`` loses, and has no pole), else its
+    equation."""
+    for unknown, solved in relation.solutions.items():
+        if unknown not in sp.sympify(solved).free_symbols:
+            return sp.sympify(unknown), sp.sympify(solved).doit()
+    return sp.sympify(relation.lhs), sp.sympify(relation.rhs)
+
+
 def _as_written(root: Any) -> Any:
     """A block's root as a textbook writes it, the shorter of: factored (``m1 m2 (1 + e)(v2 - v1_out)/(e m2 -
     m1)``, whose difference of inputs is also formed first), or a quotient whose numerator is collected on the
@@ -339,12 +364,85 @@ def _admissible(root: Mapping[Any, Any], conditions: list[Any], at: Mapping[Any,
     return all(sp.sympify(c).xreplace({**at, **real}) is not sp.false for c in conditions)
 
 
-def _values_at(point: Mapping[Any, float], chain: list[_Solved]) -> dict[Any, Any]:
-    """The inputs at ``point`` and every quantity the chain has found so far, evaluated there."""
+def _values_at(point: Mapping[Any, float], chain: list[_Solved], index: int) -> dict[Any, Any]:
+    """The inputs at ``point`` (derive's ``index``-th) and every quantity the chain has found so far, evaluated
+    there (a numeric block's unknown: the root found there, if one was)."""
     values: dict[Any, Any] = {symbol: sp.Float(value) for symbol, value in point.items()}
     for solved in chain:
+        if solved.residual is not None:
+            values[solved.unknown] = sp.Float(solved.at_points[index]) if solved.at_points[index] == \
+                solved.at_points[index] else sp.nan
+            continue
         values[solved.unknown] = sp.N(solved.numeric.doit().xreplace(values))
     return values
+
+
+def torn_block(relations: list[Relation], known: set[Any], given: set[Any], used: set[int],
+               points: Sequence[Mapping[Any, float]], chain: list[_Solved], asked: set[Any]
+               ) -> list[_Solved] | str | None:
+    """A block with no closed form, torn as equation-based tools tear it: one of its unknowns taken as known
+    (an asked one first), the others follow one equation at a time, until an equation is left with no unknown;
+    that equation, a residual in the torn unknown alone, is solved numerically (:mod:`grader.model.roots`).
+    Its steps: the torn unknown (with its residual, the interval its root is looked for in and its roots at
+    ``points``), then the unknowns that follow from it. None if no unknown tears a block that has a root at
+    some point; a sentence naming two roots if at some point two meet every condition (marked used: else)."""
+    composed: dict[Any, Any] = {}
+    for solved in chain:
+        composed[solved.unknown] = solved.unknown if solved.residual is not None else \
+            solved.numeric.doit().xreplace(composed)
+    open_unknowns = {s for i, r in enumerate(relations) if i not in used for s in r.symbols() - known}
+    for tear in sorted(open_unknowns, key=lambda s: (s not in asked, str(s))):
+        trial, have, closing = set(used), known | {tear}, None
+        inner: list[_Solved] = []
+        while True:
+            found = {tear} | {step.unknown for step in inner}
+            closing = next((i for i, r in enumerate(relations)
+                            if i not in trial and r.symbols() <= have and r.symbols() & found), None)
+            if closing is None:
+                step = _next_step(relations, have, given, trial)
+                if step is None:
+                    break
+                inner.append(step)
+                have.add(step.unknown)
+                continue
+            within = {**composed, tear: tear}
+            for step in inner:
+                within[step.unknown] = step.numeric.doit().xreplace(within)
+            closes = relations[closing]
+            lhs, rhs = _sides(closes)
+            residual = lhs - rhs
+            reduced = residual.xreplace(within)
+            unknowns = {tear} | {step.unknown for step in inner}
+            conditions = [c.holds for relation in relations for c in relation.requires
+                          if sp.sympify(c.holds).free_symbols & unknowns and sp.sympify(c.holds).free_symbols <= have]
+            low, high = interval(tear, reduced, conditions)
+            if tear in reduced.free_symbols and not (points and identity(
+                    lhs.xreplace(within), rhs.xreplace(within), tear, low, high, _values_at(points[0], chain, 0))):
+                break
+            trial.add(closing)  # an equation the torn unknown's steps already satisfy: it closes nothing
+            closing = None
+        if closing is None:
+            continue
+        block = [relations[closing]] + [step.relation for step in inner]
+        found_at: list[float] = []
+        for index, point in enumerate(points):
+            at = _values_at(point, chain, index)
+            admissible = [root for root in roots_at(reduced, tear, low, high, at)
+                          if _admissible({tear: sp.Float(root), **{step.unknown: within[step.unknown].xreplace(
+                              {tear: sp.Float(root)}) for step in inner}}, conditions, at)]
+            if len(admissible) > 1:
+                used.add(closing)
+                labels = " and ".join(f"({chr(97 + i)}) {relation.label}" for i, relation in enumerate(block))
+                one, other = (f"{tear} = {root:.6g}" for root in admissible[:2])
+                return f"the equations {labels}, which give {one} or {other} (SI) at {_where(point)}"
+            found_at.append(admissible[0] if admissible else float("nan"))
+        if all(value != value for value in found_at):
+            continue
+        used.update(trial | {closing})
+        head = _Solved(tear, relations[closing], tear, tear, block=tuple([tear, *(step.unknown for step in inner)]),
+                       residual=residual, interval=(low, high), at_points=tuple(found_at))
+        return [head, *inner]
+    return None
 
 
 def _solve(relation: Relation, unknown: Any) -> Any:
@@ -397,12 +495,16 @@ class _Compiler:
                           for r in CATALOGUE[stage.effect].relations(stage, self.ctx)]
         self.degree_angles = [self.ctx.symbols[n] for n, p in template.parameters.items() if p.unit.pi_power]
         self.inputs = {self.ctx.symbols[n] for n in list(template.parameters) + list(template.symbols)}
+        self.torn: set[Any] = set()  # the unknowns of numeric blocks, which trees may hold until _rooted
+        self.roots: dict[str, Node] = {}  # their root(...) trees over the parameters in template units
+        self.si_roots: dict[str, Node] = {}  # the same in SI, for the steps
         if "g" in self.ctx.symbols:
             self.inputs.add(self.ctx.symbols["g"])
 
     def compile(self) -> Compiled:
         wanted = {name: from_node(spec.value, self.ctx.symbols) for name, spec in self.template.answers.items()}
-        chain = derive(self.relations, self.inputs, self.inputs, wanted=wanted.values(), points=self._points())
+        chain = derive(self.relations, self.inputs, self.inputs, wanted=wanted.values(), points=self._points(),
+                       numeric=True)
         known = self.inputs | {s.unknown for s in chain}
         for name, expr in wanted.items():
             missing = expr.free_symbols - known
@@ -414,15 +516,38 @@ class _Compiler:
         composed: dict[Any, Any] = {}
         for solved in chain:
             # doit(): display forms keep sqrt(2*g*h) whole; the numeric composition wants it evaluated.
-            composed[solved.unknown] = solved.numeric.doit().xreplace(composed)
+            composed[solved.unknown] = solved.unknown if solved.residual is not None else \
+                solved.numeric.doit().xreplace(composed)
+        found = self._numeric_blocks(chain, composed)
         answers = {name: self._answer(name, expr, chain, composed) for name, expr in wanted.items()}
-        checks = self._checks(composed, [c for solved in chain for c in solved.requires])
+        checks = found + self._checks(composed, [c for solved in chain for c in solved.requires])
         self._check_every_parameter_used(chain, wanted.values(), checks)
         return Compiled(
             template_id=self.template.id, source_hash=self.template.source_hash,
             parameters=tuple(self.template.parameters),
             constants={"g": float(self.template.scene.gravity.si)} if self.template.scene.gravity else {},
             steps=tuple(self._step(s) for s in chain), checks=checks, answers=answers)
+
+    def _numeric_blocks(self, chain: list[_Solved], composed: Mapping[Any, Any]) -> tuple[Check, ...]:
+        """Each numeric block's unknown as its ``root(...)`` tree (template units; and SI for its step), which
+        every tree with it takes in its place (:meth:`_tree`), and the check that a draw has its one root."""
+        checks = []
+        for solved in chain:
+            if solved.residual is None:
+                continue
+            name, (low, high) = solved.unknown.name, solved.interval
+            residual = solved.residual.xreplace(dict(composed))
+            self.torn.add(solved.unknown)
+            user = self._tree(self._user_units(residual), "(numeric block)", [solved.unknown])
+            self.si_roots[name] = root_node(substitute(to_node(residual), self.si_roots), name, low, high)
+            root = self.roots[name] = root_node(user, name, low, high)
+            count = len(solved.block)
+            labels = " and ".join(f"({chr(97 + i)})" for i in range(count))
+            checks.append(Check(Op("ge", (root, Num(low))), (
+                f"the equations {labels} do not fix {name} for these values: solved numerically (to "
+                f"{TOLERANCE_TEXT}), they have no root, or more than one, for {name} between {low:.6g} and "
+                f"{high:.6g} (SI)")))
+        return tuple(checks)
 
     def _points(self, count: int = 8) -> list[dict[Any, float]]:
         """The inputs in SI (symbols without value at 1) at the template's example, if it gives every parameter,
@@ -462,6 +587,8 @@ class _Compiler:
         used = {str(s) for s in set().union(*(sp.sympify(w).free_symbols for w in wanted))}
         for solved in chain:
             used |= {str(s) for s in solved.display.free_symbols | solved.numeric.free_symbols}
+            if solved.residual is not None:
+                used |= {str(s) for s in solved.residual.free_symbols}
         for check in checks:
             used |= names(check.holds)
         for name in self.template.parameters:
@@ -488,8 +615,9 @@ class _Compiler:
         if not tied:
             return "; no stage involves it"
         return (f"; the equations left tie {', '.join(map(self._named, tied))} together (two or more unknowns each) "
-                f"and no set of at most {MAX_BLOCK} of them fixes as many unknowns as it has with one closed-form "
-                "solution (polynomial, of degree at most 4 together): give one of them as a parameter")
+                f"and no set of them fixes as many unknowns as it has, in closed form (at most {MAX_BLOCK}, "
+                "polynomial, of degree at most 4 together) or numerically (one unknown from which the others "
+                "follow, with a root at the sampled values): give one of them as a parameter")
 
     def _named(self, name: str) -> str:
         """A quantity as a message names it: a name the template wrote as is; one the solver gave (the template
@@ -508,9 +636,11 @@ class _Compiler:
         return f"{name} (stages[{index}].{field}, unnamed)" if field else name
 
     def _step(self, solved: _Solved) -> Step:
+        solved_form = self.si_roots[solved.unknown.name] if solved.residual is not None else \
+            to_node(for_reader(solved.display))
         return Step(solved.unknown.name, solved.relation.label,
-                    (to_node(solved.relation.lhs), to_node(solved.relation.rhs)), to_node(for_reader(solved.display)),
-                    tuple(unknown.name for unknown in solved.block))
+                    (to_node(solved.relation.lhs), to_node(solved.relation.rhs)), solved_form,
+                    tuple(unknown.name for unknown in solved.block), numeric=solved.residual is not None)
 
     def _answer(self, name: str, expr: Any, chain: list[_Solved], composed: Mapping[Any, Any]) -> CompiledAnswer:
         spec = self.template.answers[name]
@@ -527,7 +657,8 @@ class _Compiler:
 
     def _tree(self, expr: Any, name: str, extra: Iterable[Any] = ()) -> Any:
         """A numeric expression over parameters (and ``extra``) only, stabilised, as a tree."""
-        allowed = {self.ctx.symbols[p] for p in self.template.parameters} | {self.ctx.symbols.get("g"), *extra}
+        allowed = {self.ctx.symbols[p] for p in self.template.parameters} | {self.ctx.symbols.get("g"), *extra,
+                                                                              *self.torn}
         stable = stabilize(expr, self.degree_angles)
         if stable.free_symbols - allowed:
             stable = stabilize(sp.cancel(stable), self.degree_angles)
@@ -535,7 +666,11 @@ class _Compiler:
         if stray:
             raise TemplateError(self.template.where, f"answers.{name}", "a number once the parameters are given",
                                 f"an expression that still depends on {', '.join(sorted(map(str, stray)))}")
-        return numeric_order(to_node(stable))
+        return self._rooted(numeric_order(to_node(stable)))
+
+    def _rooted(self, tree: Node) -> Node:
+        """``tree`` with each numeric block's unknown replaced by its ``root(...)`` tree."""
+        return substitute(tree, self.roots) if self.roots else tree
 
     def _user_units(self, expr: Any) -> Any:
         """Rewrite an SI expression over SI-valued names into one over values in template units."""
@@ -588,7 +723,7 @@ class _Compiler:
         difference = stabilize(holds.lhs - holds.rhs, self.degree_angles)
         # Against zero, a positive factor changes nothing: 381*v*x/1250 > 0 is x > 0.
         kept = [f for f in sp.Mul.make_args(difference) if not f.is_positive]
-        return numeric_order(to_node(type(holds)(sp.Mul(*kept), 0)))
+        return self._rooted(numeric_order(to_node(type(holds)(sp.Mul(*kept), 0))))
 
 
 def for_reader(expr: Any) -> Any:
@@ -622,6 +757,8 @@ def _needed(chain: list[_Solved], wanted: Iterable[Any]) -> list[_Solved]:
             needed.add(symbol)
             step = producer[symbol]
             frontier |= step.display.free_symbols | step.numeric.free_symbols
+            if step.residual is not None:
+                frontier |= step.residual.free_symbols
     return [s for s in chain if s.unknown in needed]
 
 

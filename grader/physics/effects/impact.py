@@ -9,8 +9,9 @@ with inverse masses ``w = 1/m`` (``w = 0`` for a fixed surface); after-impact ve
 mass-centre form ``v1' = v_c - e w1 (v1 - v2)/(w1 + w2)``, which equals ``v1 - J w1`` but keeps its
 accuracy when ``e`` is small or the masses are very unequal; energy lost as
 ``1/2 mu (1 - e)(1 + e) v_rel^2``, or ``1/2 mu (v_rel - v_sep)(v_rel + v_sep)`` when ``e`` itself is derived.
-When the bodies move on together (a perfectly plastic impact) the worked solution takes a speed before from
-conservation of momentum, ``m1 v1 + m2 v2 = (m1 + m2) v'``, as the textbook does; its kernel is the impulse form's.
+When the bodies move on together (a perfectly plastic impact) the worked solution takes the common speed after,
+or a speed before, from conservation of momentum, ``m1 v1 + m2 v2 = (m1 + m2) v'``, as the textbook does,
+whichever body is listed first; its kernel is the impulse form's (the mass-centre form for the speed after).
 
 Force law (simulation): a Kelvin-Voigt contact calibrated to ``e`` (:class:`ContactLaw`), plus the
 weight during contact only where asked for.
@@ -114,12 +115,15 @@ class _Impact:
         relations = [
             Relation(f"impulse along n in the impact of {first} and {second}, with restitution {e_text}",
                      impulse, (1 + used) * approach / (w1 + w2), solutions=given_impulse, general=False),
-            Relation(f"impulse-momentum for {first} along n", a1, u1 - impulse * w1,
-                     solutions={a1: u1 - impulse * w1, impulse: (u1 - a1) / w1},
-                     stable={a1: (Stable(centre - used * w1 * approach / (w1 + w2)),)}),
         ]
         if w1 != 0 and w2 != 0 and sp.simplify(a1 - a2) == 0:
+            # Before either body's impulse-momentum: the common velocity is the textbook's momentum balance,
+            # whichever body is listed first (the bullet's own, v - J/m_b, cancels).
             relations.append(self._momentum(used))
+        relations.append(
+            Relation(f"impulse-momentum for {first} along n", a1, u1 - impulse * w1,
+                     solutions={a1: u1 - impulse * w1, impulse: (u1 - a1) / w1},
+                     stable={a1: (Stable(centre - used * w1 * approach / (w1 + w2)),)}))
         if w2 != 0:
             relations.append(Relation(
                 f"impulse-momentum for {second} along n", a2, u2 + impulse * w2,

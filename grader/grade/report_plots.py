@@ -9,12 +9,14 @@ each student as a point only in a class of at most :data:`POINTS_UP_TO`.
 
 from __future__ import annotations
 
+import gc
 import io
 import multiprocessing
 import os
 import re
 import sys
 import threading
+import warnings
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from contextlib import contextmanager
 from typing import Any
@@ -48,8 +50,14 @@ def drawn(jobs: Mapping[str, Job], workers: int | None = None) -> dict[str, str]
         return {name: function(*arguments) for name, (function, arguments) in jobs.items()}
     _JOBS[:] = [jobs[name] for name in names]
     try:
-        with multiprocessing.get_context("fork").Pool(count) as pool:
-            return dict(zip(names, pool.map(_draw, range(len(names)), chunksize=1), strict=True))
+        with warnings.catch_warnings():
+            # Python 3.12+ warns of any thread at a fork; the only ones here are numpy's BLAS workers (no
+            # Python thread runs: _can_fork), which hold no lock of ours and are forked safely by their library.
+            warnings.filterwarnings("ignore", r"This process .* is multi-threaded", DeprecationWarning)
+            # The workers never collect cycles: a pass would touch every object of the class they share
+            # with this process, and copy it.
+            with multiprocessing.get_context("fork").Pool(count, initializer=gc.disable) as pool:
+                return dict(zip(names, pool.map(_draw, range(len(names)), chunksize=1), strict=True))
     finally:
         _JOBS.clear()
 

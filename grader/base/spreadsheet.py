@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import csv
 import io
+import itertools
 import math
 import re
 from collections.abc import Iterable, Iterator, Sequence
@@ -81,10 +82,11 @@ def csv_pieces(rows: Iterable[Sequence[object]], rows_per_piece: int = 2000) -> 
     whole text of a big file would be held twice (its writer's buffer and the text)."""
     stream = io.StringIO()
     writer = csv.writer(stream, lineterminator="\n")
-    for count, row in enumerate(rows, 1):
-        writer.writerow(row)
-        if count % rows_per_piece == 0:
-            yield stream.getvalue()
-            stream.seek(0)
-            stream.truncate()
-    yield stream.getvalue()
+    rows = iter(rows)
+    writer.writerows(itertools.islice(rows, rows_per_piece))  # a piece's rows in one call: no loop in Python
+    while stream.tell():  # every row writes at least its line end: an empty piece is the end
+        yield stream.getvalue()
+        stream.seek(0)
+        stream.truncate()
+        writer.writerows(itertools.islice(rows, rows_per_piece))
+    yield ""

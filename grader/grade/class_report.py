@@ -81,9 +81,10 @@ FLAGGED_SHOWN = 50  # flagged pairs listed in the report; integrity.csv has ever
 def class_report(graded: Graded, integrity: Integrity | None = None) -> str:
     """The page, for a grading run (``integrity``: its integrity check, worked out here if not given)."""
     summary = summarize(graded)
+    figures = _figures(summary)
     title = f"{summary.key.title}: class report"
-    body = "\n".join([_header(summary), _late(graded), _scores(summary), _parts(summary), _mistakes(summary),
-                      _difficulty(summary), _invalid(summary), _tolerances(summary),
+    body = "\n".join([_header(summary), _late(graded), _scores(summary, figures), _parts(summary, figures),
+                      _mistakes(summary), _difficulty(summary, figures), _invalid(summary), _tolerances(summary),
                       _integrity(graded, check(graded) if integrity is None else integrity)])
     return ("<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
             "<meta http-equiv=\"Content-Security-Policy\" content=\"default-src 'none'; style-src 'unsafe-inline'\">\n"
@@ -162,17 +163,26 @@ def _lateness(minutes: int) -> str:
     return f"{days} d {hours} h {left} min" if days else f"{hours} h {left} min" if hours else f"{left} min"
 
 
-def _scores(summary: ClassSummary) -> str:
-    from grader.grade.report_plots import score_histogram
+def _figures(summary: ClassSummary) -> dict[str, str]:
+    """The page's figures by name, drawn at once (in parallel where the machine can)."""
+    from grader.grade.report_plots import Job, difficulty, drawn, score_histogram, verdict_bars
 
+    jobs: dict[str, Job] = {"histogram": (score_histogram, (summary,)), "verdicts": (verdict_bars, (summary,))}
+    for number, problem in enumerate(summary.problems, 1):
+        if problem.drawn and problem.attempted.any():
+            jobs[f"problem-{number}"] = (difficulty, (problem, f"problem-{number}"))
+    return drawn(jobs)
+
+
+def _scores(summary: ClassSummary, figures: dict[str, str]) -> str:
     percent = summary.percent
     below = int((percent < 50).sum())
     return (f"<h2 id=\"scores\">Scores</h2>\n<p>Each student's score as a share of the points they could earn; "
-            f"{below:,} of {len(percent):,} scored under 50 %.</p>\n{score_histogram(summary)}")
+            f"{below:,} of {len(percent):,} scored under 50 %.</p>\n{figures['histogram']}")
 
 
-def _parts(summary: ClassSummary) -> str:
-    from grader.grade.report_plots import color, verdict_bars
+def _parts(summary: ClassSummary, figures: dict[str, str]) -> str:
+    from grader.grade.report_plots import color
 
     kinds = summary.kinds
     head = ("<tr><th>part</th><th>answer</th><th class=\"n\">mean score</th>"
@@ -184,7 +194,7 @@ def _parts(summary: ClassSummary) -> str:
         rows.append(f"<tr><td>{_e(part.label)}</td><td>{_answer(part)}</td>"
                     f"<td class=\"n\">{_percent(100 * part.mean_credit)}</td>{shares}</tr>")
     return (f"<h2 id=\"parts\">Parts</h2>\n<p>What share of the class got each verdict, part by part (every "
-            f"student of the key counts: a part not answered is <i>missing</i>).</p>\n{verdict_bars(summary)}\n"
+            f"student of the key counts: a part not answered is <i>missing</i>).</p>\n{figures['verdicts']}\n"
             f"<table>\n{head}\n" + "\n".join(rows) + "\n</table>")
 
 
@@ -211,7 +221,7 @@ def _mistake(part: PartSummary, mistake: str) -> str:
     return code if says is None else f"{_e(says)} <small class=\"muted\">{code}</small>"
 
 
-def _difficulty(summary: ClassSummary) -> str:
+def _difficulty(summary: ClassSummary, figures: dict[str, str]) -> str:
     corners = [(problem, parameter, part) for problem in summary.problems
                for parameter, part in problem.hard_corners()]
     text = ["<h2 id=\"difficulty\">Difficulty per variant</h2>\n<p>Each problem's score against each parameter "
@@ -229,13 +239,12 @@ def _difficulty(summary: ClassSummary) -> str:
             + "</ul>")
     else:
         text.append("<p>No range of any parameter scored clearly below its problem.</p>")
-    text += [_problem(problem, f"problem-{number}") for number, problem in enumerate(summary.problems, 1)]
+    text += [_problem(problem, figures.get(f"problem-{number}", ""))
+             for number, problem in enumerate(summary.problems, 1)]
     return "\n".join(text)
 
 
-def _problem(problem: ProblemSummary, name: str) -> str:
-    from grader.grade.report_plots import difficulty
-
+def _problem(problem: ProblemSummary, figure: str) -> str:
     attempted = int(problem.attempted.sum())
     head = (f"<h3>Problem {_e(problem.key)}: {_e(problem.title)}</h3>\n<p class=\"muted\">parts "
             f"{_e(', '.join(problem.labels))}; {_students(attempted)} answered, mean score "
@@ -255,7 +264,6 @@ def _problem(problem: ProblemSummary, name: str) -> str:
         notes.append("the key holds no parameters for this problem")
     elif not varied and not beyond and attempted:
         notes.append("no parameter varies among the students who answered")
-    figure = difficulty(problem, name) if varied and attempted else ""
     return "\n".join([head, figure, *(f"<p class=\"note\">{_e(note)}</p>" for note in notes)])
 
 

@@ -26,6 +26,16 @@ CHAR = 0.15  # cm per character of a label at the figure's text size, an estimat
 LINE = 0.42  # cm per line of a label
 
 
+@dataclass(frozen=True)
+class VelocityArrow:
+    """A velocity drawn: the arrow's direction (a unit vector, y up), the label beside it, and the
+    direction in which the quantity its label names is positive (None: a speed, never negative)."""
+
+    direction: Point
+    label: tuple[str, ...]
+    positive: Point | None
+
+
 def _fmt(value: float) -> str:
     return f"{value:.2f}"
 
@@ -40,7 +50,7 @@ class Drawing:
     occupied: list[tuple[float, float, float, float]] = field(default_factory=list)
     strokes: list[tuple[Point, Point]] = field(default_factory=list)
     bodies: list[str] = field(default_factory=list)  # the scene's bodies named, in the order drawn: the record
-
+    velocities: list[VelocityArrow] = field(default_factory=list)  # the velocity arrows drawn: the record
 
     def _add(self, kind: str, points: Sequence[Point], options: str = "", radius: float = 0.0) -> None:
         for x, y in points:
@@ -112,6 +122,16 @@ class Drawing:
         self.line(tail, (tip[0] - ux * head * 0.8, tip[1] - uy * head * 0.8), width)
         self.polygon([tip, (base[0] - uy * head * 0.38, base[1] + ux * head * 0.38),
                       (base[0] + uy * head * 0.38, base[1] - ux * head * 0.38)])
+
+    def velocity(self, tail: Point, tip: Point, lines: Sequence[str], positive: Point | None = None,
+                 width: float = 0.9, head: float = 0.22) -> None:
+        """A velocity's arrow, from ``tail`` the way the body moves to ``tip``, kept in :attr:`velocities`
+        with ``lines``, the label its caller places beside it, and ``positive``, the direction in which the
+        quantity named there is positive (None for a speed)."""
+        length = _m.hypot(tip[0] - tail[0], tip[1] - tail[1]) or 1.0
+        self.velocities.append(VelocityArrow(((tip[0] - tail[0]) / length, (tip[1] - tail[1]) / length),
+                                             tuple(lines), positive))
+        self.arrow(tail, tip, width, head)
 
     def arc(self, center: Point, radius: float, start: float, end: float) -> None:
         """A circular arc between two angles (radians, counter-clockwise from +x)."""

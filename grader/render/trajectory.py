@@ -97,11 +97,11 @@ def _release(canvas: Drawing, scene: SceneView, stage: Stage, height: float, ang
         canvas.line((0.0, 0.0), (0.0, height), width=0.4, dash="dashed", gray=True)
         canvas.dimension((-0.35, 0.0), (-0.35, height), scene.given(stage.fields["height"]), "left")
     tip = (length * _m.cos(angle), height + length * _m.sin(angle))
-    canvas.arrow((0.0, height), tip)
+    lines = _launch(scene, stage)
+    canvas.velocity((0.0, height), tip, lines[:1])
     if angle > 0.02:  # the angle from the horizontal, marked
         canvas.line((0.0, height), (0.75 * length, height), width=0.4, dash="dashed", gray=True)
         canvas.arc((0.0, height), 0.55 * length, 0.0, angle)
-    lines = _launch(scene, stage)
     places = [((-0.15, height + 0.2), "se"), ((-0.5, height + 0.1), "e")]
     spot, anchor = next((p for p in places if canvas.fits(*p, lines)), (corner, "sw"))
     canvas.label(spot, anchor, lines)

@@ -267,3 +267,21 @@ def test_the_issues_coupling_labels_car_bs_leftward_velocity_with_its_magnitude(
     leftward = [a for label, a in arrows.items() if any("5.2" in line for line in label)]
     assert [a.label for a in leftward] == [('|v_B| = 5.2 thin "km/h"',)]
     assert leftward[0].direction == (-1.0, 0.0)
+
+
+def _paths(template: Template, printed: dict[str, str]) -> list[str]:
+    variant = ProblemVariant("1", template.id, "v", {n: float(v) for n, v in printed.items()}, printed, ())
+    typst, _ = figure_record(template, variant, _values(template, variant))
+    return re.findall(r"fig-path\([^\n]*", str(typst))
+
+
+def test_the_issues_wall_throw_draws_the_asked_heights_not_to_scale_and_the_givens_to_scale() -> None:
+    """Issue 32: `y_hit` and `x_land` could be measured off wall-throw's figure. The path now depends on
+    nothing but the givens that do not decide them alone: another speed or restitution draws the same
+    path; another release height or wall distance does not."""
+    template = BANK["wall-throw"]
+    printed = dict(example_variant(template).printed)
+    drawn = _paths(template, printed)
+    assert drawn and _paths(template, {**printed, "v0": "19.0", "e": "0.45"}) == drawn
+    assert _paths(template, {**printed, "h0": "1.90"}) != drawn
+    assert _paths(template, {**printed, "D": "4.0"}) != drawn

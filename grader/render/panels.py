@@ -279,8 +279,10 @@ PANELS: dict[str, PanelKind] = {
                        "the skid from the point of impact dimensioned; alone: the body at rest at the end of its "
                        "skid mark, the distance dimensioned, its speed at the start an arrow"),
     "flight": PanelKind(_claim_flight, _draw_flight,
-                        "the path to scale: to a wall (with the impact there), solid to the wall, dashed from the "
-                        "wall to the ground (the flight after the impact); to the ground, from its start height"),
+                        "the path: to a wall (with the impact there), solid to the wall, dashed from the wall to "
+                        "the ground (the flight after the impact), given lengths to scale, an asked height on the "
+                        "wall or landing distance drawn but not to scale; to the ground, to scale from its start "
+                        "height"),
     "bounces": PanelKind(_one, _draw_bounces,
                          "the drop and the decaying arcs until the body rests, heights and time along the floor to "
                          "scale, the bounce whose height is asked marked by its name"),

@@ -17,7 +17,7 @@ import math as _m
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
-from grader.render.typst_text import Typ, string
+from grader.render.typst_text import Typ, body_name, string
 
 Point = tuple[float, float]
 PAD = 0.05
@@ -110,7 +110,7 @@ class Drawing:
         """A body's name (and ``more`` lines, its mass), placed as :meth:`label` places lines, and
         kept in :attr:`bodies`, the record of the scene's bodies this drawing shows."""
         self.bodies.append(body)
-        self.label(at, anchor, [str(string(body)), *more])
+        self.label(at, anchor, [str(string(body_name(body))), *more])
 
     def arrow(self, tail: Point, tip: Point, width: float = 0.9, head: float = 0.22) -> None:
         """An arrow: a line and a triangular head."""

@@ -115,6 +115,9 @@ class Sheet:
     problems: tuple[ProblemSheet, ...]
 
 
+NO_NOTE = Typ("")
+
+
 @dataclass(frozen=True)
 class KeyAnswer:
     """An answer in the key: where it comes from and its value (math), or why it has none."""
@@ -124,7 +127,7 @@ class KeyAnswer:
     value: Typ
     points: str
     tolerance: str
-    widened: Typ = Typ("")  # a widened tolerance, with why (what honest rounding needs): a note under the answers
+    widened: Typ = NO_NOTE  # a widened tolerance, with why (what honest rounding needs): a note under the answers
 
 
 @dataclass(frozen=True)
@@ -357,7 +360,7 @@ def _widened(template: Template, part: AnswerPart, figure: str, reason: str) -> 
     """Why a part's tolerance was widened, its quantities as math and the answer itself as "it"
     (``rounding v_common and T ... moves loss_pct`` named what only the template knows)."""
     if not reason:
-        return Typ("")
+        return NO_NOTE
     quantities = {*template.parameters, *(step.unknown for step in compiled_for(template).steps)}
     said = re.sub(rf"\bmoves {re.escape(part.name)}\b", "moves it", reason)
     return Typ(text(f"widened to {figure}: ") + relation_markup(said, quantities))

@@ -285,3 +285,17 @@ def test_the_issues_wall_throw_draws_the_asked_heights_not_to_scale_and_the_give
     assert drawn and _paths(template, {**printed, "v0": "19.0", "e": "0.45"}) == drawn
     assert _paths(template, {**printed, "h0": "1.90"}) != drawn
     assert _paths(template, {**printed, "D": "4.0"}) != drawn
+
+
+@pytest.mark.parametrize("length", [0.15, 0.45, 2.0])
+def test_a_dimensions_label_keeps_clear_of_its_arrows(length: float) -> None:
+    """Issue 32: pile-driver's `h_rebound` was written over the arrow heads of its short dimension line.
+    The label's box (as the drawing estimates it) now crosses none of the dimension's arrows."""
+    from grader.render.drawing import Drawing, _crosses
+
+    canvas = Drawing()
+    canvas.dimension((1.0, 0.0), (1.0, length), ['h_"rebound" = 0.10 thin "m"'], "right")
+    (at, box), = canvas.labels
+    placed = (at[0] + box[0], at[1] + box[1], at[0] + box[2], at[1] + box[3])
+    assert not any(_crosses(placed, a, b) for a, b in canvas.strokes), (placed, canvas.strokes)
+    assert placed[0] >= 1.0 + 0.2  # beside the line, not on it

@@ -69,6 +69,7 @@ FORBIDDEN = {
     "a hyphen for a minus sign": re.compile(r"(?:^|[\s(=,:])-\s?(?:\d|[\U0001D400-\U0001D7FF])"),
     "L(1 − cos θ) for a swing to θ_max": re.compile(r"cos θ\)"),
     "a unit split across lines": re.compile(r"\b(?:m|ft|km|N)/\s*\n\s*(?:s|h)\b|\b(?:m|ft|km)/ s\b"),
+    "a number and its unit on two lines": re.compile(r"\d\s*\n\s*(?:m|ft|km)/(?:s|h)\b"),
     "an identifier's underscore": re.compile(r"[A-Za-z0-9]_[A-Za-z0-9{]"),
     "a subscript of internal words": re.compile(r"\d,\s*between"),
 }

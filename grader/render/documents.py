@@ -368,12 +368,12 @@ def _widened(template: Template, part: AnswerPart, figure: str, reason: str) -> 
 
 # --- statements ---------------------------------------------------------------------------------
 
-_UNIT = re.compile(r"(?<![\w/])([A-Za-z]{1,3}/[A-Za-z]{1,3}²?)(?![\w/])")
+_UNIT = re.compile(r"(?<![\w/.])((?:[-−]?\d+(?:\.\d+)? )?[A-Za-z]{1,3}/[A-Za-z]{1,3}²?)(?![\w/])")
 
 
 def statement(template: Template, variant: ProblemVariant) -> Typ:
     """The template's statement (instructor-written Typst markup, text and math only) with the
-    variant's printed values; a unit in its text (``m/s``) kept on one line."""
+    variant's printed values; a unit in its text (``m/s``), and the number before it, kept on one line."""
     parts = filled_statement(template, variant.printed).split("$")
     return Typ("$".join(_UNIT.sub(r"#box[\1]", part) if index % 2 == 0 else part
                         for index, part in enumerate(parts)))

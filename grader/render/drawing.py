@@ -92,7 +92,10 @@ class Drawing:
 
     def fits(self, at: Point, anchor: str, lines: Sequence[str]) -> bool:
         """Whether a label placed so would stay clear of the labels and blocks drawn so far."""
-        box = self._label_box(at, anchor, lines)
+        return self.clear(self._label_box(at, anchor, lines))
+
+    def clear(self, box: tuple[float, float, float, float]) -> bool:
+        """Whether the box (left, bottom, right, top) is clear of the labels, blocks and arrows drawn so far."""
         x0, y0, x1, y1 = box
         return not any(x0 < b[2] and b[0] < x1 and y0 < b[3] and b[1] < y1 for b in self.occupied) and \
             not any(_crosses(box, a, b) for a, b in self.strokes)
@@ -164,9 +167,11 @@ class Drawing:
                 self.line(low, high, width=0.5)
         if not lines:
             return
-        middle = (x + (-0.15 if side == "left" else 0.15), (low[1] + high[1]) / 2)
-        # "h = 1.20 m" as two lines, "h" over "= 1.20 m": narrower beside a tall figure
-        split = [part for line in lines for part in ([line] if " = " not in line else
+        # Beside a short one, clear of its arrows' heads and the lines out to it, on one line; beside a
+        # tall one "h = 1.20 m" as two lines, "h" over "= 1.20 m": narrower beside a tall figure.
+        gap = 0.2 if length > 0.6 else 0.3
+        middle = (x + (-gap if side == "left" else gap), (low[1] + high[1]) / 2)
+        split = [part for line in lines for part in ([line] if " = " not in line or length <= 0.6 else
                                                       [line.split(" = ", 1)[0], "= " + line.split(" = ", 1)[1]])]
         self.label(middle, "e" if side == "left" else "w", split)
 

@@ -122,7 +122,9 @@ def surface(canvas: Drawing, scene: SceneView, impact: Stage) -> bool:
         canvas.label(end, _anchor(_m.atan2(ray[1], ray[0])), lines)
         if stage is not None:
             _angle_mark(canvas, center, ray, [_axis(stage, n, t)], 0.95, _angle_label(scene, stage))
-    _axes(canvas, (3.4, 1.6), n, t)
+    # Apart from the rebound's label, which it would read on from ("v_out n").
+    origin = next((o for o in ((3.4, 1.6), (3.9, 1.9), (4.4, 1.9)) if _axes_fit(canvas, o, n, t, 0.4)), (4.4, 1.9))
+    _axes(canvas, origin, n, t)
     spots = [((0.0, 2 * radius + 0.12), "s"), ((0.0, -0.35), "n")]  # above the body, or under the surface
     canvas.name(*next((s for s in spots if canvas.fits(*s, [str(string(first))])), spots[-1]), first)
     return True
@@ -192,6 +194,7 @@ def incline(canvas: Drawing, scene: SceneView, impact: Stage) -> bool:
     canvas.circle(release, radius, "dashed", fill=False)
     canvas.name((release[0], release[1] + radius + 0.1), "s", first, [*scene.mass(first)])
     canvas.line(center, release, width=0.4, dash="dashed", gray=True)
+    canvas.strokes.append((center, release))  # the n-t glyph keeps clear of the fall
     canvas.arrow((center[0], center[1] + 0.55 * drop), (center[0], center[1] + 0.45 * drop), width=0.4, head=0.16)
     fall = find_stage(stages, "free_fall", before=impact.index, body=first)
     side = center[0] + 2.6  # beyond the rebound arrow and its label
@@ -212,8 +215,21 @@ def incline(canvas: Drawing, scene: SceneView, impact: Stage) -> bool:
                  _speed_label(scene, rebound, "v'"))
     if rebound is not None:
         _angle_mark(canvas, center, ray, [down], 1.0, _angle_label(scene, rebound))
-    _axes(canvas, (top[0] - 0.9, top[1] - 0.2), (-out[0], -out[1]), down)
+    # n and t beside the contact they are defined at: up the slope from it, above the surface, where
+    # neither the fall nor the rebound is drawn; else at the top of the incline.
+    near_contact = [(center[0] - d * down[0] + h * out[0], center[1] - d * down[1] + h * out[1])
+                    for d, h in ((1.2, 0.95), (1.6, 0.95), (2.0, 0.95), (1.6, 1.3))]
+    origin = next((o for o in near_contact if _axes_fit(canvas, o, (-out[0], -out[1]), down)),
+                  (top[0] - 0.9, top[1] - 0.2))
+    _axes(canvas, origin, (-out[0], -out[1]), down)
     return True
+
+
+def _axes_fit(canvas: Drawing, origin: Point, n: Point, t: Point, margin: float = 0.12) -> bool:
+    """Whether the n-t glyph at ``origin`` (and ``margin`` around it) is clear of what is drawn."""
+    xs = [origin[0] + s * d[0] for d in (n, t) for s in (0.0, 0.8)]
+    ys = [origin[1] + s * d[1] for d in (n, t) for s in (0.0, 0.8)]
+    return canvas.clear((min(xs) - margin, min(ys) - margin, max(xs) + margin, max(ys) + margin))
 
 
 def offset_spheres(canvas: Drawing, scene: SceneView, geometry: Stage, impact: Stage) -> bool:

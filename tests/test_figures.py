@@ -89,7 +89,8 @@ def test_the_panels_are_the_stages_in_order_and_name_every_body_and_no_other(
 def test_a_number_in_a_figure_is_a_value_the_statement_prints(
         template_id: str, figures: dict[str, tuple[str, FigureRecord, dict[str, str]]]) -> None:
     """Given values are labelled with the variant's numbers; an asked quantity is labelled with its
-    name only: every number right of an `=` in a label is a printed parameter's."""
+    name only: every number right of an `=` in a label is a printed parameter's (or its magnitude, right
+    of ``|v_B| =``: a velocity drawn the way it moves)."""
     for key in (k for k in figures if k.startswith(f"{template_id}/")):
         typst, _, printed = figures[key]
         labels = re.findall(r"fig-label\(\([^)]*\), \"[a-z]+\", \((.*)\)\)", typst)
@@ -97,7 +98,9 @@ def test_a_number_in_a_figure_is_a_value_the_statement_prints(
             if "=" not in line:
                 continue
             shown = re.findall(r"(?<![\w\"])(-?\d+(?:\.\d+)?)(?![\w\"])", line.split("=", 1)[1])
-            assert all(number in printed.values() or number == "0" for number in shown), (key, line, printed)
+            magnitudes = {value.lstrip("-") for value in printed.values()} if line.startswith("|") else set()
+            allowed = set(printed.values()) | magnitudes
+            assert all(number in allowed or number == "0" for number in shown), (key, line, printed)
 
 
 def test_the_issues_pendulum_striking_a_hanging_ball_draws_both_pendulums(
@@ -215,3 +218,84 @@ def test_a_figure_field_that_cannot_be_used_is_refused_saying_why(
     with pytest.raises(TemplateError) as refused:
         _with_figure(tmp_path, "cord-pendulum", figure, files)
     assert message in str(refused.value)
+
+
+# --- velocity arrows and their labels agree (issue 32) --------------------------------------------
+
+_SIGNED = re.compile(r"=\s*([-\u2212]?)\s*\d")
+
+
+def _velocity_arrows(template: Template, printed: dict[str, str]) -> list[tuple[str, object]]:
+    variant = ProblemVariant("1", template.id, "v", {n: float(v) for n, v in printed.items()}, printed, ())
+    _, record = figure_record(template, variant, _values(template, variant))
+    return [(panel.title, arrow) for panel in record.panels for arrow in panel.velocities]
+
+
+def _printed_variants(template: Template) -> list[dict[str, str]]:
+    from tests.scene_edits import draws
+
+    return [dict(example_variant(template).printed), *draws(template, 6, seed="arrows")]
+
+
+@pytest.mark.parametrize("template_id", sorted(load_bank()))
+def test_no_velocity_label_says_the_opposite_of_its_arrow(template_id: str) -> None:
+    """A velocity is an arrow the way the body moves, labelled with its magnitude: no label on a velocity
+    arrow shows a negative number, and a label naming a given velocity (``v_B = 3.1 km/h``, ``|v_B| = 5.2
+    km/h``) sits on an arrow that points where the statement's value says, read off the printed value
+    and the direction the quantity is positive in (coupling's ``v_B = −5.2 km/h`` on a leftward arrow
+    said "moves right")."""
+    template = BANK[template_id]
+    for printed in _printed_variants(template):
+        for title, arrow in _velocity_arrows(template, printed):
+            for line in arrow.label:  # type: ignore[attr-defined]
+                signed = _SIGNED.search(line)
+                assert signed is None or not signed.group(1), (template_id, printed, title, line)
+                named = re.match(r"\|?([A-Za-z_\"']+[^|= ]*)\|? = ", line)
+                given = next((n for n in template.parameters if named and
+                              re.sub(r"[\"_ ]", "", named.group(1)) == re.sub(r"_", "", n)), None)
+                if given is None or arrow.positive is None or float(printed[given]) == 0:  # type: ignore[attr-defined]
+                    continue
+                along = sum(d * p for d, p in zip(arrow.direction, arrow.positive, strict=True))  # type: ignore[attr-defined]
+                assert along * float(printed[given]) > 0, (template_id, printed, title, line, arrow)
+
+
+def test_the_issues_coupling_labels_car_bs_leftward_velocity_with_its_magnitude() -> None:
+    """Issue 32: `v_B = −5.2 km/h` on an arrow already pointing left. Now `|v_B| = 5.2 km/h` on it."""
+    template = BANK["coupling"]
+    printed = {**example_variant(template).printed, "v_B": "-5.2"}
+    arrows = {arrow.label: arrow for _, arrow in _velocity_arrows(template, printed)}  # type: ignore[attr-defined]
+    leftward = [a for label, a in arrows.items() if any("5.2" in line for line in label)]
+    assert [a.label for a in leftward] == [('|v_B| = 5.2 thin "km/h"',)]
+    assert leftward[0].direction == (-1.0, 0.0)
+
+
+def _paths(template: Template, printed: dict[str, str]) -> list[str]:
+    variant = ProblemVariant("1", template.id, "v", {n: float(v) for n, v in printed.items()}, printed, ())
+    typst, _ = figure_record(template, variant, _values(template, variant))
+    return re.findall(r"fig-path\([^\n]*", str(typst))
+
+
+def test_the_issues_wall_throw_draws_the_asked_heights_not_to_scale_and_the_givens_to_scale() -> None:
+    """Issue 32: `y_hit` and `x_land` could be measured off wall-throw's figure. The path now depends on
+    nothing but the givens that do not decide them alone: another speed or restitution draws the same
+    path; another release height or wall distance does not."""
+    template = BANK["wall-throw"]
+    printed = dict(example_variant(template).printed)
+    drawn = _paths(template, printed)
+    assert drawn and _paths(template, {**printed, "v0": "19.0", "e": "0.45"}) == drawn
+    assert _paths(template, {**printed, "h0": "1.90"}) != drawn
+    assert _paths(template, {**printed, "D": "4.0"}) != drawn
+
+
+@pytest.mark.parametrize("length", [0.15, 0.45, 2.0])
+def test_a_dimensions_label_keeps_clear_of_its_arrows(length: float) -> None:
+    """Issue 32: pile-driver's `h_rebound` was written over the arrow heads of its short dimension line.
+    The label's box (as the drawing estimates it) now crosses none of the dimension's arrows."""
+    from grader.render.drawing import Drawing, _crosses
+
+    canvas = Drawing()
+    canvas.dimension((1.0, 0.0), (1.0, length), ['h_"rebound" = 0.10 thin "m"'], "right")
+    (at, box), = canvas.labels
+    placed = (at[0] + box[0], at[1] + box[1], at[0] + box[2], at[1] + box[3])
+    assert not any(_crosses(placed, a, b) for a, b in canvas.strokes), (placed, canvas.strokes)
+    assert placed[0] >= 1.0 + 0.2  # beside the line, not on it

@@ -61,15 +61,17 @@ def direct(canvas: Drawing, scene: SceneView, impacts: Sequence[Stage]) -> bool:
 def _horizontal_velocity(canvas: Drawing, scene: SceneView, at: Point, velocity: Velocity | None,
                          fastest: float) -> None:
     """Above a body: an arrow centred on ``at`` the way it moves, 1.6 cm for the fastest body of the
-    figure (at least 0.5 cm), labelled with its velocity as given; ``v = 0`` for a body at rest."""
+    figure (at least 0.5 cm), labelled with its velocity as given, or its magnitude when the statement gives
+    it negative; ``v = 0`` for a body at rest."""
     given = velocity.n if velocity is not None else None
     value = scene.value(given) if given is not None else 0.0
     if given is None or not (_m.isfinite(value) and value != 0 and fastest > 0):
         canvas.label((at[0], at[1] - 0.2), "s", ["v = 0"] if given is None else scene.given(given))
         return
     half = max(0.25, 0.8 * abs(value) / fastest) * (1 if value > 0 else -1)
-    canvas.arrow((at[0] - half, at[1]), (at[0] + half, at[1]))
-    canvas.label((at[0], at[1] + 0.2), "s", scene.given(given))
+    lines, positive = scene.moving(given, (1.0, 0.0))
+    canvas.velocity((at[0] - half, at[1]), (at[0] + half, at[1]), lines, positive)
+    canvas.label((at[0], at[1] + 0.2), "s", lines)
 
 
 def row(canvas: Drawing, scene: SceneView, bodies: Sequence[str]) -> None:

@@ -40,8 +40,8 @@ from grader.model.tolerance import Tolerance, widening
 from grader.render.figures import figure
 from grader.render.typeset import compile_typst, font_paths
 from grader.render.typst_math import math, name
-from grader.render.typst_text import Typ, string, text
-from grader.render.worked import Worked, WorkedForm, WorkedStep, answer_math, worked, worked_form
+from grader.render.typst_text import Typ, signed, string, text
+from grader.render.worked import Worked, WorkedForm, WorkedStep, answer_math, relation_markup, worked, worked_form
 from grader.solve.cache import compiled_for
 from grader.solve.compiled import Compiled
 
@@ -115,6 +115,9 @@ class Sheet:
     problems: tuple[ProblemSheet, ...]
 
 
+NO_NOTE = Typ("")
+
+
 @dataclass(frozen=True)
 class KeyAnswer:
     """An answer in the key: where it comes from and its value (math), or why it has none."""
@@ -124,7 +127,7 @@ class KeyAnswer:
     value: Typ
     points: str
     tolerance: str
-    widened: str = ""  # a widened tolerance, with why (what honest rounding needs): a note under the answers
+    widened: Typ = NO_NOTE  # a widened tolerance, with why (what honest rounding needs): a note under the answers
 
 
 @dataclass(frozen=True)
@@ -303,7 +306,7 @@ class Documents:
             entry = self.generation.students[index]
             variant = entry.problems[position]
             cells = [text(entry.student.id), text(entry.student.name)]
-            cells += [text(variant.printed[n]) for n in template.parameters]
+            cells += [text(signed(variant.printed[n])) for n in template.parameters]
             cells += [_glance_value(part) for part in variant.answers]
             rows.append(tuple(cells))
         return Glance(self.glance_title(position), part, continued, tuple(header), tuple(rows))
@@ -350,15 +353,30 @@ def _key_answer(template: Template, part: AnswerPart) -> KeyAnswer:
         value = _math(f"display({source} = {answer_math(part.value, part.unit)})")
     figure, reason = part.tolerance.describe(part.unit), part.tolerance.reason
     return KeyAnswer(part.label, part.description, value, f"{part.points:g}",
-                     f"{figure} (widened)" if reason else figure, f"widened to {figure}: {reason}" if reason else "")
+                     f"{figure} (widened)" if reason else figure, _widened(template, part, figure, reason))
+
+
+def _widened(template: Template, part: AnswerPart, figure: str, reason: str) -> Typ:
+    """Why a part's tolerance was widened, its quantities as math and the answer itself as "it"
+    (``rounding v_common and T ... moves loss_pct`` named what only the template knows)."""
+    if not reason:
+        return NO_NOTE
+    quantities = {*template.parameters, *(step.unknown for step in compiled_for(template).steps)}
+    said = re.sub(rf"\bmoves {re.escape(part.name)}\b", "moves it", reason)
+    return Typ(text(f"widened to {figure}: ") + relation_markup(said, quantities))
 
 
 # --- statements ---------------------------------------------------------------------------------
 
+_UNIT = re.compile(r"(?<![\w/.])((?:[-−]?\d+(?:\.\d+)? )?[A-Za-z]{1,3}/[A-Za-z]{1,3}²?)(?![\w/])")
+
+
 def statement(template: Template, variant: ProblemVariant) -> Typ:
     """The template's statement (instructor-written Typst markup, text and math only) with the
-    variant's printed values."""
-    return Typ(filled_statement(template, variant.printed))
+    variant's printed values; a unit in its text (``m/s``), and the number before it, kept on one line."""
+    parts = filled_statement(template, variant.printed).split("$")
+    return Typ("$".join(_UNIT.sub(r"#box[\1]", part) if index % 2 == 0 else part
+                        for index, part in enumerate(parts)))
 
 
 # --- documents ----------------------------------------------------------------------------------

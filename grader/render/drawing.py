@@ -17,13 +17,23 @@ import math as _m
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
-from grader.render.typst_text import Typ, string
+from grader.render.typst_text import Typ, body_name, string
 
 Point = tuple[float, float]
 PAD = 0.05
 MAX_WIDTH = 7.6
 CHAR = 0.15  # cm per character of a label at the figure's text size, an estimate for the bounding box
 LINE = 0.42  # cm per line of a label
+
+
+@dataclass(frozen=True)
+class VelocityArrow:
+    """A velocity drawn: the arrow's direction (a unit vector, y up), the label beside it, and the
+    direction in which the quantity its label names is positive (None: a speed, never negative)."""
+
+    direction: Point
+    label: tuple[str, ...]
+    positive: Point | None
 
 
 def _fmt(value: float) -> str:
@@ -40,7 +50,7 @@ class Drawing:
     occupied: list[tuple[float, float, float, float]] = field(default_factory=list)
     strokes: list[tuple[Point, Point]] = field(default_factory=list)
     bodies: list[str] = field(default_factory=list)  # the scene's bodies named, in the order drawn: the record
-
+    velocities: list[VelocityArrow] = field(default_factory=list)  # the velocity arrows drawn: the record
 
     def _add(self, kind: str, points: Sequence[Point], options: str = "", radius: float = 0.0) -> None:
         for x, y in points:
@@ -82,7 +92,10 @@ class Drawing:
 
     def fits(self, at: Point, anchor: str, lines: Sequence[str]) -> bool:
         """Whether a label placed so would stay clear of the labels and blocks drawn so far."""
-        box = self._label_box(at, anchor, lines)
+        return self.clear(self._label_box(at, anchor, lines))
+
+    def clear(self, box: tuple[float, float, float, float]) -> bool:
+        """Whether the box (left, bottom, right, top) is clear of the labels, blocks and arrows drawn so far."""
         x0, y0, x1, y1 = box
         return not any(x0 < b[2] and b[0] < x1 and y0 < b[3] and b[1] < y1 for b in self.occupied) and \
             not any(_crosses(box, a, b) for a, b in self.strokes)
@@ -100,7 +113,7 @@ class Drawing:
         """A body's name (and ``more`` lines, its mass), placed as :meth:`label` places lines, and
         kept in :attr:`bodies`, the record of the scene's bodies this drawing shows."""
         self.bodies.append(body)
-        self.label(at, anchor, [str(string(body)), *more])
+        self.label(at, anchor, [str(string(body_name(body))), *more])
 
     def arrow(self, tail: Point, tip: Point, width: float = 0.9, head: float = 0.22) -> None:
         """An arrow: a line and a triangular head."""
@@ -112,6 +125,16 @@ class Drawing:
         self.line(tail, (tip[0] - ux * head * 0.8, tip[1] - uy * head * 0.8), width)
         self.polygon([tip, (base[0] - uy * head * 0.38, base[1] + ux * head * 0.38),
                       (base[0] + uy * head * 0.38, base[1] - ux * head * 0.38)])
+
+    def velocity(self, tail: Point, tip: Point, lines: Sequence[str], positive: Point | None = None,
+                 width: float = 0.9, head: float = 0.22) -> None:
+        """A velocity's arrow, from ``tail`` the way the body moves to ``tip``, kept in :attr:`velocities`
+        with ``lines``, the label its caller places beside it, and ``positive``, the direction in which the
+        quantity named there is positive (None for a speed)."""
+        length = _m.hypot(tip[0] - tail[0], tip[1] - tail[1]) or 1.0
+        self.velocities.append(VelocityArrow(((tip[0] - tail[0]) / length, (tip[1] - tail[1]) / length),
+                                             tuple(lines), positive))
+        self.arrow(tail, tip, width, head)
 
     def arc(self, center: Point, radius: float, start: float, end: float) -> None:
         """A circular arc between two angles (radians, counter-clockwise from +x)."""
@@ -144,9 +167,11 @@ class Drawing:
                 self.line(low, high, width=0.5)
         if not lines:
             return
-        middle = (x + (-0.15 if side == "left" else 0.15), (low[1] + high[1]) / 2)
-        # "h = 1.20 m" as two lines, "h" over "= 1.20 m": narrower beside a tall figure
-        split = [part for line in lines for part in ([line] if " = " not in line else
+        # Beside a short one, clear of its arrows' heads and the lines out to it, on one line; beside a
+        # tall one "h = 1.20 m" as two lines, "h" over "= 1.20 m": narrower beside a tall figure.
+        gap = 0.2 if length > 0.6 else 0.3
+        middle = (x + (-gap if side == "left" else gap), (low[1] + high[1]) / 2)
+        split = [part for line in lines for part in ([line] if " = " not in line or length <= 0.6 else
                                                       [line.split(" = ", 1)[0], "= " + line.split(" = ", 1)[1]])]
         self.label(middle, "e" if side == "left" else "w", split)
 

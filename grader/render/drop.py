@@ -8,7 +8,7 @@ from __future__ import annotations
 import math as _m
 from collections.abc import Sequence
 
-from grader.model.expr import Node, Op
+from grader.model.expr import Node
 from grader.model.scene import Stage
 from grader.render.drawing import Drawing, Point
 from grader.render.scene_view import SceneView
@@ -72,19 +72,15 @@ def drop(canvas: Drawing, scene: SceneView, fall: Stage, impact: Stage | None, r
 
 
 def _vertical_velocity(canvas: Drawing, scene: SceneView, at: Point, upward: float, given: Node) -> None:
-    """An arrow through ``at`` the way a surface moves (up or down), labelled with what gives its velocity."""
+    """An arrow through ``at`` the way a surface moves (up or down), labelled with what gives its velocity
+    (``given``, along n, which points down): ``u`` for ``-u``, its magnitude when negative."""
+    lines, positive = scene.moving(given, (0.0, -1.0))
     if not _m.isfinite(upward) or upward == 0:
-        canvas.label(at, "w", [*scene.given(_parameter_of(given)), "(at rest)"])
+        canvas.label(at, "w", [*lines, "(at rest)"])
         return
     sign = 1.0 if upward > 0 else -1.0
-    canvas.arrow((at[0], at[1] - 0.45 * sign), (at[0], at[1] + 0.45 * sign), width=0.9)
-    canvas.label((at[0] + 0.15, at[1]), "w", scene.given(_parameter_of(given)))
-
-
-def _parameter_of(node: Node) -> Node:
-    """``u`` for ``-u``: a velocity given with its sign turned (an axis pointing the other way) is
-    labelled with the parameter, whose positive sense the statement names."""
-    return node.args[0] if isinstance(node, Op) and node.op == "neg" else node
+    canvas.velocity((at[0], at[1] - 0.45 * sign), (at[0], at[1] + 0.45 * sign), lines, positive)
+    canvas.label((at[0] + 0.15, at[1]), "w", lines)
 
 
 def bounces(canvas: Drawing, scene: SceneView, fall: Stage, rises: Sequence[Stage], surface: str) -> bool:

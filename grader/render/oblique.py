@@ -115,16 +115,16 @@ def surface(canvas: Drawing, scene: SceneView, impact: Stage) -> bool:
         ray = (sign * vector[0] / length, sign * vector[1] / length)  # from the body toward the arrow
         near = (center[0] + ray[0] * (radius + 0.05), center[1] + ray[1] * (radius + 0.05))
         far = (near[0] + ray[0] * length * scale, near[1] + ray[1] * length * scale)
-        if sign < 0:
-            canvas.arrow(far, near)
-        else:
-            canvas.arrow(near, far)
+        lines = _speed_label(scene, stage, fallback)
+        canvas.velocity(*((far, near) if sign < 0 else (near, far)), lines)
         # The speed at the arrow's far end, clear of the angle marks near the body.
         end = (far[0] + 0.1 * ray[0], far[1] + 0.1 * ray[1])
-        canvas.label(end, _anchor(_m.atan2(ray[1], ray[0])), _speed_label(scene, stage, fallback))
+        canvas.label(end, _anchor(_m.atan2(ray[1], ray[0])), lines)
         if stage is not None:
             _angle_mark(canvas, center, ray, [_axis(stage, n, t)], 0.95, _angle_label(scene, stage))
-    _axes(canvas, (3.4, 1.6), n, t)
+    # Apart from the rebound's label, which it would read on from ("v_out n").
+    origin = next((o for o in ((3.4, 1.6), (3.9, 1.9), (4.4, 1.9)) if _axes_fit(canvas, o, n, t, 0.4)), (4.4, 1.9))
+    _axes(canvas, origin, n, t)
     spots = [((0.0, 2 * radius + 0.12), "s"), ((0.0, -0.35), "n")]  # above the body, or under the surface
     canvas.name(*next((s for s in spots if canvas.fits(*s, [str(string(first))])), spots[-1]), first)
     return True
@@ -155,8 +155,8 @@ def spheres(canvas: Drawing, scene: SceneView, impact: Stage) -> bool:
         center = centers[body]
         tip = (center[0] - ux * (radius + 0.08), center[1] - uy * (radius + 0.08))
         tail = (tip[0] - ux * 2.0, tip[1] - uy * 2.0)
-        canvas.arrow(tail, tip)
         stage = velocity_stage(stages, velocity)
+        canvas.velocity(tail, tip, _speed_label(scene, stage, "v"))
         axis = _nearest_axis((-ux, -uy), [_axis(stage, n, t) if stage is not None else n])
         _speed_mark(canvas, tail, tip, (-ux - axis[0], -uy - axis[1]), _speed_label(scene, stage, "v"), 0.2)
         if stage is not None:
@@ -194,6 +194,7 @@ def incline(canvas: Drawing, scene: SceneView, impact: Stage) -> bool:
     canvas.circle(release, radius, "dashed", fill=False)
     canvas.name((release[0], release[1] + radius + 0.1), "s", first, [*scene.mass(first)])
     canvas.line(center, release, width=0.4, dash="dashed", gray=True)
+    canvas.strokes.append((center, release))  # the n-t glyph keeps clear of the fall
     canvas.arrow((center[0], center[1] + 0.55 * drop), (center[0], center[1] + 0.45 * drop), width=0.4, head=0.16)
     fall = find_stage(stages, "free_fall", before=impact.index, body=first)
     side = center[0] + 2.6  # beyond the rebound arrow and its label
@@ -208,14 +209,27 @@ def incline(canvas: Drawing, scene: SceneView, impact: Stage) -> bool:
     far = (near[0] + 1.3 * ray[0], near[1] + 1.3 * ray[1])
     canvas.line((center[0] - 0.6 * down[0], center[1] - 0.6 * down[1]),
                 (center[0] + 1.9 * down[0], center[1] + 1.9 * down[1]), width=0.4, dash="dashed", gray=True)
-    canvas.arrow(near, far)
     rebound = velocity_stage(stages, after)
+    canvas.velocity(near, far, _speed_label(scene, rebound, "v'"))
     canvas.label((far[0] + 0.1 * ray[0], far[1] + 0.1 * ray[1]), _anchor(_m.atan2(ray[1], ray[0])),
                  _speed_label(scene, rebound, "v'"))
     if rebound is not None:
         _angle_mark(canvas, center, ray, [down], 1.0, _angle_label(scene, rebound))
-    _axes(canvas, (top[0] - 0.9, top[1] - 0.2), (-out[0], -out[1]), down)
+    # n and t beside the contact they are defined at: up the slope from it, above the surface, where
+    # neither the fall nor the rebound is drawn; else at the top of the incline.
+    near_contact = [(center[0] - d * down[0] + h * out[0], center[1] - d * down[1] + h * out[1])
+                    for d, h in ((1.2, 0.95), (1.6, 0.95), (2.0, 0.95), (1.6, 1.3))]
+    origin = next((o for o in near_contact if _axes_fit(canvas, o, (-out[0], -out[1]), down)),
+                  (top[0] - 0.9, top[1] - 0.2))
+    _axes(canvas, origin, (-out[0], -out[1]), down)
     return True
+
+
+def _axes_fit(canvas: Drawing, origin: Point, n: Point, t: Point, margin: float = 0.12) -> bool:
+    """Whether the n-t glyph at ``origin`` (and ``margin`` around it) is clear of what is drawn."""
+    xs = [origin[0] + s * d[0] for d in (n, t) for s in (0.0, 0.8)]
+    ys = [origin[1] + s * d[1] for d in (n, t) for s in (0.0, 0.8)]
+    return canvas.clear((min(xs) - margin, min(ys) - margin, max(xs) + margin, max(ys) + margin))
 
 
 def offset_spheres(canvas: Drawing, scene: SceneView, geometry: Stage, impact: Stage) -> bool:
@@ -259,8 +273,8 @@ def offset_spheres(canvas: Drawing, scene: SceneView, geometry: Stage, impact: S
         canvas.name((-drawn[1] - 0.1, across + 0.5 * drawn[1]), "e", second, [*scene.mass_value(second)])
     tip = at(one, (1.0, 0.0), -drawn[0] - 0.1)
     tail = at(tip, (1.0, 0.0), -1.8)
-    canvas.arrow(tail, tip)
     stage = velocity_stage(scene.template.scene.stages, impact.fields["before"].get(first))
+    canvas.velocity(tail, tip, _speed_label(scene, stage, "v"))
     canvas.label(((tail[0] + tip[0]) / 2, 0.15), "s", _speed_label(scene, stage, "v"))
     canvas.reserve((-drawn[1], across - drawn[1]), (drawn[1], across + drawn[1]))  # the angle's label: not on sphere 2
     _angle_mark(canvas, one, n, [(1.0, 0.0)], 0.55 * drawn[0], scene.given(geometry.fields["angle"]))

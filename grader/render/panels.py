@@ -29,7 +29,7 @@ from itertools import pairwise
 
 from grader.model.scene import Stage
 from grader.render.direct import direct, row
-from grader.render.drawing import Drawing
+from grader.render.drawing import Drawing, VelocityArrow
 from grader.render.drop import bounces, drop
 from grader.render.oblique import incline, offset_spheres, spheres, surface
 from grader.render.pendulum import swing_figure
@@ -46,11 +46,12 @@ STRIP_WIDTH = 5.2  # cm a panel of a strip may take (two side by side beside the
 @dataclass(frozen=True)
 class PanelRecord:
     """What a panel drew: its title (empty for a figure of one panel), the stages (their indices in
-    the scene) and the bodies it named, in the order named."""
+    the scene), the bodies it named, in the order named, and its velocity arrows."""
 
     title: str
     stages: tuple[int, ...]
     bodies: tuple[str, ...]
+    velocities: tuple[VelocityArrow, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -224,7 +225,7 @@ def _draw_slide(canvas: Drawing, scene: SceneView, group: Sequence[Stage]) -> bo
         x = shown + number * width
         canvas.rect((x, 0.0), (x + width, 0.6))
         canvas.name((x + width / 2, 0.3), "c", body)
-    canvas.arrow((0.0, 0.9), (1.2, 0.9))
+    canvas.velocity((0.0, 0.9), (1.2, 0.9), scene.given(slide.fields["speed"]))
     canvas.label((0.6, 1.1), "s", scene.given(slide.fields["speed"]))
     horizontal_dimension(canvas, 0.0, shown, -0.45, scene.given(slide.fields["distance"]))
     canvas.label((right, 0.8), "se", scene.given(slide.fields["friction"]))
@@ -241,7 +242,7 @@ def _draw_rise(canvas: Drawing, scene: SceneView, group: Sequence[Stage]) -> boo
     canvas.ground(0.6, 3.0, 0.0)
     canvas.circle((1.8, 0.3), 0.3)
     canvas.circle((1.8, top + 0.3), 0.3, "dashed", fill=False)
-    canvas.arrow((2.4, 0.4), (2.4, 1.4))
+    canvas.velocity((2.4, 0.4), (2.4, 1.4), scene.given(rise.fields["speed"]))
     canvas.label((2.55, 0.9), "w", scene.given(rise.fields["speed"]))
     canvas.name((1.8, top + 0.75), "s", rise.fields["body"])
     canvas.dimension((1.0, 0.0), (1.0, top), scene.given(rise.fields["height"]), "left")
@@ -278,8 +279,10 @@ PANELS: dict[str, PanelKind] = {
                        "the skid from the point of impact dimensioned; alone: the body at rest at the end of its "
                        "skid mark, the distance dimensioned, its speed at the start an arrow"),
     "flight": PanelKind(_claim_flight, _draw_flight,
-                        "the path to scale: to a wall (with the impact there), solid to the wall, dashed from the "
-                        "wall to the ground (the flight after the impact); to the ground, from its start height"),
+                        "the path: to a wall (with the impact there), solid to the wall, dashed from the wall to "
+                        "the ground (the flight after the impact), given lengths to scale, an asked height on the "
+                        "wall or landing distance drawn but not to scale; to the ground, to scale from its start "
+                        "height"),
     "bounces": PanelKind(_one, _draw_bounces,
                          "the drop and the decaying arcs until the body rests, heights and time along the floor to "
                          "scale, the bounce whose height is asked marked by its name"),
@@ -336,7 +339,8 @@ def panels_figure(scene: SceneView, groups: Sequence[Sequence[Stage]] | None = N
     groups = panel_groups(scene.template.scene.stages) if groups is None else groups
     drawings = [_panel(scene, group) for group in groups]
     titles = [f"{n} · {_title(g)}" if len(groups) > 1 else "" for n, g in enumerate(groups, start=1)]
-    record = FigureRecord(tuple(PanelRecord(title, tuple(s.index for s in group), tuple(canvas.bodies))
+    record = FigureRecord(tuple(PanelRecord(title, tuple(s.index for s in group), tuple(canvas.bodies),
+                                            tuple(canvas.velocities))
                                 for title, group, canvas in zip(titles, groups, drawings, strict=True)))
     if len(drawings) == 1:
         return drawings[0].typst(), record

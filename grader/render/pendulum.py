@@ -63,7 +63,8 @@ def _striker(canvas: Drawing, scene: SceneView, impact: Stage, target: tuple[flo
     x = target[0] - HALF_WIDTH - 1.9
     canvas.rect((x - 0.2, target[1] - 0.06), (x + 0.2, target[1] + 0.06), fill="luma(120)")
     canvas.name((x, target[1] - 0.15), "n", first, [*scene.mass(first)])
-    canvas.arrow((x + 0.35, target[1]), (x + 1.35, target[1]), width=0.7, head=0.18)
     velocity = impact.fields["before"].get(first)
-    if velocity is not None:
-        canvas.label((x + 0.85, target[1] + 0.15), "s", [math(velocity.n)])
+    lines = [math(velocity.n)] if velocity is not None else []
+    canvas.velocity((x + 0.35, target[1]), (x + 1.35, target[1]), lines, (1.0, 0.0), width=0.7, head=0.18)
+    if lines:
+        canvas.label((x + 0.85, target[1] + 0.15), "s", lines)

@@ -11,7 +11,7 @@ import numpy as np
 
 from grader.assign.variants import ProblemVariant
 from grader.bank.template import Template
-from grader.model.expr import Node, Sym, names
+from grader.model.expr import Node, Op, Sym, names
 from grader.model.kernel import evaluate
 from grader.model.scene import Stage, Velocity
 from grader.render.typst_math import math, name
@@ -43,6 +43,20 @@ class SceneView:
             shown = " degree" if unit == "deg" else f" thin {string(unit)}" if unit else ""
             return [f"{name(node.name)} = {printed}{shown}"]
         return [math(node)]
+
+    def moving(self, node: Node, along: tuple[float, float]) -> tuple[list[str], tuple[float, float]]:
+        """The label of a velocity ``node`` (positive ``along`` a direction) drawn as an arrow the way it
+        moves, and the direction in which the quantity the label names is positive: as :meth:`given`
+        when the statement gives it positive, its magnitude when negative (``|v_B| = 5.2 km/h``: the
+        arrow says which way); ``-u`` is labelled with ``u``, positive the other way."""
+        if isinstance(node, Op) and node.op == "neg":
+            node, along = node.args[0], (-along[0], -along[1])
+        lines = self.given(node)
+        if isinstance(node, Sym) and node.name in self.template.parameters and " = " in lines[0]:
+            shown, value = lines[0].split(" = ", 1)
+            if value.startswith(("-", "\u2212")):
+                return [f"|{shown}| = {value[1:]}"], along
+        return lines, along
 
     def is_given(self, node: Node) -> bool:
         """Whether the statement gives this quantity (only parameters and numbers in it): what is

@@ -50,8 +50,9 @@ def skid(canvas: Drawing, scene: SceneView, impact: Stage, slide: Stage) -> bool
     _car(canvas, a, a + b, ROW, tall, None)
     before = impact.fields["before"].get(first)
     height = ROW + tall + 0.25
-    canvas.arrow((a / 2 - 0.55, height + 0.15), (a / 2 + 0.55, height + 0.15))
-    canvas.label((a / 2, height + 0.35), "s", scene.given(before.n) if before is not None else ["v"])
+    lines, positive = scene.moving(before.n, (1.0, 0.0)) if before is not None else (["v"], None)
+    canvas.velocity((a / 2 - 0.55, height + 0.15), (a / 2 + 0.55, height + 0.15), lines, positive)
+    canvas.label((a / 2, height + 0.35), "s", lines)
     canvas.label((a + b / 2, height + 0.1), "s", ["v = 0"])
     for x, body in ((a / 2, first), (a + b / 2, second)):
         canvas.name((x, ROW + 0.2 + tall / 2), "c", body, [])

@@ -1,8 +1,10 @@
 """The figure of a projectile's flight to a wall and back to the ground (see :mod:`grader.render.figures`,
 which chooses it): the ground, the wall, the point of release with its height and the throw's velocity
-at its angle, and the path, to the variant's scale on both axes: solid to the wall, dashed from the wall
-to the ground. Given lengths are dimensioned with their values; asked ones (the height where the ball
-strikes the wall, where it lands) by their names only.
+at its angle, and the path: solid to the wall, dashed from the wall to the ground. Given lengths are
+drawn to the variant's scale and dimensioned with their values; asked ones (the height where the ball
+strikes the wall, where it lands) are drawn but not to scale, and dimensioned by their names only: the
+path leaves at the throw's angle and bends down to a height chosen without the answer, so nothing asked
+can be measured off the page.
 """
 
 from __future__ import annotations
@@ -36,6 +38,25 @@ def _path(x0: float, direction: float, y0: float, vx: float, vy: float, g: float
              y0 + vy * duration * i / steps - g * (duration * i / steps) ** 2 / 2) for i in range(steps + 1)]
 
 
+def _drawn_hit(h0: float, slope: float, distance: float) -> float:
+    """The height at which an asked strike on the wall is drawn: a little over half the height the throw
+    aims at, whatever the speed (which decides the true one), so the figure does not give it away."""
+    return 0.55 * max(h0 + slope * distance, 0.2 * distance)
+
+
+def _bent(h0: float, slope: float, distance: float, end: float) -> list[Point]:
+    """A parabola from ``(0, h0)`` leaving at ``slope`` and reaching ``end`` at ``distance``: the path's
+    shape, not to scale."""
+    bend = (h0 + slope * distance - end) / distance ** 2
+    return [(distance * i / 32, h0 + slope * distance * i / 32 - bend * (distance * i / 32) ** 2) for i in range(33)]
+
+
+def _falling(wall: float, start: float, reach: float) -> list[Point]:
+    """A half parabola from ``start`` high on the wall down to the ground ``reach`` from it: the rebound's
+    shape, not to scale."""
+    return [(wall - reach * i / 32, start * (1 - (i / 32) ** 2)) for i in range(33)]
+
+
 def trajectory(canvas: Drawing, scene: SceneView, to_wall: Stage, to_ground: Stage | None) -> bool:
     """The flight ``to_wall`` (x toward the wall) and, after the rebound, ``to_ground`` (x away from it)."""
     g = scene.values.get("g", _m.nan)
@@ -43,12 +64,19 @@ def trajectory(canvas: Drawing, scene: SceneView, to_wall: Stage, to_ground: Sta
                                                                           "distance"))
     if not all(_m.isfinite(v) for v in (g, vx, vy, h0, distance)) or vx <= 0 or distance <= 0:
         return False
-    before = _path(0.0, 1.0, h0, vx, vy, g, distance / vx)
+    hit_given = scene.is_given(to_wall.fields["end_height"])
+    before = _path(0.0, 1.0, h0, vx, vy, g, distance / vx) if hit_given else \
+        _bent(h0, vy / vx, distance, _drawn_hit(h0, vy / vx, distance))
     after: list[Point] = []
     if to_ground is not None:
         ux, uy, start = (scene.value(to_ground.fields[key]) for key in ("horizontal", "vertical", "height"))
-        if all(_m.isfinite(v) for v in (ux, uy, start)) and start >= 0:
-            after = _path(distance, -1.0, start, ux, uy, g, flight_time(uy, start, g))
+        if hit_given and scene.is_given(to_ground.fields["distance"]):
+            if all(_m.isfinite(v) for v in (ux, uy, start)) and start >= 0:
+                after = _path(distance, -1.0, start, ux, uy, g, flight_time(uy, start, g))
+        else:
+            land = scene.value(to_ground.fields["distance"])
+            shown = land if scene.is_given(to_ground.fields["distance"]) and _m.isfinite(land) else 0.6 * distance
+            after = _falling(distance, before[-1][1], shown)
     points = before + after
     low_x, top = min(x for x, _ in points), max(y for _, y in points)
     if top <= 0:
@@ -97,11 +125,11 @@ def _release(canvas: Drawing, scene: SceneView, stage: Stage, height: float, ang
         canvas.line((0.0, 0.0), (0.0, height), width=0.4, dash="dashed", gray=True)
         canvas.dimension((-0.35, 0.0), (-0.35, height), scene.given(stage.fields["height"]), "left")
     tip = (length * _m.cos(angle), height + length * _m.sin(angle))
-    canvas.arrow((0.0, height), tip)
+    lines = _launch(scene, stage)
+    canvas.velocity((0.0, height), tip, lines[:1])
     if angle > 0.02:  # the angle from the horizontal, marked
         canvas.line((0.0, height), (0.75 * length, height), width=0.4, dash="dashed", gray=True)
         canvas.arc((0.0, height), 0.55 * length, 0.0, angle)
-    lines = _launch(scene, stage)
     places = [((-0.15, height + 0.2), "se"), ((-0.5, height + 0.1), "e")]
     spot, anchor = next((p for p in places if canvas.fits(*p, lines)), (corner, "sw"))
     canvas.label(spot, anchor, lines)

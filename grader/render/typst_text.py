@@ -5,9 +5,13 @@
 '#"$x$ #1";'
 >>> print(string('say "hi"'))
 "say \\"hi\\""
+>>> body_name("cart1"), body_name("ball_2"), body_name("A"), signed("-2.8")
+('cart 1', 'ball 2', 'A', '−2.8')
 """
 
 from __future__ import annotations
+
+import re
 
 
 class Typ(str):
@@ -25,3 +29,14 @@ def text(value: object) -> Typ:
     """Text shown literally in markup: an embedded string literal, ended by ``;`` so that nothing
     after it (a dot, a bracket) can continue the expression."""
     return Typ(f"#{string(value)};")
+
+
+def body_name(body: str) -> str:
+    """A body's name as a page prints it: the scene's id with a space before a number that ends it and
+    for an underscore (``cart1`` is cart 1, as the statement says), else as it is."""
+    return re.sub(r"(?<=[A-Za-z])(?=\d+$)", " ", body).replace("_", " ")
+
+
+def signed(printed: str) -> str:
+    """A printed number with a minus sign, not a hyphen, before it (as Typst prints one in math)."""
+    return "\u2212" + printed[1:] if printed.startswith("-") else printed

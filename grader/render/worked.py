@@ -28,9 +28,9 @@ from grader.model.quantities import ACCELERATION, ANGLE, Dimension, dimension_of
 from grader.model.roots import TOLERANCE_TEXT
 from grader.render.readable import Names, readable
 from grader.render.typst_math import math, name, number
-from grader.render.typst_text import Typ, string, text
+from grader.render.typst_text import Typ, body_name, string, text
 from grader.solve.cache import compiled_for
-from grader.solve.compiled import Compiled
+from grader.solve.compiled import Compiled, Step
 
 
 def _significant(printed: str) -> int:
@@ -179,6 +179,37 @@ def relation_markup(label: str, quantities: set[str]) -> Typ:
     return Typ("".join(pieces) + (str(text(plain)) if plain else ""))
 
 
+_SWING = re.compile(r"conservation of energy in the swing of (\w+) on its cord of length (\w+) \(the cord does no "
+                    r"work\): it rises L\(1 − cos θ\) to stop at (\w+) from the vertical")
+
+
+def page_wording(step: Step, template: Template) -> str:
+    """A step's relation as the page says it: bodies by their printed names (``cart 1``); no axis n in a
+    problem on one line, where n is never drawn or defined; a swing names the speed it starts from (a
+    quantity the impact after it in the chain defines) and its angle in the height it rises.
+
+    >>> from grader.bank.template import load_bank
+    >>> template = load_bank()["head-on"]
+    >>> [page_wording(s, template) for s in compiled_for(template).steps][1]
+    'impulse-momentum for cart 1'
+    """
+    label = step.relation
+    for body in template.scene.bodies:
+        if body_name(body) != body:
+            label = re.sub(rf"\b{re.escape(body)}\b", body_name(body), label)
+    label = re.sub(r"(?<![\w)])-(?=[A-Za-z_(])", "\u2212", label)  # a minus sign, not a hyphen: "-v_x_after"
+    stages = template.scene.stages
+    if not any(stage.is_oblique or stage.effect == "velocity" for stage in stages):
+        label = re.sub(r"\s+along n\b", "", label)
+    swing = _SWING.fullmatch(label)
+    if swing and isinstance(step.equation[0], Sym):
+        body, length, angle = swing.groups()
+        label = (f"{body} swings up from {step.equation[0].name}, its speed at the lowest point, until the cord "
+                 f"(of length {length}) is at {angle} to the vertical, rising {length}(1 − cos {angle}): conservation "
+                 "of energy (the cord does no work)")
+    return label
+
+
 @dataclass(frozen=True)
 class StepForm:
     """What one step shows whatever the numbers: its relation (markup), its equation when it is not
@@ -212,18 +243,21 @@ def worked_form(template: Template, compiled: Compiled | None = None) -> WorkedF
     dimensions = quantity_dimensions(template, compiled)
     reader = reader_names(template, compiled, dimensions)
     quantities = set(dimensions) | {s.unknown for s in compiled.steps}
+    titles = [page_wording(step, template) for step in compiled.steps]
     steps = []
-    for step in compiled.steps:
+    for step, title in zip(compiled.steps, titles, strict=True):
         if step.numeric:  # its root(...) tree is what the kernel finds, not a form a reader follows
             lhs, rhs = (readable(side, reader) for side in step.equation)
-            steps.append(StepForm(step.unknown, relation_markup(step.relation, quantities),
+            steps.append(StepForm(step.unknown, relation_markup(title, quantities),
                                   f"{math(lhs)} = {math(rhs)}", Sym(step.unknown), "", step.block, numeric=True))
             continue
         lhs, rhs, solved = (readable(side, reader) for side in (*step.equation, step.solved))
         # A block's equations are each shown, labelled, before the block's solution.
         shown = step.block or not (lhs == Sym(step.unknown) and rhs == solved)
         equation = f"{math(lhs)} = {math(rhs)}" if shown else None
-        steps.append(StepForm(step.unknown, relation_markup(step.relation, quantities), equation, solved,
+        if titles.count(title) > 1 and not step.block:  # two steps, one relation: say what each finds
+            title += f", which gives {step.unknown}"
+        steps.append(StepForm(step.unknown, relation_markup(title, quantities), equation, solved,
                               math(solved), step.block))
     symbols = tuple(sorted(template.symbols))
     # A symbol no step uses (a mass the scene needs only for its simulation) gets no note.

@@ -39,7 +39,7 @@ def _speed_lines(scene: SceneView, velocity: Velocity | None) -> list[str]:
     """The label of a velocity's arrow: its one component's magnitude, or both components as given."""
     if velocity is None:
         return ["v = 0"]
-    parts = [node for node in (velocity.n, velocity.t) if not _is_zero(node)]
+    parts = [node for node in (velocity.n, velocity.t) if node is not None and not _is_zero(node)]
     if not parts:
         return ["v = 0"]
     if len(parts) == 1:
@@ -100,28 +100,27 @@ def spring(canvas: Drawing, scene: SceneView, stage: Stage, impact: Stage | None
     block, stuck = stage.fields["body"], stage.fields.get("with")
     natural, width, height, squeeze = 2.6, 1.0, 0.8, 0.9
     canvas.ground(-0.6, natural + width + 2.6, 0.0)
-    _wall(canvas, 0.0, 0.0, 1.4)
+    _wall(canvas, 0.0, 0.0, 1.6)
     _coils(canvas, (0.0, height / 2), (natural, height / 2))
     canvas.rect((natural, 0.0), (natural + width, height))
     canvas.name((natural + width / 2, height / 2), "c", block)
     canvas.rect((natural - squeeze, 0.0), (natural - squeeze + width, height), dash="dashed", fill="none")
     striker = impact.fields["bodies"][1] if impact is not None else None
     if stuck is not None:
-        x = natural + width + 0.2
+        x = natural + width + (1.9 if impact is not None and striker == stuck else 0.2)
         canvas.circle((x + 0.12, height / 2), 0.12)
-        canvas.name((x + 0.4, height / 2), "w", stuck)
-        if impact is not None and striker == stuck:
+        canvas.name((x + 0.12, height / 2 - 0.2), "n", stuck)
+        if impact is not None and striker == stuck:  # it comes in toward the block, before the impact
             velocity = impact.fields.get("before", {}).get(stuck)
-            canvas.arrow((x + 2.2, height + 0.35), (x + 0.9, height + 0.35))
-            canvas.label((x + 1.55, height + 0.55), "s", _speed_lines(scene, velocity))
-            canvas.label((x + 1.55, height - 0.1), "n", [str(string("before the impact"))])
+            canvas.arrow((x - 0.1, height / 2), (x - 1.3, height / 2))
+            canvas.label((x - 0.7, height / 2 + 0.2), "s", _speed_lines(scene, velocity))
     if impact is None or striker != stuck:
         canvas.arrow((natural + width / 2 + 0.6, height + 0.4), (natural + width / 2 - 0.6, height + 0.4))
         canvas.label((natural + width / 2, height + 0.6), "s", scene.given(magnitude(stage.fields["speed"])))
     canvas.line((natural - squeeze, -0.15), (natural - squeeze, -0.75), width=0.4)
     canvas.line((natural, -0.15), (natural, -0.75), width=0.4)
     horizontal_dimension(canvas, natural - squeeze, natural, -0.6, scene.given(stage.fields["compression"]))
-    canvas.label((natural / 2, height / 2 + 0.45), "s", scene.given(stage.fields["stiffness"]))
+    canvas.label((0.15, height + 0.1), "sw", scene.given(stage.fields["stiffness"]))
     return True
 
 
@@ -136,24 +135,23 @@ def _vertical_spring(canvas: Drawing, scene: SceneView, stage: Stage) -> bool:
     canvas.rect((0.0, top), (width, top + 0.25))
     canvas.name((width + 0.1, top + 0.12), "w", body)
     if stuck is not None:
-        canvas.rect((width / 2 - 0.4, top + 0.25), (width / 2 + 0.4, top + 0.85))
+        canvas.rect((width / 2 - 0.65, top + 0.25), (width / 2 + 0.65, top + 0.85))
         canvas.name((width / 2, top + 0.55), "c", stuck)
     lowest = top - 0.9
-    canvas.line((-0.1, lowest), (width + 0.1, lowest), width=0.5, dash="dashed")
-    canvas.arrow((-0.45, top + 1.0), (-0.45, top + 0.2))
-    canvas.label((-0.6, top + 0.6), "e", scene.given(magnitude(stage.fields["speed"])))
-    canvas.label((width / 2 + 0.35, top / 2), "w", scene.given(stage.fields["stiffness"]))
-    x = width + 1.3
+    canvas.line((-1.3, lowest), (width + 0.1, lowest), width=0.5, dash="dashed")
+    canvas.arrow((width / 2, top + 1.9), (width / 2, top + 1.0))
+    canvas.label((width / 2 + 0.15, top + 1.45), "w", scene.given(magnitude(stage.fields["speed"])))
+    canvas.label((width / 2 + 0.35, top * 0.3), "w", scene.given(stage.fields["stiffness"]))
+    x = width + 1.9
     if supports is not None:
-        canvas.line((-0.1, natural), (width + 0.1, natural), width=0.5, dash="dotted")
-        canvas.line((width, natural), (x + 0.1, natural), width=0.3, dash="dotted")
+        canvas.line((width, natural), (x + 0.1, natural), width=0.5, dash="dotted")  # the natural length
         canvas.line((width, top), (x + 0.1, top), width=0.3)
         named = stage.fields.get("static_deflection")
         canvas.dimension((x, top), (x, natural), scene.given(Sym(str(named))) if named else [], "right")
-    canvas.line((width, lowest), (x + 0.1, lowest), width=0.3)
     compression = scene.given(stage.fields["compression"])
-    canvas.dimension((x - 0.5, lowest), (x - 0.5, top if supports is None else natural), compression, "left"
-                     if supports is None else "right")
+    canvas.line((-1.3, top if supports is None else natural), (-0.1, top if supports is None else natural),
+                width=0.3, dash="dotted")
+    canvas.dimension((-1.2, lowest), (-1.2, top if supports is None else natural), compression, "left")
     return True
 
 
@@ -182,13 +180,15 @@ def slope(canvas: Drawing, scene: SceneView, stage: Stage) -> bool:
         canvas.line(low, high, width=1.0)
         canvas.line(high, (high[0], 0.0), width=0.5)
         canvas.arc(low, 0.9, 0.0, beta)
-        canvas.label((1.0, 0.05), "sw", scene.given(fields["angle"]))
+        canvas.label((0.9, -0.1), "n", scene.given(fields["angle"]))
     if rough:
         s = 0.1
         while s < length:
             x, y = s * ux, s * uy
-            canvas.line((x, y), (x + 0.16 * uy - 0.16 * ux * 0, y - 0.16 * ux), width=0.4, gray=True) \
-                if beta > 0 else canvas.line((x, y), (x - 0.16, y - 0.16), width=0.4)
+            if beta > 0:  # hatched into the wedge, across the surface
+                canvas.line((x, y), (x + 0.16 * uy, y - 0.16 * ux), width=0.4, gray=True)
+            else:
+                canvas.line((x, y), (x - 0.16, y - 0.16), width=0.4)
             s += 0.18
     nx, ny = -uy, ux  # the path's normal, away from the surface
     start, end = (high, low) if (beta > 0 and not up) else (low, high)
@@ -208,7 +208,7 @@ def slope(canvas: Drawing, scene: SceneView, stage: Stage) -> bool:
     last = (end[0] - inset * ux, end[1] - inset * uy)
     centre = block_at(first, None)
     names = [fields["body"], *([fields["with"]] if "with" in fields else [])]
-    canvas.name((centre[0] + nx * 0.45, centre[1] + ny * 0.45), "s", ", ".join(names) if len(names) > 1 else names[0])
+    canvas.name((centre[0] + nx * 0.5, centre[1] + ny * 0.5), "s", ", ".join(names) if len(names) > 1 else names[0])
     if len(names) > 1:
         canvas.bodies[-1:] = names
     block_at(last, "dashed")
@@ -216,21 +216,23 @@ def slope(canvas: Drawing, scene: SceneView, stage: Stage) -> bool:
     for at, node in ((first, speed), (last, end_speed)):
         if node is None:
             continue
-        lift = (at[0] + nx * 0.95, at[1] + ny * 0.95)
+        lift = (at[0] + nx * 1.45, at[1] + ny * 1.45)
         if _is_zero(node):
             canvas.label(lift, "s", ["v = 0"])
             continue
         tail = (lift[0] - direction * 0.5 * ux, lift[1] - direction * 0.5 * uy)
         tip = (lift[0] + direction * 0.5 * ux, lift[1] + direction * 0.5 * uy)
         canvas.arrow(tail, tip)
-        canvas.label((lift[0] + nx * 0.15, lift[1] + ny * 0.15), "s", scene.given(magnitude(node)))
+        ahead = direction * ux
+        canvas.label((tail[0] - direction * 0.1 * ux, tail[1] - direction * 0.1 * uy), "e" if ahead > 0 else "w",
+                     scene.given(magnitude(node)))
     if "distance" in fields:
         off = -0.45 if beta == 0 else 0.0
         if beta == 0:
             horizontal_dimension(canvas, low[0], high[0], off, scene.given(fields["distance"]))
         else:
-            mid = (length / 2 * ux - nx * 0.55, length / 2 * uy - ny * 0.55)
-            canvas.label(mid, "n" if beta < 0.5 else "nw", scene.given(fields["distance"]))
+            mid = (length * 0.6 * ux - nx * 0.35, length * 0.6 * uy - ny * 0.35)
+            canvas.label(mid, "nw", scene.given(fields["distance"]))
     if rough:
         canvas.label((high[0] + 0.3, high[1] + 0.1 if beta > 0 else 0.15), "sw", scene.given(fields["friction"]))
     return True
@@ -253,18 +255,15 @@ def _ramp(canvas: Drawing, scene: SceneView, stage: Stage) -> bool:
     names = [fields["body"], *([fields["with"]] if "with" in fields else [])]
     canvas.name((start[0], start[1] + 0.4), "s", names[0])
     canvas.bodies += names[1:]
-    for at, node, sideways in ((start, fields["speed"], not up), (end, fields.get("end_speed"), up)):
+    for at, node in ((start, fields["speed"]), (end, fields.get("end_speed"))):
         if node is None:
             continue
-        above = (at[0], at[1] + 0.45 if not sideways else at[1] - 0.45)
         if _is_zero(node):
             canvas.label((at[0] + 0.4, at[1]), "w", ["v = 0"])
             continue
         sign = -1 if up else 1
-        canvas.arrow((at[0] + 0.4, at[1] + 0.35), (at[0] + 0.4 + 0.9 * sign, at[1] + 0.35)) if not up or \
-            at == end else None
-        canvas.label((at[0] + 0.45 + 0.45 * sign, at[1] + 0.5), "s", scene.given(magnitude(node)))
-        del above
+        canvas.arrow((at[0] + 0.45 * sign, at[1]), (at[0] + 1.35 * sign, at[1]))
+        canvas.label((at[0] + 0.5 * sign, at[1] + 0.15), "sw" if sign > 0 else "se", scene.given(magnitude(node)))
     canvas.dimension((-0.7, 0.0), (-0.7, height), scene.given(fields["height"]), "left")
     return True
 
@@ -352,13 +351,12 @@ def separation(canvas: Drawing, scene: SceneView, stage: Stage) -> bool:
         canvas.rect((x - 0.4, 0.0), (x + 0.4, 0.7))
         canvas.name((x, 0.35), "c", body)
         velocity = after.get(body)
-        n, t = _components(scene, velocity)
+        n = _components(scene, velocity)[0]
         if velocity is None:
             continue
         way = 1 if n > 0 else -1 if n < 0 else side
         canvas.arrow((x, 1.0), (x + way * 1.0, 1.0))
         canvas.label((x + way * 0.5, 1.2), "s", scene.given(magnitude(velocity.n)))
-        del t
     if "relative" in fields:
         canvas.label((centre, -0.1), "n", [f"{string('relative')!s}: " + scene.given(fields["relative"])[0]])
     return True
@@ -385,37 +383,43 @@ def impulse(canvas: Drawing, scene: SceneView, stage: Stage) -> bool:
         canvas.rect((-1.0, -0.6), (1.0, 0.0), fill="luma(200)")
         canvas.label((1.05, -0.3), "w", [str(string("cushion"))])
         canvas.dimension((-1.4, -0.6), (-1.4, 0.0), scene.given(fields["distance"]), "left")
-        centre = (0.0, 0.35)
+        centre = (0.0, 0.3)
+        canvas.rect((-0.6, 0.0), (0.6, 0.6))
     else:
         centre = (0.0, 0.0)
-    canvas.circle(centre, 0.35)
+        canvas.circle(centre, 0.35)
     canvas.name(centre, "c", body)
-    if _m.hypot(*b) > 0:
-        _velocity_arrow(canvas, scene, (centre[0] - _unit(b)[0] * 0.4, centre[1] - _unit(b)[1] * 0.4),
-                        turned(before), 1.2, into=True, anchor_side=-1.0)
-        canvas.label((centre[0] - _unit(b)[0] * 1.9, centre[1] - _unit(b)[1] * 1.9 + 0.2), "s",
-                     [str(string("before"))])
-    if _m.hypot(*a) > 0:
-        _velocity_arrow(canvas, scene, (centre[0] + _unit(a)[0] * 0.4, centre[1] + _unit(a)[1] * 0.4 + 0.5),
-                        turned(after), 1.2, into=False)
-        canvas.label((centre[0] + _unit(a)[0] * 1.9, centre[1] + _unit(a)[1] * 1.9 + 0.7), "s",
-                     [str(string("after"))])
-    else:
-        canvas.label((centre[0] + 0.5, centre[1] + 0.3), "w", [str(string("at rest after"))])
+    # before and after beside the body (above and below it, or right of it when n is up), each centred
+    rows = ((centre[0] + 1.2, centre[1] + 0.4), (centre[0] + 1.2, centre[1] + 1.8)) if up else \
+        ((centre[0], centre[1] + 1.0), (centre[0], centre[1] - 1.0))
+    for at, vector, velocity, word in ((rows[0], b, before, "before"), (rows[1], a, after, "after")):
+        lines = [f"{string(word)}: " + line for line in _speed_lines(scene, turned(velocity))]
+        if _m.hypot(*vector) == 0:
+            canvas.label((at[0] - 0.2, at[1]) if up else at, "w" if up else "c", [f"{string(word)}: v = 0"])
+            continue
+        ux, uy = _unit(vector)
+        canvas.arrow((at[0] - ux * 0.6, at[1] - uy * 0.6), (at[0] + ux * 0.6, at[1] + uy * 0.6))
+        if abs(ux) >= abs(uy):
+            canvas.label((at[0], at[1] + 0.15), "s", lines)
+        else:
+            canvas.label((at[0] + 0.15, at[1]), "w", lines)
     jx, jy = a[0] - b[0], a[1] - b[1]
     if _m.hypot(jx, jy) > 0:
         ux, uy = _unit((jx, jy))
-        start = (centre[0] + ux * 0.4, centre[1] + uy * 0.4 - (0.5 if not up else 0.0))
+        start = (centre[0] + ux * 0.4, centre[1] + uy * 0.4)
         tip = (start[0] + ux * 1.1, start[1] + uy * 1.1)
         canvas.arrow(start, tip, width=2.0, head=0.3)
-        named = fields.get("impulse")
-        force = fields.get("force")
+        named, force = fields.get("impulse"), fields.get("force")
         lines = scene.given(named) if named is not None else ["J"]
         if force is not None:
             lines += scene.given(force)
-        canvas.label((tip[0] + 0.15, tip[1]), "w", [", ".join(lines)])
+        middle = ((start[0] + tip[0]) / 2, (start[1] + tip[1]) / 2)
+        if abs(ux) >= abs(uy):
+            canvas.label((middle[0], middle[1] + 0.15), "s", [", ".join(lines)])
+        else:
+            canvas.label((middle[0] - 0.15, middle[1]), "e", [", ".join(lines)])
     if "time" in fields:
-        canvas.label((centre[0], centre[1] - 0.5 - (0.6 if not up else 0)), "n", scene.given(fields["time"]))
+        canvas.label((centre[0], centre[1] - 1.5), "n", scene.given(fields["time"]))
     return True
 
 

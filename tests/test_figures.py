@@ -2,8 +2,8 @@
 drawing's own record of what it drew: every stage is in one panel, the panels are in stage order, every
 body of the scene is named and nothing else is, each panel names the bodies of its stages; a number in a
 label is a value the statement prints. For every shipped template and for a test bank of scenes written
-only for these tests (``tests/data/figures``: the issue's problems that today's effects can write, and
-stranger ones)."""
+only for these tests (``tests/data/figures``: the issue's problems, and stranger ones), and for issue 25's
+trial templates of the new effects (``tests/data``)."""
 
 from __future__ import annotations
 
@@ -24,11 +24,17 @@ from grader.solve.cache import compiled_for
 TEST_BANK = Path(__file__).parent / "data" / "figures"
 
 
+TRIALS = ("bullet-spring", "package-platform", "ramp-and-floor", "incline-up-and-back", "intersection",
+          "intersection-reconstruction", "explosion", "recoil", "ball-wall-impulse", "cushion", "oblique-both-moving")
+"""Issue 25's trial templates of the new effects (tests/data): their figures are checked as the bank's."""
+
+
 def _bank() -> dict[str, Template]:
     shipped = load_bank()
     written = {t.id: t for t in (load_template(p) for p in sorted(TEST_BANK.glob("*.yaml")))}
-    assert not set(shipped) & set(written)
-    return {**shipped, **written}
+    trials = {t.id: t for t in (load_template(TEST_BANK.parent / f"{name}.yaml") for name in TRIALS)}
+    assert not set(shipped) & set(written) and not (set(shipped) | set(written)) & set(trials)
+    return {**shipped, **written, **trials}
 
 
 BANK = _bank()
@@ -112,23 +118,42 @@ def test_the_issues_pendulum_striking_a_hanging_ball_draws_both_pendulums(
     assert [p.title for p in record.panels] == ["1 · A swings", "2 · A strikes B", "3 · B swings"]
 
 
-def test_the_issues_ramp_then_skid_draws_the_fall_the_impact_and_only_b_sliding(
+def test_the_issues_ramp_then_skid_draws_the_ramp_the_impact_and_only_b_sliding(
         figures: dict[str, tuple[str, FigureRecord, dict[str, str]]]) -> None:
     """Issue 26: it was drawn as the skid template's two cars locked together. Now a panel per stage: A
-    comes down the ramp's height (drawn as its fall: the catalogue has no slope yet), A strikes B, B
-    alone slides to rest."""
-    _, record, _ = figures["ramp-skid/0"]
+    comes down the ramp (a slope: the smooth ramp, its height dimensioned with the printed value), A
+    strikes B, B alone slides to rest."""
+    typst, record, printed = figures["ramp-skid/0"]
     assert [p.bodies for p in record.panels] == [("A",), ("A", "B"), ("B",)]
+    assert record.panels[0].title == "1 · A slides"
+    assert "$h$" in typst and f"$= {printed['h']} thin" in typst  # the dimension: h over its value
 
 
-@pytest.mark.parametrize("effect", ["spring", "stick"])
-def test_the_issues_spring_and_intersection_problems_wait_for_their_effects(effect: str) -> None:
-    """The bullet into a block held by a spring needs a `spring` effect, the two cars at an intersection
-    a `stick` (bodies sticking in a plane): neither is in the catalogue yet (physics catalogue II). Their
-    panels come with them; this test says so until then."""
-    if effect not in CATALOGUE:
-        pytest.skip(f"no {effect} effect in the catalogue yet: its test-bank scene and panel come with it")
-    pytest.fail(f"the {effect} effect exists: write its test-bank scene and panel (issue 26)")
+def test_the_issues_bullet_into_a_block_on_a_spring_draws_the_spring_and_the_wall(
+        figures: dict[str, tuple[str, FigureRecord, dict[str, str]]]) -> None:
+    """Issue 26: no spring, no wall, the bullet labelled `-v_b`. Now one panel: the wall (hatched), the
+    coils (a zigzag path), the block and the bullet coming in toward the wall labelled v_b, the greatest
+    compression named and not valued (it is asked)."""
+    typst, record, printed = figures["spring-bullet-block/0"]
+    assert [set(p.bodies) for p in record.panels] == [{"block", "bullet"}]
+    assert f"v_b = {printed['v_b']}" in typst and "-v_b" not in typst and "- v_b" not in typst
+    assert f"k = {printed['k']}" in typst
+    coils = [line for line in typst.splitlines() if line.strip().startswith("fig-path(") and line.count("(") > 14]
+    assert coils, "no spring drawn"
+    assert "$x_\"max\"$" in typst  # the greatest compression: its name alone
+
+
+def test_the_issues_cars_at_an_intersection_draw_both_cars_with_their_directions(
+        figures: dict[str, tuple[str, FigureRecord, dict[str, str]]]) -> None:
+    """Issue 26: a car at rest on a line. Now A and B come in along their directions, A north and B east
+    (their arrows end at the point of impact, the label their printed speeds), the wreck dashed."""
+    typst, record, printed = figures["intersection-cars/0"]
+    assert [set(p.bodies) for p in record.panels] == [{"A", "B"}]
+    assert f"v_A = {printed['v_A']}" in typst and f"v_B = {printed['v_B']}" in typst
+    arrows = re.findall(r"\(\(([\d.]+), ([\d.]+)\), \(([\d.]+), ([\d.]+)\)\)", typst)
+    moves = {(round(float(x1) - float(x0), 1) != 0, round(float(y1) - float(y0), 1) != 0) for x0, y0, x1, y1 in arrows}
+    assert (True, False) in moves and (False, True) in moves  # a line along east, one along north
+    assert "theta =" not in typst  # the wreck's direction is asked: named only
 
 
 def test_every_effect_of_the_catalogue_has_a_panel_or_labels_one() -> None:

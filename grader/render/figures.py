@@ -23,16 +23,6 @@ STAGE_FIGURES: Mapping[str, str] = {
     "angle_between": "not drawn: no panel reads it",
     "impact_geometry": "in the panel of the oblique impact after it: the two spheres at contact, radii in their "
                        "ratio, the offset dimensioned and n at its angle to the path",
-    "slope": "not drawn yet (no panel): a scene with a slope is drawn by its other stages' panels, or as its "
-             "bodies in a row",
-    "impulse": "not drawn yet (no panel): a scene with an impulse is drawn by its other stages' panels, or as its "
-               "bodies in a row",
-    "separation": "not drawn yet (no panel): a scene where a body separates in two is drawn by its other stages' "
-                  "panels, or as its bodies in a row",
-    "stick": "not drawn yet (no panel): a scene with bodies that stick in a plane is drawn by its other stages' "
-             "panels, or as its bodies in a row",
-    "spring": "not drawn yet (no panel): a scene with a spring is drawn by its other stages' panels, or as its "
-              "bodies in a row",
 }
 """How a stage of each effect is drawn, one sentence each: a figure is the scene's panels in stage
 order, a stage drawn in its own effect's panel or in the panel of the stage before it that claims it."""

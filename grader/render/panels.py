@@ -38,6 +38,7 @@ from grader.render.series import bounce_series
 from grader.render.skid import horizontal_dimension, skid
 from grader.render.trajectory import flight_time, trajectory
 from grader.render.typst_text import Typ, string
+from grader.render.work_impulse import impulse, separation, slope, spring, stick
 
 ANNOTATIONS = frozenset({"velocity", "angle_between", "impact_geometry"})
 STRIP_WIDTH = 5.2  # cm a panel of a strip may take (two side by side beside the answer blanks)
@@ -123,6 +124,8 @@ def _claim_impact(stages: Sequence[Stage], i: int) -> int:
     bodies = tuple(impact.fields["bodies"])
     if after is not None and after.effect == "slide" and set(_bodies(after)) == set(bodies):
         return 2  # the bodies locked together, skidding to rest: the skid, from the point of impact
+    if after is not None and after.effect == "spring" and set(_bodies(after)) == set(bodies):
+        return 2  # a body that embeds in a block on a spring: the spring, the body coming in
     striker_came = any(set(_bodies(s)) & {bodies[0]} for s in stages[:i])
     if after is not None and after.effect == "swing" and after.fields["body"] == bodies[1] and not striker_came:
         return 2  # a body that only strikes (a bullet) and the pendulum it strikes: the ballistic pendulum
@@ -163,6 +166,8 @@ def _draw_impact(canvas: Drawing, scene: SceneView, group: Sequence[Stage]) -> b
         return skid(canvas, scene, impact, group[1])
     if len(group) == 2 and group[1].effect == "swing":
         return swing_figure(canvas, scene, group[1], impact)
+    if len(group) == 2 and group[1].effect == "spring":
+        return spring(canvas, scene, group[1], impact)
     if not impact.is_oblique:
         return direct(canvas, scene, group)
     if scene.template.scene.bodies[impact.fields["bodies"][1]].mass is None:
@@ -249,6 +254,26 @@ def _draw_rise(canvas: Drawing, scene: SceneView, group: Sequence[Stage]) -> boo
     return True
 
 
+def _draw_spring(canvas: Drawing, scene: SceneView, group: Sequence[Stage]) -> bool:
+    return spring(canvas, scene, group[0], None)
+
+
+def _draw_slope(canvas: Drawing, scene: SceneView, group: Sequence[Stage]) -> bool:
+    return slope(canvas, scene, group[0])
+
+
+def _draw_stick(canvas: Drawing, scene: SceneView, group: Sequence[Stage]) -> bool:
+    return stick(canvas, scene, group[0])
+
+
+def _draw_separation(canvas: Drawing, scene: SceneView, group: Sequence[Stage]) -> bool:
+    return separation(canvas, scene, group[0])
+
+
+def _draw_impulse(canvas: Drawing, scene: SceneView, group: Sequence[Stage]) -> bool:
+    return impulse(canvas, scene, group[0])
+
+
 def _draw_bounces(canvas: Drawing, scene: SceneView, group: Sequence[Stage]) -> bool:
     return bounce_series(canvas, scene, group[0])
 
@@ -286,11 +311,36 @@ PANELS: dict[str, PanelKind] = {
     "bounces": PanelKind(_one, _draw_bounces,
                          "the drop and the decaying arcs until the body rests, heights and time along the floor to "
                          "scale, the bounce whose height is asked marked by its name"),
+    "spring": PanelKind(_one, _draw_spring,
+                        "horizontal: the wall, the coils at their natural length, the block (with what is stuck to "
+                        "it) moving toward the wall, dashed at the greatest compression, dimensioned; after the "
+                        "impact that sets the block moving, in its panel, the striking body coming in with its "
+                        "velocity; vertical: the platform on the spring at its static deflection below the natural "
+                        "length, what lands on it, the greatest compression dimensioned"),
+    "slope": PanelKind(_one, _draw_slope,
+                       "the path: an incline at its angle (to scale when given) with the distance along it, a "
+                       "smooth ramp with its height dimensioned, or a level floor with the distance dimensioned; "
+                       "a rough surface hatched, with its friction coefficient; the body at the start with its "
+                       "speed the way it moves, dashed at the end with its speed there"),
+    "stick": PanelKind(_one, _draw_stick,
+                       "the n (east) and t (north) axes at the point of impact, both bodies coming in along their "
+                       "velocities (given speeds to scale), the wreck's direction dashed from the point, its angle "
+                       "marked (not to scale when asked)"),
+    "separation": PanelKind(_one, _draw_separation,
+                            "the whole (the two parts together) with its velocity or at rest, and the energy "
+                            "released; then the parts flying apart along n, each with its velocity the way it "
+                            "moves"),
+    "impulse": PanelKind(_one, _draw_impulse,
+                         "the body with its velocity just before coming in and just after going out, and the "
+                         "impulse on it a thick arrow labelled with its name (and the average force); a body "
+                         "stopped over a distance on the cushion under it, the distance dimensioned"),
 }
 """How each effect's stage is drawn, keyed by effect name."""
 
 _SAID = {"free_fall": "{0} falls", "rise": "{0} rises", "impact": "{0} strikes {1}", "slide": "{0} slides",
-         "swing": "{0} swings", "flight": "{0} flies", "bounces": "{0} bounces"}
+         "swing": "{0} swings", "flight": "{0} flies", "bounces": "{0} bounces", "spring": "{0} compresses the spring",
+         "slope": "{0} slides", "stick": "{0} and {1} stick", "separation": "{0} and {1} separate",
+         "impulse": "the impulse on {0}"}
 
 
 # --- the figure ---------------------------------------------------------------------------------

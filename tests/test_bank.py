@@ -163,7 +163,7 @@ TOPIC_OF = {
     "bullet-block-spring": "direct impact", "gun-recoil": "direct impact", "head-on-approach": "direct impact",
     "shell-explosion": "direct impact", "wall-impulse": "direct impact", "crash-reconstruction": "oblique impact",
     "intersection-crash": "oblique impact", "oblique-moving-spheres": "oblique impact",
-    "cushion-stop": "drops and rebounds", "package-on-platform": "drops and rebounds",
+    "cushion-stop": "drops and rebounds", "package-on-platform": "drops and rebounds", "spring-carts": "direct impact",
 }
 
 

@@ -133,13 +133,39 @@ def ref_head_on_approach(m1, m2, v2, e, v1_out):
     return {"v1": v1, "v2_out": v1o + e * (v1 - v2)}
 
 
+def ref_spring_carts(m_A, m_B, E):  # noqa: N803
+    """0 = m_A v_A' + m_B v_B' (n to the right) and 1/2 m_A v_A'^2 + 1/2 m_B v_B'^2 = E: the speeds m_B u / M
+    and m_A u / M with 1/2 (m_A m_B / M) u^2 = E."""
+    m_a, m_b, E = mp.mpf(m_A), mp.mpf(m_B), mp.mpf(E)  # noqa: N806
+    mass = m_a + m_b
+    u = mp.sqrt(2 * E * mass / (m_a * m_b))
+    return {"v_A": m_b * u / mass, "v_B": m_a * u / mass}
+
+
+def ref_ramp_strike(m_A, m_B, h, e, mu_k):  # noqa: N803
+    """Energy down the ramp, v_A = sqrt(2 g h); momentum and e with B at rest: v_B' = m_A (1 + e) v_A / M;
+    then mu_k m_B g d = 1/2 m_B v_B'^2."""
+    m_a, m_b, h, e, mu_k = (mp.mpf(x) for x in (m_A, m_B, h, e, mu_k))
+    v_a = mp.sqrt(2 * G * h)
+    v_b = m_a * (1 + e) * v_a / (m_a + m_b)
+    return {"v_A": v_a, "vB_out": v_b, "d": v_b**2 / (2 * mu_k * G)}
+
+
+def ref_ramp_strike_inverse(m_A, m_B, h, mu_k, d):  # noqa: N803
+    """v_A = sqrt(2 g h), v_B' = sqrt(2 mu_k g d) from the slide, and v_B' = m_A (1 + e) v_A / M for e."""
+    m_a, m_b, h, mu_k, d = (mp.mpf(x) for x in (m_A, m_B, h, mu_k, d))
+    v_a, v_b = mp.sqrt(2 * G * h), mp.sqrt(2 * mu_k * G * d)
+    return {"v_A": v_a, "vB_out": v_b, "e": v_b * (m_a + m_b) / (m_a * v_a) - 1}
+
+
 REFERENCES = {
     "bullet-block-spring": ref_bullet_block_spring, "package-on-platform": ref_package_on_platform,
     "ramp-slide": ref_ramp_slide, "incline-slide": ref_incline_slide,
     "intersection-crash": ref_intersection_crash, "crash-reconstruction": ref_crash_reconstruction,
     "shell-explosion": ref_shell_explosion, "gun-recoil": ref_gun_recoil, "wall-impulse": ref_wall_impulse,
     "cushion-stop": ref_cushion_stop, "oblique-moving-spheres": ref_oblique_moving_spheres,
-    "head-on-approach": ref_head_on_approach,
+    "head-on-approach": ref_head_on_approach, "spring-carts": ref_spring_carts, "ramp-strike": ref_ramp_strike,
+    "ramp-strike-inverse": ref_ramp_strike_inverse,
 }
 
 
@@ -185,6 +211,13 @@ KNOWN = [
      {"e": 0.3631, "vB_n": 3.735, "vA_out": 3.283, "loss_pct": 41.69}),
     # v1 (4 - 0.9) = 5.5(-0.3) - 1.6(1.5)(-5) = 10.35, v1 = 3.339 m/s; v2' = -0.3 + 0.6(8.339) = 4.703 m/s
     ("head-on-approach", {"m1": 4, "m2": 1.5, "v2": -5, "e": 0.6, "v1_out": -0.3}, {"v1": 3.339, "v2_out": 4.703}),
+    # u = sqrt(2(15)(5)/6) = 5 m/s; A at 3(5)/5 = 3 m/s, B at 2(5)/5 = 2 m/s
+    ("spring-carts", {"m_A": 2, "m_B": 3, "E": 15}, {"v_A": 3.0, "v_B": 2.0}),
+    # v_A = sqrt(2(9.81)(1.2)) = 4.852 m/s; v_B' = 2(1.6)(4.852)/5 = 3.105 m/s; d = 9.643/(2(0.3)(9.81)) = 1.638 m
+    ("ramp-strike", {"m_A": 2, "m_B": 3, "h": 1.2, "e": 0.6, "mu_k": 0.3}, {"v_A": 4.852, "vB_out": 3.105, "d": 1.638}),
+    # v_A = sqrt(2(9.81)(1.1)) = 4.646 m/s; v_B' = sqrt(2(0.28)(9.81)(2)) = 3.315 m/s; e = 3.315(4.4)/(2.2(4.646)) - 1
+    ("ramp-strike-inverse", {"m_A": 2.2, "m_B": 2.2, "h": 1.1, "mu_k": 0.28, "d": 2},
+     {"v_A": 4.646, "vB_out": 3.315, "e": 0.427}),
 ]
 
 
@@ -242,6 +275,12 @@ HARD = [
     ("head-on-approach", {"m1": 1e6, "m2": 1e-6, "v2": -5, "e": 1, "v1_out": -0.3}),
     ("head-on-approach", {"m1": 4, "m2": 1.5, "v2": -5, "e": 0, "v1_out": -0.3}),
     ("head-on-approach", {"m1": 1e-3, "m2": 1e-6, "v2": -1e-100, "e": 0.5, "v1_out": -1e-101}),
+    ("spring-carts", {"m_A": 1e-6, "m_B": 1e6, "E": 15}),
+    ("spring-carts", {"m_A": 1e100, "m_B": 1e100, "E": 1e-100}),
+    ("ramp-strike", {"m_A": 1e-6, "m_B": 1e6, "h": 1.2, "e": 1, "mu_k": 0.3}),
+    ("ramp-strike", {"m_A": 1e6, "m_B": 1e-6, "h": 1e-9, "e": 0, "mu_k": 1e-6}),
+    ("ramp-strike-inverse", {"m_A": 2, "m_B": 2, "h": 1, "mu_k": 0.25, "d": 3.9}),  # e a hair below 1
+    ("ramp-strike-inverse", {"m_A": 1e6, "m_B": 1e-6, "h": 1e-9, "mu_k": 1e-3, "d": 1.5e-6}),
 ]
 
 

@@ -164,6 +164,7 @@ TOPIC_OF = {
     "shell-explosion": "direct impact", "wall-impulse": "direct impact", "crash-reconstruction": "oblique impact",
     "intersection-crash": "oblique impact", "oblique-moving-spheres": "oblique impact",
     "cushion-stop": "drops and rebounds", "package-on-platform": "drops and rebounds", "spring-carts": "direct impact",
+    "package-bounce": "drops and rebounds",
 }
 
 

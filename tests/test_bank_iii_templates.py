@@ -158,6 +158,16 @@ def ref_ramp_strike_inverse(m_A, m_B, h, mu_k, d):  # noqa: N803
     return {"v_A": v_a, "vB_out": v_b, "e": v_b * (m_a + m_b) / (m_a * v_a) - 1}
 
 
+def ref_package_bounce(m, m_p, h, e, k):
+    """Free fall; momentum and e (n down); then the platform alone oscillates about where it rested, which is
+    its static equilibrium: the greatest deflection below it is the amplitude V sqrt(m_p / k)."""
+    m, m_p, h, e, k = mp.mpf(m), mp.mpf(m_p), mp.mpf(h), mp.mpf(e), mp.mpf(k) * 1000
+    v0 = mp.sqrt(2 * G * h)
+    mass = m + m_p
+    platform = m * (1 + e) * v0 / mass
+    return {"v_up": v0 * (e * m_p - m) / mass, "V": platform, "extra": 1000 * platform * mp.sqrt(m_p / k)}
+
+
 REFERENCES = {
     "bullet-block-spring": ref_bullet_block_spring, "package-on-platform": ref_package_on_platform,
     "ramp-slide": ref_ramp_slide, "incline-slide": ref_incline_slide,
@@ -165,7 +175,7 @@ REFERENCES = {
     "shell-explosion": ref_shell_explosion, "gun-recoil": ref_gun_recoil, "wall-impulse": ref_wall_impulse,
     "cushion-stop": ref_cushion_stop, "oblique-moving-spheres": ref_oblique_moving_spheres,
     "head-on-approach": ref_head_on_approach, "spring-carts": ref_spring_carts, "ramp-strike": ref_ramp_strike,
-    "ramp-strike-inverse": ref_ramp_strike_inverse,
+    "ramp-strike-inverse": ref_ramp_strike_inverse, "package-bounce": ref_package_bounce,
 }
 
 
@@ -213,6 +223,9 @@ KNOWN = [
     ("head-on-approach", {"m1": 4, "m2": 1.5, "v2": -5, "e": 0.6, "v1_out": -0.3}, {"v1": 3.339, "v2_out": 4.703}),
     # u = sqrt(2(15)(5)/6) = 5 m/s; A at 3(5)/5 = 3 m/s, B at 2(5)/5 = 2 m/s
     ("spring-carts", {"m_A": 2, "m_B": 3, "E": 15}, {"v_A": 3.0, "v_B": 2.0}),
+    # v0 = sqrt(2(9.81)(0.8)) = 3.962 m/s; up 3.962(15 - 5)/35 = 1.132 m/s; V = 5(1.5)(3.962)/35 = 0.8490 m/s;
+    # amplitude 0.8490 sqrt(30/10^4) = 46.50 mm
+    ("package-bounce", {"m": 5, "m_p": 30, "h": 0.8, "e": 0.5, "k": 10}, {"v_up": 1.132, "V": 0.849, "extra": 46.5}),
     # v_A = sqrt(2(9.81)(1.2)) = 4.852 m/s; v_B' = 2(1.6)(4.852)/5 = 3.105 m/s; d = 9.643/(2(0.3)(9.81)) = 1.638 m
     ("ramp-strike", {"m_A": 2, "m_B": 3, "h": 1.2, "e": 0.6, "mu_k": 0.3}, {"v_A": 4.852, "vB_out": 3.105, "d": 1.638}),
     # v_A = sqrt(2(9.81)(1.1)) = 4.646 m/s; v_B' = sqrt(2(0.28)(9.81)(2)) = 3.315 m/s; e = 3.315(4.4)/(2.2(4.646)) - 1
@@ -276,6 +289,8 @@ HARD = [
     ("head-on-approach", {"m1": 4, "m2": 1.5, "v2": -5, "e": 0, "v1_out": -0.3}),
     ("head-on-approach", {"m1": 1e-3, "m2": 1e-6, "v2": -1e-100, "e": 0.5, "v1_out": -1e-101}),
     ("spring-carts", {"m_A": 1e-6, "m_B": 1e6, "E": 15}),
+    ("package-bounce", {"m": 1e-6, "m_p": 1e6, "h": 1.5, "e": 1, "k": 1e-3}),
+    ("package-bounce", {"m": 2, "m_p": 40, "h": 1e-12, "e": 0.06, "k": 1e9}),
     ("spring-carts", {"m_A": 1e100, "m_B": 1e100, "E": 1e-100}),
     ("ramp-strike", {"m_A": 1e-6, "m_B": 1e6, "h": 1.2, "e": 1, "mu_k": 0.3}),
     ("ramp-strike", {"m_A": 1e6, "m_B": 1e-6, "h": 1e-9, "e": 0, "mu_k": 1e-6}),

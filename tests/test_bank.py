@@ -159,6 +159,12 @@ TOPIC_OF = {
     "ball-plate": "oblique impact", "oblique-spheres": "oblique impact",
     "drop-rebound": "drops and rebounds", "moving-plate": "drops and rebounds", "pile-driver": "drops and rebounds",
     "two-rebounds": "drops and rebounds", "skid": "impact and sliding", "wall-throw": "impact with flight",
+    # issue 27's (ramp-slide and incline-slide declare impact and sliding: a slope alone is no slide to the scene)
+    "bullet-block-spring": "direct impact", "gun-recoil": "direct impact", "head-on-approach": "direct impact",
+    "shell-explosion": "direct impact", "wall-impulse": "direct impact", "crash-reconstruction": "oblique impact",
+    "intersection-crash": "oblique impact", "oblique-moving-spheres": "oblique impact",
+    "cushion-stop": "drops and rebounds", "package-on-platform": "drops and rebounds", "spring-carts": "direct impact",
+    "package-bounce": "drops and rebounds",
 }
 
 

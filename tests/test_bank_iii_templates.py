@@ -1,0 +1,304 @@
+"""Issue 27's templates (problem bank III: springs, slopes, cars that lock together, explosions, recoil,
+impulses, the separation in place of e, the head-on impact read backwards) against references written here.
+
+Each reference writes what a student would, from first principles, in 60-digit mpmath with the float inputs
+taken as exact, and never calls the solver. Every template is checked on its own example (worked by hand to
+four figures), on 20 variants drawn the way its sampling draws them, and on hard cases (mass ratios far from
+one, tiny and huge sizes, the limits of e and of the angles).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import mpmath as mp
+import numpy as np
+import pytest
+import yaml
+
+from grader.base.resources import bank_dir
+from tests import references
+
+G = mp.mpf(9.81)  # the bank's g, as the float the kernels use
+KMH = mp.mpf(1000) / 3600  # m/s per km/h
+
+
+def deg(angle: Any) -> Any:
+    return mp.mpf(angle) * mp.pi / 180
+
+
+# ---- references -------------------------------------------------------------------------------
+def ref_bullet_block_spring(m_b, m_blk, v_b, k):
+    """Momentum through the plastic impact; then 1/2 (m_b + m_blk) V^2 = 1/2 k x^2."""
+    m_b, m_blk, v_b, k = mp.mpf(m_b) / 1000, mp.mpf(m_blk), mp.mpf(v_b), mp.mpf(k) * 1000  # g, kN/m
+    common = m_b * v_b / (m_b + m_blk)
+    kinetic = (m_b + m_blk) * common**2 / 2
+    x = mp.sqrt(2 * kinetic / k)
+    return {"V": common, "E_lost": m_b * v_b**2 / 2 - kinetic, "x_max": 1000 * x, "E_max": kinetic}
+
+
+def ref_package_on_platform(m, m_p, h, k):
+    """Free fall, momentum, then energy from the static deflection delta = m_p g / k down to the greatest
+    compression x: 1/2 M V^2 + M g (x - delta) = 1/2 k (x^2 - delta^2), the quadratic's larger root."""
+    m, m_p, h, k = mp.mpf(m), mp.mpf(m_p), mp.mpf(h), mp.mpf(k) * 1000
+    mass = m + m_p
+    common = m * mp.sqrt(2 * G * h) / mass
+    delta = m_p * G / k
+    # k x^2 / 2 - M g x - (M V^2/2 - M g delta + k delta^2/2) = 0
+    c = mass * common**2 / 2 - mass * G * delta + k * delta**2 / 2
+    x = (mass * G + mp.sqrt((mass * G) ** 2 + 2 * k * c)) / k
+    return {"delta": 1000 * delta, "x_max": 1000 * x, "extra": 1000 * (x - delta)}
+
+
+def ref_ramp_slide(h, v0, mu_k):
+    """Energy down the smooth ramp; then mu_k m g d = 1/2 m v_B^2 on the floor."""
+    h, v0, mu_k = mp.mpf(h), mp.mpf(v0), mp.mpf(mu_k)
+    v_b = mp.sqrt(v0**2 + 2 * G * h)
+    return {"v_B": v_b, "d": v_b**2 / (2 * mu_k * G)}
+
+
+def ref_incline_slide(v0, beta, mu_k):
+    """Up: deceleration g (sin beta + mu cos beta); down from rest: acceleration g (sin beta - mu cos beta)."""
+    v0, b, mu_k = mp.mpf(v0), deg(beta), mp.mpf(mu_k)
+    d = v0**2 / (2 * G * (mp.sin(b) + mu_k * mp.cos(b)))
+    return {"d": d, "v_back": mp.sqrt(2 * G * d * (mp.sin(b) - mu_k * mp.cos(b)))}
+
+
+def ref_intersection_crash(m_A, m_B, v_A, v_B):  # noqa: N803 (the template's names)
+    """Momentum east (B's) and north (A's) of the wreck; its direction north of east; the energy."""
+    m_a, m_b, v_a, v_b = mp.mpf(m_A), mp.mpf(m_B), mp.mpf(v_A) * KMH, mp.mpf(v_B) * KMH
+    east, north = m_b * v_b, m_a * v_a
+    v = mp.sqrt(east**2 + north**2) / (m_a + m_b)
+    before = (m_a * v_a**2 + m_b * v_b**2) / 2
+    return {"v": v / KMH, "theta": mp.atan2(north, east) * 180 / mp.pi,
+            "loss_pct": 100 * (before - (m_a + m_b) * v**2 / 2) / before}
+
+
+def ref_crash_reconstruction(m_A, m_B, v_B, theta):  # noqa: N803
+    """tan theta = m_A v_A / (m_B v_B); the wreck's east component m_B v_B / M = v cos theta."""
+    m_a, m_b, v_b, t = mp.mpf(m_A), mp.mpf(m_B), mp.mpf(v_B), deg(theta)
+    return {"v_A": m_b * v_b * mp.tan(t) / m_a, "v": m_b * v_b / ((m_a + m_b) * mp.cos(t))}
+
+
+def ref_shell_explosion(m1, m2, V, E):  # noqa: N803
+    """Momentum M V = m1 v1 + m2 v2 and energy 1/2 m1 v1^2 + 1/2 m2 v2^2 = 1/2 M V^2 + E: in the centre of
+    mass frame the parts move apart at w with 1/2 (m1 m2 / M) w^2 = E, the front one forward."""
+    m1, m2, V, E = mp.mpf(m1), mp.mpf(m2), mp.mpf(V), mp.mpf(E) * 1000  # noqa: N806
+    mass = m1 + m2
+    w = mp.sqrt(2 * E * mass / (m1 * m2))
+    return {"v1": V - m2 * w / mass, "v2": V + m1 * w / mass}
+
+
+def ref_gun_recoil(m_gun, m_b, u):
+    """0 = m_gun v_gun + m_b v_b and v_b - v_gun = u."""
+    m_gun, m_b, u = mp.mpf(m_gun), mp.mpf(m_b) / 1000, mp.mpf(u)
+    v_gun = -m_b * u / (m_gun + m_b)
+    v_b = v_gun + u
+    return {"v_recoil": -v_gun, "v_b": v_b, "E": (m_gun * v_gun**2 + m_b * v_b**2) / 2 / 1000}
+
+
+def ref_wall_impulse(m, v, e, dt):
+    """The ball comes back at e v: J = m (v + e v), F = J / dt."""
+    m, v, e, dt = mp.mpf(m) / 1000, mp.mpf(v), mp.mpf(e), mp.mpf(dt) / 1000
+    impulse = m * (v + e * v)
+    return {"J": impulse, "F": impulse / dt}
+
+
+def ref_cushion_stop(m, h, d):
+    """v = sqrt(2 g h); J = m v; work-energy over d with the weight: (F - m g) d = 1/2 m v^2."""
+    m, h, d = mp.mpf(m), mp.mpf(h), mp.mpf(d) / 1000
+    v = mp.sqrt(2 * G * h)
+    return {"J": m * v, "F": (m * G + m * v**2 / (2 * d)) / 1000}
+
+
+def ref_oblique_moving_spheres(m_A, m_B, v_A, alpha, v_B, beta, s):  # noqa: N803
+    """n from A to B along the line of centres: A's n-component v_A cos alpha, B's -v_B cos beta (toward A);
+    the t-components are kept (smooth spheres); momentum along n and vB_n - vA_n = s; e = s / approach."""
+    m_a, m_b, v_a, v_b, s = (mp.mpf(x) for x in (m_A, m_B, v_A, v_B, s))
+    ua_n, ua_t = v_a * mp.cos(deg(alpha)), v_a * mp.sin(deg(alpha))
+    ub_n, ub_t = -v_b * mp.cos(deg(beta)), v_b * mp.sin(deg(beta))
+    mass, momentum = m_a + m_b, m_a * ua_n + m_b * ub_n
+    va_n, vb_n = (momentum - m_b * s) / mass, (momentum + m_a * s) / mass
+    before = (m_a * v_a**2 + m_b * v_b**2) / 2
+    after = (m_a * (va_n**2 + ua_t**2) + m_b * (vb_n**2 + ub_t**2)) / 2
+    return {"e": s / (ua_n - ub_n), "vB_n": vb_n, "vA_out": mp.sqrt(va_n**2 + ua_t**2),
+            "loss_pct": 100 * (before - after) / before}
+
+
+def ref_head_on_approach(m1, m2, v2, e, v1_out):
+    """m1 v1 + m2 v2 = m1 v1' + m2 v2' and v2' - v1' = e (v1 - v2), solved for v1 and v2' by hand:
+    v1 (m1 - e m2) = (m1 + m2) v1' - (1 + e) m2 v2."""
+    m1, m2, v2, e, v1o = (mp.mpf(x) for x in (m1, m2, v2, e, v1_out))
+    v1 = ((m1 + m2) * v1o - (1 + e) * m2 * v2) / (m1 - e * m2)
+    return {"v1": v1, "v2_out": v1o + e * (v1 - v2)}
+
+
+def ref_spring_carts(m_A, m_B, E):  # noqa: N803
+    """0 = m_A v_A' + m_B v_B' (n to the right) and 1/2 m_A v_A'^2 + 1/2 m_B v_B'^2 = E: the speeds m_B u / M
+    and m_A u / M with 1/2 (m_A m_B / M) u^2 = E."""
+    m_a, m_b, E = mp.mpf(m_A), mp.mpf(m_B), mp.mpf(E)  # noqa: N806
+    mass = m_a + m_b
+    u = mp.sqrt(2 * E * mass / (m_a * m_b))
+    return {"v_A": m_b * u / mass, "v_B": m_a * u / mass}
+
+
+def ref_ramp_strike(m_A, m_B, h, e, mu_k):  # noqa: N803
+    """Energy down the ramp, v_A = sqrt(2 g h); momentum and e with B at rest: v_B' = m_A (1 + e) v_A / M;
+    then mu_k m_B g d = 1/2 m_B v_B'^2."""
+    m_a, m_b, h, e, mu_k = (mp.mpf(x) for x in (m_A, m_B, h, e, mu_k))
+    v_a = mp.sqrt(2 * G * h)
+    v_b = m_a * (1 + e) * v_a / (m_a + m_b)
+    return {"v_A": v_a, "vB_out": v_b, "d": v_b**2 / (2 * mu_k * G)}
+
+
+def ref_ramp_strike_inverse(m_A, m_B, h, mu_k, d):  # noqa: N803
+    """v_A = sqrt(2 g h), v_B' = sqrt(2 mu_k g d) from the slide, and v_B' = m_A (1 + e) v_A / M for e."""
+    m_a, m_b, h, mu_k, d = (mp.mpf(x) for x in (m_A, m_B, h, mu_k, d))
+    v_a, v_b = mp.sqrt(2 * G * h), mp.sqrt(2 * mu_k * G * d)
+    return {"v_A": v_a, "vB_out": v_b, "e": v_b * (m_a + m_b) / (m_a * v_a) - 1}
+
+
+def ref_package_bounce(m, m_p, h, e, k):
+    """Free fall; momentum and e (n down); then the platform alone oscillates about where it rested, which is
+    its static equilibrium: the greatest deflection below it is the amplitude V sqrt(m_p / k)."""
+    m, m_p, h, e, k = mp.mpf(m), mp.mpf(m_p), mp.mpf(h), mp.mpf(e), mp.mpf(k) * 1000
+    v0 = mp.sqrt(2 * G * h)
+    mass = m + m_p
+    platform = m * (1 + e) * v0 / mass
+    return {"v_up": v0 * (e * m_p - m) / mass, "V": platform, "extra": 1000 * platform * mp.sqrt(m_p / k)}
+
+
+REFERENCES = {
+    "bullet-block-spring": ref_bullet_block_spring, "package-on-platform": ref_package_on_platform,
+    "ramp-slide": ref_ramp_slide, "incline-slide": ref_incline_slide,
+    "intersection-crash": ref_intersection_crash, "crash-reconstruction": ref_crash_reconstruction,
+    "shell-explosion": ref_shell_explosion, "gun-recoil": ref_gun_recoil, "wall-impulse": ref_wall_impulse,
+    "cushion-stop": ref_cushion_stop, "oblique-moving-spheres": ref_oblique_moving_spheres,
+    "head-on-approach": ref_head_on_approach, "spring-carts": ref_spring_carts, "ramp-strike": ref_ramp_strike,
+    "ramp-strike-inverse": ref_ramp_strike_inverse, "package-bounce": ref_package_bounce,
+}
+
+
+def check(bank, compiled, template_id, params):
+    references.check(bank, compiled, template_id, params, REFERENCES[template_id])
+
+
+def test_every_new_template_is_shipped_with_a_reference(bank):
+    assert set(REFERENCES) <= set(bank)
+
+
+# ---- the examples, worked by hand to four figures ---------------------------------------------
+KNOWN = [
+    # V = 0.010(500)/2.010 = 2.488 m/s; lost 1250 - 6.219 = 1244 J; x = sqrt(2(6.219)/5000) = 49.88 mm
+    ("bullet-block-spring", {"m_b": 10, "m_blk": 2, "v_b": 500, "k": 5},
+     {"V": 2.488, "E_lost": 1244.0, "x_max": 49.88, "E_max": 6.219}),
+    # v0 = sqrt(2(9.81)(0.5)) = 3.132, V = 1.044 m/s; delta = 20(9.81)/10000 = 19.62 mm;
+    # 5000 x^2 - 294.3 x - (16.35 - 5.774 + 1.925) = 0:
+    # x = (294.3 + sqrt(294.3^2 + 2(10^4)(12.50)))/10^4 = 87.45 mm
+    ("package-on-platform", {"m": 10, "m_p": 20, "h": 0.5, "k": 10},
+     {"delta": 19.62, "x_max": 87.45, "extra": 67.83}),
+    # v_B = sqrt(1 + 2(9.81)(1.2)) = 4.954 m/s; d = 24.54/(2(0.3)(9.81)) = 4.170 m
+    ("ramp-slide", {"h": 1.2, "v0": 1, "mu_k": 0.3}, {"v_B": 4.954, "d": 4.17}),
+    # d = 25/(2(9.81)(0.5 + 0.1732)) = 1.893 m; v = sqrt(2(9.81)(1.893)(0.5 - 0.1732)) = 3.484 m/s
+    ("incline-slide", {"v0": 5, "beta": 30, "mu_k": 0.2}, {"d": 1.893, "v_back": 3.484}),
+    # east 1200(60) = 72000, north 1500(50) = 75000 kg km/h; v = 103968/2700 = 38.51 km/h at 46.17 deg;
+    # T before 1500(2500) + 1200(3600) = 8.07e6, after 2700(38.51^2) = 4.003e6 (x 1/2 (km/h)^2): 50.39 % lost
+    ("intersection-crash", {"m_A": 1500, "m_B": 1200, "v_A": 50, "v_B": 60},
+     {"v": 38.51, "theta": 46.17, "loss_pct": 50.39}),
+    # v_A = 1200(60) tan 40 / 1500 = 40.28 km/h; v = 72000/(2700 cos 40) = 34.81 km/h
+    ("crash-reconstruction", {"m_A": 1500, "m_B": 1200, "v_B": 60, "theta": 40}, {"v_A": 40.28, "v": 34.81}),
+    # w = sqrt(2(24000)(10)/24) = 141.4 m/s; v1 = 200 - 0.6 w = 115.1, v2 = 200 + 0.4 w = 256.6 m/s
+    ("shell-explosion", {"m1": 4, "m2": 6, "V": 200, "E": 24}, {"v1": 115.1, "v2": 256.6}),
+    # v_gun = -0.02(600)/4.02 = -2.985 m/s; v_b = 597.0 m/s; E = 1/2 (4)(0.02)(600^2)/4.02 = 3.582 kJ
+    ("gun-recoil", {"m_gun": 4, "m_b": 20, "u": 600}, {"v_recoil": 2.985, "v_b": 597.0, "E": 3.582}),
+    # J = 0.2(12)(1.6) = 3.84 N s; F = 3.84/0.008 = 480 N
+    ("wall-impulse", {"m": 200, "v": 12, "e": 0.6, "dt": 8}, {"J": 3.84, "F": 480.0}),
+    # v = sqrt(2(9.81)(1.5)) = 5.425; J = 54.25 N s; F = 98.1 (1 + 1.5/0.08) = 1937 N
+    ("cushion-stop", {"m": 10, "h": 1.5, "d": 80}, {"J": 54.25, "F": 1.937}),
+    # A: (5.196, 3); B: (-1.414, 1.414); p = 8.271; vA_n = (8.271 - 3.6)/3.5 = 1.335, vB_n = 3.735;
+    # e = 2.4/6.610 = 0.3631; vA' = sqrt(1.335^2 + 9) = 3.283; T = 36 + 3 = 39, T' = 10.78 + 11.96 = 22.75: 41.69 % lost
+    ("oblique-moving-spheres", {"m_A": 2, "m_B": 1.5, "v_A": 6, "alpha": 30, "v_B": 2, "beta": 45, "s": 2.4},
+     {"e": 0.3631, "vB_n": 3.735, "vA_out": 3.283, "loss_pct": 41.69}),
+    # v1 (4 - 0.9) = 5.5(-0.3) - 1.6(1.5)(-5) = 10.35, v1 = 3.339 m/s; v2' = -0.3 + 0.6(8.339) = 4.703 m/s
+    ("head-on-approach", {"m1": 4, "m2": 1.5, "v2": -5, "e": 0.6, "v1_out": -0.3}, {"v1": 3.339, "v2_out": 4.703}),
+    # u = sqrt(2(15)(5)/6) = 5 m/s; A at 3(5)/5 = 3 m/s, B at 2(5)/5 = 2 m/s
+    ("spring-carts", {"m_A": 2, "m_B": 3, "E": 15}, {"v_A": 3.0, "v_B": 2.0}),
+    # v0 = sqrt(2(9.81)(0.8)) = 3.962 m/s; up 3.962(15 - 5)/35 = 1.132 m/s; V = 5(1.5)(3.962)/35 = 0.8490 m/s;
+    # amplitude 0.8490 sqrt(30/10^4) = 46.50 mm
+    ("package-bounce", {"m": 5, "m_p": 30, "h": 0.8, "e": 0.5, "k": 10}, {"v_up": 1.132, "V": 0.849, "extra": 46.5}),
+    # v_A = sqrt(2(9.81)(1.2)) = 4.852 m/s; v_B' = 2(1.6)(4.852)/5 = 3.105 m/s; d = 9.643/(2(0.3)(9.81)) = 1.638 m
+    ("ramp-strike", {"m_A": 2, "m_B": 3, "h": 1.2, "e": 0.6, "mu_k": 0.3}, {"v_A": 4.852, "vB_out": 3.105, "d": 1.638}),
+    # v_A = sqrt(2(9.81)(1.1)) = 4.646 m/s; v_B' = sqrt(2(0.28)(9.81)(2)) = 3.315 m/s; e = 3.315(4.4)/(2.2(4.646)) - 1
+    ("ramp-strike-inverse", {"m_A": 2.2, "m_B": 2.2, "h": 1.1, "mu_k": 0.28, "d": 2},
+     {"v_A": 4.646, "vB_out": 3.315, "e": 0.427}),
+]
+
+
+@pytest.mark.parametrize(("template_id", "params", "answers"), KNOWN, ids=[k[0] for k in KNOWN])
+def test_known_answers(bank, compiled, template_id, params, answers):
+    """The hand-worked values to four figures, the reference to 1e-9, and the template's own example."""
+    assert bank[template_id].example == params
+    references.check_known(bank, compiled, template_id, params, answers, REFERENCES[template_id])
+
+
+# ---- 20 variants each, drawn as the template's sampling draws them -----------------------------
+def drawn(template_id: str, count: int = 20) -> list[dict[str, float]]:
+    """``count`` draws from the template's sampling ranges, rounded to its printed decimals."""
+    raw = yaml.safe_load((bank_dir() / f"{template_id}.yaml").read_text(encoding="utf-8"))["parameters"]
+    rng = np.random.default_rng(27)
+    return [{name: round(float(rng.uniform(*spec["sample"]["uniform"])), spec["decimals"])
+             for name, spec in raw.items()} for _ in range(count)]
+
+
+@pytest.mark.parametrize("template_id", REFERENCES)
+def test_twenty_sampled_variants(bank, compiled, template_id):
+    for params in drawn(template_id):
+        check(bank, compiled, template_id, params)
+
+
+# ---- hard cases -------------------------------------------------------------------------------
+HARD = [
+    ("bullet-block-spring", {"m_b": 1e-6, "m_blk": 1e6, "v_b": 700, "k": 1e-3}),
+    ("bullet-block-spring", {"m_b": 1e9, "m_blk": 1e-3, "v_b": 1e-100, "k": 1e100}),
+    ("package-on-platform", {"m": 1e-6, "m_p": 40, "h": 1.5, "k": 30}),  # a hair below its rest
+    ("package-on-platform", {"m": 10, "m_p": 20, "h": 1e-9, "k": 10}),  # barely dropped
+    ("package-on-platform", {"m": 1e6, "m_p": 1e-3, "h": 1e-12, "k": 1e9}),
+    ("ramp-slide", {"h": 1e-9, "v0": 0, "mu_k": 1e-6}),
+    ("ramp-slide", {"h": 1e100, "v0": 1e50, "mu_k": 5}),
+    ("incline-slide", {"v0": 5, "beta": 89.9, "mu_k": 0.2}),
+    ("incline-slide", {"v0": 1e-6, "beta": 30, "mu_k": 0}),
+    ("incline-slide", {"v0": 5, "beta": 20, "mu_k": 0.36}),  # tan beta a hair above mu_k: it creeps back
+    ("intersection-crash", {"m_A": 1e-6, "m_B": 1e6, "v_A": 50, "v_B": 60}),
+    ("intersection-crash", {"m_A": 1500, "m_B": 1200, "v_A": 1e-9, "v_B": 60}),
+    ("intersection-crash", {"m_A": 1500, "m_B": 1200, "v_A": 1e9, "v_B": 60}),
+    ("crash-reconstruction", {"m_A": 1e6, "m_B": 1, "v_B": 60, "theta": 0.001}),
+    ("crash-reconstruction", {"m_A": 1, "m_B": 1e6, "v_B": 60, "theta": 89.999}),
+    ("shell-explosion", {"m1": 1e-6, "m2": 1e6, "V": 200, "E": 24}),
+    ("shell-explosion", {"m1": 4, "m2": 6, "V": -200, "E": 1e-12}),
+    ("shell-explosion", {"m1": 4, "m2": 6, "V": 0, "E": 24}),  # the parts pushed apart from rest
+    ("gun-recoil", {"m_gun": 1e6, "m_b": 1e-3, "u": 600}),
+    ("gun-recoil", {"m_gun": 1e-3, "m_b": 1e6, "u": 1e-100}),
+    ("wall-impulse", {"m": 1e-9, "v": 1e150, "e": 1, "dt": 1e-9}),
+    ("wall-impulse", {"m": 50, "v": 1e-150, "e": 0, "dt": 20}),
+    ("cushion-stop", {"m": 1e6, "h": 1e-12, "d": 1e9}),  # the weight all but alone
+    ("cushion-stop", {"m": 1e-6, "h": 1e3, "d": 1e-6}),
+    ("oblique-moving-spheres", {"m_A": 1e-6, "m_B": 1e6, "v_A": 6, "alpha": 0, "v_B": 2, "beta": 0, "s": 7.9}),
+    ("oblique-moving-spheres", {"m_A": 2, "m_B": 1.5, "v_A": 6, "alpha": 30, "v_B": 2, "beta": 45, "s": 0}),
+    ("oblique-moving-spheres", {"m_A": 1e6, "m_B": 1e-6, "v_A": 6, "alpha": 80, "v_B": 2, "beta": 80, "s": 1.3}),
+    ("head-on-approach", {"m1": 1e6, "m2": 1e-6, "v2": -5, "e": 1, "v1_out": -0.3}),
+    ("head-on-approach", {"m1": 4, "m2": 1.5, "v2": -5, "e": 0, "v1_out": -0.3}),
+    ("head-on-approach", {"m1": 1e-3, "m2": 1e-6, "v2": -1e-100, "e": 0.5, "v1_out": -1e-101}),
+    ("spring-carts", {"m_A": 1e-6, "m_B": 1e6, "E": 15}),
+    ("package-bounce", {"m": 1e-6, "m_p": 1e6, "h": 1.5, "e": 1, "k": 1e-3}),
+    ("package-bounce", {"m": 2, "m_p": 40, "h": 1e-12, "e": 0.06, "k": 1e9}),
+    ("spring-carts", {"m_A": 1e100, "m_B": 1e100, "E": 1e-100}),
+    ("ramp-strike", {"m_A": 1e-6, "m_B": 1e6, "h": 1.2, "e": 1, "mu_k": 0.3}),
+    ("ramp-strike", {"m_A": 1e6, "m_B": 1e-6, "h": 1e-9, "e": 0, "mu_k": 1e-6}),
+    ("ramp-strike-inverse", {"m_A": 2, "m_B": 2, "h": 1, "mu_k": 0.25, "d": 3.9}),  # e a hair below 1
+    ("ramp-strike-inverse", {"m_A": 1e6, "m_B": 1e-6, "h": 1e-9, "mu_k": 1e-3, "d": 1.5e-6}),
+]
+
+
+@pytest.mark.parametrize(("template_id", "params"), HARD, ids=[f"{t}-{i}" for i, (t, _) in enumerate(HARD)])
+def test_hard_cases(bank, compiled, template_id, params):
+    check(bank, compiled, template_id, params)

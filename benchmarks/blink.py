@@ -48,7 +48,7 @@ def timed(function):
         finally:
             drawing[0] += time.perf_counter() - began
     return wrapper
-report_plots.drawn = timed(report_plots.drawn)  # all the figures, in this process or its workers
+report_plots.drawn = timed(report_plots.drawn)  # all the figures
 from grader.cli import main
 began = time.perf_counter()
 main(["grade", "--key", sys.argv[1], sys.argv[2], "--out", sys.argv[3]])
@@ -108,7 +108,7 @@ def main() -> int:
         f"| `python -c \"import numpy, yaml\"` | {base:.3f} s | 1.00x | {base_cpu:.3f} s | 1.00x | |",
         f"| `grader grade --key DEMO/key.json DEMO/submissions.csv --out X` | {grade:.3f} s | {ratio:.2f}x "
         f"| {grade_cpu:.3f} s | {grade_cpu / base_cpu:.2f}x | <= {TARGET:.0f}x: {verdict} |", "",
-        "CPU: the seconds of CPU the command and its children used (the figures' workers included).", "",
+        "CPU: the seconds of CPU the command and its children used.", "",
         "Where one grading run's time goes (wall, in-process, after the interpreter's own start):", "",
         "| phase | seconds |", "| --- | --: |",
         *(f"| {name} | {float(value):.3f} |" for name, value in zip(names, phases, strict=True)), ""])

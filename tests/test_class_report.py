@@ -297,21 +297,6 @@ def test_grading_loads_matplotlib_only_to_draw_the_report() -> None:
     assert result.stdout.strip() == "False"
 
 
-def test_figures_drawn_by_forked_workers_are_the_bytes_drawn_here() -> None:
-    from grader.grade import report_plots
-
-    params = [{"v": float(v), "h": float(h)} for v, h in zip(range(12), range(12, 0, -1), strict=True)]
-    summary = summarize(make_class({"1a": ["correct", "incorrect", "missing"] * 4}, params))
-    jobs: dict[str, report_plots.Job] = {
-        "histogram": (report_plots.score_histogram, (summary,)), "verdicts": (report_plots.verdict_bars, (summary,)),
-        "problem-1": (report_plots.difficulty, (summary.problems[0], "problem-1"))}
-    if not report_plots._can_fork():
-        pytest.skip("this process cannot fork its figures' workers here (not Linux, or a thread running)")
-    here = report_plots.drawn(jobs, workers=1)
-    assert list(here) == list(jobs) and all(text.startswith("<svg") for text in here.values())
-    assert report_plots.drawn(jobs, workers=2) == here
-
-
 def test_the_figures_are_the_same_bytes_in_a_fresh_process_that_skipped_matplotlibs_docstrings() -> None:
     """The report's figures do not depend on how matplotlib was imported (its ``set`` docstrings skipped or not)."""
     code = ("import sys; from grader.grade import report_plots as p; from tests.test_class_report import make_class; "

@@ -9,14 +9,9 @@ each student as a point only in a class of at most :data:`POINTS_UP_TO`.
 
 from __future__ import annotations
 
-import gc
 import io
-import multiprocessing
-import os
 import re
 import sys
-import threading
-import warnings
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from contextlib import contextmanager
 from typing import Any
@@ -37,47 +32,12 @@ _WIDTH = 10.5  # inches: the page's column at 96 px an inch
 Job = tuple[Callable[..., str], tuple[Any, ...]]  # a figure's function and its arguments
 
 
-def drawn(jobs: Mapping[str, Job], workers: int | None = None) -> dict[str, str]:
-    """Each figure's SVG by its name. With two cores or more, the figures are drawn by ``workers``
-    processes forked from this one (by default as many as the cores, at most 2): a figure is the same
-    bytes whichever process draws it, and drawing is most of a small class's grading time. Where
-    forking is not safe (not Linux, threads running, a daemonic process) they are drawn here, one by one.
-    """
-    _import_matplotlib()  # once, before the fork: the workers share it
-    names = list(jobs)
-    count = min(len(names), _cores() if workers is None else workers)
-    if count < 2 or not _can_fork():
-        return {name: function(*arguments) for name, (function, arguments) in jobs.items()}
-    _JOBS[:] = [jobs[name] for name in names]
-    try:
-        with warnings.catch_warnings():
-            # Python 3.12+ warns of any thread at a fork; the only ones here are numpy's BLAS workers (no
-            # Python thread runs: _can_fork), which hold no lock of ours and are forked safely by their library.
-            warnings.filterwarnings("ignore", r"This process .* is multi-threaded", DeprecationWarning)
-            # The workers never collect cycles: a pass would touch every object of the class they share
-            # with this process, and copy it.
-            with multiprocessing.get_context("fork").Pool(count, initializer=gc.disable) as pool:
-                return dict(zip(names, pool.map(_draw, range(len(names)), chunksize=1), strict=True))
-    finally:
-        _JOBS.clear()
-
-
-_JOBS: list[Job] = []  # what the forked workers draw, by index
-
-
-def _draw(index: int) -> str:
-    function, arguments = _JOBS[index]
-    return function(*arguments)
-
-
-def _cores() -> int:
-    cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1
-    return min(cores, 2)
-
-
-def _can_fork() -> bool:
-    return (sys.platform == "linux" and threading.active_count() == 1
-            and not multiprocessing.current_process().daemon)
+def drawn(jobs: Mapping[str, Job]) -> dict[str, str]:
+    """Each figure's SVG by its name, drawn here one by one. (Drawing them in forked worker processes was
+    tried and removed: a worker forked from a process with native threads, pytest's run of the suite, hung
+    on a lock held at the fork.)"""
+    _import_matplotlib()
+    return {name: function(*arguments) for name, (function, arguments) in jobs.items()}
 
 
 def _import_matplotlib() -> None:

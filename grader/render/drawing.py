@@ -185,7 +185,7 @@ class Drawing:
         """A ``fig-canvas`` call drawing everything, shifted to start at the origin; a drawing wider
         than ``max_width`` has its geometry (not its labels) scaled down until it fits."""
         scale = 1.0
-        while scale > 0.5 and self._extent(scale)[2] - self._extent(scale)[0] + 2 * PAD > max_width:
+        while scale > 0.25 and self._extent(scale)[2] - self._extent(scale)[0] + 2 * PAD > max_width:
             scale -= 0.05
         x0, y0, x1, y1 = self._extent(scale)
 

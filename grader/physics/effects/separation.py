@@ -103,8 +103,8 @@ class _Separation:
             solutions[u] = sp.sqrt(2 * energy * (w_a + w_b))
         if _is_symbol(energy):
             solutions[energy] = u**2 / (2 * (w_a + w_b))
-        return Relation("energy released: the kinetic energy of the parts' relative motion, ½ μ u² with μ = "
-                        "m_A m_B/(m_A + m_B)", energy, u**2 / (2 * (w_a + w_b)), solutions=solutions, general=False,
+        return Relation("energy released: the kinetic energy of the parts' relative motion, ½ μ u² with μ the "
+                        "reduced mass, the product of the two masses over their sum", energy, u**2 / (2 * (w_a + w_b)), solutions=solutions, general=False,
                         requires=(Condition(sp.Ge(energy, 0), f"the energy released {self.stage.text('energy')} "
                                             "must not be negative"),
                                   Condition(sp.Ge(u, 0), "the relative velocity of separation must not be negative: "

@@ -116,6 +116,7 @@ def test_each_broken_template_gets_one_line_saying_why(tmp_path: Path, capsys: p
     assert out.splitlines()[-1] == f"{len(BROKEN) + 1} templates: {len(BROKEN)} failed" and code == 2
 
 
+@pytest.mark.slow  # 4.5 s: checks a whole copy of the bank
 def test_a_template_repeating_an_id_is_reported_and_the_rest_checked(
         tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     broken(tmp_path / "mine", "drop-rebound")

@@ -175,6 +175,7 @@ TRIALS = ("bullet-spring", "package-platform", "ramp-and-floor", "incline-up-and
 """Issue 25's trial templates in tests/data, until the bank carries templates of these effects."""
 
 
+@pytest.mark.slow  # 4 s; the shipped bank III templates of these effects pass check-bank in the default run
 def test_check_bank_passes_every_trial_template(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     """Sampled, solved, simulated (to 1e-6 on 4 draws) and typeset, sheet and key: an effect without a figure
     panel of its own falls back to the figure its other stages choose, or its bodies in a row."""
@@ -542,6 +543,7 @@ def test_two_moving_spheres_are_re_derived_by_the_simulation_searching_for_e() -
     assert "e" in simulate(OBLIQUE, params, ADAPTIVE).fitted
 
 
+@pytest.mark.slow  # 4 s: grades every mistake of a scene; the default run keeps the per-effect mistake tests
 def test_the_separation_in_place_of_e_keeps_the_impacts_mistakes() -> None:
     """1/e for e (approach over separation): e = (approach)/s."""
     params = {"m_A": 2, "m_B": 1.5, "v_A": 6, "alpha": 30, "v_B": 2, "beta": 45, "s": 2.4}

@@ -34,6 +34,7 @@ def _pytest(clone: Path, *arguments: str) -> subprocess.CompletedProcess[str]:
                           env=env, capture_output=True, text=True, timeout=600)
 
 
+@pytest.mark.slow  # 8 s: .ci/run itself runs the suite of a fresh clone
 def test_the_whole_suite_of_a_fresh_clone_collects(clone: Path) -> None:
     """No test reads a file outside the repository while it is collected (the golden answers did)."""
     result = _pytest(clone, "--collect-only", "tests")

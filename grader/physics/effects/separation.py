@@ -104,7 +104,8 @@ class _Separation:
         if _is_symbol(energy):
             solutions[energy] = u**2 / (2 * (w_a + w_b))
         return Relation("energy released: the kinetic energy of the parts' relative motion, ½ μ u² with μ the "
-                        "reduced mass, the product of the two masses over their sum", energy, u**2 / (2 * (w_a + w_b)), solutions=solutions, general=False,
+                        "reduced mass, the product of the two masses over their sum", energy, u**2 / (2 * (w_a + w_b)),
+                        solutions=solutions, general=False,
                         requires=(Condition(sp.Ge(energy, 0), f"the energy released {self.stage.text('energy')} "
                                             "must not be negative"),
                                   Condition(sp.Ge(u, 0), "the relative velocity of separation must not be negative: "

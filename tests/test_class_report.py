@@ -297,6 +297,7 @@ def test_grading_loads_matplotlib_only_to_draw_the_report() -> None:
     assert result.stdout.strip() == "False"
 
 
+@pytest.mark.slow  # two fresh interpreters importing matplotlib
 def test_the_figures_are_the_same_bytes_in_a_fresh_process_that_skipped_matplotlibs_docstrings() -> None:
     """The report's figures do not depend on how matplotlib was imported (its ``set`` docstrings skipped or not)."""
     code = ("import sys; from grader.grade import report_plots as p; from tests.test_class_report import make_class; "

@@ -193,6 +193,7 @@ def test_the_grades_are_in_the_demo_folder_manifest_and_have_their_own(demo_run:
     assert "submissions.csv" in outer["files"]
 
 
+@pytest.mark.slow  # 12 s: three whole demos; tests/test_files.py and test_hardening.py keep --force's rules
 def test_demo_force_then_the_documented_regrade_then_demo_force_again_change_nothing(
         demo_run: DemoRun, tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
         capsys: pytest.CaptureFixture[str]) -> None:

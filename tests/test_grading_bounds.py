@@ -202,6 +202,7 @@ def _peak_of_grading(folder: Path, submissions: Path, *options: str) -> int:
     return int(report.read_text()) * 1024
 
 
+@pytest.mark.slow  # 2.2 s: a bound at scale
 def test_grading_400000_rows_takes_no_memory_per_row(tmp_path: Path) -> None:
     """400,000 rows (200,000 of nobody, 200,000 resubmissions) in a 4 MB file: about 650 bytes a row were
     kept (a CsvRow, its dict, a problem each): 336 MB here, 3.4 GB for 5 M rows. Measured in a subprocess:
@@ -236,6 +237,7 @@ def _export(path: Path, students: int, assignments: int = 0) -> Path:
     return path
 
 
+@pytest.mark.slow  # 3.5 s: a bound at scale
 def test_a_canvas_export_of_100000_students_is_read_row_by_row(tmp_path: Path) -> None:
     """``--canvas`` read the export whole, about 640 bytes a row beside what canvas.csv needs: a 64 MB
     export of 100,000 students took 1.2 GB, and the 7 M short rows of another 64 MB file 8.1 GB (3.5

@@ -393,7 +393,7 @@ def test_a_formula_like_id_is_guarded_in_key_csv_and_kept_in_key_json(tmp_path: 
 
 # --- arbitrary bytes --------------------------------------------------------------------------------
 
-FUZZ = settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+FUZZ = settings(max_examples=30, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
 CSV_ALPHABET = st.sampled_from([b"h_drop", b"h_rebound", b"id", b"name", b"email", b"section", b",", b";", b"\t",
                                 b"\n", b"\r\n", b'"', b"1", b"2.5e3", b"-0", b"1e309", b" mm", b"\xff", b"\0",
                                 b"\xef\xbb\xbf", b"=1+1", "\u200b".encode()])

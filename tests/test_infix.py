@@ -66,7 +66,7 @@ TOKENS = st.lists(st.sampled_from(["p", "v", "pi", "2", "0.5", "1e-3", "10", "3.
                                    ")", ",", "sqrt", "Max", "hypot", "exp", "in", "0", "07"]), max_size=25)
 
 
-@settings(max_examples=2000, deadline=None)
+@settings(max_examples=1000, deadline=None)
 @given(TOKENS)
 def test_random_tokens_are_read_as_parse_reads_them_or_left_to_it(tokens: list[str]) -> None:
     tree = read_tokens(tokens)
@@ -77,7 +77,7 @@ def test_random_tokens_are_read_as_parse_reads_them_or_left_to_it(tokens: list[s
 TEXTS = st.text(alphabet="pve2 .01()+-*/^,×·sqrtMaxhyotxpin", max_size=40)
 
 
-@settings(max_examples=3000, deadline=None)
+@settings(max_examples=1500, deadline=None)
 @given(TEXTS, st.sampled_from([("p", "v"), ("p", "v", "e"), ("in", "p")]))
 def test_a_students_text_is_read_as_parse_reads_it_or_left_to_it(text: str, symbols: tuple[str, ...]) -> None:
     try:

@@ -143,7 +143,7 @@ def _digest(path: Path) -> str:
     return hashlib.sha256(path.read_bytes()).hexdigest()
 
 
-@settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@settings(max_examples=16, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(data=st.data())
 def test_grading_a_mutated_key_grades_or_refuses_it_and_never_crashes(sample: tuple[dict[str, Any], str],
                                                                      data: st.DataObject) -> None:

@@ -17,7 +17,7 @@ from grader.solve.compiled import Compiled
 from grader.solve.evaluate import solve_one
 from grader.solve.solver import compile_template
 
-PROPERTY = settings(max_examples=200, deadline=None)
+PROPERTY = settings(max_examples=100, deadline=None)
 
 TWO_BODIES = """
 id: two-bodies

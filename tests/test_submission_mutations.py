@@ -64,7 +64,7 @@ def _mutate(lines: list[str], data: st.DataObject) -> list[str]:
     return [line.replace(",", data.draw(st.sampled_from([";", "\t", "|"]), label="delimiter")) for line in lines]
 
 
-FEW = settings(max_examples=12, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+FEW = settings(max_examples=6, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 MANY = settings(max_examples=300, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 
 

@@ -186,7 +186,7 @@ def _compiled(template: Template, folder: str) -> Compiled:
     return found
 
 
-SAMPLED = random.Random(24).sample(range(len(MUTATIONS)), 200)
+SAMPLED = random.Random(24).sample(range(len(MUTATIONS)), 100)
 
 
 def _check(indexes: list[int], folder: Path) -> None:
@@ -200,7 +200,7 @@ def _check(indexes: list[int], folder: Path) -> None:
 
 
 def test_a_sample_of_mutated_templates_is_told_what_to_change(tmp_path: Path) -> None:
-    """200 mutations, a seeded sample of all of them."""
+    """100 mutations, a seeded sample of all of them."""
     _check(SAMPLED, tmp_path)
 
 

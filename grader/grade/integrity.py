@@ -315,7 +315,8 @@ def _needed(parts: Sequence[_Part], wrong: Mapping[str, Ints], students: int, ex
     for index, part in enumerate(parts):
         finite = part.chance[np.isfinite(part.chance)]
         least[wrong[part.label], index] = UNRELATED * float(finite.min()) if len(finite) else 0.0
-    with np.errstate(divide="ignore"):
+    # log 0 = -inf (a part no chance bounds) then log inf (a part not wrong) make NaN: not possible, as meant.
+    with np.errstate(divide="ignore", invalid="ignore"):
         bound = math.log(max(examined, 1)) + np.cumsum(np.log(np.sort(least, axis=1)), axis=1)
     possible = (bound < math.log(KEPT)) & (np.arange(least.shape[1]) >= 1)
     return np.where(possible.any(axis=1), np.argmax(possible, axis=1) + 1, least.shape[1] + 1).astype(np.int64)

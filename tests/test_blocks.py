@@ -131,3 +131,14 @@ def test_show_says_which_steps_are_solved_together(tmp_path: Path, capsys: pytes
     chain = capsys.readouterr().out.split("Step chain")[1].splitlines()
     assert chain[1] == "  (steps 1-2: these equations solved together for v1, J)"
     assert chain[2].startswith("  1. impulse along n")
+
+
+
+def test_a_condition_that_always_holds_once_a_block_is_solved_is_dropped_not_refused() -> None:
+    """incline-slide asked the other way round (the speed up the slope from the speed back): the slope's
+    condition reduces, once the block is solved, to positive factors only (sympy's ``True``); it was refused
+    as "a value that is a function no expression may call". Now it round-trips to 1e-9 on its variants."""
+    from tests.test_inverse_walk import VARIANTS, round_trips
+
+    (trip,) = round_trips(load_bank()["incline-slide"], {("v_back", "v0")})
+    assert trip.refusal is None and trip.rows == VARIANTS and not trip.bad, trip

@@ -709,6 +709,8 @@ class _Compiler:
                 if condition.subject is not None and sp.sympify(condition.subject).free_symbols <= known:
                     subject = self._tree(self._user_units(sp.sympify(condition.subject).xreplace(dict(composed))),
                                          "(check)")
+                if self._reduced(holds) is sp.true:  # its sides differ by positive factors only: it always holds
+                    continue
                 check = Check(self._tree_condition(holds), condition.message, subject)
                 if check not in checks:
                     checks.append(check)
@@ -720,10 +722,18 @@ class _Compiler:
         if holds in (sp.true, sp.false):
             raise TemplateError(_INNER, "stages or answers", "a condition that depends on the parameters",
                                 f"one that is always {str(holds).lower()}")
+        reduced = self._reduced(holds)
+        if reduced in (sp.true, sp.false):
+            raise TemplateError(_INNER, "stages or answers", "a condition that depends on the parameters",
+                                f"one that is always {str(reduced).lower()}")
+        return self._rooted(numeric_order(to_node(reduced)))
+
+    def _reduced(self, holds: Any) -> Any:
+        """A condition against zero without its positive factors (381*v*x/1250 > 0 is x > 0): sympy's true
+        or false where only positive factors were left (x**2 + 1 > 0, found after a block is solved)."""
         difference = stabilize(holds.lhs - holds.rhs, self.degree_angles)
-        # Against zero, a positive factor changes nothing: 381*v*x/1250 > 0 is x > 0.
         kept = [f for f in sp.Mul.make_args(difference) if not f.is_positive]
-        return self._rooted(numeric_order(to_node(type(holds)(sp.Mul(*kept), 0))))
+        return type(holds)(sp.Mul(*kept), 0)
 
 
 def for_reader(expr: Any) -> Any:

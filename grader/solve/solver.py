@@ -84,10 +84,7 @@ def derive(relations: list[Relation], knowns: Iterable[Any], given: Iterable[Any
         if block is None and numeric:
             torn = torn_block(relations, known, given_set, used, points, chain, targets)
             if isinstance(torn, str):
-                raise TemplateError(_INNER, torn, "a scene that tells its solutions apart",
-                                    "two physical solutions that nothing in it (a sign, a domain, a condition) tells "
-                                    "apart: give the quantity that decides between them, or ask the question the "
-                                    "other way round")
+                raise TemplateError(_INNER, "stages", "a scene that tells its solutions apart", _two_solutions(torn))
             block = torn
         if block is None:
             return chain
@@ -169,10 +166,16 @@ def next_block(relations: list[Relation], known: set[Any], used: set[int],
             used.update(members)
             return found
     if ambiguous:
-        raise TemplateError(_INNER, ambiguous[0], "a scene that tells its solutions apart",
-                            "two physical solutions that nothing in it (a sign, a domain, a condition) tells apart: "
-                            "give the quantity that decides between them, or ask the question the other way round")
+        raise TemplateError(_INNER, "stages", "a scene that tells its solutions apart", _two_solutions(ambiguous[0]))
     return None
+
+
+def _two_solutions(equations: str) -> str:
+    """The refusal of a block with two admissible roots: ``equations`` (which, and the roots at a sampled
+    point) after the field it is about, so the message reads file: field: expected ..., got ...."""
+    return (f"{equations}: two physical solutions that nothing in it (a sign, a domain, a condition) tells apart: "
+            "give the quantity that decides between them, or ask the question the other way round (a name no "
+            "parameter, symbol or answer defines is an unknown the scene must find: check its spelling)")
 
 
 def _matching(rows: list[int], columns_of: Mapping[int, set[Any]]) -> dict[Any, int]:

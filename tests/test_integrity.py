@@ -276,3 +276,11 @@ def test_answers_counted_by_their_search_range_count_as_those_tested_one_by_one(
     monkeypatch.setattr(integrity, "COUNTED", 0)
     assert [(m.student, m.label, m.matches) for m in check(result).matches] == tested
     assert max(matches for _, _, matches in tested) > 5
+
+
+def test_a_wrong_answer_near_the_float64_limit_makes_no_overflow() -> None:
+    """1.6e308 typed for 0.47 (the mutated-submissions sweep): its ratio overflows, its logs do not."""
+    from grader.grade.integrity_chance import Spread
+
+    spread = Spread.of(np.array([1.6e308, 0.5, 0.45]), np.array([0.47, 0.47, 0.47]), np.arange(3), 3)
+    assert np.isfinite(spread.start) and np.isfinite(spread.step)

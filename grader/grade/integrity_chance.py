@@ -81,7 +81,8 @@ class Spread:
         """From the wrong answers, their students' own values and the students (by index, of ``count``);
         pairs with a zero are left out."""
         usable = (answers != 0) & (own != 0) & np.isfinite(answers) & np.isfinite(own)
-        logs = np.log(np.abs(answers[usable] / own[usable]))
+        # log |a| - log |o|, not log |a/o|: a ratio of two finite numbers may overflow (1.6e308 typed for 0.47).
+        logs = np.log(np.abs(answers[usable])) - np.log(np.abs(own[usable]))
         same = np.sign(answers[usable]) == np.sign(own[usable])
         width = _bandwidth(logs)
         start = (float(logs.min()) if len(logs) else 0.0) - _REACH * width

@@ -164,14 +164,14 @@ def _lateness(minutes: int) -> str:
 
 
 def _figures(summary: ClassSummary) -> dict[str, str]:
-    """The page's figures by name, drawn at once (in parallel where the machine can)."""
-    from grader.grade.report_plots import Job, difficulty, drawn, score_histogram, verdict_bars
+    """The page's figures by name: the scores' histogram, the verdicts' bars, each drawn problem's difficulty."""
+    from grader.grade.report_plots import difficulty, score_histogram, verdict_bars
 
-    jobs: dict[str, Job] = {"histogram": (score_histogram, (summary,)), "verdicts": (verdict_bars, (summary,))}
+    figures = {"histogram": score_histogram(summary), "verdicts": verdict_bars(summary)}
     for number, problem in enumerate(summary.problems, 1):
         if problem.drawn and problem.attempted.any():
-            jobs[f"problem-{number}"] = (difficulty, (problem, f"problem-{number}"))
-    return drawn(jobs)
+            figures[f"problem-{number}"] = difficulty(problem, f"problem-{number}")
+    return figures
 
 
 def _scores(summary: ClassSummary, figures: dict[str, str]) -> str:

@@ -12,7 +12,7 @@ from __future__ import annotations
 import io
 import re
 import sys
-from collections.abc import Callable, Iterator, Mapping, Sequence
+from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 from typing import Any
 
@@ -27,17 +27,6 @@ INK, MUTED, ACCENT, WARN = "#222222", "#8a94a6", "#1f4e99", "#c62828"
 POINTS_UP_TO = 1000  # students drawn as points below the bins' means
 PANELS_PER_ROW = 4
 _WIDTH = 10.5  # inches: the page's column at 96 px an inch
-
-
-Job = tuple[Callable[..., str], tuple[Any, ...]]  # a figure's function and its arguments
-
-
-def drawn(jobs: Mapping[str, Job]) -> dict[str, str]:
-    """Each figure's SVG by its name, drawn here one by one. (Drawing them in forked worker processes was
-    tried and removed: a worker forked from a process with native threads, pytest's run of the suite, hung
-    on a lock held at the fork.)"""
-    _import_matplotlib()
-    return {name: function(*arguments) for name, (function, arguments) in jobs.items()}
 
 
 def _import_matplotlib() -> None:

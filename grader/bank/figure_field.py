@@ -20,6 +20,11 @@
 ... except TemplateError as error:
 ...     print(error)
 t.yaml: figure.panel: expected one of file, panels (did you mean panels?), got an unknown field
+>>> try:
+...     parse_figure({"panels": [1, [1, 2]]}, "t.yaml", 2, {"h"})
+... except TemplateError as error:
+...     print(error)
+t.yaml: figure.panels, panel 2 of 2: expected each stage in one panel at most, got stage 1 again
 """
 
 from __future__ import annotations
@@ -84,14 +89,20 @@ def _panels(raw: Any, where: str, stages: int) -> tuple[tuple[int, ...], ...]:
         members = item if isinstance(item, list) else [item]
         if not members or not all(isinstance(m, int) and not isinstance(m, bool) and 1 <= m <= stages
                                   for m in members):
-            raise TemplateError(where, f"figure.panels[{number}]", expected, shown(item))
+            raise TemplateError(where, _panel_key(number, len(raw)), expected, shown(item))
         again = seen & set(members)
         if again:
-            raise TemplateError(where, f"figure.panels[{number}]", "each stage in one panel at most",
+            raise TemplateError(where, _panel_key(number, len(raw)), "each stage in one panel at most",
                                 f"stage {min(again)} again")
         seen |= set(members)
         panels.append(tuple(sorted(m - 1 for m in members)))
     return tuple(panels)
+
+
+def _panel_key(number: int, count: int) -> str:
+    """Which panel, counted as the author counts them (from 1): ``figure.panels, panel 2 of 3``; never
+    ``panels[1]``, which reads as an index from 0 to a programmer and as the first panel to an author."""
+    return f"figure.panels, panel {number} of {count}"
 
 
 def _file(raw: Any, where: str, parameters: Collection[str]) -> FigureSpec:

@@ -24,6 +24,7 @@ PAD = 0.05
 MAX_WIDTH = 7.6
 CHAR = 0.15  # cm per character of a label at the figure's text size, an estimate for the bounding box
 LINE = 0.42  # cm per line of a label
+GAP = 0.15  # cm between a label and what it labels that a drawing scaled down keeps
 
 
 @dataclass(frozen=True)
@@ -177,9 +178,16 @@ class Drawing:
 
     def _extent(self, scale: float) -> tuple[float, float, float, float]:
         """The bounding box with the geometry scaled by ``scale`` and the labels at their size."""
-        xs = [x * scale for x, _ in self.points] + [a[0] * scale + d for a, box in self.labels for d in box[::2]]
-        ys = [y * scale for _, y in self.points] + [a[1] * scale + d for a, box in self.labels for d in box[1::2]]
+        anchors = [_anchored(at, box, scale) for at, box in self.labels]
+        xs = [x * scale for x, _ in self.points] + [a[0] + d for a, (_, box) in zip(anchors, self.labels) for d in box[::2]]
+        ys = [y * scale for _, y in self.points] + [a[1] + d for a, (_, box) in zip(anchors, self.labels)
+                                                    for d in box[1::2]]
         return (min(xs), min(ys), max(xs), max(ys)) if xs else (0.0, 0.0, 0.0, 0.0)
+
+    def natural_width(self) -> float:
+        """The drawing's width (cm) unscaled, labels and margins included."""
+        x0, _, x1, _ = self._extent(1.0)
+        return x1 - x0 + 2 * PAD
 
     def typst(self, max_width: float = MAX_WIDTH) -> Typ:
         """A ``fig-canvas`` call drawing everything, shifted to start at the origin; a drawing wider
@@ -191,6 +199,11 @@ class Drawing:
 
         def place(point: Point) -> str:
             return f"({_fmt(point[0] * scale - x0 + PAD)}, {_fmt(y1 - point[1] * scale + PAD)})"
+        labels = iter(self.labels)  # in the order of their calls
+
+        def place_label(point: Point) -> str:
+            x, y = _anchored(point, next(labels)[1], scale)
+            return f"({_fmt(x - x0 + PAD)}, {_fmt(y1 - y + PAD)})"
         body = []
         # Lines drawn one after another with one stroke are one curve (the ground's hatching: 25 lines).
         for (kind, options), calls in itertools.groupby(self.calls, key=lambda call: (call[0], call[3])):
@@ -199,10 +212,27 @@ class Drawing:
                 body.append(f"  fig-lines({', '.join([*arguments, options])})")
                 continue
             for _, points, radius, _ in calls:
-                arguments = [place(p) for p in points] + ([_fmt(radius * scale)] if radius else []) + \
+                arguments = [(place_label if kind == "fig-label" else place)(p) for p in points] + ([_fmt(radius * scale)] if radius else []) + \
                     ([options] if options else [])
                 body.append(f"  {kind}({', '.join(arguments)})")
         return Typ(f"fig-canvas({_fmt(x1 - x0 + 2 * PAD)}, {_fmt(y1 - y0 + 2 * PAD)}, {{\n" + "\n".join(body) + "\n})")
+
+
+def _anchored(at: Point, box: tuple[float, float, float, float], scale: float) -> Point:
+    """Where a label's anchor goes when the geometry is scaled by ``scale`` (the text is not): the point
+    scaled, then moved ``(1 - scale) * GAP`` the way the label reaches from it (its box, relative to the
+    anchor, says which), so that a label placed a gap away from a line keeps that gap once shrunk
+    (an incline's angle under its foot, in a strip).
+
+    >>> _anchored((1.0, 1.0), (-0.5, -0.4, 0.5, 0.0), 0.5)  # reaches down from its anchor
+    (0.5, 0.425)
+    >>> _anchored((1.0, 1.0), (-0.5, -0.2, 0.5, 0.2), 0.5)  # centred: only scaled
+    (0.5, 0.5)
+    """
+    shift = (1 - scale) * GAP
+    dx = shift if abs(box[0]) < 1e-9 else -shift if abs(box[2]) < 1e-9 else 0.0
+    dy = shift if abs(box[1]) < 1e-9 else -shift if abs(box[3]) < 1e-9 else 0.0
+    return at[0] * scale + dx, at[1] * scale + dy
 
 
 def _crosses(box: tuple[float, float, float, float], a: Point, b: Point) -> bool:

@@ -383,6 +383,27 @@ def _panel(scene: SceneView, group: Sequence[Stage]) -> Drawing:
     return canvas
 
 
+def strip_widths(naturals: Sequence[float]) -> list[float]:
+    """The widths (cm) the panels of a strip may take, two columns: each column as wide as its widest
+    panel, the two together at most ``2 * STRIP_WIDTH``; where they are wider, a column narrower than
+    ``STRIP_WIDTH`` keeps its width and the other takes the rest (a tall fall beside a wide spring: the
+    spring is not shrunk until its labels crowd it), else each takes ``STRIP_WIDTH``.
+
+    >>> strip_widths([3.0, 6.5, 4.0])
+    [4.0, 6.4, 4.0]
+    >>> strip_widths([6.0, 7.0])
+    [5.2, 5.2]
+    """
+    columns = [max(naturals[0::2]), max(naturals[1::2], default=0.0)]
+    if sum(columns) > 2 * STRIP_WIDTH:
+        narrow = 0 if columns[0] <= columns[1] else 1
+        if columns[narrow] >= STRIP_WIDTH:
+            columns = [STRIP_WIDTH, STRIP_WIDTH]
+        else:
+            columns[1 - narrow] = 2 * STRIP_WIDTH - columns[narrow]
+    return [columns[n % 2] for n in range(len(naturals))]
+
+
 def panels_figure(scene: SceneView, groups: Sequence[Sequence[Stage]] | None = None) -> tuple[Typ, FigureRecord]:
     """The figure of a scene (its panels in stage order, or the panels ``groups`` of its stages) as a
     Typst expression (code mode), and the record of what it drew."""
@@ -394,8 +415,9 @@ def panels_figure(scene: SceneView, groups: Sequence[Sequence[Stage]] | None = N
                                 for title, group, canvas in zip(titles, groups, drawings, strict=True)))
     if len(drawings) == 1:
         return drawings[0].typst(), record
+    widths = strip_widths([canvas.natural_width() for canvas in drawings])
     shown = [f"stack(dir: ttb, spacing: 0.2cm, text(size: 8pt, fill: luma(80), {string(title)}), "
-             f"{canvas.typst(STRIP_WIDTH)})" for title, canvas in zip(titles, drawings, strict=True)]
+             f"{canvas.typst(width)})" for title, canvas, width in zip(titles, drawings, widths, strict=True)]
     columns = min(2, len(shown))
     return Typ(f"grid(columns: {columns}, column-gutter: 0.5cm, row-gutter: 0.4cm, align: bottom + left, "
                + ", ".join(shown) + ")"), record

@@ -50,7 +50,7 @@ def swing_figure(canvas: Drawing, scene: SceneView, swing: Stage, impact: Stage 
     canvas.label((-0.12, -mark), "e", scene.given(swing.fields["angle"]))
     middle, normal = (0.5 * high[0], 0.5 * high[1]), (_m.cos(theta), _m.sin(theta))  # normal: away from the arc
     steep = theta < _m.pi / 4
-    canvas.label((middle[0] + 0.25 * normal[0], middle[1] + 0.25 * normal[1]), "w" if steep else "s",
+    canvas.label((middle[0] + 0.25 * normal[0], middle[1] + 0.25 * normal[1]), "w" if steep else "sw",
                  scene.given(swing.fields["length"]))
     if impact is not None:
         _striker(canvas, scene, impact, low)

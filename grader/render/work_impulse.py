@@ -24,6 +24,12 @@ def magnitude(node: Node) -> Node:
     return node.args[0] if isinstance(node, Op) and node.op == "neg" else node
 
 
+def _said(words: str) -> str:
+    """Words before a value in a math label, the colon theirs: ``"before:" v = 0``, not ``"before" : v``
+    (in math a bare colon is a relation, spaced as one)."""
+    return str(string(f"{words}:"))
+
+
 def _is_zero(node: Node | None) -> bool:
     return node is None or (isinstance(node, Num) and node.value == 0)
 
@@ -98,8 +104,10 @@ def spring(canvas: Drawing, scene: SceneView, stage: Stage, impact: Stage | None
     if stage.fields.get("vertical", False):
         return _vertical_spring(canvas, scene, stage)
     block, stuck = stage.fields["body"], stage.fields.get("with")
-    natural, width, height, squeeze = 2.6, 1.0, 0.8, 0.9
-    canvas.ground(-0.6, natural + width + 2.6, 0.0)
+    # The block dashed at the greatest compression stands clear of it at natural length (squeeze > width):
+    # the two overlapping read as one block with a line through it.
+    natural, width, height, squeeze = 2.8, 1.0, 0.8, 1.25
+    canvas.ground(-0.6, natural + width + 2.3, 0.0)
     _wall(canvas, 0.0, 0.0, 1.6)
     _coils(canvas, (0.0, height / 2), (natural, height / 2))
     canvas.rect((natural, 0.0), (natural + width, height))
@@ -109,7 +117,7 @@ def spring(canvas: Drawing, scene: SceneView, stage: Stage, impact: Stage | None
     if stuck is not None:
         x = natural + width + (1.9 if impact is not None and striker == stuck else 0.2)
         canvas.circle((x + 0.12, height / 2), 0.12)
-        canvas.name((x + 0.12, height / 2 - 0.2), "n", stuck)
+        canvas.name((x + 0.3, height / 2), "w", stuck)  # beside it: under it, the name sat on the floor
         if impact is not None and striker == stuck:  # it comes in toward the block, before the impact
             velocity = impact.fields.get("before", {}).get(stuck)
             canvas.arrow((x - 0.1, height / 2), (x - 1.3, height / 2))
@@ -133,25 +141,26 @@ def _vertical_spring(canvas: Drawing, scene: SceneView, stage: Stage) -> bool:
     canvas.ground(-0.4, width + 2.2, 0.0)
     _coils(canvas, (width / 2, 0.0), (width / 2, top), amplitude=0.3)
     canvas.rect((0.0, top), (width, top + 0.25))
-    canvas.name((width + 0.1, top + 0.12), "w", body)
+    canvas.name((width / 2 + 0.45, top - 0.35), "w", body)  # under it, by the coils: right of it, the lines out
+    # to the static deflection's dimension ran through the name
     if stuck is not None:
         canvas.rect((width / 2 - 0.65, top + 0.25), (width / 2 + 0.65, top + 0.85))
         canvas.name((width / 2, top + 0.55), "c", stuck)
     lowest = top - 0.9
-    canvas.line((-1.3, lowest), (width + 0.1, lowest), width=0.5, dash="dashed")
+    canvas.line((-0.9, lowest), (width + 0.1, lowest), width=0.5, dash="dashed")
     canvas.arrow((width / 2, top + 1.9), (width / 2, top + 1.0))
     canvas.label((width / 2 + 0.15, top + 1.45), "w", scene.given(magnitude(stage.fields["speed"])))
     canvas.label((width / 2 + 0.35, top * 0.3), "w", scene.given(stage.fields["stiffness"]))
-    x = width + 1.9
+    x = width + 1.0  # close beside the platform: a strip gives the panel at most half its width
     if supports is not None:
         canvas.line((width, natural), (x + 0.1, natural), width=0.5, dash="dotted")  # the natural length
         canvas.line((width, top), (x + 0.1, top), width=0.3)
         named = stage.fields.get("static_deflection")
         canvas.dimension((x, top), (x, natural), scene.given(Sym(str(named))) if named else [], "right")
     compression = scene.given(stage.fields["compression"])
-    canvas.line((-1.3, top if supports is None else natural), (-0.1, top if supports is None else natural),
+    canvas.line((-0.9, top if supports is None else natural), (-0.1, top if supports is None else natural),
                 width=0.3, dash="dotted")
-    canvas.dimension((-1.2, lowest), (-1.2, top if supports is None else natural), compression, "left")
+    canvas.dimension((-0.8, lowest), (-0.8, top if supports is None else natural), compression, "left")
     return True
 
 
@@ -223,9 +232,9 @@ def slope(canvas: Drawing, scene: SceneView, stage: Stage) -> bool:
         tail = (lift[0] - direction * 0.5 * ux, lift[1] - direction * 0.5 * uy)
         tip = (lift[0] + direction * 0.5 * ux, lift[1] + direction * 0.5 * uy)
         canvas.arrow(tail, tip)
-        ahead = direction * ux
-        canvas.label((tail[0] - direction * 0.1 * ux, tail[1] - direction * 0.1 * uy), "e" if ahead > 0 else "w",
-                     scene.given(magnitude(node)))
+        # Above the arrow, clear of its higher end: beside it, the label widened the panel (and a strip
+        # then shrank it until the labels touched the slope).
+        canvas.label((lift[0], lift[1] + 0.5 * abs(uy) + 0.1), "s", scene.given(magnitude(node)))
     if "distance" in fields:
         off = -0.45 if beta == 0 else 0.0
         if beta == 0:
@@ -234,8 +243,19 @@ def slope(canvas: Drawing, scene: SceneView, stage: Stage) -> bool:
             mid = (length * 0.6 * ux - nx * 0.35, length * 0.6 * uy - ny * 0.35)
             canvas.label(mid, "nw", scene.given(fields["distance"]))
     if rough:
-        canvas.label((high[0] + 0.3, high[1] + 0.1 if beta > 0 else 0.15), "sw", scene.given(fields["friction"]))
+        _friction_label(canvas, scene.given(fields["friction"]), high, beta)
     return True
+
+
+def _friction_label(canvas: Drawing, lines: list[str], high: Point, beta: float) -> None:
+    """The friction coefficient: on a level floor above it, midway; on an incline under its base at the
+    right, or right of its upright side where the angle's label is in the way (a steep one)."""
+    if beta == 0:
+        canvas.label((high[0] / 2, 0.1), "s", lines)
+    elif canvas.fits((high[0], -0.1), "ne", lines):
+        canvas.label((high[0], -0.1), "ne", lines)
+    else:
+        canvas.label((high[0] + 0.15, high[1] / 2), "w", lines)
 
 
 def _ramp(canvas: Drawing, scene: SceneView, stage: Stage) -> bool:
@@ -253,7 +273,10 @@ def _ramp(canvas: Drawing, scene: SceneView, stage: Stage) -> bool:
     canvas.circle(start, 0.3)
     canvas.circle(end, 0.3, "dashed", fill=False)
     names = [fields["body"], *([fields["with"]] if "with" in fields else [])]
-    canvas.name((start[0], start[1] + 0.4), "s", names[0])
+    if up:
+        canvas.name((start[0], start[1] + 0.4), "s", names[0])
+    else:  # left of the ball, on the level top: above it, the name ran into the speed's label
+        canvas.name((start[0] - 0.4, start[1]), "e", names[0])
     canvas.bodies += names[1:]
     for at, node in ((start, fields["speed"]), (end, fields.get("end_speed"))):
         if node is None:
@@ -315,7 +338,7 @@ def stick(canvas: Drawing, scene: SceneView, stage: Stage) -> bool:
     canvas.path([(0.0, 0.0), tip], width=0.8, dash="dashed")
     canvas.arrow((tip[0] * 0.8, tip[1] * 0.8), tip)
     wreck = " + ".join(bodies)
-    canvas.label((tip[0] + 0.1, tip[1] + 0.1), "sw", [f"{string(wreck)!s}: {scene.given(fields['speed'])[0]}"
+    canvas.label((tip[0] + 0.1, tip[1] + 0.1), "sw", [f"{_said(wreck)} {scene.given(fields['speed'])[0]}"
                                                        if "speed" in fields else str(string(wreck))])
     if angle is not None:
         start, end = (0.0, heading) if from_n else (heading, _m.pi / 2)
@@ -328,8 +351,9 @@ def stick(canvas: Drawing, scene: SceneView, stage: Stage) -> bool:
 # --- separation ---------------------------------------------------------------------------------
 
 def separation(canvas: Drawing, scene: SceneView, stage: Stage) -> bool:
-    """Left, the whole: the two parts together, its velocity (or at rest), the energy released; right, the
-    parts flying apart along n, each with its velocity the way it moves (asked: its name, not to scale)."""
+    """Two states side by side, captioned: before, the whole (the two parts together), its velocity (or at
+    rest), the energy released; after, the parts flying apart along n, each with its velocity the way it
+    moves (asked: its name, not to scale)."""
     fields = stage.fields
     first, second = fields["bodies"]
     whole = fields.get("whole")
@@ -343,7 +367,8 @@ def separation(canvas: Drawing, scene: SceneView, stage: Stage) -> bool:
         canvas.label((0.8, 0.95), "s", [str(string("at rest"))])
     if "energy" in fields:
         canvas.label((0.8, -0.1), "n", scene.given(fields["energy"]))
-    canvas.line((2.1, 0.35), (2.6, 0.35), width=0.4, dash="dotted")
+    canvas.label((0.8, 1.9), "s", [str(string("before"))])  # two states, side by side: no line joins them
+    canvas.label((5.0, 1.9), "s", [str(string("after"))])
     after = fields.get("after", {})
     centre = 5.0
     for body, side in ((first, -1), (second, 1)):
@@ -358,7 +383,7 @@ def separation(canvas: Drawing, scene: SceneView, stage: Stage) -> bool:
         canvas.arrow((x, 1.0), (x + way * 1.0, 1.0))
         canvas.label((x + way * 0.5, 1.2), "s", scene.given(magnitude(velocity.n)))
     if "relative" in fields:
-        canvas.label((centre, -0.1), "n", [f"{string('relative')!s}: " + scene.given(fields["relative"])[0]])
+        canvas.label((centre, -0.1), "n", [f"{_said('relative')} " + scene.given(fields["relative"])[0]])
     return True
 
 
@@ -381,7 +406,7 @@ def impulse(canvas: Drawing, scene: SceneView, stage: Stage) -> bool:
     if "distance" in fields:
         canvas.ground(-1.2, 1.2, -0.6)
         canvas.rect((-1.0, -0.6), (1.0, 0.0), fill="luma(200)")
-        canvas.label((1.05, -0.3), "w", [str(string("cushion"))])
+        canvas.label((0.0, -0.3), "c", [str(string("cushion"))])  # inside: beside it, it widened the panel
         canvas.dimension((-1.4, -0.6), (-1.4, 0.0), scene.given(fields["distance"]), "left")
         centre = (0.0, 0.3)
         canvas.rect((-0.6, 0.0), (0.6, 0.6))
@@ -393,9 +418,12 @@ def impulse(canvas: Drawing, scene: SceneView, stage: Stage) -> bool:
     rows = ((centre[0] + 1.2, centre[1] + 0.4), (centre[0] + 1.2, centre[1] + 1.8)) if up else \
         ((centre[0], centre[1] + 1.0), (centre[0], centre[1] - 1.0))
     for at, vector, velocity, word in ((rows[0], b, before, "before"), (rows[1], a, after, "after")):
-        lines = [f"{string(word)}: " + line for line in _speed_lines(scene, turned(velocity))]
+        # Beside an upright arrow, the word over the value: on one line they widened the panel.
+        lines = [_said(word), *_speed_lines(scene, turned(velocity))] if up else \
+            [f"{_said(word)} " + line for line in _speed_lines(scene, turned(velocity))]
         if _m.hypot(*vector) == 0:
-            canvas.label((at[0] - 0.2, at[1]) if up else at, "w" if up else "c", [f"{string(word)}: v = 0"])
+            canvas.label((at[0] - 0.2, at[1]) if up else at, "w" if up else "c",
+                         [_said(word), "v = 0"] if up else [f"{_said(word)} v = 0"])
             continue
         ux, uy = _unit(vector)
         canvas.arrow((at[0] - ux * 0.6, at[1] - uy * 0.6), (at[0] + ux * 0.6, at[1] + uy * 0.6))

@@ -324,3 +324,51 @@ def test_a_dimensions_label_keeps_clear_of_its_arrows(length: float) -> None:
     placed = (at[0] + box[0], at[1] + box[1], at[0] + box[2], at[1] + box[3])
     assert not any(_crosses(placed, a, b) for a, b in canvas.strokes), (placed, canvas.strokes)
     assert placed[0] >= 1.0 + 0.2  # beside the line, not on it
+
+
+# --- what the contact sheet showed (docs/make_contact_sheet.py) -------------------------------------
+
+def test_a_separation_shows_before_and_after_side_by_side_and_no_line_joins_them(
+        figures: dict[str, tuple[str, FigureRecord, dict[str, str]]]) -> None:
+    """The whole and its parts were joined by a dotted line, which read as a connection between bodies;
+    they are two states, captioned "before" and "after", with nothing drawn between them."""
+    for key in ("gun-recoil/0", "shell-explosion/0", "spring-carts/0", "explosion/0", "recoil/0"):
+        typst, _, _ = figures[key]
+        assert '"dotted"' not in typst, key
+        assert '$"before"$' in typst and '$"after"$' in typst, key
+
+
+def test_words_before_a_value_keep_their_colon(figures: dict[str, tuple[str, FigureRecord, dict[str, str]]]) -> None:
+    """`"relative": u` set a bare colon in math, spaced as a relation ("relative : u"); the colon is the
+    words' own (`"relative:" u`)."""
+    for key, (typst, _, _) in figures.items():
+        assert not re.search(r'"\s*:', typst), key
+
+
+@pytest.mark.parametrize("template_id", ["incline-slide", "incline-up-and-back", "ramp-and-floor", "cushion-stop"])
+def test_a_strip_of_a_slope_or_an_impulse_is_not_shrunk(template_id: str) -> None:
+    """A panel wider than its room in a strip is shrunk (its geometry, not its text) until its labels crowd
+    it: an incline's angle ran into the slope. These panels now fit their room unshrunk: their labels sit
+    above their arrows and under the base, and a strip's narrower column leaves its room to the other."""
+    from grader.render.panels import _panel, panel_groups, strip_widths
+    from grader.render.scene_view import SceneView
+
+    template = BANK[template_id]
+    variant = example_variant(template)
+    scene = SceneView(template, variant, _values(template, variant))
+    naturals = [_panel(scene, group).natural_width() for group in panel_groups(template.scene.stages)]
+    assert all(natural <= room + 1e-9 for natural, room in zip(naturals, strip_widths(naturals), strict=True)), \
+        naturals
+
+
+def test_a_label_keeps_its_gap_when_its_drawing_is_shrunk() -> None:
+    """A label placed 0.15 cm under a line stays 0.15 cm under it when the drawing is scaled to fit."""
+    from grader.render.drawing import Drawing
+
+    canvas = Drawing()
+    canvas.line((0.0, 0.0), (12.0, 0.0))
+    canvas.label((6.0, -0.15), "n", ["x"])
+    shrunk = str(canvas.typst(max_width=6.0))
+    (line_y,), (label_y,) = (re.findall(r"fig-lines\(\(\([0-9.]+, ([0-9.]+)\)", shrunk),
+                             re.findall(r'fig-label\(\([-0-9.]+, ([-0-9.]+)\), "n"', shrunk))
+    assert float(label_y) - float(line_y) == pytest.approx(0.15, abs=0.011)

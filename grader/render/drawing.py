@@ -200,10 +200,16 @@ class Drawing:
         def place(point: Point) -> str:
             return f"({_fmt(point[0] * scale - x0 + PAD)}, {_fmt(y1 - point[1] * scale + PAD)})"
         labels = iter(self.labels)  # in the order of their calls
+        width, height = x1 - x0 + 2 * PAD, y1 - y0 + 2 * PAD
 
         def place_label(point: Point) -> str:
-            x, y = _anchored(point, next(labels)[1], scale)
-            return f"({_fmt(x - x0 + PAD)}, {_fmt(y1 - y + PAD)})"
+            # The offset from where the label's alignment in the canvas puts it (``fig-label``): the
+            # label is placed by its anchor directly, with nothing to measure and no box around it.
+            box = next(labels)[1]
+            x, y = _anchored(point, box, scale)
+            across = 0.0 if abs(box[0]) < 1e-9 else 1.0 if abs(box[2]) < 1e-9 else 0.5
+            down = 0.0 if abs(box[3]) < 1e-9 else 1.0 if abs(box[1]) < 1e-9 else 0.5
+            return f"({_fmt(x - x0 + PAD - across * width)}, {_fmt(y1 - y + PAD - down * height)})"
         body = []
         # Lines drawn one after another with one stroke are one curve (the ground's hatching: 25 lines).
         for (kind, options), calls in itertools.groupby(self.calls, key=lambda call: (call[0], call[3])):
@@ -212,10 +218,10 @@ class Drawing:
                 body.append(f"  fig-lines({', '.join([*arguments, options])})")
                 continue
             for _, points, radius, _ in calls:
-                arguments = [(place_label if kind == "fig-label" else place)(p) for p in points] + ([_fmt(radius * scale)] if radius else []) + \
-                    ([options] if options else [])
+                arguments = [(place_label if kind == "fig-label" else place)(p) for p in points] + \
+                    ([_fmt(radius * scale)] if radius else []) + ([options] if options else [])
                 body.append(f"  {kind}({', '.join(arguments)})")
-        return Typ(f"fig-canvas({_fmt(x1 - x0 + 2 * PAD)}, {_fmt(y1 - y0 + 2 * PAD)}, {{\n" + "\n".join(body) + "\n})")
+        return Typ(f"fig-canvas({_fmt(width)}, {_fmt(height)}, {{\n" + "\n".join(body) + "\n})")
 
 
 def _anchored(at: Point, box: tuple[float, float, float, float], scale: float) -> Point:

@@ -234,7 +234,7 @@ def slope(canvas: Drawing, scene: SceneView, stage: Stage) -> bool:
         canvas.arrow(tail, tip)
         # Above the arrow, clear of its higher end: beside it, the label widened the panel (and a strip
         # then shrank it until the labels touched the slope).
-        canvas.label((lift[0], lift[1] + 0.5 * abs(uy) + 0.1), "s", scene.given(magnitude(node)))
+        canvas.label((lift[0], lift[1] + 0.5 * abs(uy) + 0.22), "s", scene.given(magnitude(node)))
     if "distance" in fields:
         off = -0.45 if beta == 0 else 0.0
         if beta == 0:
@@ -251,7 +251,7 @@ def _friction_label(canvas: Drawing, lines: list[str], high: Point, beta: float)
     """The friction coefficient: on a level floor above it, midway; on an incline under its base at the
     right, or right of its upright side where the angle's label is in the way (a steep one)."""
     if beta == 0:
-        canvas.label((high[0] / 2, 0.1), "s", lines)
+        canvas.label((high[0] / 2, 0.2), "s", lines)  # a subscript hangs below its box
     elif canvas.fits((high[0], -0.1), "ne", lines):
         canvas.label((high[0], -0.1), "ne", lines)
     else:
@@ -263,20 +263,21 @@ def _ramp(canvas: Drawing, scene: SceneView, stage: Stage) -> bool:
     fields = stage.fields
     up = fields.get("direction", "down") == "up"
     height = 2.2 if scene.is_given(fields["height"]) else 1.8
-    curve = [(3.0 * i / 16, height * (1 + _m.cos(_m.pi * i / 16)) / 2) for i in range(17)]
+    run = 2.6  # cm the ramp runs across: with its labels, the panel fits half a strip unshrunk
+    curve = [(run * i / 16, height * (1 + _m.cos(_m.pi * i / 16)) / 2) for i in range(17)]
     canvas.line((-0.4, height), (0.0, height), width=1.0)
     canvas.path(curve, width=1.0)
-    canvas.line((3.0, 0.0), (4.4, 0.0), width=1.0)
-    canvas.line((-0.4, 0.0), (3.0, 0.0), width=0.4, dash="dotted")
-    top, bottom = (0.0, height + 0.3), (3.9, 0.3)
+    canvas.line((run, 0.0), (run + 1.2, 0.0), width=1.0)
+    canvas.line((-0.4, 0.0), (run, 0.0), width=0.4, dash="dotted")
+    top, bottom = (0.0, height + 0.3), (run + 0.5, 0.3)
     start, end = (bottom, top) if up else (top, bottom)
     canvas.circle(start, 0.3)
     canvas.circle(end, 0.3, "dashed", fill=False)
     names = [fields["body"], *([fields["with"]] if "with" in fields else [])]
     if up:
         canvas.name((start[0], start[1] + 0.4), "s", names[0])
-    else:  # left of the ball, on the level top: above it, the name ran into the speed's label
-        canvas.name((start[0] - 0.4, start[1]), "e", names[0])
+    else:  # above it to the left: above it, the name ran into the speed's label
+        canvas.name((start[0] - 0.2, start[1] + 0.3), "se", names[0])
     canvas.bodies += names[1:]
     for at, node in ((start, fields["speed"]), (end, fields.get("end_speed"))):
         if node is None:
@@ -285,9 +286,10 @@ def _ramp(canvas: Drawing, scene: SceneView, stage: Stage) -> bool:
             canvas.label((at[0] + 0.4, at[1]), "w", ["v = 0"])
             continue
         sign = -1 if up else 1
-        canvas.arrow((at[0] + 0.45 * sign, at[1]), (at[0] + 1.35 * sign, at[1]))
-        canvas.label((at[0] + 0.5 * sign, at[1] + 0.15), "sw" if sign > 0 else "se", scene.given(magnitude(node)))
-    canvas.dimension((-0.7, 0.0), (-0.7, height), scene.given(fields["height"]), "left")
+        canvas.arrow((at[0] + 0.45 * sign, at[1]), (at[0] + 1.05 * sign, at[1]))
+        canvas.label((at[0] + 0.5 * sign, at[1] + 0.22), "sw" if sign > 0 else "se", scene.given(magnitude(node)))
+    # The height's label right of its line, under the ramp's top: left of it, it widened the panel.
+    canvas.dimension((-0.7, 0.0), (-0.7, height), scene.given(fields["height"]), "right")
     return True
 
 
@@ -407,7 +409,7 @@ def impulse(canvas: Drawing, scene: SceneView, stage: Stage) -> bool:
         canvas.ground(-1.2, 1.2, -0.6)
         canvas.rect((-1.0, -0.6), (1.0, 0.0), fill="luma(200)")
         canvas.label((0.0, -0.3), "c", [str(string("cushion"))])  # inside: beside it, it widened the panel
-        canvas.dimension((-1.4, -0.6), (-1.4, 0.0), scene.given(fields["distance"]), "left")
+        canvas.dimension((-1.2, -0.6), (-1.2, 0.0), scene.given(fields["distance"]), "left")
         centre = (0.0, 0.3)
         canvas.rect((-0.6, 0.0), (0.6, 0.6))
     else:

@@ -229,7 +229,8 @@ def test_a_figure_of_the_authors_own_gets_the_variants_values(tmp_path: Path) ->
 @pytest.mark.parametrize(("figure", "files", "message"), [
     ({"panel": [1]}, {}, "figure.panel: expected one of file, panels (did you mean panels?)"),
     ({"panels": [1, 4]}, {}, "figure.panels, panel 2 of 2: expected a list of panels, each a stage's number (1 to 3)"),
-    ({"panels": [1, [1, 2]]}, {}, "figure.panels, panel 2 of 2: expected each stage in one panel at most, got stage 1 again"),
+    ({"panels": [1, [1, 2]]}, {},
+     "figure.panels, panel 2 of 2: expected each stage in one panel at most, got stage 1 again"),
     ({"file": "missing.typ"}, {}, "figure.file: expected a UTF-8 file"),
     ({"file": "../x.typ"}, {}, "figure.file: expected the name of a .typ or .svg file beside the template"),
     ({"file": "a.typ"}, {"a.typ": "$x = {{ nope }}$"}, "expected {{ name }} of parameters only, got {{ nope }}"),

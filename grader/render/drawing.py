@@ -178,10 +178,9 @@ class Drawing:
 
     def _extent(self, scale: float) -> tuple[float, float, float, float]:
         """The bounding box with the geometry scaled by ``scale`` and the labels at their size."""
-        anchors = [_anchored(at, box, scale) for at, box in self.labels]
-        xs = [x * scale for x, _ in self.points] + [a[0] + d for a, (_, box) in zip(anchors, self.labels) for d in box[::2]]
-        ys = [y * scale for _, y in self.points] + [a[1] + d for a, (_, box) in zip(anchors, self.labels)
-                                                    for d in box[1::2]]
+        placed = [(_anchored(at, box, scale), box) for at, box in self.labels]
+        xs = [x * scale for x, _ in self.points] + [a[0] + d for a, box in placed for d in box[::2]]
+        ys = [y * scale for _, y in self.points] + [a[1] + d for a, box in placed for d in box[1::2]]
         return (min(xs), min(ys), max(xs), max(ys)) if xs else (0.0, 0.0, 0.0, 0.0)
 
     def natural_width(self) -> float:

@@ -373,3 +373,24 @@ def test_a_label_keeps_its_gap_when_its_drawing_is_shrunk() -> None:
     (line_y,), (label_y,) = (re.findall(r"fig-lines\(\(\([0-9.]+, ([0-9.]+)\)", shrunk),
                              re.findall(r'fig-label\(\([-0-9.]+, ([-0-9.]+)\), "n"', shrunk))
     assert float(label_y) - float(line_y) == pytest.approx(0.15, abs=0.011)
+
+
+@pytest.mark.slow
+def test_the_contact_sheet_shows_every_effects_panel(tmp_path: Path) -> None:
+    """docs/make_contact_sheet.py (docs/images/figures.png): every template's figure, and among them a panel
+    of each effect that has one; its Typst source compiles."""
+    import importlib.util
+
+    from grader.render.panels import PANELS
+    from grader.render.typeset import compile_typst
+
+    spec = importlib.util.spec_from_file_location("make_contact_sheet", Path(__file__).parents[1] / "docs" /
+                                                  "make_contact_sheet.py")
+    assert spec is not None and spec.loader is not None
+    sheet = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(sheet)
+    chosen = sheet.sections()
+    assert sum(len(templates) for _, templates in chosen) == len(BANK)
+    _, shown = sheet.source(chosen)
+    assert shown == set(PANELS)
+    compile_typst(sheet.source([(heading, templates[:1]) for heading, templates in chosen])[0], tagged=False)

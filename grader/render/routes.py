@@ -1,0 +1,466 @@
+"""The answer key's routes: the steps a textbook writes, where the solver's chain takes a stable route.
+
+The kernels keep their stable forms (docs/design.md, Numerics): an impact in impulse form with inverse
+masses, ``J = (1 + e) v/(1/m1 + 1/m2)``, angles from ``atan2``, magnitudes from ``hypot``. A student, and the
+textbook, write the same physics another way, and the worked solution shows that way, each value still the
+kernel's (``tests/test_routes.py`` evaluates every form on the page against the kernel's value to 1e-9):
+
+- two bodies that both move after an impact: **conservation of momentum** and **the restitution equation**
+  as two labelled equations, then their simultaneous solution (Sample Problems 3/28 and 3/30); a velocity
+  after found from the other's: conservation of momentum alone (the pile driver's ``v_p'``);
+- a bounce measured by heights: ``e = √(h′/h)`` (Problem 3/251), not ``e = −v′/v`` with the numbers;
+- an angle from its sine, cosine or tangent: ``θ = sin⁻¹(b/(2r))``, ``θ′ = tan⁻¹(v′_n/v′_t)``, the angle between
+  two velocities ``cos⁻¹`` of their dot product over their speeds; a speed already found stands for its
+  components' root (``v`` for ``√(v_n² + v_t²)``), and a speed with one component zero is that component's size;
+- reciprocal sums combined: ``1/(1/m1 + 1/m2)`` is ``m1 m2/(m1 + m2)``.
+
+The route's forms are Nodes of the same expressions, with three functions only the page knows
+(``asin``, ``acos``, ``atan``: :func:`page_value` evaluates them).
+"""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, replace
+from fractions import Fraction
+from typing import Any
+
+import numpy as np
+
+from grader.bank.template import Template
+from grader.model.expr import Node, Num, Op, Sym, fold, names
+from grader.model.kernel import evaluate
+from grader.model.scene import Stage, Velocity
+from grader.solve.compiled import Compiled, Step
+
+INVERSE_TRIG = {"asin": "sin", "acos": "cos", "atan": "tan"}
+"""The page's inverse functions, by the function they invert."""
+
+_IMPULSE = re.compile(r"impulse along n in the impact of (\S+) and (\S+), with restitution .+")
+_MOMENTUM_OF = re.compile(r"impulse-momentum for (\S+) along n")
+_RISES = re.compile(r"conservation of energy, \S+ rises through (\w+)")
+_FALLS = re.compile(r"conservation of energy, \S+ falls through (\w+)")
+_COMPONENT = re.compile(r"(\w+): component along ([nt])")
+_ZERO, _ONE = Num(Fraction(0)), Num(Fraction(1))
+
+
+@dataclass(frozen=True)
+class Route:
+    """A template's worked solution as the page shows it: its ``steps`` (each a chain quantity or one of
+    ``extra``, in the order a student writes them), and ``extra``, the quantities the route names that the
+    kernels' chain never computes (the struck block's rebound, for a momentum balance), evaluated after it.
+    ``positive`` names, per step, the quantity that must be positive at a variant for its form to hold
+    (``tan⁻¹(y/x)`` is the angle only where ``x > 0``): elsewhere the page shows the kernel's form."""
+
+    steps: tuple[Step, ...]
+    extra: tuple[Step, ...] = ()
+    positive: Mapping[str, Node] = ()  # type: ignore[assignment]
+
+
+def page_value(node: Node, env: Mapping[str, Any]) -> Any:
+    """A page form's value: the kernel's evaluation, with ``asin``, ``acos`` and ``atan`` as ``atan2``.
+
+    >>> float(page_value(Op("asin", (Num(0.5),)), {})) * 6
+    3.1415926535897927
+    """
+    return evaluate(_kernel_form(node), env)
+
+
+def _kernel_form(node: Node) -> Node:
+    if not isinstance(node, Op):
+        return node
+    args = tuple(_kernel_form(a) for a in node.args)
+    if node.op not in INVERSE_TRIG:
+        return Op(node.op, args)
+    (x,) = args
+    other = Op("sqrt", (Op("sub", (_ONE, Op("pow", (x, Num(Fraction(2))))),),))
+    return Op("atan2", {"asin": (x, other), "acos": (other, x), "atan": (x, _ONE)}[node.op])
+
+
+# --- building trees ------------------------------------------------------------------------------
+
+def _is_zero(node: Node | None) -> bool:
+    return node is None or (isinstance(node, Num) and node.value == 0)
+
+
+def _add(*terms: Node | None) -> Node:
+    kept = [t for t in terms if not _is_zero(t)]
+    if not kept:
+        return _ZERO
+    total = kept[0]
+    for term in kept[1:]:
+        total = Op("sub", (total, term.args[0])) if isinstance(term, Op) and term.op == "neg" else Op("add", (total, term))
+    return total
+
+
+def _mul(*factors: Node) -> Node:
+    if any(_is_zero(f) for f in factors):
+        return _ZERO
+    kept = [f for f in factors if f != _ONE]
+    if not kept:
+        return _ONE
+    product = kept[0]
+    for factor in kept[1:]:
+        product = Op("mul", (product, factor))
+    return product
+
+
+def _neg(node: Node) -> Node:
+    return node.args[0] if isinstance(node, Op) and node.op == "neg" else Op("neg", (node,))
+
+
+def _div(numerator: Node, denominator: Node) -> Node:
+    return numerator if denominator == _ONE else Op("div", (numerator, denominator))
+
+
+def _sub(left: Node | None, right: Node | None) -> Node:
+    if _is_zero(right):
+        return left if left is not None else _ZERO
+    return _neg(right) if _is_zero(left) else Op("sub", (left, right))  # type: ignore[arg-type]
+
+
+def _factors(node: Node) -> list[Node]:
+    if isinstance(node, Op) and node.op == "mul":
+        return _factors(node.args[0]) + _factors(node.args[1])
+    return [node]
+
+
+def _without_common(masses: tuple[Node, Node], valueless: set[str]) -> tuple[Node, Node]:
+    """The two masses with the valueless factors they share taken out (``m`` and ``p m`` are 1 and ``p``),
+    as a student cancels them."""
+    first, second = (_factors(m) for m in masses)
+    for factor in list(first):
+        if isinstance(factor, Sym) and factor.name in valueless and factor in second:
+            first.remove(factor)
+            second.remove(factor)
+    return _mul(*first) if first else _ONE, _mul(*second) if second else _ONE
+
+
+# --- the impact: momentum and restitution ----------------------------------------------------------
+
+@dataclass(frozen=True)
+class _Pair:
+    """An impact of two bodies that both move, as the momentum balance names it."""
+
+    first: str
+    second: str
+    masses: tuple[Node, Node]  # as the scene gives them
+    cancelled: tuple[Node, Node]  # with the factors they share and that have no value taken out
+    before: tuple[Node | None, Node | None]  # along n (None: at rest)
+    after: tuple[str, str]  # the names of the velocities after, along n
+    e: Node
+
+    def momentum(self) -> tuple[Node, Node]:
+        (m1, m2), (u1, u2), (a1, a2) = self.masses, self.before, self.after
+        return (_add(_mul(m1, u1) if u1 is not None else None, _mul(m2, u2) if u2 is not None else None),
+                _add(_mul(m1, Sym(a1)), _mul(m2, Sym(a2))))
+
+    def restitution(self) -> tuple[Node, Node]:
+        (u1, u2), (a1, a2) = self.before, self.after
+        return self.e, _div(_sub(Sym(a2), Sym(a1)), _sub(u1 or _ZERO, u2))
+
+    def relation(self) -> str:
+        return f"conservation of momentum along n for {self.first} and {self.second}"
+
+    def both_after(self) -> tuple[Node, Node]:
+        """Simultaneous solution of the momentum and restitution equations for both velocities after."""
+        (m1, m2), (u1, u2), e = self.cancelled, self.before, self.e
+        total = _add(m1, m2)
+        if u2 is None and u1 is not None:  # the second at rest: v1' = v1 (m1 - e m2)/(m1 + m2)
+            return (_div(_mul(u1, _sub(m1, _mul(e, m2))), total), _div(_mul(m1, u1, _add(_ONE, e)), total))
+        momentum = _add(_mul(m1, u1) if u1 is not None else None, _mul(m2, u2) if u2 is not None else None)
+        approach = _sub(u1 or _ZERO, u2)
+        return (_div(_sub(momentum, _mul(e, m2, approach)), total), _div(_add(momentum, _mul(e, m1, approach)), total))
+
+    def one_after(self, known: int) -> Node:
+        """The momentum balance solved for the velocity after of the body other than ``known``."""
+        other = 1 - known
+        masses, before = self.cancelled, self.before
+        change = _mul(masses[known], _sub(before[known] or _ZERO, Sym(self.after[known])))
+        if before[other] is None:
+            return _div(change, masses[other])
+        balance = _add(_mul(masses[0], before[0]) if before[0] is not None else None,
+                       _mul(masses[1], before[1]) if before[1] is not None else None)
+        return _div(_sub(balance, _mul(masses[known], Sym(self.after[known]))), masses[other])
+
+    def first_before(self) -> Node:
+        """The momentum and restitution equations solved for the first body's velocity before, the second's
+        after unknown too: ``v1 = ((m1 + m2) v1' - (1 + e) m2 v2)/(m1 - e m2)``."""
+        (m1, m2), (_, u2), e = self.cancelled, self.before, self.e
+        given = _mul(_add(m1, m2), Sym(self.after[0]))
+        return _div(_sub(given, _mul(_add(_ONE, e), m2, u2) if u2 is not None else None), _sub(m1, _mul(e, m2)))
+
+    def second_after_from_restitution(self, first_before: str) -> Node:
+        """``v2' = v1' + e (v1 - v2)``."""
+        return _add(Sym(self.after[0]), _mul(self.e, _sub(Sym(first_before), self.before[1])))
+
+
+def _pair(template: Template, first: str, second: str) -> _Pair | None:
+    """The impact of ``first`` and ``second`` that both move, if the scene has exactly one."""
+    stages = [s for s in template.scene.stages if s.effect == "impact" and tuple(s.fields["bodies"]) == (first, second)]
+    if len(stages) != 1:
+        return None
+    stage: Stage = stages[0]
+    bodies = template.scene.bodies
+    masses = (bodies[first].mass, bodies[second].mass)
+    after = stage.fields.get("after", {})
+    names_after = [after.get(b).n if isinstance(after.get(b), Velocity) else None for b in (first, second)]
+    if masses[0] is None or masses[1] is None or not all(isinstance(n, Sym) for n in names_after):
+        return None
+    before = tuple(_along_n(stage.fields.get("before", {}).get(b)) for b in (first, second))
+    valueless = set(template.symbols)
+    return _Pair(first, second, (masses[0], masses[1]), _without_common((masses[0], masses[1]), valueless),
+                 (before[0], before[1]), (names_after[0].name, names_after[1].name),  # type: ignore[union-attr]
+                 stage.fields["restitution"])
+
+
+def _along_n(velocity: Any) -> Node | None:
+    if isinstance(velocity, Velocity):
+        return None if _is_zero(velocity.n) else velocity.n
+    return None if velocity is None or _is_zero(velocity) else velocity
+
+
+def _uses(step: Step, quantity: str) -> bool:
+    return quantity in names(step.solved)
+
+
+def _impacts(template: Template, compiled: Compiled, steps: list[Step], extra: list[Step]) -> list[Step]:
+    """The impulse form of every impact of two moving bodies, as momentum and restitution."""
+    answers = set().union(*(names(spec.value) for spec in template.answers.values()))
+    for impulse in [s.unknown for s in steps if _IMPULSE.fullmatch(s.relation) or
+                    (_MOMENTUM_OF.fullmatch(s.relation) and s.unknown.startswith("J"))]:
+        steps = _one_impact(template, steps, extra, impulse, answers) or steps
+    return steps
+
+
+def _one_impact(template: Template, steps: list[Step], extra: list[Step], impulse: str,
+                answers: set[str]) -> list[Step] | None:
+    defining = [s for s in steps if s.unknown == impulse]
+    if len(defining) != 1:
+        return None
+    found = defining[0]
+    bodies = _IMPULSE.fullmatch(found.relation)
+    if bodies is None:  # found from one body's impulse-momentum; the impact step says which two
+        labels = [_IMPULSE.fullmatch(s.relation) for s in steps if impulse in names(s.equation[0])]
+        bodies = next((b for b in labels if b), None)
+        if bodies is None:
+            first_body = _MOMENTUM_OF.fullmatch(found.relation)
+            return _momentum_only(template, steps, found, first_body.group(1) if first_body else "", impulse, answers)
+    pair = _pair(template, bodies.group(1), bodies.group(2))
+    if pair is None:
+        return None
+    members = [s for s in steps if s.unknown in pair.after and _MOMENTUM_OF.fullmatch(s.relation)
+               and impulse in names(s.equation[0]) | names(s.equation[1])]
+    others = [s for s in steps if s is not found and s not in members]
+    if any(_uses(s, impulse) for s in others) or impulse in answers:
+        return None
+    if found.block:
+        return _first_before(steps, found, members, pair)
+    if not members or any(m.block for m in members):
+        return None
+    block = pair.after
+    momentum, restitution = pair.momentum(), pair.restitution()
+    forms = pair.both_after()
+    shown = [Step(block[0], pair.relation(), momentum, forms[0], block),
+             Step(block[1], f"coefficient of restitution for {pair.first} and {pair.second}", restitution, forms[1], block)]
+    chain = {s.unknown for s in steps}
+    extra += [s for s in shown if s.unknown not in chain]
+    index = steps.index(found)
+    rest = [s for s in steps if s is not found and s not in members]
+    return rest[:index] + shown + rest[index:]
+
+
+def _momentum_only(template: Template, steps: list[Step], found: Step, body: str, impulse: str,
+                   answers: set[str]) -> list[Step] | None:
+    """A velocity after from the other body's: the impulse found from one body's momentum change and given to
+    the other's is the momentum balance of the two, solved for one velocity."""
+    users = [s for s in steps if s is not found and _uses(s, impulse)]
+    if len(users) != 1 or impulse in answers or not _MOMENTUM_OF.fullmatch(users[0].relation):
+        return None
+    other = _MOMENTUM_OF.fullmatch(users[0].relation).group(1)  # type: ignore[union-attr]
+    pair = _pair(template, body, other) or _pair(template, other, body)
+    if pair is None or users[0].unknown not in pair.after:
+        return None
+    known = pair.after.index(users[0].unknown) ^ 1
+    step = Step(users[0].unknown, pair.relation(), pair.momentum(), pair.one_after(known))
+    index = steps.index(found)
+    rest = [s for s in steps if s is not found and s is not users[0]]
+    return rest[:index] + [step] + rest[index:]
+
+
+def _first_before(steps: list[Step], found: Step, members: list[Step], pair: _Pair) -> list[Step] | None:
+    """A block that finds the first body's velocity before and the impulse, the second's velocity after then
+    from the impulse: the momentum and restitution equations in the first's velocity before and the second's
+    after."""
+    block = [s for s in steps if s.block == found.block]
+    u1 = pair.before[0]
+    if not isinstance(u1, Sym) or set(found.block) != {u1.name, found.unknown}:
+        return None
+    after = [m for m in members if not m.block]
+    if len(after) != 1 or after[0].unknown != pair.after[1]:
+        return None
+    unknowns = (u1.name, pair.after[1])
+    shown = [Step(unknowns[0], pair.relation(), pair.momentum(), pair.first_before(), unknowns),
+             Step(unknowns[1], f"coefficient of restitution for {pair.first} and {pair.second}", pair.restitution(),
+                  pair.second_after_from_restitution(u1.name), unknowns)]
+    index = steps.index(block[0])
+    rest = [s for s in steps if s not in block and s is not after[0]]
+    return rest[:index] + shown + rest[index:]
+
+
+# --- heights, angles, magnitudes, reciprocals ------------------------------------------------------
+
+def _bounce_heights(steps: list[Step]) -> list[Step]:
+    """``e = -v'/v`` with ``v = √(2 g h)`` and ``v' = -√(2 g h')``: ``e = √(h'/h)``."""
+    heights: dict[str, tuple[str, str]] = {}
+    for step in steps:
+        for kind, pattern in (("rise", _RISES), ("fall", _FALLS)):
+            found = pattern.fullmatch(step.relation)
+            if found:
+                heights[step.unknown] = (kind, found.group(1))
+    result = []
+    for step in steps:
+        ratio = _ratio(step.solved)
+        if step.relation.startswith("coefficient of restitution") and ratio is not None:
+            (rise, fall) = (heights.get(ratio[0]), heights.get(ratio[1]))
+            if rise and fall and rise[0] == "rise" and fall[0] == "fall":
+                step = replace(step, solved=Op("sqrt", (Op("div", (Sym(rise[1]), Sym(fall[1]))),)))
+        result.append(step)
+    return result
+
+
+def _ratio(node: Node) -> tuple[str, str] | None:
+    """``(x, y)`` of ``-x/y`` (or ``(-x)/y``), names both."""
+    if isinstance(node, Op) and node.op == "neg" and isinstance(node.args[0], Op) and node.args[0].op == "div":
+        top, bottom = node.args[0].args
+    elif isinstance(node, Op) and node.op == "div" and isinstance(node.args[0], Op) and node.args[0].op == "neg":
+        top, bottom = node.args[0].args[0], node.args[1]
+    else:
+        return None
+    return (top.name, bottom.name) if isinstance(top, Sym) and isinstance(bottom, Sym) else None
+
+
+def _inverse_trig(steps: list[Step], positive: dict[str, Node]) -> list[Step]:
+    """An angle from ``sin θ = ...``, ``cos θ = ...`` or ``tan θ = y/x`` solved by ``atan2``: ``sin⁻¹(...)``, and
+    so on, as the relation reads (``tan⁻¹(y/x)`` only where ``x > 0``, which the page checks per variant)."""
+    result = []
+    for step in steps:
+        lhs, rhs = step.equation
+        if (isinstance(step.solved, Op) and step.solved.op == "atan2" and isinstance(lhs, Op)
+                and lhs.op in INVERSE_TRIG.values() and lhs.args == (Sym(step.unknown),)):
+            inverse = next(k for k, v in INVERSE_TRIG.items() if v == lhs.op)
+            if inverse == "atan":
+                if not (isinstance(rhs, Op) and rhs.op == "div"):
+                    result.append(step)
+                    continue
+                positive[step.unknown] = rhs.args[1]
+            step = replace(step, solved=Op(inverse, (rhs,)))
+        result.append(step)
+    return result
+
+
+def _magnitudes(steps: list[Step]) -> list[Step]:
+    """A speed found once stands for its components' root afterwards (``v`` for ``√(v_n² + v_t²)``, where ``v_n =
+    v cos θ`` and ``v_t = v sin θ``), and the root of one component and a zero is that component's size."""
+    known: dict[frozenset[Node], Node] = {}
+    components: dict[str, dict[str, str]] = {}
+    zero = {s.unknown for s in steps if _is_zero(s.solved)}
+    result = []
+    for step in steps:
+        step = replace(step, equation=tuple(_speeds(side, known, zero) for side in step.equation),  # type: ignore[arg-type]
+                       solved=_speeds(step.solved, known, zero))
+        result.append(step)
+        found = _COMPONENT.fullmatch(step.relation)
+        if found:
+            parts = components.setdefault(found.group(1), {})
+            parts[found.group(2)] = step.unknown
+            if len(parts) == 2:
+                known[frozenset({Sym(parts["n"]), Sym(parts["t"])})] = Sym(found.group(1))
+        if isinstance(step.solved, Op) and step.solved.op == "hypot":
+            known[frozenset(step.solved.args)] = Sym(step.unknown)
+    return result
+
+
+def _speeds(node: Node, known: Mapping[frozenset[Node], Node], zero: set[str]) -> Node:
+    if not isinstance(node, Op):
+        return node
+    args = tuple(_speeds(a, known, zero) for a in node.args)
+    if node.op == "hypot":
+        if frozenset(args) in known:
+            return known[frozenset(args)]
+        kept = [a for a in args if not (isinstance(a, Sym) and a.name in zero) and not _is_zero(a)]
+        if len(kept) == 1:
+            return Op("abs", (kept[0],))
+    return Op(node.op, args)
+
+
+def combine_reciprocals(node: Node) -> Node:
+    """Reciprocal sums as one fraction: ``c/a + c/b`` is ``c (a + b)/(a b)``, and a quotient by a quotient is a
+    product over one denominator, so ``1/(1/m1 + 1/m2)`` reads ``m1 m2/(m1 + m2)``.
+
+    >>> from grader.model.expr import parse, to_text
+    >>> to_text(combine_reciprocals(parse("v*(1 + e)/(1/m + 1/(m*p))")))
+    'v*(1 + e)*(m*(m*p))/(m*p + m)'
+    """
+    if not isinstance(node, Op):
+        return node
+    args = tuple(combine_reciprocals(a) for a in node.args)
+    if node.op == "add" and all(isinstance(a, Op) and a.op == "div" for a in args):
+        (c1, a), (c2, b) = (arg.args for arg in args)  # type: ignore[union-attr]
+        if c1 == c2:
+            return Op("div", (_mul(c1, Op("add", (b, a))), Op("mul", (a, b))))
+    if node.op == "div" and isinstance(args[1], Op) and args[1].op == "div":
+        top, bottom = args[1].args
+        return Op("div", (_mul(args[0], bottom), top))
+    if node.op == "mul" and isinstance(args[1], Op) and args[1].op == "div" and isinstance(args[0], Op) \
+            and args[0].op == "div":
+        return Op("div", (Op("mul", (args[0].args[0], args[1].args[0])), Op("mul", (args[0].args[1], args[1].args[1]))))
+    return Op(node.op, args)
+
+
+def textbook_route(template: Template, compiled: Compiled) -> Route:
+    """The steps of ``template``'s worked solution as the page shows them (see the module's docstring)."""
+    extra: list[Step] = []
+    positive: dict[str, Node] = {}
+    steps = _impacts(template, compiled, list(compiled.steps), extra)
+    steps = _bounce_heights(steps)
+    steps = _magnitudes(steps)
+    steps = _inverse_trig(steps, positive)
+    steps = [_one_fraction(s) for s in steps]
+    return Route(tuple(_folded(s) for s in steps), tuple(_folded(s) for s in extra), positive)
+
+
+def _folded(step: Step) -> Step:
+    """Whole numbers added up (``1 + 1`` is 2) where a route put them side by side."""
+    if step.numeric:
+        return step
+    return replace(step, equation=(fold(step.equation[0]), fold(step.equation[1])), solved=fold(step.solved))
+
+
+def _one_fraction(step: Step) -> Step:
+    """Reciprocal sums combined; an equation that only said the unknown is a nested fraction is the solved form."""
+    if step.numeric:
+        return step
+    lhs, rhs = (combine_reciprocals(side) for side in step.equation)
+    if lhs == Sym(step.unknown) and rhs != step.equation[1]:
+        rhs = combine_reciprocals(step.solved)
+    return replace(step, equation=(lhs, rhs), solved=combine_reciprocals(step.solved))
+
+
+def route_values(route: Route, values: Mapping[str, float]) -> dict[str, float]:
+    """The route's extra quantities' values (SI), from the chain's ``values``."""
+    env: dict[str, Any] = dict(values)
+    with np.errstate(all="ignore"):
+        for step in route.extra:
+            try:
+                env[step.unknown] = float(page_value(step.solved, env))
+            except KeyError:
+                continue
+    return {step.unknown: env[step.unknown] for step in route.extra if step.unknown in env}
+
+
+def kernel_steps(route: Route, compiled: Compiled) -> Sequence[Step]:
+    """The chain with the route's extra quantities after it (evaluated with :func:`page_value`'s functions
+    only if they use none)."""
+    return (*compiled.steps, *route.extra)

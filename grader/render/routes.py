@@ -21,12 +21,10 @@ The route's forms are Nodes of the same expressions, with three functions only t
 from __future__ import annotations
 
 import re
-from collections.abc import Mapping, Sequence
+from collections.abc import Mapping
 from dataclasses import dataclass, replace
 from fractions import Fraction
 from typing import Any
-
-import numpy as np
 
 from grader.bank.template import Template
 from grader.model.expr import Node, Num, Op, Sym, fold, names
@@ -61,8 +59,8 @@ class Route:
 def page_value(node: Node, env: Mapping[str, Any]) -> Any:
     """A page form's value: the kernel's evaluation, with ``asin``, ``acos`` and ``atan`` as ``atan2``.
 
-    >>> float(page_value(Op("asin", (Num(0.5),)), {})) * 6
-    3.1415926535897927
+    >>> round(float(page_value(Op("asin", (Num(0.5),)), {})) * 6, 12)
+    3.14159265359
     """
     return evaluate(_kernel_form(node), env)
 
@@ -85,12 +83,13 @@ def _is_zero(node: Node | None) -> bool:
 
 
 def _add(*terms: Node | None) -> Node:
-    kept = [t for t in terms if not _is_zero(t)]
+    kept = [t for t in terms if t is not None and not _is_zero(t)]
     if not kept:
         return _ZERO
     total = kept[0]
     for term in kept[1:]:
-        total = Op("sub", (total, term.args[0])) if isinstance(term, Op) and term.op == "neg" else Op("add", (total, term))
+        negative = isinstance(term, Op) and term.op == "neg"
+        total = Op("sub", (total, term.args[0])) if isinstance(term, Op) and negative else Op("add", (total, term))
     return total
 
 
@@ -115,9 +114,11 @@ def _div(numerator: Node, denominator: Node) -> Node:
 
 
 def _sub(left: Node | None, right: Node | None) -> Node:
-    if _is_zero(right):
+    if right is None or _is_zero(right):
         return left if left is not None else _ZERO
-    return _neg(right) if _is_zero(left) else Op("sub", (left, right))  # type: ignore[arg-type]
+    if left is None or _is_zero(left):
+        return _neg(right)
+    return Op("sub", (left, right))
 
 
 def _factors(node: Node) -> list[Node]:
@@ -162,6 +163,9 @@ class _Pair:
 
     def relation(self) -> str:
         return f"conservation of momentum along n for {self.first} and {self.second}"
+
+    def restitution_relation(self) -> str:
+        return f"coefficient of restitution for {self.first} and {self.second}"
 
     def both_after(self) -> tuple[Node, Node]:
         """Simultaneous solution of the momentum and restitution equations for both velocities after."""
@@ -263,7 +267,7 @@ def _one_impact(template: Template, steps: list[Step], extra: list[Step], impuls
     momentum, restitution = pair.momentum(), pair.restitution()
     forms = pair.both_after()
     shown = [Step(block[0], pair.relation(), momentum, forms[0], block),
-             Step(block[1], f"coefficient of restitution for {pair.first} and {pair.second}", restitution, forms[1], block)]
+             Step(block[1], pair.restitution_relation(), restitution, forms[1], block)]
     chain = {s.unknown for s in steps}
     extra += [s for s in shown if s.unknown not in chain]
     index = steps.index(found)
@@ -286,7 +290,7 @@ def _momentum_only(template: Template, steps: list[Step], found: Step, body: str
     step = Step(users[0].unknown, pair.relation(), pair.momentum(), pair.one_after(known))
     index = steps.index(found)
     rest = [s for s in steps if s is not found and s is not users[0]]
-    return rest[:index] + [step] + rest[index:]
+    return [*rest[:index], step, *rest[index:]]
 
 
 def _first_before(steps: list[Step], found: Step, members: list[Step], pair: _Pair) -> list[Step] | None:
@@ -302,7 +306,7 @@ def _first_before(steps: list[Step], found: Step, members: list[Step], pair: _Pa
         return None
     unknowns = (u1.name, pair.after[1])
     shown = [Step(unknowns[0], pair.relation(), pair.momentum(), pair.first_before(), unknowns),
-             Step(unknowns[1], f"coefficient of restitution for {pair.first} and {pair.second}", pair.restitution(),
+             Step(unknowns[1], pair.restitution_relation(), pair.restitution(),
                   pair.second_after_from_restitution(u1.name), unknowns)]
     index = steps.index(block[0])
     rest = [s for s in steps if s not in block and s is not after[0]]
@@ -446,21 +450,3 @@ def _one_fraction(step: Step) -> Step:
     if lhs == Sym(step.unknown) and rhs != step.equation[1]:
         rhs = combine_reciprocals(step.solved)
     return replace(step, equation=(lhs, rhs), solved=combine_reciprocals(step.solved))
-
-
-def route_values(route: Route, values: Mapping[str, float]) -> dict[str, float]:
-    """The route's extra quantities' values (SI), from the chain's ``values``."""
-    env: dict[str, Any] = dict(values)
-    with np.errstate(all="ignore"):
-        for step in route.extra:
-            try:
-                env[step.unknown] = float(page_value(step.solved, env))
-            except KeyError:
-                continue
-    return {step.unknown: env[step.unknown] for step in route.extra if step.unknown in env}
-
-
-def kernel_steps(route: Route, compiled: Compiled) -> Sequence[Step]:
-    """The chain with the route's extra quantities after it (evaluated with :func:`page_value`'s functions
-    only if they use none)."""
-    return (*compiled.steps, *route.extra)

@@ -356,8 +356,12 @@ def _answer_steps(template: Template, compiled: Compiled, si: Mapping[str, float
     return steps
 
 
-_DOUBLE_NEGATIVE = ((re.compile(r" - \(-([0-9.]+)\)(?!\^)"), r" + \1"), (re.compile(r" \+ \(-([0-9.]+)\)(?!\^)"), r" - \1"),
-                    (re.compile(r"(^|[(, ])-\(-([0-9.]+)\)(?!\^)"), r"\1\2"), (re.compile(r"abs\(\((-[0-9.]+)\)\)"), r"abs(\1)"))
+_DOUBLE_NEGATIVE = (
+    (re.compile(r" - \(-([0-9.]+)\)(?!\^)"), r" + \1"),
+    (re.compile(r" \+ \(-([0-9.]+)\)(?!\^)"), r" - \1"),
+    (re.compile(r"(^|[(, ])-\(-([0-9.]+)\)(?!\^)"), r"\1\2"),
+    (re.compile(r"abs\(\((-[0-9.]+)\)\)"), r"abs(\1)"),
+)
 
 
 def _tidy_signs(shown: str) -> str:

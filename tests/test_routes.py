@@ -28,7 +28,7 @@ from grader.model.kernel import evaluate
 from grader.render.readable import readable
 from grader.render.routes import page_value, textbook_route
 from grader.render.typst_math import math as typst_math
-from grader.render.worked import chain_values, reader_names, si_parameters, worked, worked_form
+from grader.render.worked import answer_math, chain_values, reader_names, si_parameters, worked, worked_form
 from grader.solve.cache import compiled_for
 
 BANK = load_bank()
@@ -170,21 +170,28 @@ def test_an_answer_asked_as_an_expression_of_steps_is_a_step(template_id: str,
         assert typst_math(readable(spec.value, reader)) in shown, (template_id, spec.name)
 
 
-def test_a_symbolic_answer_is_derived_to_the_keys_expression() -> None:
-    """Problem 3/255: the page solves momentum and restitution for v_A′ and v_B′ in terms of p and v; with the
-    variant's e put in, that form is the key's symbolic answer at any p and v."""
+def test_a_symbolic_answer_is_derived_to_the_keys_expression(variants: dict[str, list[ProblemVariant]]) -> None:
+    """Problem 3/255: the page solves momentum and restitution for v_A′ and v_B′ in terms of p and v; with e = 0.1
+    that form is the book's answer at any p and v, and with a variant's e it is the key's answer, which the step
+    then writes before the numbers go in."""
     template = BANK["car-collision"]
-    printed = {"p": "0.5", "e": "0.1"}
-    variant = ProblemVariant("1", template.id, "3/255", {n: float(v) for n, v in printed.items()}, printed, ())
     forms = {step.unknown: step.solved for step in worked_form(template).steps}
     rng = np.random.default_rng(255)
     points = {"p": rng.uniform(0.1, 5, 16), "v": rng.uniform(-10, 10, 16), "m": rng.uniform(0.5, 5, 16)}
     textbook = {"vA_after": "v*(1 - 0.1*p)/(1 + p)", "vB_after": "1.1*v/(1 + p)"}  # the book's answers
     for quantity, answer in textbook.items():
-        page = substitute(forms[quantity], {"e": Num(float(variant.printed["e"]))})
+        page = substitute(forms[quantity], {"e": Num(0.1)})
         assert np.allclose(evaluate(page, points), evaluate(parse(answer), points), rtol=1e-12)
-    steps = {step.chain[0]: step for step in worked(template, variant).steps if step.chain}
-    assert len(steps["v'_A"].chain) == 5  # the form, in p and v, with the numbers, the value
+    for variant in variants["car-collision"]:
+        steps = {step.chain[0]: step for step in worked(template, variant).steps if step.chain}
+        for part in variant.answers:
+            spec = template.answers[part.name]
+            if not spec.symbolic:
+                continue
+            assert isinstance(spec.value, Sym) and isinstance(part.value, str)
+            page = substitute(forms[spec.value.name], {"e": Num(float(variant.printed["e"]))})
+            assert np.allclose(evaluate(page, points), evaluate(parse(part.value), points), rtol=1e-12)
+            assert answer_math(part.value, "") in steps[typst_math(spec.value)].chain
 
 
 def test_billiards_finds_the_angle_from_its_sine_and_its_speeds_by_name() -> None:
@@ -194,3 +201,18 @@ def test_billiards_finds_the_angle_from_its_sine_and_its_speeds_by_name() -> Non
     assert steps["theta"] == "sin^(-1)(b/(2 r))"
     assert steps["angle_cue"].startswith("cos^(-1)(") and steps["angle_cue"].endswith('/(v v_"cue"))')
     assert steps["v_obj"] == "abs(v'_(\"obj\", n))"
+
+
+def test_the_contact_sheet_shows_a_worked_solution_of_every_effect_the_bank_uses() -> None:
+    """docs/contact_sheet.py tiles one worked solution per effect (docs/images/worked-by-effect.png): a template
+    with a new effect is listed there too."""
+    import importlib.util
+    from pathlib import Path
+
+    path = Path(__file__).parent.parent / "docs" / "contact_sheet.py"
+    spec = importlib.util.spec_from_file_location("contact_sheet", path)
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    shown = {stage.effect for template in module.CHOSEN for stage in BANK[template].scene.stages}
+    assert {stage.effect for template in BANK.values() for stage in template.scene.stages} <= shown

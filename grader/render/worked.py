@@ -287,7 +287,7 @@ class _Context:
     symbol_units: Mapping[str, str]
     undefined: Mapping[str, str]
     conversions: Mapping[str, tuple[str, float]]  # an answer's quantity: the unit it is asked in, its SI factor
-    symbolic: Mapping[str, tuple[str, ...]]  # an answer's quantity asked as an expression: the names kept in it
+    symbolic: Mapping[str, str]  # an answer's quantity asked as an expression: the key's expression (math)
 
 
 def worked(template: Template, variant: ProblemVariant, compiled: Compiled | None = None,
@@ -307,7 +307,9 @@ def worked(template: Template, variant: ProblemVariant, compiled: Compiled | Non
         form.symbol_units, _undefined(template, variant),
         {spec.value.name: (spec.unit.text, spec.unit.to_si) for spec in answers  # type: ignore[union-attr]
          if spec.unit.text not in ("", "deg") and spec.unit.text != si_unit(spec.unit.dimension)},
-        {spec.value.name: spec.symbolic for spec in answers if spec.symbolic})  # type: ignore[union-attr]
+        {template.answers[part.name].value.name: answer_math(part.value, "")  # type: ignore[union-attr]
+         for part in variant.answers if isinstance(part.value, str) and template.answers[part.name].symbolic
+         and isinstance(template.answers[part.name].value, Sym)})
     values = chain_values(evaluated, {**si, **{s: 1.0 for s in form.symbols}})
     steps = []
     for index, step in enumerate(form.steps):
@@ -449,11 +451,9 @@ def _symbol_note(symbol: str, description: str) -> Typ:
 def _step(step: StepForm, scaling: Scaling | None, dim: Dimension | None, context: _Context) -> WorkedStep:
     relation, equation = step.relation, step.equation
     chain = [name(step.unknown)] if step.numeric else [name(step.unknown), step.solved_math]
-    kept = context.symbolic.get(step.unknown, ())
-    if kept and not step.numeric:  # asked in terms of some names: the form with every other number in
-        partial = math(step.solved, {n: v for n, v in context.shown.items() if n not in kept}, context.degrees)
-        if partial != chain[-1]:
-            chain.append(_tidy_signs(partial))
+    printed = context.symbolic.get(step.unknown)
+    if printed and printed != chain[-1]:  # asked as an expression: the form, the variant's numbers in, is the key's
+        chain.append(printed)
     substituted = chain[-1] if step.numeric else _tidy_signs(math(step.solved, context.shown, context.degrees))
     if substituted != chain[-1]:
         chain.append(substituted)

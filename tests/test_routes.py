@@ -216,3 +216,16 @@ def test_the_contact_sheet_shows_a_worked_solution_of_every_effect_the_bank_uses
     spec.loader.exec_module(module)
     shown = {stage.effect for template in module.CHOSEN for stage in BANK[template].scene.stages}
     assert {stage.effect for template in BANK.values() for stage in template.scene.stages} <= shown
+
+
+def test_an_angle_whose_inverse_is_not_the_principal_value_is_shown_with_the_kernels_atan2() -> None:
+    """tan⁻¹(v_t/v_n) is the wreck's direction only while v_n > 0: with car B driving the other way (a draw no
+    shipped range makes, written by hand), the page falls back to the kernel's atan2, and its value stays the
+    kernel's (an obtuse angle)."""
+    template = BANK["intersection-crash"]
+    printed = {"m_A": "1500", "m_B": "1200", "v_A": "50", "v_B": "-60"}
+    variant = ProblemVariant("1", template.id, "by hand", {n: float(v) for n, v in printed.items()}, printed, ())
+    steps = {step.chain[0]: step for step in worked(template, variant).steps if step.chain}
+    assert steps["theta"].chain[1].startswith('op("atan2")')
+    kernel = _kernel_values(template, variant)["theta"]
+    assert kernel > math.pi / 2 and steps["theta"].chain[-1] == f"{math.degrees(kernel):.1f} degree"  # 4 figures

@@ -347,18 +347,16 @@ def _ratio(node: Node) -> tuple[str, str] | None:
 
 def _inverse_trig(steps: list[Step], positive: dict[str, Node]) -> list[Step]:
     """An angle from ``sin θ = ...``, ``cos θ = ...`` or ``tan θ = y/x`` solved by ``atan2``: ``sin⁻¹(...)``, and
-    so on, as the relation reads (``tan⁻¹(y/x)`` only where ``x > 0``, which the page checks per variant)."""
+    so on, as the relation reads, where the inverse's principal value is the kernel's angle (``positive``: the
+    page checks it per variant, and shows the kernel's ``atan2`` elsewhere)."""
     result = []
     for step in steps:
         lhs, rhs = step.equation
         if (isinstance(step.solved, Op) and step.solved.op == "atan2" and isinstance(lhs, Op)
                 and lhs.op in INVERSE_TRIG.values() and lhs.args == (Sym(step.unknown),)):
             inverse = next(k for k, v in INVERSE_TRIG.items() if v == lhs.op)
-            if inverse == "atan":
-                if not (isinstance(rhs, Op) and rhs.op == "div"):
-                    result.append(step)
-                    continue
-                positive[step.unknown] = rhs.args[1]
+            # The kernel's atan2(y, x) is the principal value only where x > 0 (sin⁻¹, tan⁻¹) or y > 0 (cos⁻¹)
+            positive[step.unknown] = step.solved.args[0 if inverse == "acos" else 1]
             step = replace(step, solved=Op(inverse, (rhs,)))
         result.append(step)
     return result

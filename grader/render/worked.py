@@ -184,6 +184,12 @@ _SWING = re.compile(r"conservation of energy in the swing of (\w+) on its cord o
                     r"work\): it rises L\(1 − cos θ\) to stop at (\w+) from the vertical")
 
 
+_FLIGHT_AXES = ((re.compile(r"component along n\b"), "horizontal component"),
+                (re.compile(r"component along t\b"), "vertical component"),
+                (re.compile(r"separation over approach along n\b"), "separation over approach, horizontally"),
+                (re.compile(r"no impulse along t, so (.+?)'s t-velocity"), r"no vertical impulse, so \1's vertical velocity"))
+
+
 def page_wording(step: Step, template: Template) -> str:
     """A step's relation as the page says it: bodies by their printed names (``cart 1``); no axis n in a
     problem on one line, where n is never drawn or defined; a swing names the speed it starts from (a
@@ -203,6 +209,9 @@ def page_wording(step: Step, template: Template) -> str:
     stages = template.scene.stages
     if not any(stage.is_oblique or stage.effect == "velocity" for stage in stages):
         label = re.sub(r"\s+along n\b", "", label)
+    if any(stage.effect == "flight" for stage in stages):  # a throw is drawn in x and y: n is across, t up
+        for axis, words in _FLIGHT_AXES:
+            label = axis.sub(words, label)
     swing = _SWING.fullmatch(label)
     if swing and isinstance(step.equation[0], Sym):
         body, length, angle = swing.groups()

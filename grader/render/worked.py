@@ -187,7 +187,8 @@ _SWING = re.compile(r"conservation of energy in the swing of (\w+) on its cord o
 _FLIGHT_AXES = ((re.compile(r"component along n\b"), "horizontal component"),
                 (re.compile(r"component along t\b"), "vertical component"),
                 (re.compile(r"separation over approach along n\b"), "separation over approach, horizontally"),
-                (re.compile(r"no impulse along t, so (.+?)'s t-velocity"), r"no vertical impulse, so \1's vertical velocity"))
+                (re.compile(r"no impulse along t, so (.+?)'s t-velocity"),
+                 r"no vertical impulse, so \1's vertical velocity"))
 
 
 def page_wording(step: Step, template: Template) -> str:

@@ -27,7 +27,7 @@ from grader.model.kernel import evaluate
 from grader.model.quantities import ACCELERATION, ANGLE, Dimension, dimension_of, si_unit
 from grader.model.roots import TOLERANCE_TEXT
 from grader.render.readable import Names, readable
-from grader.render.routes import page_value, textbook_route
+from grader.render.textbook_steps import page_value, textbook_route
 from grader.render.typst_math import math, name, number
 from grader.render.typst_text import Typ, body_name, string, text
 from grader.solve.cache import compiled_for
@@ -334,21 +334,22 @@ def worked(template: Template, variant: ProblemVariant, compiled: Compiled | Non
         steps.append(_step(step, scaling, form.dimensions.get(step.unknown), context))
         if scaling is not None:
             shown[step.unknown] = scaling.math()
-    steps += _answer_steps(template, evaluated, si, form, context)
+    steps += _answer_steps(template, evaluated, si, form, context, values)
     return Worked(tuple(given_lines(template, variant, compiled)), form.notes, tuple(steps), values)
 
 
 def _answer_steps(template: Template, compiled: Compiled, si: Mapping[str, float], form: WorkedForm,
-                  context: _Context) -> list[WorkedStep]:
+                  context: _Context, ones: Mapping[str, float]) -> list[WorkedStep]:
     """An answer asked as an expression of the chain's quantities (a ratio, a sum of two losses) as a step of
-    its own, so the answer's cell shows a value the page computes."""
+    its own, so the answer's cell shows a value the page computes (``ones``: the chain's values, the symbols
+    without value at 1; a value that changes with them is not shown)."""
+    asked = [spec for spec in template.answers.values() if not (isinstance(spec.value, Sym) or spec.symbolic)]
+    if not asked:
+        return []
     reader = reader_names(template, compiled, form.dimensions)
-    ones = chain_values(compiled, {**si, **{s: 1.0 for s in form.symbols}})
-    twos = chain_values(compiled, {**si, **{s: 2.0 for s in form.symbols}})
+    twos = chain_values(compiled, {**si, **{s: 2.0 for s in form.symbols}}) if form.symbols else ones
     steps = []
-    for spec in template.answers.values():
-        if isinstance(spec.value, Sym) or spec.symbolic:
-            continue
+    for spec in asked:
         try:
             value, check = (float(page_value(spec.value, env)) for env in (ones, twos))
         except KeyError:

@@ -3,7 +3,7 @@
 The kernels keep their stable forms (docs/design.md, Numerics): an impact in impulse form with inverse
 masses, ``J = (1 + e) v/(1/m1 + 1/m2)``, angles from ``atan2``, magnitudes from ``hypot``. A student, and the
 textbook, write the same physics another way, and the worked solution shows that way, each value still the
-kernel's (``tests/test_routes.py`` evaluates every form on the page against the kernel's value to 1e-9):
+kernel's (``tests/test_textbook_steps.py`` evaluates every form on the page against the kernel's value to 1e-9):
 
 - two bodies that both move after an impact: **conservation of momentum** and **the restitution equation**
   as two labelled equations, then their simultaneous solution (Sample Problems 3/28 and 3/30); a velocity
@@ -22,7 +22,7 @@ from __future__ import annotations
 
 import re
 from collections.abc import Mapping
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from fractions import Fraction
 from typing import Any
 
@@ -53,7 +53,7 @@ class Route:
 
     steps: tuple[Step, ...]
     extra: tuple[Step, ...] = ()
-    positive: Mapping[str, Node] = ()  # type: ignore[assignment]
+    positive: Mapping[str, Node] = field(default_factory=dict)
 
 
 def page_value(node: Node, env: Mapping[str, Any]) -> Any:
@@ -232,14 +232,18 @@ def _uses(step: Step, quantity: str) -> bool:
 def _impacts(template: Template, compiled: Compiled, steps: list[Step], extra: list[Step]) -> list[Step]:
     """The impulse form of every impact of two moving bodies, as momentum and restitution."""
     answers = set().union(*(names(spec.value) for spec in template.answers.values()))
+    # An impulse is the unknown of its impact's impulse relation, or of a body's impulse-momentum solved for it
+    # (whose equation gives the body's velocity after: v' = v - J/m)
     for impulse in [s.unknown for s in steps if _IMPULSE.fullmatch(s.relation) or
-                    (_MOMENTUM_OF.fullmatch(s.relation) and s.unknown.startswith("J"))]:
+                    (_MOMENTUM_OF.fullmatch(s.relation) and s.equation[0] != Sym(s.unknown))]:
         steps = _one_impact(template, steps, extra, impulse, answers) or steps
     return steps
 
 
 def _one_impact(template: Template, steps: list[Step], extra: list[Step], impulse: str,
                 answers: set[str]) -> list[Step] | None:
+    """``steps`` with the impulse ``impulse`` of one impact worked out of them (None: they keep it, because a step
+    or an answer other than the bodies' velocities uses it, or the impact is not one this module knows)."""
     defining = [s for s in steps if s.unknown == impulse]
     if len(defining) != 1:
         return None

@@ -1,11 +1,14 @@
-"""The contact sheet of worked solutions: one shipped template per effect of the catalogue, its worked solution as
-the answer key prints it for the demo roster's first student, tiled into ``docs/images/worked-by-effect.png``.
+"""Contact sheets: one shipped template per effect of the catalogue, its worked solution as the answer key
+prints it for the demo roster's first student, tiled into ``docs/images/worked-by-effect.png``; and every
+shipped template's problem as the student's sheet prints it (statement, figure, blanks), tiled into
+``docs/images/sheets-by-template.png``.
 
-An instructor reads it as a key: every effect's route on one page (momentum and restitution solved together,
-``e = √(h′/h)``, ``tan⁻¹`` of components, unit conversions as steps). Redo it when the key changes its look::
+An instructor reads them as a key and a set of sheets: every effect's route (momentum and restitution solved
+together, ``e = √(h′/h)``, ``tan⁻¹`` of components, unit conversions as steps) and every figure, each on one
+page. Redo them when the key or the sheets change their look::
 
-    .venv/bin/python docs/contact_sheet.py            # writes docs/images/worked-by-effect.png
-    .venv/bin/python docs/contact_sheet.py --out /tmp/sheet.png --columns 3
+    .venv/bin/python docs/contact_sheet.py            # writes both images
+    .venv/bin/python docs/contact_sheet.py --only worked --out /tmp/sheet.png --columns 3
 
 Each template is an assignment of its own (one problem, one student), compiled by Typst to PNG; a page is cut
 below its last line of ink and the pages are tiled left to right, each titled by the effects it shows.
@@ -24,19 +27,21 @@ CHOSEN = ("head-on", "oblique-spheres", "billiards", "car-collision", "pile-driv
 """The templates shown, in order: together they take every effect of the catalogue the bank uses."""
 
 
-def _pages(template_id: str, ppi: int) -> list[bytes]:
+def _pages(template_id: str, ppi: int, key: bool = True) -> list[bytes]:
     from grader.assign.assignment import ProblemSpec, load_assignment, load_roster
     from grader.assign.variants import generate
     from grader.bank.template import load_bank
     from grader.base.resources import sample_dir
-    from grader.render.documents import Documents, key_source
+    from grader.render.documents import Documents, key_source, student_source
     from grader.render.typeset import compile_typst
 
     bank = load_bank()
     assignment = load_assignment(sample_dir() / "assignment.yaml")
     assignment = dataclasses.replace(assignment, problems=(ProblemSpec("1", template_id, {"*": 1.0}, {}, {}, {}),))
     generation = generate(assignment, load_roster(sample_dir() / "roster.csv")[:1], bank)
-    pages = compile_typst(key_source(Documents(assignment, generation, bank), people=[0]), "png", ppi)
+    documents = Documents(assignment, generation, bank)
+    source = key_source(documents, people=[0]) if key else student_source(documents, [0])
+    pages = compile_typst(source, "png", ppi)
     return [pages] if isinstance(pages, bytes) else list(pages)
 
 
@@ -52,22 +57,21 @@ def _inked(page: bytes) -> object:
     return ImageOps.expand(body.crop((0, 0, body.width, min(body.height, box[3] + 12))), border=1, fill="#999999")
 
 
-def contact_sheet(out: Path, columns: int, ppi: int) -> None:
-    """Writes the tiled worked solutions of :data:`CHOSEN` to ``out``."""
+def contact_sheet(out: Path, columns: int, ppi: int, templates: tuple[str, ...] = CHOSEN, key: bool = True) -> None:
+    """Writes the first page of each of ``templates``' worked solutions (``key``) or sheets, tiled, to ``out``."""
     from PIL import Image, ImageDraw
 
     from grader.bank.template import load_bank
 
     bank = load_bank()
     tiles = []
-    for template_id in CHOSEN:
+    for template_id in templates:
         effects = sorted({stage.effect for stage in bank[template_id].scene.stages})
-        for page in _pages(template_id, ppi)[:1]:
-            tile = _inked(page)
-            titled = Image.new("RGB", (tile.width, tile.height + 28), "white")  # type: ignore[attr-defined]
-            titled.paste(tile, (0, 28))  # type: ignore[arg-type]
-            ImageDraw.Draw(titled).text((8, 6), f"{template_id}: {', '.join(effects)}", fill="black")
-            tiles.append(titled)
+        tile = _inked(_pages(template_id, ppi, key)[0])
+        titled = Image.new("RGB", (tile.width, tile.height + 28), "white")  # type: ignore[attr-defined]
+        titled.paste(tile, (0, 28))  # type: ignore[arg-type]
+        ImageDraw.Draw(titled).text((8, 6), f"{template_id}: {', '.join(effects)}", fill="black")
+        tiles.append(titled)
     width = max(t.width for t in tiles)
     rows = [tiles[i:i + columns] for i in range(0, len(tiles), columns)]
     heights = [max(t.height for t in row) for row in rows]
@@ -82,13 +86,24 @@ def contact_sheet(out: Path, columns: int, ppi: int) -> None:
 
 
 def main() -> None:
+    from grader.bank.template import load_bank
+
+    images = Path(__file__).parent / "images"
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--out", type=Path, default=Path(__file__).parent / "images" / "worked-by-effect.png")
+    parser.add_argument("--only", choices=("worked", "sheets"), help="write one of the two images")
+    parser.add_argument("--out", type=Path, help="where to write it (with --only)")
     parser.add_argument("--columns", type=int, default=3)
     parser.add_argument("--ppi", type=int, default=80)
     arguments = parser.parse_args()
-    contact_sheet(arguments.out, arguments.columns, arguments.ppi)
-    print(arguments.out)
+    if arguments.only in (None, "worked"):
+        out = arguments.out if arguments.only else None
+        contact_sheet(out or images / "worked-by-effect.png", arguments.columns, arguments.ppi)
+        print(out or images / "worked-by-effect.png")
+    if arguments.only in (None, "sheets"):
+        out = arguments.out if arguments.only else None
+        contact_sheet(out or images / "sheets-by-template.png", arguments.columns + 1, arguments.ppi,
+                      tuple(sorted(load_bank())), key=False)
+        print(out or images / "sheets-by-template.png")
 
 
 if __name__ == "__main__":

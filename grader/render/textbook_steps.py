@@ -373,9 +373,9 @@ def _magnitudes(steps: list[Step]) -> list[Step]:
     components: dict[str, dict[str, str]] = {}
     zero = {s.unknown for s in steps if _is_zero(s.solved)}
     result = []
-    for step in steps:
-        step = replace(step, equation=tuple(_speeds(side, known, zero) for side in step.equation),  # type: ignore[arg-type]
-                       solved=_speeds(step.solved, known, zero))
+    for original in steps:
+        step = replace(original, equation=tuple(_speeds(side, known, zero) for side in original.equation),  # type: ignore[arg-type]
+                       solved=_speeds(original.solved, known, zero))
         result.append(step)
         found = _COMPONENT.fullmatch(step.relation)
         if found:
@@ -383,8 +383,8 @@ def _magnitudes(steps: list[Step]) -> list[Step]:
             parts[found.group(2)] = step.unknown
             if len(parts) == 2:
                 known[frozenset({Sym(parts["n"]), Sym(parts["t"])})] = Sym(found.group(1))
-        if isinstance(step.solved, Op) and step.solved.op == "hypot":
-            known[frozenset(step.solved.args)] = Sym(step.unknown)
+        if isinstance(original.solved, Op) and original.solved.op == "hypot":  # its own page form may be |v_n|
+            known[frozenset(original.solved.args)] = Sym(step.unknown)
     return result
 
 

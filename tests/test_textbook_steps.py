@@ -229,3 +229,33 @@ def test_an_angle_whose_inverse_is_not_the_principal_value_is_shown_with_the_ker
     assert steps["theta"].chain[1].startswith('op("atan2")')
     kernel = _kernel_values(template, variant)["theta"]
     assert kernel > math.pi / 2 and steps["theta"].chain[-1] == f"{math.degrees(kernel):.1f} degree"  # 4 figures
+
+
+@pytest.mark.parametrize("template_id", ["head-on", "pile-driver", "billiards"])
+def test_the_route_gives_the_kernels_values_whichever_way_the_scene_is_written(template_id: str) -> None:
+    """Bodies and stages listed in reverse and each impact's two bodies swapped (its n turned round): the page
+    still works momentum and restitution, and each of its forms still gives the kernels' value."""
+    from pathlib import Path
+
+    import yaml
+
+    from grader.bank.template import parse_template
+    from grader.render.preview import example_printed
+    from grader.solve.solver import compile_template
+    from tests.scene_edits import reversed_scene
+
+    template = BANK[template_id]
+    turned = parse_template(reversed_scene(yaml.safe_load(Path(template.where).read_text())),
+                            f"test:{template_id}:reversed", template_id)
+    compiled = compile_template(turned)
+    printed = example_printed(turned)
+    variant = ProblemVariant("1", turned.id, "reversed", {n: float(v) for n, v in printed.items()}, printed, ())
+    kernel = chain_values(compiled, {**si_parameters(turned, variant), **{s: 1.0 for s in turned.symbols}})
+    route = textbook_route(turned, compiled)
+    env = {**kernel, **{s.unknown: float(page_value(s.solved, kernel)) for s in route.extra}}
+    assert any("conservation of momentum" in step.relation for step in route.steps), template_id
+    for step in route.steps:
+        if step.unknown in kernel:
+            assert _close(float(page_value(step.solved, env)), kernel[step.unknown]), (template_id, step.unknown)
+        lhs, rhs = (float(page_value(side, env)) for side in step.equation)
+        assert _close(lhs, rhs), (template_id, step.relation)

@@ -142,24 +142,29 @@ def _without_common(masses: tuple[Node, Node], valueless: set[str]) -> tuple[Nod
 
 @dataclass(frozen=True)
 class _Pair:
-    """An impact of two bodies that both move, as the momentum balance names it."""
+    """An impact of two bodies that both move, as the momentum balance names it. Its velocities along n are
+    expressions: a scene written the other way round has n turned, and names a velocity after ``-v1_out``."""
 
     first: str
     second: str
     masses: tuple[Node, Node]  # as the scene gives them
     cancelled: tuple[Node, Node]  # with the factors they share and that have no value taken out
     before: tuple[Node | None, Node | None]  # along n (None: at rest)
-    after: tuple[str, str]  # the names of the velocities after, along n
+    after: tuple[Node, Node]  # along n: a name, or a name with its sign turned
     e: Node
+
+    @property
+    def after_names(self) -> tuple[str, str]:
+        return (_named(self.after[0]) or "", _named(self.after[1]) or "")
 
     def momentum(self) -> tuple[Node, Node]:
         (m1, m2), (u1, u2), (a1, a2) = self.masses, self.before, self.after
         return (_add(_mul(m1, u1) if u1 is not None else None, _mul(m2, u2) if u2 is not None else None),
-                _add(_mul(m1, Sym(a1)), _mul(m2, Sym(a2))))
+                _add(_mul(m1, a1), _mul(m2, a2)))
 
     def restitution(self) -> tuple[Node, Node]:
         (u1, u2), (a1, a2) = self.before, self.after
-        return self.e, _div(_sub(Sym(a2), Sym(a1)), _sub(u1 or _ZERO, u2))
+        return self.e, _div(_sub(a2, a1), _sub(u1 or _ZERO, u2))
 
     def relation(self) -> str:
         return f"conservation of momentum along n for {self.first} and {self.second}"
@@ -168,36 +173,55 @@ class _Pair:
         return f"coefficient of restitution for {self.first} and {self.second}"
 
     def both_after(self) -> tuple[Node, Node]:
-        """Simultaneous solution of the momentum and restitution equations for both velocities after."""
+        """Simultaneous solution of the momentum and restitution equations for both velocities after, each
+        solved for its name."""
         (m1, m2), (u1, u2), e = self.cancelled, self.before, self.e
         total = _add(m1, m2)
         if u2 is None and u1 is not None:  # the second at rest: v1' = v1 (m1 - e m2)/(m1 + m2)
-            return (_div(_mul(u1, _sub(m1, _mul(e, m2))), total), _div(_mul(m1, u1, _add(_ONE, e)), total))
-        momentum = _add(_mul(m1, u1) if u1 is not None else None, _mul(m2, u2) if u2 is not None else None)
-        approach = _sub(u1 or _ZERO, u2)
-        return (_div(_sub(momentum, _mul(e, m2, approach)), total), _div(_add(momentum, _mul(e, m1, approach)), total))
+            forms = (_div(_mul(u1, _sub(m1, _mul(e, m2))), total), _div(_mul(m1, u1, _add(_ONE, e)), total))
+        else:
+            momentum = _add(_mul(m1, u1) if u1 is not None else None, _mul(m2, u2) if u2 is not None else None)
+            approach = _sub(u1 or _ZERO, u2)
+            forms = (_div(_sub(momentum, _mul(e, m2, approach)), total),
+                     _div(_add(momentum, _mul(e, m1, approach)), total))
+        return _solved_for(self.after[0], forms[0]), _solved_for(self.after[1], forms[1])
 
     def one_after(self, known: int) -> Node:
-        """The momentum balance solved for the velocity after of the body other than ``known``."""
+        """The momentum balance solved for the name of the velocity after of the body other than ``known``."""
         other = 1 - known
         masses, before = self.cancelled, self.before
-        change = _mul(masses[known], _sub(before[known] or _ZERO, Sym(self.after[known])))
         if before[other] is None:
-            return _div(change, masses[other])
-        balance = _add(_mul(masses[0], before[0]) if before[0] is not None else None,
-                       _mul(masses[1], before[1]) if before[1] is not None else None)
-        return _div(_sub(balance, _mul(masses[known], Sym(self.after[known]))), masses[other])
+            form = _div(_mul(masses[known], _sub(before[known] or _ZERO, self.after[known])), masses[other])
+        else:
+            balance = _add(_mul(masses[0], before[0]) if before[0] is not None else None,
+                           _mul(masses[1], before[1]) if before[1] is not None else None)
+            form = _div(_sub(balance, _mul(masses[known], self.after[known])), masses[other])
+        return _solved_for(self.after[other], form)
 
     def first_before(self) -> Node:
         """The momentum and restitution equations solved for the first body's velocity before, the second's
         after unknown too: ``v1 = ((m1 + m2) v1' - (1 + e) m2 v2)/(m1 - e m2)``."""
-        (m1, m2), (_, u2), e = self.cancelled, self.before, self.e
-        given = _mul(_add(m1, m2), Sym(self.after[0]))
-        return _div(_sub(given, _mul(_add(_ONE, e), m2, u2) if u2 is not None else None), _sub(m1, _mul(e, m2)))
+        (m1, m2), (u1, u2), e = self.cancelled, self.before, self.e
+        given = _mul(_add(m1, m2), self.after[0])
+        form = _div(_sub(given, _mul(_add(_ONE, e), m2, u2) if u2 is not None else None), _sub(m1, _mul(e, m2)))
+        return _solved_for(u1 or _ZERO, form)
 
-    def second_after_from_restitution(self, first_before: str) -> Node:
-        """``v2' = v1' + e (v1 - v2)``."""
-        return _add(Sym(self.after[0]), _mul(self.e, _sub(Sym(first_before), self.before[1])))
+    def second_after_from_restitution(self) -> Node:
+        """``v2' = v1' + e (v1 - v2)``, solved for the name of ``v2'``."""
+        form = _add(self.after[0], _mul(self.e, _sub(self.before[0] or _ZERO, self.before[1])))
+        return _solved_for(self.after[1], form)
+
+
+def _named(node: Node | None) -> str | None:
+    """The name in ``v`` or ``-v``."""
+    if isinstance(node, Op) and node.op == "neg":
+        node = node.args[0]
+    return node.name if isinstance(node, Sym) else None
+
+
+def _solved_for(expression: Node, form: Node) -> Node:
+    """The name in ``expression`` (``v`` or ``-v``) from ``expression = form``."""
+    return form if isinstance(expression, Sym) else _neg(form)
 
 
 def _pair(template: Template, first: str, second: str) -> _Pair | None:
@@ -209,14 +233,14 @@ def _pair(template: Template, first: str, second: str) -> _Pair | None:
     bodies = template.scene.bodies
     masses = (bodies[first].mass, bodies[second].mass)
     after = stage.fields.get("after", {})
-    names_after = [after.get(b).n if isinstance(after.get(b), Velocity) else None for b in (first, second)]
-    if masses[0] is None or masses[1] is None or not all(isinstance(n, Sym) for n in names_after):
+    along = [after.get(b).n if isinstance(after.get(b), Velocity) else None for b in (first, second)]
+    if masses[0] is None or masses[1] is None or along[0] is None or along[1] is None \
+            or _named(along[0]) is None or _named(along[1]) is None:
         return None
     before = tuple(_along_n(stage.fields.get("before", {}).get(b)) for b in (first, second))
     valueless = set(template.symbols)
     return _Pair(first, second, (masses[0], masses[1]), _without_common((masses[0], masses[1]), valueless),
-                 (before[0], before[1]), (names_after[0].name, names_after[1].name),  # type: ignore[union-attr]
-                 stage.fields["restitution"])
+                 (before[0], before[1]), (along[0], along[1]), stage.fields["restitution"])
 
 
 def _along_n(velocity: Any) -> Node | None:
@@ -258,7 +282,7 @@ def _one_impact(template: Template, steps: list[Step], extra: list[Step], impuls
     pair = _pair(template, bodies.group(1), bodies.group(2))
     if pair is None:
         return None
-    members = [s for s in steps if s.unknown in pair.after and _MOMENTUM_OF.fullmatch(s.relation)
+    members = [s for s in steps if s.unknown in pair.after_names and _MOMENTUM_OF.fullmatch(s.relation)
                and impulse in names(s.equation[0]) | names(s.equation[1])]
     others = [s for s in steps if s is not found and s not in members]
     if any(_uses(s, impulse) for s in others) or impulse in answers:
@@ -267,7 +291,7 @@ def _one_impact(template: Template, steps: list[Step], extra: list[Step], impuls
         return _first_before(steps, found, members, pair)
     if not members or any(m.block for m in members):
         return None
-    block = pair.after
+    block = pair.after_names
     momentum, restitution = pair.momentum(), pair.restitution()
     forms = pair.both_after()
     shown = [Step(block[0], pair.relation(), momentum, forms[0], block),
@@ -288,9 +312,9 @@ def _momentum_only(template: Template, steps: list[Step], found: Step, body: str
         return None
     other = _MOMENTUM_OF.fullmatch(users[0].relation).group(1)  # type: ignore[union-attr]
     pair = _pair(template, body, other) or _pair(template, other, body)
-    if pair is None or users[0].unknown not in pair.after:
+    if pair is None or users[0].unknown not in pair.after_names:
         return None
-    known = pair.after.index(users[0].unknown) ^ 1
+    known = pair.after_names.index(users[0].unknown) ^ 1
     step = Step(users[0].unknown, pair.relation(), pair.momentum(), pair.one_after(known))
     index = steps.index(found)
     rest = [s for s in steps if s is not found and s is not users[0]]
@@ -302,16 +326,16 @@ def _first_before(steps: list[Step], found: Step, members: list[Step], pair: _Pa
     from the impulse: the momentum and restitution equations in the first's velocity before and the second's
     after."""
     block = [s for s in steps if s.block == found.block]
-    u1 = pair.before[0]
-    if not isinstance(u1, Sym) or set(found.block) != {u1.name, found.unknown}:
+    first = _named(pair.before[0])
+    if first is None or set(found.block) != {first, found.unknown}:
         return None
     after = [m for m in members if not m.block]
-    if len(after) != 1 or after[0].unknown != pair.after[1]:
+    if len(after) != 1 or after[0].unknown != pair.after_names[1]:
         return None
-    unknowns = (u1.name, pair.after[1])
+    unknowns = (first, pair.after_names[1])
     shown = [Step(unknowns[0], pair.relation(), pair.momentum(), pair.first_before(), unknowns),
-             Step(unknowns[1], pair.restitution_relation(), pair.restitution(),
-                  pair.second_after_from_restitution(u1.name), unknowns)]
+             Step(unknowns[1], pair.restitution_relation(), pair.restitution(), pair.second_after_from_restitution(),
+                  unknowns)]
     index = steps.index(block[0])
     rest = [s for s in steps if s not in block and s is not after[0]]
     return rest[:index] + shown + rest[index:]

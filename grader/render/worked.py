@@ -316,7 +316,7 @@ def worked(template: Template, variant: ProblemVariant, compiled: Compiled | Non
         shown, {n: f"{variant.printed[n]} degree" for n, p in template.parameters.items() if p.unit.text == "deg"},
         form.symbol_units, _undefined(template, variant),
         {spec.value.name: (spec.unit.text, spec.unit.to_si) for spec in answers  # type: ignore[union-attr]
-         if spec.unit.text not in ("", "deg") and spec.unit.text != si_unit(spec.unit.dimension)},
+         if spec.unit.text not in ("", "deg") and spec.unit.to_si != 1.0},
         {template.answers[part.name].value.name: answer_math(part.value, "")  # type: ignore[union-attr]
          for part in variant.answers if isinstance(part.value, str) and template.answers[part.name].symbolic
          and isinstance(template.answers[part.name].value, Sym)})
@@ -363,7 +363,7 @@ def _answer_steps(template: Template, compiled: Compiled, si: Mapping[str, float
         chain.append(number(value))
         if spec.unit.text not in ("", "deg"):
             chain[-1] += _unit_math(si_unit(spec.unit.dimension))
-            if spec.unit.to_si != 1.0 or spec.unit.text != si_unit(spec.unit.dimension):
+            if spec.unit.to_si != 1.0:
                 chain.append(number(value / spec.unit.to_si) + _unit_math(spec.unit.text))
         steps.append(WorkedStep(text(spec.description), None, tuple(chain), Typ("")))
     return steps

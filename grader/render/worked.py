@@ -26,8 +26,9 @@ from grader.model.expr import Node, Num, Sym, format_number, names, parse
 from grader.model.kernel import evaluate
 from grader.model.quantities import ACCELERATION, ANGLE, Dimension, dimension_of, si_unit
 from grader.model.roots import TOLERANCE_TEXT
+from grader.render.page_forms import page_value, tidy_signs
 from grader.render.readable import Names, readable
-from grader.render.textbook_steps import page_value, textbook_route
+from grader.render.textbook_steps import textbook_route
 from grader.render.typst_math import math, name, number
 from grader.render.typst_text import Typ, body_name, string, text
 from grader.solve.cache import compiled_for
@@ -357,7 +358,7 @@ def _answer_steps(template: Template, compiled: Compiled, si: Mapping[str, float
         if not (_m.isfinite(value) and _m.isclose(value, check, rel_tol=1e-9, abs_tol=1e-300)):
             continue
         shown = readable(spec.value, reader)
-        chain = [math(shown), _tidy_signs(math(shown, context.shown, context.degrees))]
+        chain = [math(shown), tidy_signs(math(shown, context.shown, context.degrees))]
         if chain[-1] == number(value):
             chain.pop()
         chain.append(number(value))
@@ -367,25 +368,6 @@ def _answer_steps(template: Template, compiled: Compiled, si: Mapping[str, float
                 chain.append(number(value / spec.unit.to_si) + _unit_math(spec.unit.text))
         steps.append(WorkedStep(text(spec.description), None, tuple(chain), Typ("")))
     return steps
-
-
-_DOUBLE_NEGATIVE = (
-    (re.compile(r" - \(-([0-9.]+)\)(?!\^)"), r" + \1"),
-    (re.compile(r" \+ \(-([0-9.]+)\)(?!\^)"), r" - \1"),
-    (re.compile(r"(^|[(, ])-\(-([0-9.]+)\)(?!\^)"), r"\1\2"),
-    (re.compile(r"abs\(\((-[0-9.]+)\)\)"), r"abs(\1)"),
-)
-
-
-def _tidy_signs(shown: str) -> str:
-    """A substituted form without a double sign: ``-(-3.072)`` is ``3.072``, ``x - (-2)`` is ``x + 2``.
-
-    >>> _tidy_signs("atan2(-(-3.072), 19.43)"), _tidy_signs("0.54 - (-2.100)")
-    ('atan2(3.072, 19.43)', '0.54 + 2.100')
-    """
-    for pattern, replacement in _DOUBLE_NEGATIVE:
-        shown = pattern.sub(replacement, shown)
-    return shown
 
 
 def _letter(index: int) -> str:
@@ -465,7 +447,7 @@ def _step(step: StepForm, scaling: Scaling | None, dim: Dimension | None, contex
     printed = context.symbolic.get(step.unknown)
     if printed and printed != chain[-1]:  # asked as an expression: the form, the variant's numbers in, is the key's
         chain.append(printed)
-    substituted = chain[-1] if step.numeric else _tidy_signs(math(step.solved, context.shown, context.degrees))
+    substituted = chain[-1] if step.numeric else tidy_signs(math(step.solved, context.shown, context.degrees))
     if substituted != chain[-1]:
         chain.append(substituted)
     if step.unknown in context.undefined:

@@ -363,6 +363,9 @@ def _widened(template: Template, part: AnswerPart, figure: str, reason: str) -> 
         return NO_NOTE
     quantities = {*template.parameters, *(step.unknown for step in compiled_for(template).steps)}
     said = re.sub(rf"\bmoves {re.escape(part.name)}\b", "moves it", reason)
+    # The reason writes a velocity after as ``v_obj_n′`` (assign/fair.py): the page prints the quantity, v′_(obj, n)
+    said = re.sub(r"\b(\w+)\u2032", lambda found: found.group(1) + "_after"
+                  if found.group(1) + "_after" in quantities else found.group(0), said)
     return Typ(text(f"widened to {figure}: ") + relation_markup(said, quantities))
 
 

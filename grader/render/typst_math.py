@@ -77,7 +77,9 @@ def number(value: float, figures: int = 4) -> str:
 
 _LEVEL = {"add": 4, "sub": 4, "mul": 5, "div": 5, "neg": 6, "pow": 7}
 _CALLS = {"sqrt": "sqrt", "sin": "sin", "cos": "cos", "tan": "tan", "sind": "sin", "cosd": "cos",
-          "log": "ln", "abs": "abs", "Max": "max", "Min": "min", "atan2": 'op("atan2")'}
+          "log": "ln", "abs": "abs", "Max": "max", "Min": "min", "atan2": 'op("atan2")',
+          # the worked solutions' inverse functions (render/textbook_steps.py), which no template or student writes
+          "asin": "sin^(-1)", "acos": "cos^(-1)", "atan": "tan^(-1)"}
 _TRIG = {"sin", "cos", "tan", "sind", "cosd"}
 
 
@@ -99,7 +101,7 @@ class _Math:
                 return name(node.name), 9, False
             bare = re.fullmatch(r"[0-9.]+|[0-9.]+ degree", value)
             return (value if bare else f"({value})"), 9, True
-        if node.op in FUNCTIONS:
+        if node.op in FUNCTIONS or node.op in _CALLS:
             return self._call(node), 9, False
         if node.op == "mul":
             return self._product(node), 5, False

@@ -26,7 +26,9 @@ from grader.model.expr import Node, Num, Sym, format_number, names, parse
 from grader.model.kernel import evaluate
 from grader.model.quantities import ACCELERATION, ANGLE, Dimension, dimension_of, si_unit
 from grader.model.roots import TOLERANCE_TEXT
+from grader.render.page_forms import page_value, tidy_signs
 from grader.render.readable import Names, readable
+from grader.render.textbook_steps import textbook_route
 from grader.render.typst_math import math, name, number
 from grader.render.typst_text import Typ, body_name, string, text
 from grader.solve.cache import compiled_for
@@ -171,7 +173,7 @@ def relation_markup(label: str, quantities: set[str]) -> Typ:
     """
     pieces, plain = [], ""
     for word in re.split(r"([A-Za-z_][A-Za-z0-9_]*)", label):
-        if word in quantities:
+        if word in quantities and not plain.endswith("'"):  # "A's": a possessive, not the quantity s
             pieces += [str(text(plain)) if plain else "", f"${name(word)}$"]
             plain = ""
         else:
@@ -181,6 +183,13 @@ def relation_markup(label: str, quantities: set[str]) -> Typ:
 
 _SWING = re.compile(r"conservation of energy in the swing of (\w+) on its cord of length (\w+) \(the cord does no "
                     r"work\): it rises L\(1 − cos θ\) to stop at (\w+) from the vertical")
+
+
+_FLIGHT_AXES = ((re.compile(r"component along n\b"), "horizontal component"),
+                (re.compile(r"component along t\b"), "vertical component"),
+                (re.compile(r"separation over approach along n\b"), "separation over approach, horizontally"),
+                (re.compile(r"no impulse along t, so (.+?)'s t-velocity"),
+                 r"no vertical impulse, so \1's vertical velocity"))
 
 
 def page_wording(step: Step, template: Template) -> str:
@@ -198,9 +207,13 @@ def page_wording(step: Step, template: Template) -> str:
         if body_name(body) != body:
             label = re.sub(rf"\b{re.escape(body)}\b", body_name(body), label)
     label = re.sub(r"(?<![\w)])-(?=[A-Za-z_(])", "\u2212", label)  # a minus sign, not a hyphen: "-v_x_after"
+    label = re.sub(r"\b([A-Za-z]\w*) \+ \1\b", r"2\1", label)  # two equal radii: "2r apart", not "r + r"
     stages = template.scene.stages
     if not any(stage.is_oblique or stage.effect == "velocity" for stage in stages):
         label = re.sub(r"\s+along n\b", "", label)
+    if any(stage.effect == "flight" for stage in stages):  # a throw is drawn in x and y: n is across, t up
+        for axis, words in _FLIGHT_AXES:
+            label = axis.sub(words, label)
     swing = _SWING.fullmatch(label)
     if swing and isinstance(step.equation[0], Sym):
         body, length, angle = swing.groups()
@@ -222,6 +235,8 @@ class StepForm:
     solved_math: str
     block: tuple[str, ...] = ()  # the unknowns of the block of equations solved together (empty: one equation)
     numeric: bool = False  # the unknown of a block solved numerically: shown by its value alone
+    positive: Node | None = None  # a quantity that must be positive for ``solved`` to hold (tan⁻¹(y/x): x)
+    kernel: Node | None = None  # the kernel's form, shown where ``positive`` is not
 
 
 @dataclass(frozen=True)
@@ -235,17 +250,21 @@ class WorkedForm:
     symbols: tuple[str, ...]
     symbol_units: Mapping[str, str]
     notes: tuple[Typ, ...]
+    extra: tuple[Step, ...] = ()  # quantities only the page's route names, evaluated after the chain
 
 
 def worked_form(template: Template, compiled: Compiled | None = None) -> WorkedForm:
     """The parts of ``template``'s worked solutions that do not depend on a variant's numbers."""
     compiled = compiled or compiled_for(template)
-    dimensions = quantity_dimensions(template, compiled)
-    reader = reader_names(template, compiled, dimensions)
-    quantities = set(dimensions) | {s.unknown for s in compiled.steps}
-    titles = [page_wording(step, template) for step in compiled.steps]
+    route = textbook_route(template, compiled)
+    evaluated = replace(compiled, steps=(*compiled.steps, *route.extra))
+    dimensions = quantity_dimensions(template, evaluated)
+    reader = reader_names(template, evaluated, dimensions)
+    quantities = set(dimensions) | {s.unknown for s in route.steps}
+    titles = [page_wording(step, template) for step in route.steps]
+    kernel_forms = {step.unknown: step.solved for step in compiled.steps}
     steps = []
-    for step, title in zip(compiled.steps, titles, strict=True):
+    for step, title in zip(route.steps, titles, strict=True):
         if step.numeric:  # its root(...) tree is what the kernel finds, not a form a reader follows
             lhs, rhs = (readable(side, reader) for side in step.equation)
             steps.append(StepForm(step.unknown, relation_markup(title, quantities),
@@ -257,14 +276,17 @@ def worked_form(template: Template, compiled: Compiled | None = None) -> WorkedF
         equation = f"{math(lhs)} = {math(rhs)}" if shown else None
         if titles.count(title) > 1 and not step.block:  # two steps, one relation: say what each finds
             title += f", which gives {step.unknown}"
+        positive = route.positive.get(step.unknown)
+        kernel = readable(kernel_forms[step.unknown], reader) if positive is not None else None
         steps.append(StepForm(step.unknown, relation_markup(title, quantities), equation, solved,
-                              math(solved), step.block))
+                              math(solved), step.block, positive=positive, kernel=kernel))
     symbols = tuple(sorted(template.symbols))
     # A symbol no step uses (a mass the scene needs only for its simulation) gets no note.
     used = set().union(*(names(step.solved) for step in compiled.steps))
     return WorkedForm(tuple(steps), dimensions, symbols,
                       {n: si_unit(s.unit.dimension) or "1" for n, s in template.symbols.items()},
-                      tuple(_symbol_note(s, template.symbols[s].description) for s in symbols if s in used))
+                      tuple(_symbol_note(s, template.symbols[s].description) for s in symbols if s in used),
+                      route.extra)
 
 
 @dataclass(frozen=True)
@@ -275,6 +297,8 @@ class _Context:
     degrees: Mapping[str, str]
     symbol_units: Mapping[str, str]
     undefined: Mapping[str, str]
+    conversions: Mapping[str, tuple[str, float]]  # an answer's quantity: the unit it is asked in, its SI factor
+    symbolic: Mapping[str, str]  # an answer's quantity asked as an expression: the key's expression (math)
 
 
 def worked(template: Template, variant: ProblemVariant, compiled: Compiled | None = None,
@@ -283,13 +307,21 @@ def worked(template: Template, variant: ProblemVariant, compiled: Compiled | Non
     has them)."""
     compiled = compiled or compiled_for(template)
     form = form or worked_form(template, compiled)
+    evaluated = replace(compiled, steps=(*compiled.steps, *form.extra))
     si = si_parameters(template, variant)
-    scaled = scalings(compiled, si, form.symbols)
+    scaled = scalings(evaluated, si, form.symbols)
     shown = {n: _shown_parameter(variant.printed[n], p.unit.to_si) for n, p in template.parameters.items()}
     shown.update({c: number(v, 3) for c, v in compiled.constants.items()})
+    answers = [spec for spec in template.answers.values() if isinstance(spec.value, Sym)]
     context = _Context(
         shown, {n: f"{variant.printed[n]} degree" for n, p in template.parameters.items() if p.unit.text == "deg"},
-        form.symbol_units, _undefined(template, variant))
+        form.symbol_units, _undefined(template, variant),
+        {spec.value.name: (spec.unit.text, spec.unit.to_si) for spec in answers  # type: ignore[union-attr]
+         if spec.unit.text not in ("", "deg") and spec.unit.to_si != 1.0},
+        {template.answers[part.name].value.name: answer_math(part.value, "")  # type: ignore[union-attr]
+         for part in variant.answers if isinstance(part.value, str) and template.answers[part.name].symbolic
+         and isinstance(template.answers[part.name].value, Sym)})
+    values = chain_values(evaluated, {**si, **{s: 1.0 for s in form.symbols}})
     steps = []
     for index, step in enumerate(form.steps):
         if step.block:
@@ -297,12 +329,45 @@ def worked(template: Template, variant: ProblemVariant, compiled: Compiled | Non
                 steps += _block_equations(form.steps[index:index + len(step.block)])
             step = replace(step, relation=(numerically if step.numeric else simultaneous)(len(step.block)),
                            equation=None)
+        if step.positive is not None and step.kernel is not None and not page_value(step.positive, values) > 0:
+            step = replace(step, solved=step.kernel, solved_math=math(step.kernel))  # tan⁻¹(y/x) is not the angle
         scaling = scaled.get(step.unknown)
         steps.append(_step(step, scaling, form.dimensions.get(step.unknown), context))
         if scaling is not None:
             shown[step.unknown] = scaling.math()
-    values = chain_values(compiled, {**si, **{s: 1.0 for s in form.symbols}})
+    steps += _answer_steps(template, evaluated, si, form, context, values)
     return Worked(tuple(given_lines(template, variant, compiled)), form.notes, tuple(steps), values)
+
+
+def _answer_steps(template: Template, compiled: Compiled, si: Mapping[str, float], form: WorkedForm,
+                  context: _Context, ones: Mapping[str, float]) -> list[WorkedStep]:
+    """An answer asked as an expression of the chain's quantities (a ratio, a sum of two losses) as a step of
+    its own, so the answer's cell shows a value the page computes (``ones``: the chain's values, the symbols
+    without value at 1; a value that changes with them is not shown)."""
+    asked = [spec for spec in template.answers.values() if not (isinstance(spec.value, Sym) or spec.symbolic)]
+    if not asked:
+        return []
+    reader = reader_names(template, compiled, form.dimensions)
+    twos = chain_values(compiled, {**si, **{s: 2.0 for s in form.symbols}}) if form.symbols else ones
+    steps = []
+    for spec in asked:
+        try:
+            value, check = (float(page_value(spec.value, env)) for env in (ones, twos))
+        except KeyError:
+            continue
+        if not (_m.isfinite(value) and _m.isclose(value, check, rel_tol=1e-9, abs_tol=1e-300)):
+            continue
+        shown = readable(spec.value, reader)
+        chain = [math(shown), tidy_signs(math(shown, context.shown, context.degrees))]
+        if chain[-1] == number(value):
+            chain.pop()
+        chain.append(number(value))
+        if spec.unit.text not in ("", "deg"):
+            chain[-1] += _unit_math(si_unit(spec.unit.dimension))
+            if spec.unit.to_si != 1.0:
+                chain.append(number(value / spec.unit.to_si) + _unit_math(spec.unit.text))
+        steps.append(WorkedStep(text(spec.description), None, tuple(chain), Typ("")))
+    return steps
 
 
 def _letter(index: int) -> str:
@@ -379,7 +444,10 @@ def _symbol_note(symbol: str, description: str) -> Typ:
 def _step(step: StepForm, scaling: Scaling | None, dim: Dimension | None, context: _Context) -> WorkedStep:
     relation, equation = step.relation, step.equation
     chain = [name(step.unknown)] if step.numeric else [name(step.unknown), step.solved_math]
-    substituted = chain[-1] if step.numeric else math(step.solved, context.shown, context.degrees)
+    printed = context.symbolic.get(step.unknown)
+    if printed and printed != chain[-1]:  # asked as an expression: the form, the variant's numbers in, is the key's
+        chain.append(printed)
+    substituted = chain[-1] if step.numeric else tidy_signs(math(step.solved, context.shown, context.degrees))
     if substituted != chain[-1]:
         chain.append(substituted)
     if step.unknown in context.undefined:
@@ -399,6 +467,9 @@ def _step(step: StepForm, scaling: Scaling | None, dim: Dimension | None, contex
     chain[-1] += _unit_math(unit)
     if dim == ANGLE:
         chain.append(f"{number(_m.degrees(scaling.coefficient))} degree")
+    if step.unknown in context.conversions:  # the unit the answer is asked in, as a step of its own
+        asked, to_si = context.conversions[step.unknown]
+        chain.append(number(scaling.coefficient / to_si) + _unit_math(asked))
     return WorkedStep(relation, equation, tuple(chain), Typ(""))
 
 

@@ -35,14 +35,15 @@ import math
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from functools import lru_cache
-from typing import NamedTuple
+from typing import Any, NamedTuple
 
 import numpy as np
 
 from grader.base.errors import shown
 from grader.grade.identity import identical
 from grader.model.expr import CONSTANTS, Node, Num, Op, Sym, parse, to_text
-from grader.model.kernel import evaluate
+from grader.model.kernel import OPERATIONS, evaluate
+from grader.model.kernel import _float  # evaluate's own reading of a constant: one place
 
 REFUSED = {"Max": "piecewise", "Min": "piecewise", "sign": "a step", "abs": "piecewise",
            "atan2": "a step across its branch cut"}
@@ -123,18 +124,25 @@ def _key_form(expected: Node | str) -> _Form:
 
 def _equivalent(student: Node, expected: _Form, domains: Domains, seed: str, rtol: float,
                 points: int) -> bool | str:
-    survey, key_survey = _survey(student), _survey_of_key(expected)
-    missing = sorted((survey.names | key_survey.names) - {name for name, _ in domains})
+    keyed = _keyed(expected, domains, seed, points)
+    fixed, key_survey = keyed.fixed, keyed.survey
+    # One walk of the student's tree finds what _survey finds and its values at the fixed points and the lines
+    # (see _Fixed); a tree it cannot evaluate is surveyed alone, and is NaN everywhere as _values makes it.
+    walked = _walk(student, fixed.everywhere) if fixed is not None and domains else None
+    survey = walked.survey if walked is not None else _survey(student)
+    missing = sorted((survey.names | key_survey.names) - keyed.known)
     if missing:
         return f"the expression uses {', '.join(missing)}, which this answer does not know"
-    fixed, b, largest = _fixed(expected, domains, seed, points)
+    assert fixed is not None  # the key's names are known
+    b, largest = fixed.values, fixed.largest
     if b.size == 0:
         return "the key's expression cannot be evaluated at any test point; please ask your instructor to check it"
     # A sub-term found twice is probed twice (the same points): cheaper than hashing every one to drop repeats.
-    found = [*(_structure(watched, domains) for watched in survey.watched), *_key_structure(expected, domains)]
+    found = [*(_structure(watched, domains) if line is None or not _tame_values(watched.kind, line) else _TAME
+               for watched, line in zip(survey.watched, _lines(survey, walked, keyed.lines), strict=True)),
+             *keyed.structure]
     probes = _stack([probe for probe, _ in found])
-    values = _values(student, fixed if probes is None else _joined([fixed, probes]))
-    a = values[:b.size]
+    a = walked.values[:b.size] if walked is not None and walked.values is not None else _values(student, fixed.points)
     finite = np.isfinite(a)
     if not np.logical_and.reduce(finite):  # finite.all(), without its Python wrapper
         return False if finite.any() else "the expression cannot be evaluated at any test point (division by zero?)"
@@ -142,7 +150,7 @@ def _equivalent(student: Node, expected: _Form, domains: Domains, seed: str, rto
     if not _agree(a, b, rtol, floor):
         return False
     if probes is not None:
-        a, b = values[b.size:], _values(expected.tree, probes)
+        a, b = _values(student, probes), _values(expected.tree, probes)
         both = np.isfinite(a) & np.isfinite(b)  # a probe may sit on a pole: compare beside it
         if not _agree(a[both], b[both], rtol, floor):
             return False
@@ -150,6 +158,42 @@ def _equivalent(student: Node, expected: _Form, domains: Domains, seed: str, rto
     if touches_zero or not survey.functions <= key_survey.functions:
         return identical(student, expected.tree, domains)
     return True
+
+
+_TAME: tuple[Points | None, bool] = (None, False)
+
+
+class _Keyed(NamedTuple):
+    """What every answer to a key is compared with: the key's survey, the names the domains know, the points (None:
+    the key uses a name they do not), the key's probes, where each name's line starts among the points."""
+
+    survey: _Survey
+    known: frozenset[str]
+    fixed: _Fixed | None
+    structure: tuple[tuple[Points | None, bool], ...]
+    lines: Mapping[str, int]
+
+
+@lru_cache(maxsize=256)
+def _keyed(expected: _Form, domains: Domains, seed: str, points: int) -> _Keyed:
+    """Worked out once per key (one look-up an answer, not one a part)."""
+    survey, known = _survey_of_key(expected), frozenset(name for name, _ in domains)
+    if not survey.names <= known:
+        return _Keyed(survey, known, None, (), {})
+    fixed = _fixed(expected, domains, seed, points)
+    lines = {name: fixed.values.size + index * _GRID for index, (name, _) in enumerate(domains)}
+    return _Keyed(survey, known, fixed, _key_structure(expected, domains), lines)
+
+
+def _lines(survey: _Survey, walked: _Walked | None, starts: Mapping[str, int]) -> list[np.ndarray | None]:
+    """For each watched sub-term, its values along its name's line (the :func:`_tame` grid), where the walk
+    evaluated it (``starts``: where each name's line starts); None for a sub-term of several names, or where not
+    evaluated."""
+    if walked is None:
+        return [None] * len(survey.watched)
+    return [None if len(watched.names) != 1 or values is None else
+            values[(start := starts[next(iter(watched.names))]):start + _GRID]
+            for watched, values in zip(survey.watched, walked.watched_values, strict=True)]
 
 
 def _agree(a: np.ndarray, b: np.ndarray, rtol: float, floor: float) -> bool:
@@ -170,11 +214,14 @@ Score = Callable[[Points], np.ndarray]
 
 
 class _Fixed(NamedTuple):
-    """The points every answer to a key is compared at, the key's values there and the largest of their sizes."""
+    """The points every answer to a key is compared at, the key's values there and the largest of their sizes;
+    ``everywhere``: those points, then for each name in turn a line along it (the :func:`_tame` grid, the other
+    names at their centre), where a student's expression is evaluated in the same walk."""
 
     points: Points
     values: np.ndarray
     largest: float
+    everywhere: Points
 
 
 @lru_cache(maxsize=256)
@@ -191,7 +238,10 @@ def _fixed(expected: _Form, domains: Domains, seed: str, points: int) -> _Fixed:
     defined = np.isfinite(values)
     values = values[defined]
     largest = float(np.max(np.abs(values))) if values.size else 0.0
-    return _Fixed({name: column[defined] for name, column in everywhere.items()}, values, largest)
+    compared = {name: column[defined] for name, column in everywhere.items()}
+    centre = {name: (low + high) / 2 for name, (low, high) in domains}
+    lines = _joined([_line(centre, name, _grid(low, high)) for name, (low, high) in domains])
+    return _Fixed(compared, values, largest, _joined([compared, lines]))
 
 
 def _corners(domains: Domains) -> Points:
@@ -272,42 +322,98 @@ def _survey(tree: Node) -> _Survey:
     >>> sorted(found.names), sorted(found.functions), sorted((w.kind, to_text(w.node)) for w in found.watched)
     (['p', 'v'], ['exp'], [('large', '-p'), ('small', 'p + 1')])
     """
+    walked = _walk(tree, None)
+    assert walked is not None  # without points nothing is evaluated, so nothing can fail
+    return walked.survey
+
+
+class _Walked(NamedTuple):
+    """A tree's survey, its values at the points (None: not evaluated) and, for each watched sub-term, its own."""
+
+    survey: _Survey
+    values: np.ndarray | None
+    watched_values: list[np.ndarray | None]
+
+
+class _UnevaluatedError(Exception):
+    """An operation :func:`_walk` leaves to :func:`grader.model.kernel.evaluate` (``and``, ``or``, ``root``)."""
+
+
+_EVALUATED = {op: function for op, function in OPERATIONS.items() if op not in ("and", "or")}  # as evaluate does
+
+
+def _operation(op: str) -> Callable[..., Any]:
+    function = _EVALUATED.get(op)
+    if function is None:
+        raise _UnevaluatedError(op)
+    return function
+
+
+def _walk(tree: Node, env: Points | None) -> _Walked | None:
+    """The survey of a tree and, where ``env`` is given, its values there as :func:`_values` finds them, in one walk;
+    None where evaluating it would raise (a name ``env`` does not have, an operation evaluate treats apart), which
+    :func:`_values` turns into NaN everywhere."""
     functions: set[str] = set()
     found: list[_Watched] = []
+    seen: list[np.ndarray | None] = []
+    evaluating = env is not None
 
-    def visit(node: Node) -> frozenset[str]:  # the names the node uses; depth is bounded by the parser
+    def visit(node: Node) -> tuple[frozenset[str], Any]:  # names and value; depth is bounded by the parser
         if isinstance(node, Sym):
-            return _NONE if node.name in CONSTANTS else _named(node.name)
+            if node.name in CONSTANTS:
+                return _NONE, np.pi
+            return _named(node.name), env[node.name] if evaluating else None
         if isinstance(node, Num):
-            return _NONE
-        args = node.args
+            return _NONE, _float(node.value) if evaluating else None
+        args, op = node.args, node.op
         if len(args) == 2:  # most operations: no list, no loop
-            left, right = visit(args[0]), visit(args[1])
+            (left, at_left), (right, at_right) = visit(args[0]), visit(args[1])
             uses: tuple[frozenset[str], ...] = (left, right)
             used = left if right <= left else right if left <= right else left | right
+            value = _operation(op)(at_left, at_right) if evaluating else None
+            values: tuple[Any, ...] = (at_left, at_right)
         else:
-            uses = tuple(visit(arg) for arg in args)
+            walked = [visit(arg) for arg in args]
+            uses = tuple(its for its, _ in walked)
+            values = tuple(at for _, at in walked)
             used = uses[0] if len(uses) == 1 else _union(uses)
-        op = node.op
+            value = _operation(op)(*values) if evaluating else None
         if op in _TRANSCENDENTAL:
             functions.add(op)
         if not used:
-            return used
+            return used, value
         if op == "div" and uses[1]:
-            found.append(_Watched("small", node.args[1], uses[1]))
+            found.append(_Watched("small", args[1], uses[1]))
+            seen.append(values[1])
         elif op in _SMALLEST:
-            found.extend(_Watched("small", arg, its) for arg, its in zip(node.args, uses, strict=True) if its)
+            for arg, its, at in zip(args, uses, values, strict=True):
+                if its:
+                    found.append(_Watched("small", arg, its))
+                    seen.append(at)
         elif op in ("Max", "Min"):
-            found.append(_Watched("small", Op("sub", node.args), used))
+            found.append(_Watched("small", Op("sub", args), used))
+            seen.append(None)
         elif op == "exp":
-            found.append(_Watched("large", node.args[0], used))
-        elif op == "pow" and uses[0] and not (isinstance(node.args[1], Num) and node.args[1].value >= 0
-                                               and float(node.args[1].value).is_integer()):
-            found.append(_Watched("small", node.args[0], uses[0]))  # a root or a negative power: a kink or a pole at 0
-        return used
+            found.append(_Watched("large", args[0], used))
+            seen.append(values[0])
+        elif op == "pow" and uses[0] and not (isinstance(args[1], Num) and args[1].value >= 0
+                                               and float(args[1].value).is_integer()):
+            found.append(_Watched("small", args[0], uses[0]))  # a root or a negative power: a kink or a pole at 0
+            seen.append(values[0])
+        return used, value
 
-    used = visit(tree)
-    return _Survey(used, frozenset(functions), tuple(found))
+    try:
+        with np.errstate(all="ignore"):
+            used, value = visit(tree)
+    except (_UnevaluatedError, ArithmeticError, ValueError, TypeError, KeyError):
+        return None
+    survey = _Survey(used, frozenset(functions), tuple(found))
+    if not evaluating:
+        return _Walked(survey, None, seen)
+    size = len(next(iter(env.values())))
+    values_at = np.asarray(value, dtype=float)
+    values_at = values_at.copy() if values_at.shape == (size,) else np.broadcast_to(values_at, (size,)).copy()
+    return _Walked(survey, values_at, seen)
 
 
 @lru_cache(maxsize=1024)
@@ -376,7 +482,11 @@ def _tame(kind: str, node: Node, used: frozenset[str], domains: Domains) -> bool
         return False  # in two names or more the scans may pass beside the place: search it
     name = next(iter(used))
     low, high = next(bounds for other, bounds in domains if other == name)
-    values = _values(node, {name: _grid(low, high)})
+    return _tame_values(kind, _values(node, {name: _grid(low, high)}))
+
+
+def _tame_values(kind: str, values: np.ndarray) -> bool:
+    """:func:`_tame` on a sub-term's values along the grid of its one name."""
     least, most = float(np.minimum.reduce(values)), float(np.maximum.reduce(values))  # NaN if any value is
     if not (math.isfinite(least) and math.isfinite(most)):
         return False

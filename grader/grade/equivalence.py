@@ -41,7 +41,7 @@ import numpy as np
 
 from grader.base.errors import shown
 from grader.grade.identity import identical
-from grader.model.expr import CONSTANTS, Node, Num, Op, Sym, parse, to_text
+from grader.model.expr import CONSTANTS, Node, Num, Op, Sym, names, parse, to_text
 from grader.model.kernel import OPERATIONS, evaluate
 from grader.model.kernel import _float  # evaluate's own reading of a constant: one place
 
@@ -127,22 +127,28 @@ def _equivalent(student: Node, expected: _Form, domains: Domains, seed: str, rto
     keyed = _keyed(expected, domains, seed, points)
     fixed, key_survey = keyed.fixed, keyed.survey
     # One walk of the student's tree finds what _survey finds and its values at the fixed points and the lines
-    # (see _Fixed); a tree it cannot evaluate is surveyed alone, and is NaN everywhere as _values makes it.
+    # (see _Fixed); a tree it cannot evaluate there is surveyed alone, and is NaN everywhere as _values makes it.
     walked = _walk(student, fixed.everywhere) if fixed is not None and domains else None
-    survey = walked.survey if walked is not None else _survey(student)
-    missing = sorted((survey.names | key_survey.names) - keyed.known)
-    if missing:
-        return f"the expression uses {', '.join(missing)}, which this answer does not know"
+    if walked is None:
+        survey = _survey(student)
+        missing = sorted((survey.names | key_survey.names) - keyed.known)
+        if missing:
+            return f"the expression uses {', '.join(missing)}, which this answer does not know"
     assert fixed is not None  # the key's names are known
     b, largest = fixed.values, fixed.largest
     if b.size == 0:
         return "the key's expression cannot be evaluated at any test point; please ask your instructor to check it"
+    if walked is None:
+        functions, watched, lines = survey.functions, survey.watched, [None] * len(survey.watched)
+        a = _values(student, fixed.points)
+    else:
+        functions, watched, lines = walked.functions, walked.watched, _lines(walked, keyed.lines)
+        a = walked.values[:b.size]
     # A sub-term found twice is probed twice (the same points): cheaper than hashing every one to drop repeats.
-    found = [*(_structure(watched, domains) if line is None or not _tame_values(watched.kind, line) else _TAME
-               for watched, line in zip(survey.watched, _lines(survey, walked, keyed.lines), strict=True)),
+    found = [*(_structure(one, domains) if line is None or not _tame_values(one.kind, line) else _TAME
+               for one, line in zip(watched, lines, strict=True)),
              *keyed.structure]
     probes = _stack([probe for probe, _ in found])
-    a = walked.values[:b.size] if walked is not None and walked.values is not None else _values(student, fixed.points)
     finite = np.isfinite(a)
     if not np.logical_and.reduce(finite):  # finite.all(), without its Python wrapper
         return False if finite.any() else "the expression cannot be evaluated at any test point (division by zero?)"
@@ -155,7 +161,7 @@ def _equivalent(student: Node, expected: _Form, domains: Domains, seed: str, rto
         if not _agree(a[both], b[both], rtol, floor):
             return False
     touches_zero = any(near for _, near in found)
-    if touches_zero or not survey.functions <= key_survey.functions:
+    if touches_zero or not functions <= key_survey.functions:
         return identical(student, expected.tree, domains)
     return True
 
@@ -185,15 +191,13 @@ def _keyed(expected: _Form, domains: Domains, seed: str, points: int) -> _Keyed:
     return _Keyed(survey, known, fixed, _key_structure(expected, domains), lines)
 
 
-def _lines(survey: _Survey, walked: _Walked | None, starts: Mapping[str, int]) -> list[np.ndarray | None]:
+def _lines(walked: _Walked, starts: Mapping[str, int]) -> list[np.ndarray | None]:
     """For each watched sub-term, its values along its name's line (the :func:`_tame` grid), where the walk
     evaluated it (``starts``: where each name's line starts); None for a sub-term of several names, or where not
     evaluated."""
-    if walked is None:
-        return [None] * len(survey.watched)
     return [None if len(watched.names) != 1 or values is None else
             values[(start := starts[next(iter(watched.names))]):start + _GRID]
-            for watched, values in zip(survey.watched, walked.watched_values, strict=True)]
+            for watched, values in zip(walked.watched, walked.watched_values, strict=True)]
 
 
 def _agree(a: np.ndarray, b: np.ndarray, rtol: float, floor: float) -> bool:
@@ -322,98 +326,105 @@ def _survey(tree: Node) -> _Survey:
     >>> sorted(found.names), sorted(found.functions), sorted((w.kind, to_text(w.node)) for w in found.watched)
     (['p', 'v'], ['exp'], [('large', '-p'), ('small', 'p + 1')])
     """
-    walked = _walk(tree, None)
-    assert walked is not None  # without points nothing is evaluated, so nothing can fail
-    return walked.survey
+    functions: set[str] = set()
+    found: list[_Watched] = []
+
+    def visit(node: Node) -> frozenset[str]:  # the names the node uses; depth is bounded by the parser
+        if isinstance(node, Sym):
+            return _NONE if node.name in CONSTANTS else _named(node.name)
+        if isinstance(node, Num):
+            return _NONE
+        args = node.args
+        if len(args) == 2:  # most operations: no list, no loop
+            left, right = visit(args[0]), visit(args[1])
+            uses: tuple[frozenset[str], ...] = (left, right)
+            used = left if right <= left else right if left <= right else left | right
+        else:
+            uses = tuple(visit(arg) for arg in args)
+            used = uses[0] if len(uses) == 1 else _union(uses)
+        op = node.op
+        if op in _TRANSCENDENTAL:
+            functions.add(op)
+        if used and op in _WATCHING:
+            found.extend(_Watched(kind, watched, used if index is None else uses[index])
+                         for kind, index, watched in _watches(node, [bool(its) for its in uses]))
+        return used
+
+    used = visit(tree)
+    return _Survey(used, frozenset(functions), tuple(found))
+
+
+_WATCHING = frozenset(("div", "pow", "exp", "Max", "Min", *_SMALLEST))
+
+
+def _watches(node: Op, named: list[bool]) -> list[tuple[str, int | None, Node]]:
+    """The sub-terms of an operation that uses a name to watch: (kind, which argument (None: the difference of
+    ``Max`` or ``Min``'s two), sub-term); ``named``: whether each argument uses a name."""
+    op, args = node.op, node.args
+    if op == "div":
+        return [("small", 1, args[1])] if named[1] else []
+    if op in _SMALLEST:
+        return [("small", index, arg) for index, arg in enumerate(args) if named[index]]
+    if op in ("Max", "Min"):
+        return [("small", None, Op("sub", args))]
+    if op == "exp":
+        return [("large", 0, args[0])]
+    exponent = args[1]  # pow
+    if named[0] and not (isinstance(exponent, Num) and exponent.value >= 0 and float(exponent.value).is_integer()):
+        return [("small", 0, args[0])]  # a root or a negative power: a kink or a pole at 0
+    return []
 
 
 class _Walked(NamedTuple):
-    """A tree's survey, its values at the points (None: not evaluated) and, for each watched sub-term, its own."""
+    """What :func:`_walk` finds: a tree's functions of :data:`_TRANSCENDENTAL`, its watched sub-terms with the
+    values of each at the points (None for ``Max`` or ``Min``'s difference), its values at the points."""
 
-    survey: _Survey
-    values: np.ndarray | None
+    functions: frozenset[str]
+    watched: tuple[_Watched, ...]
     watched_values: list[np.ndarray | None]
-
-
-class _UnevaluatedError(Exception):
-    """An operation :func:`_walk` leaves to :func:`grader.model.kernel.evaluate` (``and``, ``or``, ``root``)."""
+    values: np.ndarray
 
 
 _EVALUATED = {op: function for op, function in OPERATIONS.items() if op not in ("and", "or")}  # as evaluate does
 
 
-def _operation(op: str) -> Callable[..., Any]:
-    function = _EVALUATED.get(op)
-    if function is None:
-        raise _UnevaluatedError(op)
-    return function
-
-
-def _walk(tree: Node, env: Points | None) -> _Walked | None:
-    """The survey of a tree and, where ``env`` is given, its values there as :func:`_values` finds them, in one walk;
-    None where evaluating it would raise (a name ``env`` does not have, an operation evaluate treats apart), which
-    :func:`_values` turns into NaN everywhere."""
+def _walk(tree: Node, env: Points) -> _Walked | None:
+    """What :func:`_survey` finds of a tree but its names, and its values at ``env``'s points as :func:`_values`
+    finds them, in one walk; None where evaluating it would raise (a name ``env`` does not have, an operation
+    evaluate treats apart), which :func:`_values` turns into NaN everywhere. A sub-term uses a name where its value
+    is an array (every name's is; a constant's is a number)."""
     functions: set[str] = set()
     found: list[_Watched] = []
     seen: list[np.ndarray | None] = []
-    evaluating = env is not None
 
-    def visit(node: Node) -> tuple[frozenset[str], Any]:  # names and value; depth is bounded by the parser
+    def visit(node: Node) -> Any:  # the node's value; depth is bounded by the parser
+        if isinstance(node, Op):
+            args, op = node.args, node.op
+            if len(args) == 2:
+                values: tuple[Any, ...] = (visit(args[0]), visit(args[1]))
+            else:
+                values = tuple(visit(arg) for arg in args)
+            value = _EVALUATED[op](*values)
+            if op in _TRANSCENDENTAL:
+                functions.add(op)
+            if op in _WATCHING and type(value) is np.ndarray:
+                for kind, index, watched in _watches(node, [type(at) is np.ndarray for at in values]):
+                    found.append(_Watched(kind, watched, frozenset(names(watched))))
+                    seen.append(None if index is None else values[index])
+            return value
         if isinstance(node, Sym):
-            if node.name in CONSTANTS:
-                return _NONE, np.pi
-            return _named(node.name), env[node.name] if evaluating else None
-        if isinstance(node, Num):
-            return _NONE, _float(node.value) if evaluating else None
-        args, op = node.args, node.op
-        if len(args) == 2:  # most operations: no list, no loop
-            (left, at_left), (right, at_right) = visit(args[0]), visit(args[1])
-            uses: tuple[frozenset[str], ...] = (left, right)
-            used = left if right <= left else right if left <= right else left | right
-            value = _operation(op)(at_left, at_right) if evaluating else None
-            values: tuple[Any, ...] = (at_left, at_right)
-        else:
-            walked = [visit(arg) for arg in args]
-            uses = tuple(its for its, _ in walked)
-            values = tuple(at for _, at in walked)
-            used = uses[0] if len(uses) == 1 else _union(uses)
-            value = _operation(op)(*values) if evaluating else None
-        if op in _TRANSCENDENTAL:
-            functions.add(op)
-        if not used:
-            return used, value
-        if op == "div" and uses[1]:
-            found.append(_Watched("small", args[1], uses[1]))
-            seen.append(values[1])
-        elif op in _SMALLEST:
-            for arg, its, at in zip(args, uses, values, strict=True):
-                if its:
-                    found.append(_Watched("small", arg, its))
-                    seen.append(at)
-        elif op in ("Max", "Min"):
-            found.append(_Watched("small", Op("sub", args), used))
-            seen.append(None)
-        elif op == "exp":
-            found.append(_Watched("large", args[0], used))
-            seen.append(values[0])
-        elif op == "pow" and uses[0] and not (isinstance(args[1], Num) and args[1].value >= 0
-                                               and float(args[1].value).is_integer()):
-            found.append(_Watched("small", args[0], uses[0]))  # a root or a negative power: a kink or a pole at 0
-            seen.append(values[0])
-        return used, value
+            return np.pi if node.name in CONSTANTS else env[node.name]
+        return _float(node.value)
 
     try:
         with np.errstate(all="ignore"):
-            used, value = visit(tree)
-    except (_UnevaluatedError, ArithmeticError, ValueError, TypeError, KeyError):
+            value = visit(tree)
+    except (ArithmeticError, ValueError, TypeError, KeyError):
         return None
-    survey = _Survey(used, frozenset(functions), tuple(found))
-    if not evaluating:
-        return _Walked(survey, None, seen)
     size = len(next(iter(env.values())))
-    values_at = np.asarray(value, dtype=float)
-    values_at = values_at.copy() if values_at.shape == (size,) else np.broadcast_to(values_at, (size,)).copy()
-    return _Walked(survey, values_at, seen)
+    at = np.asarray(value, dtype=float)
+    at = at.copy() if at.shape == (size,) else np.broadcast_to(at, (size,)).copy()
+    return _Walked(frozenset(functions), tuple(found), seen, at)
 
 
 @lru_cache(maxsize=1024)

@@ -42,8 +42,11 @@ import numpy as np
 from grader.base.errors import shown
 from grader.grade.identity import identical
 from grader.model.expr import CONSTANTS, Node, Num, Op, Sym, names, parse, to_text
-from grader.model.kernel import OPERATIONS, evaluate
-from grader.model.kernel import _float  # evaluate's own reading of a constant: one place
+from grader.model.kernel import (
+    OPERATIONS,
+    _float,  # evaluate's own reading of a constant: one place
+    evaluate,
+)
 
 REFUSED = {"Max": "piecewise", "Min": "piecewise", "sign": "a step", "abs": "piecewise",
            "atan2": "a step across its branch cut"}

@@ -141,6 +141,7 @@ def _equivalent(student: Node, expected: _Form, domains: Domains, seed: str, rto
     b, largest = fixed.values, fixed.largest
     if b.size == 0:
         return "the key's expression cannot be evaluated at any test point; please ask your instructor to check it"
+    lines: list[np.ndarray | None]
     if walked is None:
         functions, watched, lines = survey.functions, survey.watched, [None] * len(survey.watched)
         a = _values(student, fixed.points)

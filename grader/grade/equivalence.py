@@ -390,6 +390,7 @@ class _Walked(NamedTuple):
 
 
 _EVALUATED = {op: function for op, function in OPERATIONS.items() if op not in ("and", "or")}  # as evaluate does
+_PLAIN = frozenset(("add", "sub", "mul"))  # neither transcendental nor watched
 
 
 def _walk(tree: Node, env: Points) -> _Walked | None:
@@ -405,10 +406,16 @@ def _walk(tree: Node, env: Points) -> _Walked | None:
         if isinstance(node, Op):
             args, op = node.args, node.op
             if len(args) == 2:
-                values: tuple[Any, ...] = (visit(args[0]), visit(args[1]))
+                left, right = visit(args[0]), visit(args[1])
+                value = _EVALUATED[op](left, right)
+                if op in _PLAIN:
+                    return value
+                values: tuple[Any, ...] = (left, right)
             else:
                 values = tuple(visit(arg) for arg in args)
-            value = _EVALUATED[op](*values)
+                value = _EVALUATED[op](*values)
+                if op == "neg":
+                    return value
             if op in _TRANSCENDENTAL:
                 functions.add(op)
             if op in _WATCHING and type(value) is np.ndarray:

@@ -51,6 +51,7 @@ from grader.model.kernel import (
 REFUSED = {"Max": "piecewise", "Min": "piecewise", "sign": "a step", "abs": "piecewise",
            "atan2": "a step across its branch cut"}
 """Functions refused in a student's expression unless the key's uses them, and why."""
+_REFUSED_CALLS = tuple(f"{name}(" for name in REFUSED)  # as to_text prints a call
 
 _TRANSCENDENTAL = {"sqrt", "sin", "cos", "tan", "sind", "cosd", "exp", "log", "hypot", "atan2", "abs", "sign",
                    "Max", "Min"}
@@ -62,9 +63,12 @@ _LEVELS = 7  # zoomed-in grids: a bracket of 2/64 of the domain narrowed to abou
 _NEAR_ZERO = 1e-7  # a sub-term this small relative to its largest size is "at zero"
 
 
-def refused(student: Node, key: Node | str) -> str | None:
+def refused(student: Node, key: Node | str, text: str | None = None) -> str | None:
     """Why ``student`` is refused (a function of :data:`REFUSED` the key does not use), or None. ``key``: the key's
-    expression, a tree or its text (read once per distinct text)."""
+    expression, a tree or its text (read once per distinct text); ``text``: ``to_text(student)`` where the caller
+    has it (a function whose call it does not print, the tree does not use: no walk)."""
+    if text is not None and not any(call in text for call in _REFUSED_CALLS):
+        return None
     allowed = _survey_of_key(_key_form(key)).functions
     for name in sorted(_functions(student) - allowed):
         if name in REFUSED:

@@ -41,7 +41,7 @@ import numpy as np
 
 from grader.base.errors import shown
 from grader.grade.identity import identical
-from grader.model.expr import CONSTANTS, Node, Num, Op, Sym, names, parse, to_text
+from grader.model.expr import CONSTANTS, Node, Num, Op, Sym, parse, to_text
 from grader.model.kernel import (
     OPERATIONS,
     _float,  # evaluate's own reading of a constant: one place
@@ -75,6 +75,18 @@ def refused(student: Node, key: Node | str, text: str | None = None) -> str | No
             return f"{name}() is not accepted in this answer (it is {REFUSED[name]}: a physical answer here does " \
                    "not need it)"
     return None
+
+
+def _names(tree: Node) -> frozenset[str]:
+    """:func:`grader.model.expr.names` of a tree without ``root`` (one loop, no set a node)."""
+    found, stack = set(), [tree]
+    while stack:
+        node = stack.pop()
+        if isinstance(node, Op):
+            stack.extend(node.args)
+        elif isinstance(node, Sym) and node.name not in CONSTANTS:
+            found.add(node.name)
+    return frozenset(found)
 
 
 def _functions(tree: Node) -> set[str]:
@@ -424,7 +436,7 @@ def _walk(tree: Node, env: Points) -> _Walked | None:
                 functions.add(op)
             if op in _WATCHING and type(value) is np.ndarray:
                 for kind, index, watched in _watches(node, [type(at) is np.ndarray for at in values]):
-                    found.append(_Watched(kind, watched, frozenset(names(watched))))
+                    found.append(_Watched(kind, watched, _names(watched)))
                     seen.append(None if index is None else values[index])
             return value
         if isinstance(node, Sym):

@@ -24,7 +24,7 @@ from grader.grade.compare import (
     feedbacks,
     is_correct,
 )
-from grader.grade.equivalence import _functions, _survey, equivalent
+from grader.grade.equivalence import _functions, _survey, _values, _walk, equivalent
 from grader.grade.grading import symbolic_outcome
 from grader.model.expr import names, parse, to_text
 from grader.model.tolerance import Tolerance, ToleranceError
@@ -411,3 +411,20 @@ def test_one_walk_of_a_symbolic_answer_finds_its_names_and_functions(pieces: lis
     found = _survey(tree)
     assert found.names == names(tree) and found.functions == _functions(tree)
     assert all(watched.names == names(watched.node) and watched.names for watched in found.watched)
+
+
+@given(pieces=st.lists(_PIECES, min_size=1, max_size=5), joins=st.lists(st.sampled_from("+-*/^"),
+                                                                          min_size=4, max_size=4))
+def test_the_evaluating_walk_finds_what_the_survey_and_the_evaluation_find(pieces: list[str], joins: list[str]) -> None:
+    """Symbolic comparison surveys and evaluates a student's tree in one walk: the same functions and watched
+    sub-terms as the survey, the same values as evaluating the tree (NaN where it is undefined), and for each
+    watched sub-term its own values."""
+    tree = parse("".join(piece + join for piece, join in zip(pieces, [*joins[:len(pieces) - 1], ""], strict=True)))
+    env = {"p": np.linspace(-1.0, 3.0, 9), "v": np.linspace(0.0, 10.0, 9)}
+    walked, survey = _walk(tree, env), _survey(tree)
+    assert walked is not None
+    assert walked.functions == survey.functions and walked.watched == survey.watched
+    np.testing.assert_array_equal(walked.values, _values(tree, env))
+    for watched, values in zip(walked.watched, walked.watched_values, strict=True):
+        if values is not None:
+            np.testing.assert_array_equal(values, _values(watched.node, env))

@@ -35,18 +35,23 @@ import math
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from functools import lru_cache
-from typing import NamedTuple
+from typing import Any, NamedTuple
 
 import numpy as np
 
 from grader.base.errors import shown
 from grader.grade.identity import identical
 from grader.model.expr import CONSTANTS, Node, Num, Op, Sym, parse, to_text
-from grader.model.kernel import evaluate
+from grader.model.kernel import (
+    OPERATIONS,
+    _float,  # evaluate's own reading of a constant: one place
+    evaluate,
+)
 
 REFUSED = {"Max": "piecewise", "Min": "piecewise", "sign": "a step", "abs": "piecewise",
            "atan2": "a step across its branch cut"}
 """Functions refused in a student's expression unless the key's uses them, and why."""
+_REFUSED_CALLS = tuple(f"{name}(" for name in REFUSED)  # as to_text prints a call
 
 _TRANSCENDENTAL = {"sqrt", "sin", "cos", "tan", "sind", "cosd", "exp", "log", "hypot", "atan2", "abs", "sign",
                    "Max", "Min"}
@@ -58,15 +63,30 @@ _LEVELS = 7  # zoomed-in grids: a bracket of 2/64 of the domain narrowed to abou
 _NEAR_ZERO = 1e-7  # a sub-term this small relative to its largest size is "at zero"
 
 
-def refused(student: Node, key: Node | str) -> str | None:
+def refused(student: Node, key: Node | str, text: str | None = None) -> str | None:
     """Why ``student`` is refused (a function of :data:`REFUSED` the key does not use), or None. ``key``: the key's
-    expression, a tree or its text (read once per distinct text)."""
+    expression, a tree or its text (read once per distinct text); ``text``: ``to_text(student)`` where the caller
+    has it (a function whose call it does not print, the tree does not use: no walk)."""
+    if text is not None and not any(call in text for call in _REFUSED_CALLS):
+        return None
     allowed = _survey_of_key(_key_form(key)).functions
     for name in sorted(_functions(student) - allowed):
         if name in REFUSED:
             return f"{name}() is not accepted in this answer (it is {REFUSED[name]}: a physical answer here does " \
                    "not need it)"
     return None
+
+
+def _names(tree: Node) -> frozenset[str]:
+    """:func:`grader.model.expr.names` of a tree without ``root`` (one loop, no set a node)."""
+    found, stack = set(), [tree]
+    while stack:
+        node = stack.pop()
+        if isinstance(node, Op):
+            stack.extend(node.args)
+        elif isinstance(node, Sym) and node.name not in CONSTANTS:
+            found.add(node.name)
+    return frozenset(found)
 
 
 def _functions(tree: Node) -> set[str]:
@@ -123,18 +143,32 @@ def _key_form(expected: Node | str) -> _Form:
 
 def _equivalent(student: Node, expected: _Form, domains: Domains, seed: str, rtol: float,
                 points: int) -> bool | str:
-    survey, key_survey = _survey(student), _survey_of_key(expected)
-    missing = sorted((survey.names | key_survey.names) - {name for name, _ in domains})
-    if missing:
-        return f"the expression uses {', '.join(missing)}, which this answer does not know"
-    fixed, b, largest = _fixed(expected, domains, seed, points)
+    keyed = _keyed(expected, domains, seed, points)
+    fixed, key_survey = keyed.fixed, keyed.survey
+    # One walk of the student's tree finds what _survey finds and its values at the fixed points and the lines
+    # (see _Fixed); a tree it cannot evaluate there is surveyed alone, and is NaN everywhere as _values makes it.
+    walked = _walk(student, fixed.everywhere) if fixed is not None and domains else None
+    if walked is None:
+        survey = _survey(student)
+        missing = sorted((survey.names | key_survey.names) - keyed.known)
+        if missing:
+            return f"the expression uses {', '.join(missing)}, which this answer does not know"
+    assert fixed is not None  # the key's names are known
+    b, largest = fixed.values, fixed.largest
     if b.size == 0:
         return "the key's expression cannot be evaluated at any test point; please ask your instructor to check it"
+    lines: list[np.ndarray | None]
+    if walked is None:
+        functions, watched, lines = survey.functions, survey.watched, [None] * len(survey.watched)
+        a = _values(student, fixed.points)
+    else:
+        functions, watched, lines = walked.functions, walked.watched, _lines(walked, keyed.lines)
+        a = walked.values[:b.size]
     # A sub-term found twice is probed twice (the same points): cheaper than hashing every one to drop repeats.
-    found = [*(_structure(watched, domains) for watched in survey.watched), *_key_structure(expected, domains)]
+    found = [*(_structure(one, domains) if line is None or not _tame_values(one.kind, line) else _TAME
+               for one, line in zip(watched, lines, strict=True)),
+             *keyed.structure]
     probes = _stack([probe for probe, _ in found])
-    values = _values(student, fixed if probes is None else _joined([fixed, probes]))
-    a = values[:b.size]
     finite = np.isfinite(a)
     if not np.logical_and.reduce(finite):  # finite.all(), without its Python wrapper
         return False if finite.any() else "the expression cannot be evaluated at any test point (division by zero?)"
@@ -142,14 +176,48 @@ def _equivalent(student: Node, expected: _Form, domains: Domains, seed: str, rto
     if not _agree(a, b, rtol, floor):
         return False
     if probes is not None:
-        a, b = values[b.size:], _values(expected.tree, probes)
+        a, b = _values(student, probes), _values(expected.tree, probes)
         both = np.isfinite(a) & np.isfinite(b)  # a probe may sit on a pole: compare beside it
         if not _agree(a[both], b[both], rtol, floor):
             return False
     touches_zero = any(near for _, near in found)
-    if touches_zero or not survey.functions <= key_survey.functions:
+    if touches_zero or not functions <= key_survey.functions:
         return identical(student, expected.tree, domains)
     return True
+
+
+_TAME: tuple[Points | None, bool] = (None, False)
+
+
+class _Keyed(NamedTuple):
+    """What every answer to a key is compared with: the key's survey, the names the domains know, the points (None:
+    the key uses a name they do not), the key's probes, where each name's line starts among the points."""
+
+    survey: _Survey
+    known: frozenset[str]
+    fixed: _Fixed | None
+    structure: tuple[tuple[Points | None, bool], ...]
+    lines: Mapping[str, int]
+
+
+@lru_cache(maxsize=256)
+def _keyed(expected: _Form, domains: Domains, seed: str, points: int) -> _Keyed:
+    """Worked out once per key (one look-up an answer, not one a part)."""
+    survey, known = _survey_of_key(expected), frozenset(name for name, _ in domains)
+    if not survey.names <= known:
+        return _Keyed(survey, known, None, (), {})
+    fixed = _fixed(expected, domains, seed, points)
+    lines = {name: fixed.values.size + index * _GRID for index, (name, _) in enumerate(domains)}
+    return _Keyed(survey, known, fixed, _key_structure(expected, domains), lines)
+
+
+def _lines(walked: _Walked, starts: Mapping[str, int]) -> list[np.ndarray | None]:
+    """For each watched sub-term, its values along its name's line (the :func:`_tame` grid), where the walk
+    evaluated it (``starts``: where each name's line starts); None for a sub-term of several names, or where not
+    evaluated."""
+    return [None if len(watched.names) != 1 or values is None else
+            values[(start := starts[next(iter(watched.names))]):start + _GRID]
+            for watched, values in zip(walked.watched, walked.watched_values, strict=True)]
 
 
 def _agree(a: np.ndarray, b: np.ndarray, rtol: float, floor: float) -> bool:
@@ -170,11 +238,14 @@ Score = Callable[[Points], np.ndarray]
 
 
 class _Fixed(NamedTuple):
-    """The points every answer to a key is compared at, the key's values there and the largest of their sizes."""
+    """The points every answer to a key is compared at, the key's values there and the largest of their sizes;
+    ``everywhere``: those points, then for each name in turn a line along it (the :func:`_tame` grid, the other
+    names at their centre), where a student's expression is evaluated in the same walk."""
 
     points: Points
     values: np.ndarray
     largest: float
+    everywhere: Points
 
 
 @lru_cache(maxsize=256)
@@ -191,7 +262,10 @@ def _fixed(expected: _Form, domains: Domains, seed: str, points: int) -> _Fixed:
     defined = np.isfinite(values)
     values = values[defined]
     largest = float(np.max(np.abs(values))) if values.size else 0.0
-    return _Fixed({name: column[defined] for name, column in everywhere.items()}, values, largest)
+    compared = {name: column[defined] for name, column in everywhere.items()}
+    centre = {name: (low + high) / 2 for name, (low, high) in domains}
+    lines = _joined([_line(centre, name, _grid(low, high)) for name, (low, high) in domains])
+    return _Fixed(compared, values, largest, _joined([compared, lines]))
 
 
 def _corners(domains: Domains) -> Points:
@@ -291,23 +365,93 @@ def _survey(tree: Node) -> _Survey:
         op = node.op
         if op in _TRANSCENDENTAL:
             functions.add(op)
-        if not used:
-            return used
-        if op == "div" and uses[1]:
-            found.append(_Watched("small", node.args[1], uses[1]))
-        elif op in _SMALLEST:
-            found.extend(_Watched("small", arg, its) for arg, its in zip(node.args, uses, strict=True) if its)
-        elif op in ("Max", "Min"):
-            found.append(_Watched("small", Op("sub", node.args), used))
-        elif op == "exp":
-            found.append(_Watched("large", node.args[0], used))
-        elif op == "pow" and uses[0] and not (isinstance(node.args[1], Num) and node.args[1].value >= 0
-                                               and float(node.args[1].value).is_integer()):
-            found.append(_Watched("small", node.args[0], uses[0]))  # a root or a negative power: a kink or a pole at 0
+        if used and op in _WATCHING:
+            found.extend(_Watched(kind, watched, used if index is None else uses[index])
+                         for kind, index, watched in _watches(node, [bool(its) for its in uses]))
         return used
 
     used = visit(tree)
     return _Survey(used, frozenset(functions), tuple(found))
+
+
+_WATCHING = frozenset(("div", "pow", "exp", "Max", "Min", *_SMALLEST))
+
+
+def _watches(node: Op, named: list[bool]) -> list[tuple[str, int | None, Node]]:
+    """The sub-terms of an operation that uses a name to watch: (kind, which argument (None: the difference of
+    ``Max`` or ``Min``'s two), sub-term); ``named``: whether each argument uses a name."""
+    op, args = node.op, node.args
+    if op == "div":
+        return [("small", 1, args[1])] if named[1] else []
+    if op in _SMALLEST:
+        return [("small", index, arg) for index, arg in enumerate(args) if named[index]]
+    if op in ("Max", "Min"):
+        return [("small", None, Op("sub", args))]
+    if op == "exp":
+        return [("large", 0, args[0])]
+    exponent = args[1]  # pow
+    if named[0] and not (isinstance(exponent, Num) and exponent.value >= 0 and float(exponent.value).is_integer()):
+        return [("small", 0, args[0])]  # a root or a negative power: a kink or a pole at 0
+    return []
+
+
+class _Walked(NamedTuple):
+    """What :func:`_walk` finds: a tree's functions of :data:`_TRANSCENDENTAL`, its watched sub-terms with the
+    values of each at the points (None for ``Max`` or ``Min``'s difference), its values at the points."""
+
+    functions: frozenset[str]
+    watched: tuple[_Watched, ...]
+    watched_values: list[np.ndarray | None]
+    values: np.ndarray
+
+
+_EVALUATED = {op: function for op, function in OPERATIONS.items() if op not in ("and", "or")}  # as evaluate does
+_PLAIN = frozenset(("add", "sub", "mul"))  # neither transcendental nor watched
+
+
+def _walk(tree: Node, env: Points) -> _Walked | None:
+    """What :func:`_survey` finds of a tree but its names, and its values at ``env``'s points as :func:`_values`
+    finds them, in one walk; None where evaluating it would raise (a name ``env`` does not have, an operation
+    evaluate treats apart), which :func:`_values` turns into NaN everywhere. A sub-term uses a name where its value
+    is an array (every name's is; a constant's is a number)."""
+    functions: set[str] = set()
+    found: list[_Watched] = []
+    seen: list[np.ndarray | None] = []
+
+    def visit(node: Node) -> Any:  # the node's value; depth is bounded by the parser
+        if isinstance(node, Op):
+            args, op = node.args, node.op
+            if len(args) == 2:
+                left, right = visit(args[0]), visit(args[1])
+                value = _EVALUATED[op](left, right)
+                if op in _PLAIN:
+                    return value
+                values: tuple[Any, ...] = (left, right)
+            else:
+                values = tuple(visit(arg) for arg in args)
+                value = _EVALUATED[op](*values)
+                if op == "neg":
+                    return value
+            if op in _TRANSCENDENTAL:
+                functions.add(op)
+            if op in _WATCHING and type(value) is np.ndarray:
+                for kind, index, watched in _watches(node, [type(at) is np.ndarray for at in values]):
+                    found.append(_Watched(kind, watched, _names(watched)))
+                    seen.append(None if index is None else values[index])
+            return value
+        if isinstance(node, Sym):
+            return np.pi if node.name in CONSTANTS else env[node.name]
+        return _float(node.value)
+
+    try:
+        with np.errstate(all="ignore"):
+            value = visit(tree)
+    except (ArithmeticError, ValueError, TypeError, KeyError):
+        return None
+    size = len(next(iter(env.values())))
+    at = np.asarray(value, dtype=float)
+    at = at.copy() if at.shape == (size,) else np.broadcast_to(at, (size,)).copy()
+    return _Walked(frozenset(functions), tuple(found), seen, at)
 
 
 @lru_cache(maxsize=1024)
@@ -376,7 +520,11 @@ def _tame(kind: str, node: Node, used: frozenset[str], domains: Domains) -> bool
         return False  # in two names or more the scans may pass beside the place: search it
     name = next(iter(used))
     low, high = next(bounds for other, bounds in domains if other == name)
-    values = _values(node, {name: _grid(low, high)})
+    return _tame_values(kind, _values(node, {name: _grid(low, high)}))
+
+
+def _tame_values(kind: str, values: np.ndarray) -> bool:
+    """:func:`_tame` on a sub-term's values along the grid of its one name."""
     least, most = float(np.minimum.reduce(values)), float(np.maximum.reduce(values))  # NaN if any value is
     if not (math.isfinite(least) and math.isfinite(most)):
         return False

@@ -460,7 +460,7 @@ def symbolic_outcome(text: str, delimiter: str, domains: tuple[tuple[str, tuple[
         return "missing", 0.0, "the answer was blank", ""
     if isinstance(cell, CellInvalid):
         return "invalid", 0.0, f"could not read this answer: {cell.reason}", ""
-    refusal = refused(cell.tree, expected_text)
+    refusal = refused(cell.tree, expected_text, cell.text)
     if refusal is not None:
         return "invalid", 0.0, f"could not read this answer: {refusal}", cell.text
     same = equivalent(cell.tree, expected_text, dict(domains), seed=seed)

@@ -23,6 +23,7 @@ import ast
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from fractions import Fraction
+from functools import lru_cache
 from typing import Any
 
 from grader.base.errors import ExpressionError
@@ -263,30 +264,40 @@ def to_text(node: Node) -> str:
     return _text(node)[0]
 
 
+_LEFT_ASSOCIATIVE = frozenset(("sub", "div", "mul"))
+
+
 def _text(node: Node) -> tuple[str, int]:
     if isinstance(node, Sym):
         return node.name, 9
     if isinstance(node, Num):
         text = format_number(node.value)
         return text, (6 if text.startswith("-") else 9) if "/" not in text else 5
-    if node.op in FUNCTIONS or node.op == ROOT:
-        return f"{node.op}({', '.join(_text(a)[0] for a in node.args)})", 9
-    level = _PRECEDENCE[node.op]
-    if node.op == "neg":
-        inner, inner_level = _text(node.args[0])
+    op, args = node.op, node.args
+    if op in FUNCTIONS or op == ROOT:
+        return f"{op}({', '.join(_text(a)[0] for a in args)})", 9
+    level = _PRECEDENCE[op]
+    if op == "neg":
+        inner, inner_level = _text(args[0])
         # -(a*b) and (-a)*b are the same number, so a product needs no parentheses.
-        bare = inner_level > level or (isinstance(node.args[0], Op) and node.args[0].op in ("mul", "div"))
+        bare = inner_level > level or (isinstance(args[0], Op) and args[0].op in ("mul", "div"))
         return "-" + (inner if bare else f"({inner})"), level
+    # Left-associative operators keep a right operand of equal level in parentheses,
+    # power is right-associative and does the opposite.
+    if len(args) == 2:  # all but a long 'and' or 'or': no list, no loop
+        (left, left_level), (right, right_level) = _text(args[0]), _text(args[1])
+        if left_level < level or (left_level == level and op == "pow"):
+            left = f"({left})"
+        if right_level < level or (right_level == level and op in _LEFT_ASSOCIATIVE):
+            right = f"({right})"
+        return left + _SYMBOL[op] + right, level
     parts = []
-    for index, arg in enumerate(node.args):
+    for index, arg in enumerate(args):
         inner, inner_level = _text(arg)
-        # Left-associative operators keep a right operand of equal level in parentheses,
-        # power is right-associative and does the opposite.
-        right_side = index > 0
         needs = inner_level < level or (inner_level == level and (
-            (right_side and node.op in ("sub", "div", "mul")) or (not right_side and node.op == "pow")))
+            (index > 0 and op in _LEFT_ASSOCIATIVE) or (index == 0 and op == "pow")))
         parts.append(f"({inner})" if needs else inner)
-    return _SYMBOL[node.op].join(parts), level
+    return _SYMBOL[op].join(parts), level
 
 
 def format_number(value: Fraction | float) -> str:
@@ -297,17 +308,22 @@ def format_number(value: Fraction | float) -> str:
     """
     if isinstance(value, float):
         return repr(value)
-    if value.denominator == 1:
-        return str(value.numerator)
-    denominator, twos, fives = value.denominator, 0, 0
-    while denominator % 2 == 0:
-        denominator, twos = denominator // 2, twos + 1
-    while denominator % 5 == 0:
-        denominator, fives = denominator // 5, fives + 1
-    if denominator != 1:
-        return f"{value.numerator}/{value.denominator}"
+    return _fraction_text(value.numerator, value.denominator)
+
+
+@lru_cache(maxsize=4096)  # a class writes the same numbers; a fraction's own hash costs as much as this
+def _fraction_text(numerator: int, denominator: int) -> str:
+    if denominator == 1:
+        return str(numerator)
+    rest, twos, fives = denominator, 0, 0
+    while rest % 2 == 0:
+        rest, twos = rest // 2, twos + 1
+    while rest % 5 == 0:
+        rest, fives = rest // 5, fives + 1
+    if rest != 1:
+        return f"{numerator}/{denominator}"
     places = max(twos, fives)
-    scaled = value.numerator * (10**places // value.denominator)  # exact: the denominator divides 10**places
+    scaled = numerator * (10**places // denominator)  # exact: the denominator divides 10**places
     sign = "-" if scaled < 0 else ""
     digits = str(abs(scaled)).rjust(places + 1, "0")
     return f"{sign}{digits[:-places]}.{digits[-places:]}"

@@ -205,7 +205,8 @@ def _float(value: Fraction | float) -> float:
     (inf, 0.25)
     """
     try:
-        return float(value)
+        # A fraction's float is its numerator over its denominator (numbers.Rational.__float__, without its calls).
+        return value.numerator / value.denominator if type(value) is Fraction else float(value)
     except OverflowError:
         return math.inf if value > 0 else -math.inf
 

@@ -181,11 +181,13 @@ def _simulate_separation(stage: Stage, run: Run) -> None:
     whole = fields.get("whole")
     v_n, v_t = (run.value(whole.n), run.value(whole.t)) if whole is not None else (0.0, 0.0)
     reduced = 1 / (w_a + w_b)
+    # What sets the relative velocity is an input: giving it back would only check the run against itself.
     if "relative" in fields and run.known(fields["relative"]):
-        u = run.value(fields["relative"])
+        u, source = run.value(fields["relative"]), "relative"
     else:
         u = math.sqrt(2 * run.value(fields["energy"]) / reduced) if "energy" in fields else \
             run.value(Sym("u_rel"))  # neither given: the stage waits (nothing produces u_rel)
+        source = "energy"
     if u < 0:
         run.problems.append(f"the relative velocity of separation {u:g} m/s is negative")
         u = 0.0
@@ -206,10 +208,11 @@ def _simulate_separation(stage: Stage, run: Run) -> None:
         path = run.integrate([release], np.array([0.0, 0.0, v_n, v_n]))
         run.record(f"{first} and {second} separate", ("xA", "xB", "vA", "vB"), path)
         after = [float(v) for v in path.y[-1][2:]]
-    _output(stage, run, (w_a, w_b), after, v_t)
+    _output(stage, run, (w_a, w_b), after, v_t, source)
 
 
-def _output(stage: Stage, run: Run, inverse: tuple[float, float], after: list[float], v_t: float) -> None:
+def _output(stage: Stage, run: Run, inverse: tuple[float, float], after: list[float], v_t: float,
+            source: str) -> None:
     fields = stage.fields
     for index, body in enumerate(fields["bodies"]):
         given = fields.get("after", {}).get(body)
@@ -218,9 +221,9 @@ def _output(stage: Stage, run: Run, inverse: tuple[float, float], after: list[fl
             if given.t is not None:
                 run.output(given.t, v_t)
     separating = after[1] - after[0]
-    if "relative" in fields:
+    if "relative" in fields and source != "relative":
         run.output(fields["relative"], separating)
-    if "energy" in fields:
+    if "energy" in fields and source != "energy":
         run.output(fields["energy"], separating * separating / (2 * (inverse[0] + inverse[1])))
 
 

@@ -24,9 +24,10 @@ import math
 from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING, Any
 
-from grader.model.expr import Sym, to_text
+from grader.model.expr import Sym
 from grader.model.quantities import ANGLE, ENERGY, PURE, SPEED
 from grader.physics.effects.base import Condition, Effect, Field, Mistake, Relation, Stable
+from grader.physics.effects.velocity import output_polar
 
 if TYPE_CHECKING:
     from grader.model.scene import Stage
@@ -226,16 +227,9 @@ def _output(stage: Stage, run: Run, inverse: tuple[float, ...], before: list[flo
     if "common" in fields:
         run.output(fields["common"].n, common[0])
         run.output(fields["common"].t, common[1])
-    speed = math.hypot(*common)
-    if "speed" in fields:
-        run.output(fields["speed"], speed)
-    if "angle" in fields:
-        along, across = common if fields.get("from", _FROM) == "n" else common[::-1]
-        if speed > 0 and run.resolves(speed):
-            run.output(fields["angle"], math.atan2(across, along))
-        else:
-            run.undefined[to_text(fields["angle"])] = "the wreck does not move, so it has no direction"
-            run.output(fields["angle"], math.nan)
+    along_across = common if fields.get("from", _FROM) == "n" else (common[1], common[0])
+    output_polar(run, along_across, fields.get("speed"), fields.get("angle"),
+                 "the wreck does not move, so it has no direction", math.hypot(*common))
     # The loss from the relative velocity the contact took away, 1/2 mu (a - s)(a + s) with a = |u1 - u2| and
     # s = |v1 - v2| as simulated: never T - T', which cancels when the bodies nearly moved together already.
     approach = math.hypot(before[0] - before[2], before[1] - before[3])

@@ -26,7 +26,7 @@ import numpy as np
 
 from grader.model.expr import Sym
 from grader.model.quantities import ENERGY, SPEED
-from grader.physics.effects.base import Condition, Effect, Field, Mistake, Relation, Stable
+from grader.physics.effects.base import Condition, Effect, Field, Mistake, Relation, Stable, TwoBodyStage
 
 if TYPE_CHECKING:
     from grader.model.scene import Stage
@@ -47,12 +47,9 @@ _FIELDS = (
 
 
 @dataclass(frozen=True)
-class _Separation:
+class _Separation(TwoBodyStage):
     """One stage's quantities; a mistake is the same stage with one changed."""
 
-    stage: Stage
-    bodies: tuple[str, str]
-    inverse: tuple[Any, Any]
     before: tuple[Any, Any]
     after: tuple[tuple[Any, Any], tuple[Any, Any]]
     relative: Any
@@ -65,9 +62,7 @@ class _Separation:
         import sympy as sp
 
         fields = stage.fields
-        bodies = tuple(fields["bodies"])
-        for body in bodies:
-            ctx.mass(stage, body, "bodies")
+        bodies, inverse = cls.pair(stage, ctx)
         whole = fields.get("whole")
         before = (ctx.sym(whole.n), ctx.sym(whole.t)) if whole is not None else (sp.Integer(0), sp.Integer(0))
         plane = before[1] != 0 or any(v.t is not None for v in fields.get("after", {}).values())
@@ -79,8 +74,8 @@ class _Separation:
             return ctx.symbol(ctx.unused_name(f"v_{body}_{axis}_after", stage)) if axis == "n" or plane else None
 
         relative = ctx.sym(fields["relative"]) if "relative" in fields else ctx.symbol(ctx.unused_name("u_rel", stage))
-        return cls(stage, bodies, (ctx.inverse_mass(bodies[0]), ctx.inverse_mass(bodies[1])), before,
-                   tuple((after(body, "n"), after(body, "t")) for body in bodies), relative)  # type: ignore[arg-type]
+        parts = tuple((after(body, "n"), after(body, "t")) for body in bodies)
+        return cls(stage, bodies, inverse, before, parts, relative)  # type: ignore[arg-type]
 
     def relations(self, ctx: Context) -> list[Relation]:
         """The stage's relations as a student writes them."""

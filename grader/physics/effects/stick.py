@@ -26,7 +26,7 @@ from typing import TYPE_CHECKING, Any
 
 from grader.model.expr import Sym
 from grader.model.quantities import ANGLE, ENERGY, PURE, SPEED
-from grader.physics.effects.base import Condition, Effect, Field, Mistake, Relation, Stable
+from grader.physics.effects.base import Condition, Effect, Field, Mistake, Relation, Stable, TwoBodyStage
 from grader.physics.effects.velocity import output_polar
 
 if TYPE_CHECKING:
@@ -54,12 +54,9 @@ _FIELDS = (
 
 
 @dataclass(frozen=True)
-class _Stick:
+class _Stick(TwoBodyStage):
     """One stage's quantities; a mistake is the same stage with a field changed."""
 
-    stage: Stage
-    bodies: tuple[str, str]
-    inverse: tuple[Any, Any]  # 1/m of each
     before: tuple[tuple[Any, Any], tuple[Any, Any]]  # (n, t) of each
     common: tuple[Any, Any]
     speeds: str = "vector"  # the common speed from the momentum vector, or as a student who adds "scalar" speeds
@@ -70,9 +67,7 @@ class _Stick:
         """The collision a stage describes."""
         import sympy as sp
 
-        first, second = stage.fields["bodies"]
-        for body in (first, second):
-            ctx.mass(stage, body, "bodies")  # a fixed surface does not move on with a body
+        (first, second), inverse = cls.pair(stage, ctx)  # a fixed surface does not move on with a body
 
         def component(body: str, axis: str) -> Any:
             given = stage.fields.get("before", {}).get(body)
@@ -82,7 +77,7 @@ class _Stick:
         named = stage.fields.get("common")
         common = (ctx.sym(named.n), ctx.sym(named.t)) if named is not None else tuple(
             ctx.symbol(ctx.unused_name(f"v_common_{axis}", stage)) for axis in ("n", "t"))
-        return cls(stage, (first, second), (ctx.inverse_mass(first), ctx.inverse_mass(second)),
+        return cls(stage, (first, second), inverse,
                    ((component(first, "n"), component(first, "t")), (component(second, "n"), component(second, "t"))),
                    common)
 

@@ -421,15 +421,15 @@ def ref_floor_push(m: Any, v: Any, dt: Any, F: Any) -> dict[str, Any]:  # noqa: 
 
 
 def test_the_impulse_is_simulated_by_integrating_a_force_pulse() -> None:
-    """The wall's force on the ball is a half-sine pulse over the contact time, integrated step by step: not the
+    """The wall's force on the ball is a parabolic pulse over the contact time, integrated step by step: not the
     impulse taken from the velocities the impact gives."""
     simulated = simulate(WALL, {"m": 200, "v": 12, "e": 0.6, "dt": 8}, ADAPTIVE)
-    assert "force pulse over the contact time (half-sine)" in simulated.effects
+    assert "force pulse over the contact time (parabolic)" in simulated.effects
     phase = next(p for p in simulated.phases if p.label == "the force on ball")
     assert phase.path.steps > 1 and phase.path.t[-1] == pytest.approx(0.008, rel=1e-12)
-    # against the ball's motion (-n), a half-sine whose mean is F = 480 N: its peak is pi/2 times that
+    # against the ball's motion (-n), 6 s (1 - s) times its mean F = 480 N at s = t/dt: 3/2 of it at its peak
     for t, force in zip(phase.path.t, phase.path.force, strict=True):
-        assert force == pytest.approx(-math.pi / 2 * 480 * math.sin(math.pi * t / 0.008), rel=1e-6, abs=1e-9)
+        assert force == pytest.approx(-6 * 480 * (t / 0.008) * (1 - t / 0.008), rel=1e-9, abs=1e-9)
 
 
 @pytest.mark.parametrize("params", [{"m": 0.5, "v": 6, "dt": 8, "F": 700},

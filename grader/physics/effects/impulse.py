@@ -8,7 +8,7 @@ declares the weight during the contact (``weight: true``, n pointing up), the fo
 normal force, ``J_n/dt + m g`` or ``(1/2 m (v**2 - v'**2) + m g d)/d``.
 
 Force law (simulation): a force on the body, integrated with its weight where the scene declares it: over a
-contact time, a half-sine pulse ``F(t) = (pi/2) F_avg sin(pi t/dt)`` (the given contact time, else the
+contact time, a parabolic pulse ``F(t) = 6 F_avg (t/dt)(1 - t/dt)`` (the given contact time, else the
 simulation's contact duration), whose mean is ``F_avg``; over a stopping distance, a constant force, ended where
 the body has travelled ``d``. ``F_avg`` is the force the scene gives (along n where the weight acts, else at the
 impulse's angle where given, else against the motion), or else the one that takes the body from its velocity
@@ -210,7 +210,7 @@ class _Push:
     before: tuple[float, float]
     net: tuple[float, float]
     gravity: float  # along -n, where the scene declares the weight during the contact
-    pulse: bool  # a half-sine pulse over a contact time; else a constant force over a distance
+    pulse: bool  # a parabolic pulse over a contact time; else a constant force over a distance
     duration: float = 0.0
     distance: float = 0.0
 
@@ -268,30 +268,36 @@ class _Push:
         return -before[0] / speed, -before[1] / speed
 
     def mode(self) -> Mode:
-        """The body under the force (and its weight): ``[x_n, x_t, clock, v_n, v_t, 1]``, until the contact time is
-        over or the distance is travelled."""
+        """The body under the force (and its weight): ``[x_n, x_t, v_n, v_t]`` from ``t = 0``, for the contact time
+        or until the distance is travelled."""
         from grader.physics.integrate import Mode  # the simulator's part: loading a template needs none of it
 
-        (net_n, net_t), mass, duration = self.net, self.mass, self.duration
-        pulse = self.pulse
+        (net_n, net_t), mass, duration, shape = self.net, self.mass, self.duration, self.shape
 
-        def shape(clock: float) -> float:  # the force's share of its mean: a half-sine's over the time, or all of it
-            return math.pi / 2 * math.sin(math.pi * clock / duration) if pulse else 1.0
-
-        def pushed(_: float, y: Any) -> Any:
-            share = shape(y[2]) / mass
-            return np.array([y[3], y[4], 1.0, net_n * share, net_t * share, 0.0])
+        def pushed(t: float, y: Any) -> Any:
+            share = shape(t) / mass
+            return np.array([y[2], y[3], net_n * share, net_t * share])
 
         scale = duration or self.distance / math.hypot(*self.before)
         speed = max(math.hypot(*self.before), math.hypot(*self.net) * scale / mass)
-        sizes = np.array([speed * scale, speed * scale, scale, speed, speed, 1.0])
+        sizes = np.array([speed * scale, speed * scale, speed, speed])
         if duration:
-            event: Any = lambda y: y[2] - duration  # noqa: E731
-        else:
-            event = lambda y: math.hypot(y[0], y[1]) - self.distance  # noqa: E731
-        weight = mass * self.gravity
-        return Mode("force on the body", pushed, event, 1, scale=scale, force=lambda y: weight + shape(y[2]) * net_n,
+            return Mode("force on the body", pushed, None, 1, scale=scale, sizes=lambda y: sizes, lasts=duration)
+        return Mode("force on the body", pushed, lambda y: math.hypot(y[0], y[1]) - self.distance, 1, scale=scale,
                     sizes=lambda y: sizes)
+
+    def shape(self, t: float) -> float:
+        """The force's share of its mean at time ``t``: a parabolic pulse's, ``6 s (1 - s)`` at ``s = t/dt`` (zero at
+        both ends, 3/2 at its peak, 1 on average), or all of it. Its velocity is a cubic in time, which the
+        adaptive method's 8th-order steps follow in a few steps."""
+        if not self.pulse:
+            return 1.0
+        share = t / self.duration
+        return 6 * share * (1 - share)
+
+    def normal_force(self, t: float) -> float:
+        """The surface's force along n at time ``t`` (what a plot shows): the weight held up and the pulse."""
+        return self.mass * self.gravity + self.shape(t) * self.net[0]
 
     def stopped_short(self) -> float | None:
         """Where a given force over a distance stops the body before it has travelled it (None: it does not)."""
@@ -321,19 +327,20 @@ def _simulate_impulse(stage: Stage, run: Run) -> None:
         run.problems.append(f"the force {stage.text('force')} stops {fields['body']} within {short:.4g} m, before "
                             f"it has moved the distance {stage.text('distance')}")
         return
-    run.uses("force pulse over the contact time (half-sine)" if push.pulse else "constant force over a distance")
+    run.uses("force pulse over the contact time (parabolic)" if push.pulse else "constant force over a distance")
     if push.gravity:
         run.uses("gravity")
-    path = run.integrate([push.mode()], np.array([0.0, 0.0, 0.0, *push.before, 1.0]))
-    run.record(f"the force on {fields['body']}", ("xn", "xt", "clock", "vn", "vt", "tick"), path)
+    path = run.integrate([push.mode()], np.array([0.0, 0.0, *push.before]))
+    path.force = [push.normal_force(t) for t in path.t]  # a function of time, which a mode's force(y) cannot see
+    run.record(f"the force on {fields['body']}", ("xn", "xt", "vn", "vt"), path)
     end = path.y[-1]
-    after = (float(end[3]), float(end[4]))
+    after = (float(end[2]), float(end[3]))
     run.speed_scale = max(run.speed_scale, *map(abs, push.before), *map(abs, after))
     for axis, value in zip(("n", "t"), after, strict=True):
         part = getattr(fields["velocity_after"], axis)
         if not isinstance(part, Num):  # a number is the scene's: no outcome to find anything from
             run.output(part, value)
-    _output(stage, run, push, after, math.hypot(float(end[0]), float(end[1])), float(end[2]))
+    _output(stage, run, push, after, math.hypot(float(end[0]), float(end[1])), path.t[-1])
 
 
 def _output(stage: Stage, run: Run, push: _Push, after: tuple[float, float], travelled: float,
@@ -367,7 +374,7 @@ IMPULSE_EFFECT = Effect(
     _impulse,
     _simulate_impulse,
     _mistakes,
-    force_law="a force on the body (and its weight, where the scene declares it): a half-sine pulse over the "
+    force_law="a force on the body (and its weight, where the scene declares it): a parabolic pulse over the "
               "contact time, or a constant force until the body has travelled the stopping distance; its mean the "
               "force given, or else the one that takes the body to the velocity after the scene gives; the impulse "
               "is the simulated change of momentum",

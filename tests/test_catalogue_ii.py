@@ -476,6 +476,29 @@ def test_a_given_force_over_a_distance_is_integrated_until_the_body_has_travelle
         simulate(template, {"m": 10, "v": 6, "d": 800, "F": 1000}, ADAPTIVE)
 
 
+def cushion_height() -> Template:
+    """The cushion's average force given and the drop height asked: the simulation searches for the height whose
+    fall the force, found from the stop, reproduces."""
+    raw = yaml.safe_load((DATA / "cushion.yaml").read_text(encoding="utf-8"))
+    del raw["parameters"]["h"]
+    raw["parameters"]["F"] = {"unit": "kN", "domain": "(0, inf)", "sample": {"uniform": [1, 3]}, "decimals": 2}
+    raw["answers"] = {"h": {"value": "h", "unit": "m", "description": "height of the drop"},
+                      "J": {"value": "J", "unit": "N·s", "description": "impulse of the cushion"}}
+    raw["statement"], raw["example"] = "Given {{ m }}, {{ F }} and {{ d }}.", {"m": 10, "F": 2, "d": 80}
+    return parse_template(raw, "test:cushion-height", "cushion-height")
+
+
+def test_the_drop_height_is_found_from_the_cushions_force() -> None:
+    """(F - m g) d = m g h (the fall's energy, taken by the cushion with the weight's work), by a 50-digit
+    reference; the simulation's search finds h."""
+    params = {"m": 10, "F": 2, "d": 80}
+    with mp.workdps(DIGITS):
+        m, force, d = mp.mpf(10), mp.mpf(2000), mp.mpf("0.08")
+        h = (force - m * G) * d / (m * G)
+        assert_matches_reference(cushion_height(), params, lambda **_: {"h": h, "J": m * mp.sqrt(2 * G * h)})
+    assert_simulated(cushion_height(), params)
+
+
 def rebound_given() -> Template:
     """The ball's rebound speed given instead of e: the impulse stage alone (with e, the impact's own
     "rebound's sign turned" mistake gives the same number first)."""

@@ -320,8 +320,10 @@ def _simulate_impulse(stage: Stage, run: Run) -> None:
     fields = stage.fields
     push = _Push.of(stage, run)
     if not (push.duration or push.distance):
-        run.problems.append(f"{fields['body']} does not move, so the average force over the distance "
-                            f"{stage.text('distance')} is not defined")
+        if push.pulse:
+            run.problems.append(f"the contact time {stage.text('time')} is not positive")
+        else:  # at rest before and after: nothing moves, and the surface holds up the weight alone
+            _output(stage, run, push, push.before, run.value(fields["distance"]), 0.0)
         return
     if not push.pulse and not push.duration and (short := push.stopped_short()) is not None:
         run.problems.append(f"the force {stage.text('force')} stops {fields['body']} within {short:.4g} m, before "
@@ -345,6 +347,8 @@ def _simulate_impulse(stage: Stage, run: Run) -> None:
 
 def _output(stage: Stage, run: Run, push: _Push, after: tuple[float, float], travelled: float,
             elapsed: float) -> None:
+    # The distance travelled is not given back: where the force was found from the velocity after, it is the
+    # distance the force was calibrated over, and a second outcome would leave a search nothing to choose by.
     """The impulse from the simulated change of momentum, its size and direction, and the average force."""
     fields, mass = stage.fields, push.mass
     j = (mass * (after[0] - push.before[0]), mass * (after[1] - push.before[1]))
@@ -353,8 +357,6 @@ def _output(stage: Stage, run: Run, push: _Push, after: tuple[float, float], tra
         run.output(fields["components"].t, j[1])
     output_polar(run, j, fields.get("impulse"), fields.get("angle"), "the impulse is zero, so it has no direction",
                  math.hypot(*j) / mass)
-    if "distance" in fields and not isinstance(fields["distance"], Num):
-        run.output(fields["distance"], travelled)
     if "force" not in fields:
         return
     weight = mass * push.gravity

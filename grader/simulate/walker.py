@@ -131,7 +131,8 @@ def _walk(template: Template, options: Options, values: dict[str, float], budget
 SEARCH_PASSES = 25
 # What a search may find, by the stage field that needs it: a restitution in [0, 1]; a fall height, the
 # speed of an approach along n before an impact (a car's, from the skid after it) or at the start of a
-# slide in [0, inf), bracketed by growing an upper end from the size of the outcome it must match.
+# slide in [0, inf), bracketed by growing an upper end from the size of the outcome it must match; the
+# velocity of a whole before it separates in (-inf, inf), bracketed by growing both ends from 0.
 _SEARCHABLE = {("impact", "restitution"): ("coefficient of restitution", 0.0, 1.0),
                ("free_fall", "height"): ("fall height", 0.0, math.inf),
                ("impact", "before"): ("velocity before the impact", 0.0, math.inf),

@@ -16,7 +16,7 @@ import yaml
 
 from grader.bank.template import Template, parse_template
 from grader.cli import main
-from grader.physics.integrate import Settings
+from grader.physics.integrate import Settings, SimulationError
 from grader.physics.record import Options
 from grader.simulate.walker import simulate
 from grader.solve.cache import alternatives_for, compiled_for
@@ -170,8 +170,8 @@ def test_a_support_needs_a_vertical_spring() -> None:
 
 
 TRIALS = ("bullet-spring", "package-platform", "ramp-and-floor", "incline-up-and-back", "intersection",
-          "intersection-reconstruction", "ball-wall-impulse", "cushion", "recoil", "explosion",
-          "oblique-both-moving")
+          "intersection-reconstruction", "ball-wall-impulse", "cushion", "floor-push", "recoil", "explosion",
+          "explosion-before", "oblique-both-moving")
 """Issue 25's trial templates in tests/data, until the bank carries templates of these effects."""
 
 
@@ -403,9 +403,100 @@ def test_impulse_answers_match_a_50_digit_reference(template: Template, params: 
 
 
 @pytest.mark.parametrize(("template", "params"), [(WALL, {"m": 200, "v": 12, "e": 0.6, "dt": 8}),
-                                                  (CUSHION, {"m": 10, "h": 1.5, "d": 80})])
+                                                  (WALL, {"m": 50, "v": 1e-150, "e": 0, "dt": 20}),
+                                                  (CUSHION, {"m": 10, "h": 1.5, "d": 80}),
+                                                  (CUSHION, {"m": 1e6, "h": 1e-12, "d": 1e9})])
 def test_impulse_scenes_are_re_derived_by_the_simulation(template: Template, params: dict[str, float]) -> None:
     assert_simulated(template, params)
+
+
+FLOOR = trial("floor-push")
+
+
+def ref_floor_push(m: Any, v: Any, dt: Any, F: Any) -> dict[str, Any]:  # noqa: N803 (its names)
+    """Impulse-momentum along n (up) with the weight: m v_up - m (-v) = (F - m g) dt."""
+    dt = dt / 1000
+    v_up = -v + (F - m * G) * dt / m
+    return {"v_up": v_up, "J": m * (v_up + v)}
+
+
+def test_the_impulse_is_simulated_by_integrating_a_force_pulse() -> None:
+    """The wall's force on the ball is a parabolic pulse over the contact time, integrated step by step: not the
+    impulse taken from the velocities the impact gives."""
+    simulated = simulate(WALL, {"m": 200, "v": 12, "e": 0.6, "dt": 8}, ADAPTIVE)
+    assert "force pulse over the contact time (parabolic)" in simulated.effects
+    phase = next(p for p in simulated.phases if p.label == "the force on ball")
+    assert phase.path.steps > 1 and phase.path.t[-1] == pytest.approx(0.008, rel=1e-12)
+    # against the ball's motion (-n), 6 s (1 - s) times its mean F = 480 N at s = t/dt: 3/2 of it at its peak
+    for t, force in zip(phase.path.t, phase.path.force, strict=True):
+        assert force == pytest.approx(-6 * 480 * (t / 0.008) * (1 - t / 0.008), rel=1e-9, abs=1e-9)
+
+
+@pytest.mark.parametrize("params", [{"m": 0.5, "v": 6, "dt": 8, "F": 700},
+                                    {"m": 2, "v": 0.5, "dt": 20, "F": 30},  # the weight all but cancels it
+                                    {"m": 1e-6, "v": 1e3, "dt": 1e-6, "F": 3e-3}])
+def test_a_given_force_drives_the_body_to_its_velocity_after(params: dict[str, float]) -> None:
+    """The force the scene gives is the input: the velocity after is what its integration gives, to 1e-6 of the
+    50-digit reference and of the closed form."""
+    assert_matches_reference(FLOOR, params, ref_floor_push)
+    assert_simulated(FLOOR, params)
+    with mp.workdps(DIGITS):
+        want = ref_floor_push(**{k: mp.mpf(v) for k, v in params.items()})
+    got = simulate(FLOOR, params, ADAPTIVE).answers["v_up"]
+    assert got == pytest.approx(float(want["v_up"]), rel=1e-8)
+
+
+def cushion_through() -> Template:
+    """The cushion's force given and the speed after the distance asked (the solver refuses it: v' from v'**2 has two
+    signs; the simulation is run alone)."""
+    raw = yaml.safe_load((DATA / "cushion.yaml").read_text(encoding="utf-8"))
+    raw["stages"] = raw["stages"][1:]
+    raw["stages"][0]["velocity"] = {"n": "-v", "t": 0}
+    raw["stages"][0]["velocity_after"] = {"n": "-v2", "t": 0}
+    del raw["parameters"]["h"]
+    raw["parameters"]["v"] = {"unit": "m/s", "domain": "(0, inf)", "sample": {"uniform": [4, 8]}, "decimals": 1}
+    raw["parameters"]["F"] = {"unit": "N", "domain": "(0, inf)", "sample": {"uniform": [500, 1000]}, "decimals": 0}
+    raw["answers"] = {"v2": {"value": "v2", "unit": "m/s", "description": "speed after"}}
+    raw["statement"], raw["example"] = "Given {{ m }}, {{ v }}, {{ d }} and {{ F }}.", {"m": 10, "v": 6, "d": 80,
+                                                                                      "F": 1000}
+    return parse_template(raw, "test:cushion-through", "cushion-through")
+
+
+def test_a_given_force_over_a_distance_is_integrated_until_the_body_has_travelled_it() -> None:
+    """Work-energy with the weight, (F - m g) d = 1/2 m (v**2 - v'**2), by a 50-digit reference; a force that stops
+    the body short of the distance is refused, saying where it stops."""
+    template = cushion_through()
+    with mp.workdps(DIGITS):
+        m, v, d, force = mp.mpf(10), mp.mpf(6), mp.mpf("0.08"), mp.mpf(1000)
+        want = mp.sqrt(v**2 - 2 * (force / m - G) * d)
+    got = simulate(template, {"m": 10, "v": 6, "d": 80, "F": 1000}, ADAPTIVE)
+    assert got.answers["v2"] == pytest.approx(float(want), rel=1e-9)
+    assert "constant force over a distance" in got.effects
+    with pytest.raises(SimulationError, match=r"stops package within 0\.1996 m, before it has moved the distance d"):
+        simulate(template, {"m": 10, "v": 6, "d": 800, "F": 1000}, ADAPTIVE)
+
+
+def cushion_height() -> Template:
+    """The cushion's average force given and the drop height asked: the simulation searches for the height whose
+    fall the force, found from the stop, reproduces."""
+    raw = yaml.safe_load((DATA / "cushion.yaml").read_text(encoding="utf-8"))
+    del raw["parameters"]["h"]
+    raw["parameters"]["F"] = {"unit": "kN", "domain": "(0, inf)", "sample": {"uniform": [1, 3]}, "decimals": 2}
+    raw["answers"] = {"h": {"value": "h", "unit": "m", "description": "height of the drop"},
+                      "J": {"value": "J", "unit": "N·s", "description": "impulse of the cushion"}}
+    raw["statement"], raw["example"] = "Given {{ m }}, {{ F }} and {{ d }}.", {"m": 10, "F": 2, "d": 80}
+    return parse_template(raw, "test:cushion-height", "cushion-height")
+
+
+def test_the_drop_height_is_found_from_the_cushions_force() -> None:
+    """(F - m g) d = m g h (the fall's energy, taken by the cushion with the weight's work), by a 50-digit
+    reference; the simulation's search finds h."""
+    params = {"m": 10, "F": 2, "d": 80}
+    with mp.workdps(DIGITS):
+        m, force, d = mp.mpf(10), mp.mpf(2000), mp.mpf("0.08")
+        h = (force - m * G) * d / (m * G)
+        assert_matches_reference(cushion_height(), params, lambda **_: {"h": h, "J": m * mp.sqrt(2 * G * h)})
+    assert_simulated(cushion_height(), params)
 
 
 def rebound_given() -> Template:
@@ -493,6 +584,32 @@ def test_separation_answers_match_a_50_digit_reference(template: Template, param
 def test_separation_scenes_are_re_derived_by_a_spring_between_the_parts(template: Template,
                                                                         params: dict[str, float]) -> None:
     assert_simulated(template, params)
+
+
+EXPLOSION_BEFORE = trial("explosion-before")
+
+
+def ref_explosion_before(m1: Any, m2: Any, v1: Any, E: Any) -> dict[str, Any]:  # noqa: N803 (its names)
+    """Momentum M V = m1 v1 + m2 v2 and energy 1/2 m1 v1^2 + 1/2 m2 v2^2 = 1/2 M V^2 + E with V put in, a quadratic
+    for v2 whose larger root is the front fragment's (it moves off ahead of the rear one)."""
+    released, total = E * 1000, m1 + m2
+    a = m2 - m2**2 / total
+    b = -2 * m1 * m2 * v1 / total
+    c = m1 * v1**2 - (m1 * v1) ** 2 / total - 2 * released
+    v2 = (-b + mp.sqrt(b**2 - 4 * a * c)) / (2 * a)
+    return {"V": (m1 * v1 + m2 * v2) / total, "v2": v2}
+
+
+@pytest.mark.parametrize("params", [{"m1": 4, "m2": 6, "v1": 40, "E": 24},
+                                    {"m1": 4, "m2": 6, "v1": -400, "E": 24},  # the shell was flying backwards
+                                    {"m1": 9, "m2": 2.5, "v1": 0, "E": 40},
+                                    {"m1": 1e-3, "m2": 1e3, "v1": 250, "E": 1e-3}])
+def test_the_whole_velocity_before_a_separation_is_found_by_the_simulation(params: dict[str, float]) -> None:
+    """The shell's velocity before it explodes asked (the rear fragment's after given): the simulation searches
+    for it both ways from 0, so that the spring between the parts leaves the rear fragment at the given velocity."""
+    assert_matches_reference(EXPLOSION_BEFORE, params, ref_explosion_before)
+    assert_simulated(EXPLOSION_BEFORE, params)
+    assert set(simulate(EXPLOSION_BEFORE, params, ADAPTIVE).fitted) == {"V"}
 
 
 SEPARATION_MISTAKES = [

@@ -1,9 +1,10 @@
 """Time integration of a phase as a sequence of modes, each ended by a located event.
 
 A mode is a right-hand side (free flight, contact, ...) and an event function; the mode ends
-where the event crosses zero. Events are located, never detected by a sign test inside the
-step: the fixed-step methods find the crossing on their own partial step, the adaptive method
-uses ``scipy.integrate.solve_ivp``'s event location. Methods:
+where the event crosses zero, or, for a mode of known length (a force pulse over a contact time),
+at its end, where the integration stops with nothing to locate. Events are located, never
+detected by a sign test inside the step: the fixed-step methods find the crossing on their own
+partial step, the adaptive method uses ``scipy.integrate.solve_ivp``'s event location. Methods:
 
 - ``euler``: semi-implicit (symplectic) Euler, fixed steps;
 - ``rk4``: classical Runge-Kutta, fixed steps;
@@ -25,11 +26,14 @@ import math
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from grader.base.errors import GraderError
+
+if TYPE_CHECKING:
+    from grader.physics.dop853 import Integration
 
 METHODS = ("euler", "rk4", "adaptive")
 # rk4 reaches rounding (1e-16) at about 10,000 steps per contact, and Euler's first-order error
@@ -48,7 +52,8 @@ class SimulationError(GraderError):
 
 @dataclass(frozen=True)
 class Mode:
-    """One regime of motion: ``rhs(t, y)``, ended where ``event(y)`` crosses zero in ``direction``.
+    """One regime of motion: ``rhs(t, y)``, ended where ``event(y)`` crosses zero in ``direction``,
+    or ``lasts`` seconds after it starts (then ``event`` is None).
 
     ``scale`` is the mode's time scale (a fixed step is ``scale/steps``); ``omega`` its highest
     natural angular frequency (0 for free motion); ``force(y)`` what a plot shows; ``sizes(y)``
@@ -57,12 +62,13 @@ class Mode:
 
     name: str
     rhs: Callable[[float, Any], Any]
-    event: Callable[[Any], float]
+    event: Callable[[Any], float] | None
     direction: int
     scale: float
     omega: float = 0.0
     force: Callable[[Any], float] | None = None
     sizes: Callable[[Any], Any] | None = None
+    lasts: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -196,6 +202,9 @@ def _fixed(mode: Mode, t: float, y: Any, settings: Settings, path: Path, budget:
             f"{settings.method}: a step of {dt:.3g} s is at or above the stability limit 2/omega = "
             f"{2 / mode.omega:.3g} s of the {mode.name} mode; use at least "
             f"{math.floor(mode.scale * mode.omega / 2) + 1} steps per contact")
+    if mode.lasts:
+        return _fixed_span(mode, t, y, settings, dt, path, budget)
+    assert mode.event is not None  # a mode without an event lasts a given time (Mode's contract)
     for count in range(MAX_STEPS + 1):
         budget.spend(1)
         following = _step(settings.method, mode.rhs, t, y, dt)
@@ -218,6 +227,23 @@ def _fixed(mode: Mode, t: float, y: Any, settings: Settings, path: Path, budget:
     raise SimulationError(f"the {mode.name} mode did not end within {MAX_STEPS} steps{_never_ends(mode)}")
 
 
+def _fixed_span(mode: Mode, t: float, y: Any, settings: Settings, dt: float, path: Path,
+                budget: Budget) -> tuple[float, Any]:
+    """A mode of known length in whole steps, the last one shortened to end on it."""
+    end = t + mode.lasts
+    steps = max(1, math.ceil(mode.lasts / dt * (1 - 1e-12)))
+    if steps > MAX_STEPS:
+        raise SimulationError(f"the {mode.name} mode did not end within {MAX_STEPS} steps")
+    for count in range(steps):
+        budget.spend(1)
+        step = dt if count < steps - 1 else end - t
+        y = _step(settings.method, mode.rhs, t, y, step)
+        t = t + step if count < steps - 1 else end
+        path.steps += 1
+        path.add(t, y, mode)
+    return t, y
+
+
 def _sizes(mode: Mode, t: float, y: Any) -> Any:
     """What each component's error is measured against: the mode's own sizes, or else the largest
     position and the largest velocity (per component, one that starts at 0 would get none)."""
@@ -233,14 +259,14 @@ def _locate(mode: Mode, method: str, t: float, y: Any, dt: float) -> float:
     """The fraction of the step at which the event crosses zero, on the method's own partial step."""
     from scipy.optimize import brentq  # here, not at the top: every command imports the effects
 
-    return float(brentq(lambda f: mode.event(_step(method, mode.rhs, t, y, f * dt)), 0.0, 1.0,
+    event = mode.event
+    assert event is not None  # only a mode that ends at its event is located
+    return float(brentq(lambda f: event(_step(method, mode.rhs, t, y, f * dt)), 0.0, 1.0,
                         xtol=1e-15, rtol=8.9e-16))
 
 
 def _adaptive(mode: Mode, t: float, y: Any, rtol: float, path: Path, dense: bool,
               budget: Budget) -> tuple[float, Any]:
-    from scipy.integrate import solve_ivp  # here, not at the top: every command imports the effects
-
     # Time in units of the mode's own scale and each state component in units of its own size:
     # the event is located to a tolerance relative to the contact's duration (a 1 ns contact
     # survives), and the error of a 1e-300 m/s motion is measured against itself, with no
@@ -248,39 +274,59 @@ def _adaptive(mode: Mode, t: float, y: Any, rtol: float, path: Path, dense: bool
     start, unit = t, mode.scale
     sizes = _sizes(mode, t, y)
     sizes = np.where(sizes > 0, sizes, 1.0)
+    ended = mode.event
 
     def event(_: float, state: Any) -> float:
-        return mode.event(state * sizes)
-
-    event.terminal = True  # type: ignore[attr-defined]
-    event.direction = mode.direction  # type: ignore[attr-defined]
+        return ended(state * sizes)  # type: ignore[misc]  # passed on only where the mode has an event
 
     def scaled(s: float, state: Any) -> Any:
-        budget.spend(0)
         return unit * mode.rhs(start + s * unit, state * sizes) / sizes
 
     horizon, y = 0.0, y / sizes
+    span = mode.lasts / unit if mode.lasts else 10.0  # a mode of known length is integrated to its end at once
     for _ in range(60):
-        origin, horizon = horizon, horizon + 10
-        solution = solve_ivp(scaled, (origin, horizon), y, method="DOP853", rtol=rtol, atol=rtol, events=event,
-                             dense_output=dense)
-        path.steps += len(solution.t) - 1
-        budget.spend(len(solution.t) - 1)
-        if solution.status < 0:
-            raise SimulationError(f"the {mode.name} mode could not be integrated: {solution.message}")
-        interior = (((s, solution.sol(s)) for s in np.linspace(origin, solution.t[-1], 50)[1:-1]) if dense
-                    else zip(solution.t[1:-1], solution.y.T[1:-1], strict=True))
+        origin, horizon = horizon, horizon + span
+        run, interior = _stretch(scaled, origin, horizon, y, rtol, None if mode.lasts else event, mode.direction,
+                                 dense, budget)
+        path.steps += len(run.t) - 1
+        budget.spend(len(run.t) - 1)
+        if run.status < 0:
+            raise SimulationError(f"the {mode.name} mode could not be integrated: {run.message}")
         for s, state in interior:
             path.add(start + float(s) * unit, state * sizes, mode)
-        end, y = float(solution.t[-1]), solution.y[:, -1]
-        if solution.status == 1:
-            end, y = float(solution.t_events[0][0]), solution.y_events[0][0]
-        t = start + end * unit
+        end, y = float(run.t[-1]), run.y[-1]
+        t = start + mode.lasts if mode.lasts else start + end * unit
         path.add(t, y * sizes, mode)
-        if solution.status == 1:
+        if run.status == 1 or mode.lasts:
             return t, y * sizes
         horizon = end
     raise SimulationError(f"the {mode.name} mode did not end within {600 * mode.scale:.3g} s{_never_ends(mode)}")
+
+
+def _stretch(fun: Callable[[float, Any], Any], origin: float, horizon: float, y: Any, rtol: float,
+             event: Callable[[float, Any], float] | None, direction: int, dense: bool,
+             budget: Budget) -> tuple[Integration, list[tuple[float, Any]]]:
+    """One stretch of the adaptive method: its steps (the last at the event, if it is crossed), and the points
+    between its ends that a plot shows: the steps, or for a dense plot 48 points of ``solve_ivp``'s interpolant.
+    The budget's clock is checked at every step."""
+    from grader.physics import dop853  # scipy's tableau: here, not at the top, as solve_ivp below
+
+    if not dense:
+        run = dop853.integrate(fun, origin, horizon, y, rtol, rtol, event, direction, lambda: budget.spend(0))
+        return run, list(zip(run.t[1:-1], run.y[1:-1], strict=True))
+    from scipy.integrate import solve_ivp  # here, not at the top: every command imports the effects
+
+    if event is not None:
+        event.terminal = True  # type: ignore[attr-defined]
+        event.direction = direction  # type: ignore[attr-defined]
+    def timed(s: float, state: Any) -> Any:
+        budget.spend(0)
+        return fun(s, state)
+
+    solution = solve_ivp(timed, (origin, horizon), y, method="DOP853", rtol=rtol, atol=rtol, events=event,
+                         dense_output=True)
+    run = dop853.Integration(list(solution.t), list(solution.y.T), solution.status, solution.message)
+    return run, [(s, solution.sol(s)) for s in np.linspace(origin, solution.t[-1], 50)[1:-1]]
 
 
 def _never_ends(mode: Mode) -> str:

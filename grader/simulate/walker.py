@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 
 from scipy.optimize import brentq
@@ -131,7 +131,8 @@ def _walk(template: Template, options: Options, values: dict[str, float], budget
 SEARCH_PASSES = 25
 # What a search may find, by the stage field that needs it: a restitution in [0, 1]; a fall height, the
 # speed of an approach along n before an impact (a car's, from the skid after it) or at the start of a
-# slide in [0, inf), bracketed by growing an upper end from the size of the outcome it must match.
+# slide in [0, inf), bracketed by growing an upper end from the size of the outcome it must match; the
+# velocity of a whole before it separates in (-inf, inf), bracketed by growing both ends from 0.
 _SEARCHABLE = {("impact", "restitution"): ("coefficient of restitution", 0.0, 1.0),
                ("free_fall", "height"): ("fall height", 0.0, math.inf),
                ("impact", "before"): ("velocity before the impact", 0.0, math.inf),
@@ -141,7 +142,8 @@ _SEARCHABLE = {("impact", "restitution"): ("coefficient of restitution", 0.0, 1.
                ("slope", "friction"): ("coefficient of kinetic friction", 0.0, math.inf),
                ("stick", "before"): ("speed before the collision", 0.0, math.inf),
                ("separation", "relative"): ("relative velocity of separation", 0.0, math.inf),
-               ("separation", "energy"): ("energy released", 0.0, math.inf)}
+               ("separation", "energy"): ("energy released", 0.0, math.inf),
+               ("separation", "whole"): ("velocity of the whole before it separates", -math.inf, math.inf)}
 _PROBE = 0.5  # a value of the unknown that shows which outcome it leads to
 _GROWTH, _MAX_GROWTH = 4.0, 120  # an open upper end grows 4x at a time, at most 120 times (4**120 ~ 1e72)
 
@@ -218,13 +220,15 @@ def _next_unknown(template: Template, options: Options, values: dict[str, float]
 
 
 def _names(field: object, name: str) -> bool:
-    """Whether a stage field is the quantity ``name`` itself: the field, or a body's velocity along one axis
-    alone, or its negative, the other component a given number (a bullet's or a car's speed before it strikes,
-    found from what happens after: a car driving north, ``{n: 0, t: v_A}``)."""
-    if isinstance(field, Mapping):  # the velocity, or its negative (a bullet coming in along -n)
+    """Whether a stage field is the quantity ``name`` itself: the field, or a velocity (a body's, or the whole's
+    before it separates) along one axis alone, or its negative, the other component a given number (a bullet's or
+    a car's speed before it strikes, found from what happens after: a car driving north, ``{n: 0, t: v_A}``)."""
+    if isinstance(field, Mapping):  # per body
+        return any(_names(v, name) for v in field.values())
+    if isinstance(field, Velocity):  # the velocity, or its negative (a bullet coming in along -n)
         alone = (Sym(name), Op("neg", (Sym(name),)))
-        return any(isinstance(v, Velocity) and ((v.n in alone and (v.t is None or isinstance(v.t, Num))) or
-                                                (v.t in alone and isinstance(v.n, Num))) for v in field.values())
+        return (field.n in alone and (field.t is None or isinstance(field.t, Num))) or \
+            (field.t in alone and isinstance(field.n, Num))
     return field == Sym(name)
 
 
@@ -237,15 +241,18 @@ def _search(template: Template, options: Options, values: dict[str, float], budg
         return _walk(template, options, {**values, name: x}, budget).observed[unknown.outcome]
 
     low, high = unknown.low, unknown.high
-    simulated, given = outcome(low)
+    simulated, given = outcome(0.0 if math.isinf(low) else low)
     at_low = simulated - given
     if at_low == 0:
-        return low
+        return 0.0 if math.isinf(low) else low
 
     def mismatch(x: float) -> float:
         return outcome(x)[0] - given
 
-    if math.isinf(high):  # an upper end grown from the size of the outcome until it brackets the root
+    if math.isinf(low):  # a signed quantity: ends grown both ways from 0 until one brackets the root
+        low, high, at_low, at_high = _bracket_both_ways(mismatch, at_low, abs(given) or 1.0)
+        span = "(-inf, inf)"
+    elif math.isinf(high):  # an upper end grown from the size of the outcome until it brackets the root
         high = abs(given) or 1.0
         for _ in range(_MAX_GROWTH):
             at_high = mismatch(high)
@@ -260,16 +267,31 @@ def _search(template: Template, options: Options, values: dict[str, float], budg
         raise SimulationError(f"no {unknown.what} in {span} reproduces the given {unknown.outcome} (with {name} = "
                               f"{high if at_high < 0 else low:g} the simulated {unknown.outcome} is still "
                               f"{'below' if at_high < 0 else 'above'} it)")
-    xtol, rtol = 1e-15 * high, 8.9e-16
+    xtol, rtol = 1e-15 * max(abs(low), abs(high)), 8.9e-16
     found = brentq(mismatch, low, high, xtol=xtol, rtol=rtol, maxiter=200)
     if _walk(template, options, {**values, name: found}, budget).problems and mismatch(found) * at_low > 0:
         # brentq returns a point within its tolerance of the root, on either side. Where the
         # outcome is a body that just stops (a rebound of 0), the low side leaves it moving on down
         # by a rounding: the root is then just above, within the tolerance.
-        upper = min(high, found + 2 * (xtol + rtol * found))
+        upper = min(high, found + 2 * (xtol + rtol * abs(found)))
         if mismatch(upper) * at_low <= 0:
             found = upper
     return float(found)
+
+
+def _bracket_both_ways(mismatch: Callable[[float], float], at_zero: float,
+                       size: float) -> tuple[float, float, float, float]:
+    """Ends ``0`` and ``+size`` or ``-size``, ``size`` grown 4x at a time, between which ``mismatch`` changes
+    sign: ``(low, high, mismatch(low), mismatch(high))``, or the last pair tried, unbracketed."""
+    for _ in range(_MAX_GROWTH):
+        at_plus = mismatch(size)
+        if at_plus * at_zero <= 0:
+            return 0.0, size, at_zero, at_plus
+        at_minus = mismatch(-size)
+        if at_minus * at_zero <= 0:
+            return -size, 0.0, at_minus, at_zero
+        size *= _GROWTH
+    return -size, size, at_minus, at_plus
 
 
 def _why_undefined(template: Template, run: Run, name: str) -> str | None:

@@ -157,3 +157,22 @@ class Effect:
         for spec in self.fields:
             if spec.required and spec.default is not None:
                 raise ValueError(f"effect {self.name}: field {spec.name} is required, so it has no default")
+
+
+@dataclass(frozen=True)
+class TwoBodyStage:
+    """A stage of two bodies with a mass each (a separation's parts, two bodies that stick), as its effect's
+    relations read it: the stage, the two bodies' names and their inverse masses ``1/m`` (sympy). An effect's
+    own stage class adds its quantities; a mistake is the same stage with one of them changed."""
+
+    stage: Stage
+    bodies: tuple[str, str]
+    inverse: tuple[Any, Any]
+
+    @staticmethod
+    def pair(stage: Stage, ctx: Context) -> tuple[tuple[str, str], tuple[Any, Any]]:
+        """The stage's ``bodies`` and their inverse masses; a body without a mass (a fixed surface) is refused."""
+        first, second = stage.fields["bodies"]
+        for body in (first, second):
+            ctx.mass(stage, body, "bodies")
+        return (first, second), (ctx.inverse_mass(first), ctx.inverse_mass(second))

@@ -7,9 +7,15 @@ The average force: over a contact time, ``F = |J|/dt``; over a stopping distance
 declares the weight during the contact (``weight: true``, n pointing up), the force asked is the surface's
 normal force, ``J_n/dt + m g`` or ``(1/2 m (v**2 - v'**2) + m g d)/d``.
 
-Force law (simulation): none: kinematics. The impulse is ``m (v' - v)`` of the velocities the scene gives; the
-average force is the impulse over the time (the time average of whatever the contact force was), or the
-work-energy over the distance.
+Force law (simulation): a force on the body, integrated with its weight where the scene declares it: over a
+contact time, a parabolic pulse ``F(t) = 6 F_avg (t/dt)(1 - t/dt)`` (the given contact time, else the
+simulation's contact duration), whose mean is ``F_avg``; over a stopping distance, a constant force, ended where
+the body has travelled ``d``. ``F_avg`` is the force the scene gives (along n where the weight acts, else at the
+impulse's angle where given, else against the motion), or else the one that takes the body from its velocity
+before to the velocity after the scene gives, as an impact's contact is calibrated to ``e``; a constant force
+then acts for ``2 d/(|v| + |v'|)`` and the distance the body travels is checked against ``d``. The impulse is the
+body's simulated change of momentum, the average force that impulse over the time, or the work over the distance
+travelled (``F d = 1/2 m (v**2 - v'**2)`` of the simulated speeds).
 
 Mistakes: speeds for velocities (``m(|v'| - |v|)``: the rebound's sign lost); the weight left in or out against
 what the scene declares.
@@ -21,13 +27,17 @@ import math
 from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING, Any
 
+import numpy as np
+
 from grader.base.errors import TemplateError
-from grader.model.expr import to_text
+from grader.model.expr import Num
 from grader.model.quantities import ANGLE, FORCE, IMPULSE, LENGTH, SPEED, TIME
 from grader.physics.effects.base import Condition, Effect, Field, Mistake, Relation
+from grader.physics.effects.velocity import output_polar
 
 if TYPE_CHECKING:
     from grader.model.scene import Stage
+    from grader.physics.integrate import Mode
     from grader.physics.record import Run
     from grader.physics.symbolic import Context
 
@@ -188,35 +198,174 @@ def _mistakes(stage: Stage, ctx: Context) -> list[Mistake]:
     return found
 
 
+@dataclass(frozen=True)
+class _Push:
+    """What the simulation integrates for one impulse stage (SI): the body's mass and velocity before, the mean
+    ``net`` of the force on it beyond what holds up its weight (n and t) and its shape, and what ends it: a time
+    (``duration``) or, for a given force over a stopping distance, the distance travelled (``distance``). The
+    surface's force is ``m g + shape(t) net`` along n, so the body's acceleration is ``shape(t) net/m``: no ``g``
+    to cancel against a small change of velocity."""
+
+    mass: float
+    before: tuple[float, float]
+    net: tuple[float, float]
+    gravity: float  # along -n, where the scene declares the weight during the contact
+    pulse: bool  # a parabolic pulse over a contact time; else a constant force over a distance
+    duration: float = 0.0
+    distance: float = 0.0
+
+    @classmethod
+    def of(cls, stage: Stage, run: Run) -> _Push:
+        """The force a stage describes: the one given, or else the one that takes the body to its velocity after."""
+        fields = stage.fields
+        mass = run.value(run.scene.bodies[fields["body"]].mass)  # type: ignore[arg-type]
+        before = (run.value(fields["velocity"].n), run.value(fields["velocity"].t))
+        gravity = run.gravity() if fields.get("weight", False) else 0.0
+        pulse = "distance" not in fields
+        given = fields["velocity_after"]
+        if run.known(given.n) and run.known(given.t):
+            return cls._calibrated(stage, run, mass, before, (run.value(given.n), run.value(given.t)), gravity)
+        if "force" not in fields:
+            run.value(given.n), run.value(given.t)  # the stage waits for the velocity after
+        size = run.value(fields["force"])
+        direction = cls._direction(stage, run, before)
+        net = (size * direction[0] - mass * gravity, size * direction[1])
+        if pulse:
+            return cls(mass, before, net, gravity, pulse, duration=_contact_time(stage, run))
+        return cls(mass, before, net, gravity, pulse, distance=run.value(fields["distance"]))
+
+    @classmethod
+    def _calibrated(cls, stage: Stage, run: Run, mass: float, before: tuple[float, float],
+                    after: tuple[float, float], gravity: float) -> _Push:
+        """The mean force that takes the body from ``before`` to ``after``: over the contact time, or constant over
+        the distance, which it then crosses in ``2 d/(|v| + |v'|)``."""
+        if "distance" in stage.fields:
+            speeds = math.hypot(*before) + math.hypot(*after)
+            duration = 2 * run.value(stage.fields["distance"]) / speeds if speeds > 0 else 0.0
+        else:
+            duration = _contact_time(stage, run)
+        if duration == 0:
+            return cls(mass, before, (0.0, 0.0), gravity, "distance" not in stage.fields)
+        net = (mass * (after[0] - before[0]) / duration, mass * (after[1] - before[1]) / duration)
+        return cls(mass, before, net, gravity, "distance" not in stage.fields, duration=duration)
+
+    @staticmethod
+    def _direction(stage: Stage, run: Run, before: tuple[float, float]) -> tuple[float, float]:
+        """A given force's direction: the surface's normal force along n where the weight acts; else the impulse's
+        direction where the scene gives it; else against the body's motion."""
+        fields = stage.fields
+        if fields.get("weight", False):
+            return 1.0, 0.0
+        if "angle" in fields and run.known(fields["angle"]):
+            angle = run.value(fields["angle"])
+            return math.cos(angle), math.sin(angle)
+        speed = math.hypot(*before)
+        if speed == 0:
+            from grader.physics.integrate import SimulationError  # the simulator's: loading a template needs none
+
+            raise SimulationError(f"{run.scene.where}: stages[{stage.index}]: the force {stage.text('force')} on a "
+                                  "body at rest has no direction: give the impulse's angle or the velocity after")
+        return -before[0] / speed, -before[1] / speed
+
+    def mode(self) -> Mode:
+        """The body under the force (and its weight): ``[x_n, x_t, v_n, v_t]`` from ``t = 0``, for the contact time
+        or until the distance is travelled."""
+        from grader.physics.integrate import Mode  # the simulator's part: loading a template needs none of it
+
+        (net_n, net_t), mass, duration, shape = self.net, self.mass, self.duration, self.shape
+
+        def pushed(t: float, y: Any) -> Any:
+            share = shape(t) / mass
+            return np.array([y[2], y[3], net_n * share, net_t * share])
+
+        scale = duration or self.distance / math.hypot(*self.before)
+        speed = max(math.hypot(*self.before), math.hypot(*self.net) * scale / mass)
+        sizes = np.array([speed * scale, speed * scale, speed, speed])
+        if duration:
+            return Mode("force on the body", pushed, None, 1, scale=scale, sizes=lambda y: sizes, lasts=duration)
+        return Mode("force on the body", pushed, lambda y: math.hypot(y[0], y[1]) - self.distance, 1, scale=scale,
+                    sizes=lambda y: sizes)
+
+    def shape(self, t: float) -> float:
+        """The force's share of its mean at time ``t``: a parabolic pulse's, ``6 s (1 - s)`` at ``s = t/dt`` (zero at
+        both ends, 3/2 at its peak, 1 on average), or all of it. Its velocity is a cubic in time, which the
+        adaptive method's 8th-order steps follow in a few steps."""
+        if not self.pulse:
+            return 1.0
+        share = t / self.duration
+        return 6 * share * (1 - share)
+
+    def normal_force(self, t: float) -> float:
+        """The surface's force along n at time ``t`` (what a plot shows): the weight held up and the pulse."""
+        return self.mass * self.gravity + self.shape(t) * self.net[0]
+
+    def stopped_short(self) -> float | None:
+        """Where a given force over a distance stops the body before it has travelled it (None: it does not)."""
+        speed = math.hypot(*self.before)
+        if speed == 0:
+            return 0.0
+        along = (self.net[0] * self.before[0] + self.net[1] * self.before[1]) / (self.mass * speed)
+        stop = speed * speed / (-2 * along) if along < 0 else math.inf
+        return stop if stop <= self.distance else None
+
+
+def _contact_time(stage: Stage, run: Run) -> float:
+    """The stage's contact time, or the simulation's contact duration where the scene gives none."""
+    return run.value(stage.fields["time"]) if "time" in stage.fields else run.options.contact_duration
+
+
 def _simulate_impulse(stage: Stage, run: Run) -> None:
-    """Kinematics, not a force: the impulse from the velocities the scene gives, the average force from it."""
+    """The body under the force over the contact, integrated (see :class:`_Push`); the impulse is the change of its
+    simulated momentum, the average force the impulse over the time or the work over the distance."""
     fields = stage.fields
-    mass = run.value(run.scene.bodies[fields["body"]].mass)  # type: ignore[arg-type]
-    before = (run.value(fields["velocity"].n), run.value(fields["velocity"].t))
-    after = (run.value(fields["velocity_after"].n), run.value(fields["velocity_after"].t))
-    j = (mass * (after[0] - before[0]), mass * (after[1] - before[1]))
+    push = _Push.of(stage, run)
+    if not (push.duration or push.distance):
+        if push.pulse:
+            run.problems.append(f"the contact time {stage.text('time')} is not positive")
+        else:  # at rest before and after: nothing moves, and the surface holds up the weight alone
+            _output(stage, run, push, push.before, run.value(fields["distance"]), 0.0)
+        return
+    if not push.pulse and not push.duration and (short := push.stopped_short()) is not None:
+        run.problems.append(f"the force {stage.text('force')} stops {fields['body']} within {short:.4g} m, before "
+                            f"it has moved the distance {stage.text('distance')}")
+        return
+    run.uses("force pulse over the contact time (parabolic)" if push.pulse else "constant force over a distance")
+    if push.gravity:
+        run.uses("gravity")
+    path = run.integrate([push.mode()], np.array([0.0, 0.0, *push.before]))
+    path.force = [push.normal_force(t) for t in path.t]  # a function of time, which a mode's force(y) cannot see
+    run.record(f"the force on {fields['body']}", ("xn", "xt", "vn", "vt"), path)
+    end = path.y[-1]
+    after = (float(end[2]), float(end[3]))
+    run.speed_scale = max(run.speed_scale, *map(abs, push.before), *map(abs, after))
+    for axis, value in zip(("n", "t"), after, strict=True):
+        part = getattr(fields["velocity_after"], axis)
+        if not isinstance(part, Num):  # a number is the scene's: no outcome to find anything from
+            run.output(part, value)
+    _output(stage, run, push, after, math.hypot(float(end[0]), float(end[1])), path.t[-1])
+
+
+def _output(stage: Stage, run: Run, push: _Push, after: tuple[float, float], travelled: float,
+            elapsed: float) -> None:
+    # The distance travelled is not given back: where the force was found from the velocity after, it is the
+    # distance the force was calibrated over, and a second outcome would leave a search nothing to choose by.
+    """The impulse from the simulated change of momentum, its size and direction, and the average force."""
+    fields, mass = stage.fields, push.mass
+    j = (mass * (after[0] - push.before[0]), mass * (after[1] - push.before[1]))
     if "components" in fields:
         run.output(fields["components"].n, j[0])
         run.output(fields["components"].t, j[1])
-    size = math.hypot(*j)
-    if "impulse" in fields:
-        run.output(fields["impulse"], size)
-    if "angle" in fields:
-        if size > 0:
-            run.output(fields["angle"], math.atan2(j[1], j[0]))
-        else:
-            run.undefined[to_text(fields["angle"])] = "the impulse is zero, so it has no direction"
-            run.output(fields["angle"], math.nan)
-    if "force" in fields:
-        weight = mass * run.gravity() if fields.get("weight", False) else 0.0
-        if "time" in fields:
-            dt = run.value(fields["time"])
-            average = j[0] / dt + weight if weight else size / dt
-        else:
-            d = run.value(fields["distance"])
-            speed, speed_after = math.hypot(*before), math.hypot(*after)
-            average = mass * (speed - speed_after) * (speed + speed_after) / (2 * d) + weight
-        run.output(fields["force"], average)
+    output_polar(run, j, fields.get("impulse"), fields.get("angle"), "the impulse is zero, so it has no direction",
+                 math.hypot(*j) / mass)
+    if "force" not in fields:
+        return
+    weight = mass * push.gravity
+    if push.pulse:
+        average = j[0] / elapsed + weight if weight else math.hypot(*j) / elapsed
+    else:
+        speed, speed_after = math.hypot(*push.before), math.hypot(*after)
+        average = mass * (speed - speed_after) * (speed + speed_after) / (2 * travelled) + weight
+    run.output(fields["force"], average)
 
 
 IMPULSE_EFFECT = Effect(
@@ -227,6 +376,8 @@ IMPULSE_EFFECT = Effect(
     _impulse,
     _simulate_impulse,
     _mistakes,
-    force_law="none: kinematics; the impulse is m (v' - v) of the velocities the scene gives, the average force the "
-              "impulse over the contact time, or the work-energy over the stopping distance",
+    force_law="a force on the body (and its weight, where the scene declares it): a parabolic pulse over the "
+              "contact time, or a constant force until the body has travelled the stopping distance; its mean the "
+              "force given, or else the one that takes the body to the velocity after the scene gives; the impulse "
+              "is the simulated change of momentum",
 )

@@ -26,7 +26,7 @@ import numpy as np
 
 from grader.model.expr import Sym
 from grader.model.quantities import ENERGY, SPEED
-from grader.physics.effects.base import Condition, Effect, Field, Mistake, Relation, Stable
+from grader.physics.effects.base import Condition, Effect, Field, Mistake, Relation, Stable, TwoBodyStage
 
 if TYPE_CHECKING:
     from grader.model.scene import Stage
@@ -47,12 +47,9 @@ _FIELDS = (
 
 
 @dataclass(frozen=True)
-class _Separation:
+class _Separation(TwoBodyStage):
     """One stage's quantities; a mistake is the same stage with one changed."""
 
-    stage: Stage
-    bodies: tuple[str, str]
-    inverse: tuple[Any, Any]
     before: tuple[Any, Any]
     after: tuple[tuple[Any, Any], tuple[Any, Any]]
     relative: Any
@@ -65,9 +62,7 @@ class _Separation:
         import sympy as sp
 
         fields = stage.fields
-        bodies = tuple(fields["bodies"])
-        for body in bodies:
-            ctx.mass(stage, body, "bodies")
+        bodies, inverse = cls.pair(stage, ctx)
         whole = fields.get("whole")
         before = (ctx.sym(whole.n), ctx.sym(whole.t)) if whole is not None else (sp.Integer(0), sp.Integer(0))
         plane = before[1] != 0 or any(v.t is not None for v in fields.get("after", {}).values())
@@ -79,8 +74,8 @@ class _Separation:
             return ctx.symbol(ctx.unused_name(f"v_{body}_{axis}_after", stage)) if axis == "n" or plane else None
 
         relative = ctx.sym(fields["relative"]) if "relative" in fields else ctx.symbol(ctx.unused_name("u_rel", stage))
-        return cls(stage, bodies, (ctx.inverse_mass(bodies[0]), ctx.inverse_mass(bodies[1])), before,
-                   tuple((after(body, "n"), after(body, "t")) for body in bodies), relative)  # type: ignore[arg-type]
+        parts = tuple((after(body, "n"), after(body, "t")) for body in bodies)
+        return cls(stage, bodies, inverse, before, parts, relative)  # type: ignore[arg-type]
 
     def relations(self, ctx: Context) -> list[Relation]:
         """The stage's relations as a student writes them."""
@@ -181,11 +176,13 @@ def _simulate_separation(stage: Stage, run: Run) -> None:
     whole = fields.get("whole")
     v_n, v_t = (run.value(whole.n), run.value(whole.t)) if whole is not None else (0.0, 0.0)
     reduced = 1 / (w_a + w_b)
+    # What sets the relative velocity is an input: giving it back would only check the run against itself.
     if "relative" in fields and run.known(fields["relative"]):
-        u = run.value(fields["relative"])
+        u, source = run.value(fields["relative"]), "relative"
     else:
         u = math.sqrt(2 * run.value(fields["energy"]) / reduced) if "energy" in fields else \
             run.value(Sym("u_rel"))  # neither given: the stage waits (nothing produces u_rel)
+        source = "energy"
     if u < 0:
         run.problems.append(f"the relative velocity of separation {u:g} m/s is negative")
         u = 0.0
@@ -206,10 +203,11 @@ def _simulate_separation(stage: Stage, run: Run) -> None:
         path = run.integrate([release], np.array([0.0, 0.0, v_n, v_n]))
         run.record(f"{first} and {second} separate", ("xA", "xB", "vA", "vB"), path)
         after = [float(v) for v in path.y[-1][2:]]
-    _output(stage, run, (w_a, w_b), after, v_t)
+    _output(stage, run, (w_a, w_b), after, v_t, source)
 
 
-def _output(stage: Stage, run: Run, inverse: tuple[float, float], after: list[float], v_t: float) -> None:
+def _output(stage: Stage, run: Run, inverse: tuple[float, float], after: list[float], v_t: float,
+            source: str) -> None:
     fields = stage.fields
     for index, body in enumerate(fields["bodies"]):
         given = fields.get("after", {}).get(body)
@@ -218,9 +216,9 @@ def _output(stage: Stage, run: Run, inverse: tuple[float, float], after: list[fl
             if given.t is not None:
                 run.output(given.t, v_t)
     separating = after[1] - after[0]
-    if "relative" in fields:
+    if "relative" in fields and source != "relative":
         run.output(fields["relative"], separating)
-    if "energy" in fields:
+    if "energy" in fields and source != "energy":
         run.output(fields["energy"], separating * separating / (2 * (inverse[0] + inverse[1])))
 
 

@@ -24,9 +24,10 @@ import math
 from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING, Any
 
-from grader.model.expr import Sym, to_text
+from grader.model.expr import Sym
 from grader.model.quantities import ANGLE, ENERGY, PURE, SPEED
-from grader.physics.effects.base import Condition, Effect, Field, Mistake, Relation, Stable
+from grader.physics.effects.base import Condition, Effect, Field, Mistake, Relation, Stable, TwoBodyStage
+from grader.physics.effects.velocity import output_polar
 
 if TYPE_CHECKING:
     from grader.model.scene import Stage
@@ -53,12 +54,9 @@ _FIELDS = (
 
 
 @dataclass(frozen=True)
-class _Stick:
+class _Stick(TwoBodyStage):
     """One stage's quantities; a mistake is the same stage with a field changed."""
 
-    stage: Stage
-    bodies: tuple[str, str]
-    inverse: tuple[Any, Any]  # 1/m of each
     before: tuple[tuple[Any, Any], tuple[Any, Any]]  # (n, t) of each
     common: tuple[Any, Any]
     speeds: str = "vector"  # the common speed from the momentum vector, or as a student who adds "scalar" speeds
@@ -69,9 +67,7 @@ class _Stick:
         """The collision a stage describes."""
         import sympy as sp
 
-        first, second = stage.fields["bodies"]
-        for body in (first, second):
-            ctx.mass(stage, body, "bodies")  # a fixed surface does not move on with a body
+        (first, second), inverse = cls.pair(stage, ctx)  # a fixed surface does not move on with a body
 
         def component(body: str, axis: str) -> Any:
             given = stage.fields.get("before", {}).get(body)
@@ -81,7 +77,7 @@ class _Stick:
         named = stage.fields.get("common")
         common = (ctx.sym(named.n), ctx.sym(named.t)) if named is not None else tuple(
             ctx.symbol(ctx.unused_name(f"v_common_{axis}", stage)) for axis in ("n", "t"))
-        return cls(stage, (first, second), (ctx.inverse_mass(first), ctx.inverse_mass(second)),
+        return cls(stage, (first, second), inverse,
                    ((component(first, "n"), component(first, "t")), (component(second, "n"), component(second, "t"))),
                    common)
 
@@ -226,16 +222,9 @@ def _output(stage: Stage, run: Run, inverse: tuple[float, ...], before: list[flo
     if "common" in fields:
         run.output(fields["common"].n, common[0])
         run.output(fields["common"].t, common[1])
-    speed = math.hypot(*common)
-    if "speed" in fields:
-        run.output(fields["speed"], speed)
-    if "angle" in fields:
-        along, across = common if fields.get("from", _FROM) == "n" else common[::-1]
-        if speed > 0 and run.resolves(speed):
-            run.output(fields["angle"], math.atan2(across, along))
-        else:
-            run.undefined[to_text(fields["angle"])] = "the wreck does not move, so it has no direction"
-            run.output(fields["angle"], math.nan)
+    along_across = common if fields.get("from", _FROM) == "n" else (common[1], common[0])
+    output_polar(run, along_across, fields.get("speed"), fields.get("angle"),
+                 "the wreck does not move, so it has no direction", math.hypot(*common))
     # The loss from the relative velocity the contact took away, 1/2 mu (a - s)(a + s) with a = |u1 - u2| and
     # s = |v1 - v2| as simulated: never T - T', which cancels when the bodies nearly moved together already.
     approach = math.hypot(before[0] - before[2], before[1] - before[3])

@@ -18,6 +18,7 @@ from grader.model.quantities import ANGLE, SPEED
 from grader.physics.effects.base import Condition, Effect, Field, Mistake, Relation
 
 if TYPE_CHECKING:
+    from grader.model.expr import Node
     from grader.model.scene import Stage
     from grader.physics.record import Run
     from grader.physics.symbolic import Context
@@ -56,6 +57,32 @@ def _components(stage: Stage, ctx: Context, other_axis: bool = False) -> list[Re
             solutions={angle: sp.pi / 2 - direction if other_axis else direction}, general=False,
             undefined={angle: (sp.Le(hypot(n, t), 0), f"{what} is zero, so it has no direction")}))
     return relations
+
+
+def output_polar(run: Run, vector: tuple[float, float], size: Node | None, angle: Node | None, still: str,
+                 speed: float) -> None:
+    """Give a simulated vector's magnitude (``hypot``) and direction (``atan2``, from its first component toward
+    its second) to the fields that name them (None: not asked). A vector whose ``speed`` (the speed it stands
+    for) the run does not tell apart from zero has no direction: ``still`` says why.
+
+    >>> from grader.model.expr import Sym
+    >>> from grader.model.scene import Scene
+    >>> from grader.physics.record import Options, Run
+    >>> run = Run(Scene("x", {}, (), None), Options(), {}, speed_scale=5.0)
+    >>> output_polar(run, (3.0, 4.0), Sym("J"), Sym("theta"), "no impulse", 5.0)
+    >>> run.values["J"], round(math.degrees(run.values["theta"]), 2)
+    (5.0, 53.13)
+    """
+    magnitude = math.hypot(*vector)
+    if size is not None:
+        run.output(size, magnitude)
+    if angle is None:
+        return
+    if magnitude > 0 and run.resolves(speed):
+        run.output(angle, math.atan2(vector[1], vector[0]))
+    else:
+        run.undefined[to_text(angle)] = still
+        run.output(angle, math.nan)
 
 
 def _signed_symbol(expr: Any) -> bool:

@@ -3,9 +3,10 @@
 A student's file shows their sheet's header and total, then per problem their numbers, the figure and each
 part marked (what they typed, what it was read as, the verdict with its credit, the sentence that explains
 it, the expected value within its tolerance, the late deduction), then the worked solutions of their own
-variants exactly as the answer key has them: the key's part for that student
-(:func:`~grader.render.documents.key_source`), typeset on its own and joined after the marked pages
-(:mod:`grader.render.joining`). A student who sent nothing gets the same, saying that no answers were received.
+variants exactly as the answer key has them (``templates/solutions.typ.j2``, the key's own), on pages of the
+key's margins. It is one Typst document, a compile a student: every page has the footer of the student's
+file (their name and id, "page k of n" of that file), and the PDF keeps its tags for screen readers. A
+student who sent nothing gets the same, saying that no answers were received.
 
 Only that student's record (:class:`~grader.assign.returned.Returned`) and their own variants go into a
 file: nothing of another student, and none of the run's notes for the instructor. Sources are made from
@@ -19,10 +20,8 @@ are inline SVG typeset by Typst.
 
 from __future__ import annotations
 
-import concurrent.futures
 import html
 import re
-import tempfile
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -35,15 +34,8 @@ from grader.bank.template import Template
 from grader.base.errors import visible
 from grader.base.files import write_atomic
 from grader.base.spreadsheet import csv_text, number_cell, safe_cell
-from grader.render.documents import (
-    PAPER,
-    Documents,
-    _assignment_view,
-    _environment,
-    file_names,
-    key_source,
-)
-from grader.render.joining import Part, join, read_part
+from grader.render.documents import PAPER, Documents, KeyPerson, assignment_view, document_environment, file_names
+from grader.render.joining import without_false_suspects
 from grader.render.typeset import compile_typst, font_paths, one_pdf, release_memory
 from grader.render.typst_text import Typ, string
 
@@ -126,16 +118,18 @@ class Feedback:
                  fonts: tuple[str, ...] = ()) -> None:
         self.documents, self.fonts = Documents(assignment, generation, bank), fonts
 
-    def view(self, back: Returned) -> SheetView:
-        """What the graded sheet shows for one student."""
-        sheet, person = self.documents.sheet(back.index), self.documents.person(back.index)
+    def view(self, back: Returned, person: KeyPerson) -> SheetView:
+        """What the graded sheet shows for one student (``person``: their section of the key)."""
+        variants = self.documents.generation.students[back.index].problems
         marks = {part.label: part for part in back.parts}
         problems = []
-        for shown, worked in zip(sheet.problems, person.problems, strict=True):
-            parts = [marks[blank.label] for blank in shown.blanks]
-            views = tuple(self._mark(part, blank.description) for part, blank in zip(parts, shown.blanks, strict=True))
+        for number, (variant, worked) in enumerate(zip(variants, person.problems, strict=True)):
+            parts = [marks[answer.label] for answer in variant.answers]
+            views = tuple(self._mark(part, answer.description) for part, answer in zip(parts, variant.answers,
+                                                                                     strict=True))
             score = f"{_points(sum(p.score for p in parts))} of {_points(sum(p.points for p in parts))} points"
-            problems.append(ProblemView(shown.key, shown.title, score, worked.given, shown.figure, views))
+            problems.append(ProblemView(variant.key, worked.title, score, worked.given,
+                                        self.documents.figure(back.index, number), views))
         total = f"{_points(back.total)} of {_points(back.possible)} points"
         return SheetView(back.name, back.id, back.section, total, _late(back), back.submitted, tuple(problems))
 
@@ -148,29 +142,27 @@ class Feedback:
                         _credit(part), typed, part.typed, part.read_as if part.typed is not None else "", part.feedback,
                         part.expected, part.tolerance, late)
 
-    def marked_source(self, back: Returned) -> str:
-        """The Typst source of the marked pages."""
+    def source(self, back: Returned) -> str:
+        """The Typst source of the student's file: the marked pages, then their worked solutions."""
+        person = self.documents.person(back.index)
         assignment = self.documents.assignment
-        return _environment().get_template("feedback.typ.j2").render(
-            assignment=_assignment_view(assignment), sheet=self.view(back), paper=PAPER,
-            document_title=f"{assignment.title}: {back.name}, graded")
+        return document_environment().get_template("feedback.typ.j2").render(
+            assignment=assignment_view(assignment), sheet=self.view(back, person), person=person, paper=PAPER,
+            document_title=f"{assignment.title}: {back.name}, graded", begin=False)
 
-    def pdf(self, back: Returned, target: Path, scratch: Path, pool: concurrent.futures.Executor) -> None:
-        """Write the student's PDF: the marked pages, then their worked solutions as in the answer key (the
-        two typeset at once in ``pool``)."""
-        sources = (self.marked_source(back), key_source(self.documents, people=[back.index]))
-        parts = [pool.submit(_typeset_part, source, scratch / f"{number}.pdf", self.fonts)
-                 for number, source in enumerate(sources)]
-        assignment = self.documents.assignment
-        join([part.result() for part in parts], target, title=f"{assignment.title}: {back.name}, graded",
-             author=assignment.course, lang="en")
+    def pdf(self, back: Returned) -> bytes:
+        """The student's PDF: one document, so every page has their footer and its own page numbers."""
+        return without_false_suspects(one_pdf(compile_typst(self.source(back), fonts=self.fonts)))
 
-    def page(self, back: Returned, pool: concurrent.futures.Executor) -> str:
-        """The student's self-contained HTML page (its figures and worked solutions typeset at once in ``pool``)."""
-        view = self.view(back)
-        figures, worked = (pool.submit(_svg_pages, source, self.fonts)
-                           for source in (_figures_source(view), key_source(self.documents, people=[back.index])))
-        return _html(self.documents.assignment, view, figures.result(), worked.result())
+    def page(self, back: Returned) -> str:
+        """The student's self-contained HTML page (its figures and worked solutions typeset as one document)."""
+        person = self.documents.person(back.index)
+        view = self.view(back, person)
+        source = document_environment().get_template("feedback-figures.typ.j2").render(
+            assignment=assignment_view(self.documents.assignment), problems=view.problems, person=person,
+            paper=PAPER, begin=True)
+        pages = _svg_pages(source, self.fonts)
+        return _html(self.documents.assignment, view, pages[:len(view.problems)], pages[len(view.problems):])
 
     def forget(self, back: Returned) -> None:
         """Drop what was built for this student."""
@@ -188,20 +180,15 @@ def write_feedback(assignment: Assignment, generation: Generation, bank: Mapping
     feedback = Feedback(assignment, generation, bank, font_paths(tuple(font_dirs)))
     names = file_names([back.id for back in returned])
     written = []
-    with tempfile.TemporaryDirectory(prefix=".feedback-", dir=out) as scratch, \
-            concurrent.futures.ThreadPoolExecutor(max_workers=2) as pool:  # Typst lets go of the GIL
-        for count, (back, name) in enumerate(zip(returned, names, strict=True), start=1):
-            target = out / f"{name}.{fmt}"
-            if fmt == "pdf":
-                feedback.pdf(back, target, Path(scratch), pool)
-            else:
-                write_atomic(target, feedback.page(back, pool))
-            feedback.forget(back)
-            written.append(target)
-            if count % RELEASE_EVERY == 0:
-                release_memory()
-            if progress:
-                progress(1)
+    for count, (back, name) in enumerate(zip(returned, names, strict=True), start=1):
+        target = out / f"{name}.{fmt}"
+        write_atomic(target, feedback.pdf(back) if fmt == "pdf" else feedback.page(back))
+        feedback.forget(back)
+        written.append(target)
+        if count % RELEASE_EVERY == 0:
+            release_memory()
+        if progress:
+            progress(1)
     rows: list[list[object]] = [["id", "name", "email", "file", "total"]]
     rows += [[safe_cell(visible(b.id)), safe_cell(visible(b.name)), safe_cell(visible(b.email)), safe_cell(path.name),
               number_cell(b.total)]
@@ -245,21 +232,11 @@ def _e(value: object) -> str:
     return html.escape(str(value), quote=True)
 
 
-def _typeset_part(source: str, path: Path, fonts: tuple[str, ...]) -> Part:
-    path.write_bytes(one_pdf(compile_typst(source, tagged=False, fonts=fonts)))
-    return read_part(path)
-
-
 def _svg_pages(source: str, fonts: tuple[str, ...]) -> list[str]:
     """A source typeset as SVG, a page each."""
     result = compile_typst(source, "svg", fonts=fonts)
     pages = [result] if isinstance(result, bytes) else result
     return [page.decode("utf-8") for page in pages]
-
-
-def _figures_source(view: SheetView) -> str:
-    """A Typst document of the student's numbers and figure of each problem, one problem a page."""
-    return _environment().get_template("feedback-figures.typ.j2").render(problems=view.problems)
 
 
 def _html(assignment: Assignment, view: SheetView, figures: Sequence[str], worked: Sequence[str]) -> str:

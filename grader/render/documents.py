@@ -398,7 +398,7 @@ def document_environment() -> jinja2.Environment:
     environment = jinja2.Environment(
         loader=jinja2.FileSystemLoader(str(templates_dir())), undefined=jinja2.StrictUndefined,
         finalize=_finalize, trim_blocks=True, lstrip_blocks=True, keep_trailing_newline=True,
-        autoescape=False)  # noqa: S701
+        auto_reload=False, autoescape=False)  # noqa: S701 (the templates are the package's: no file checks a render)
     environment.filters["str"] = string
     environment.filters["int"] = lambda value: Typ(str(int(value)))
     environment.filters["bool"] = lambda value: Typ("true" if value else "false")

@@ -20,8 +20,10 @@ are inline SVG typeset by Typst.
 
 from __future__ import annotations
 
+import concurrent.futures
 import html
 import re
+from collections import deque
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -42,6 +44,7 @@ from grader.render.typst_text import Typ, string
 FOLDER, INDEX = "feedback", "index.csv"
 Format = Literal["pdf", "html"]
 RELEASE_EVERY = 8  # students between letting Typst's memo go: memory stays flat over a class
+JOBS, AHEAD = 2, 3  # students typeset at once (on 2 cores), and whose sources may wait for a thread
 
 VERDICT_WORDS = {"correct": "correct", "ecf": "correct for your earlier answer (error carried forward)",
                  "mistake": "a common mistake", "incorrect": "incorrect", "invalid": "could not be read",
@@ -142,31 +145,28 @@ class Feedback:
                         _credit(part), typed, part.typed, part.read_as if part.typed is not None else "", part.feedback,
                         part.expected, part.tolerance, late)
 
-    def source(self, back: Returned) -> str:
-        """The Typst source of the student's file: the marked pages, then their worked solutions."""
-        person = self.documents.person(back.index)
-        assignment = self.documents.assignment
-        return document_environment().get_template("feedback.typ.j2").render(
-            assignment=assignment_view(assignment), sheet=self.view(back, person), person=person, paper=PAPER,
-            document_title=f"{assignment.title}: {back.name}, graded", begin=False)
+    def submit(self, back: Returned, fmt: Format,
+               pool: concurrent.futures.Executor) -> concurrent.futures.Future[bytes | str]:
+        """Make the student's Typst source here and typeset it in ``pool``: the future is the file's content.
 
-    def pdf(self, back: Returned) -> bytes:
-        """The student's PDF: one document, so every page has their footer and its own page numbers."""
-        return without_false_suspects(one_pdf(compile_typst(self.source(back), fonts=self.fonts)))
-
-    def page(self, back: Returned) -> str:
-        """The student's self-contained HTML page (its figures and worked solutions typeset as one document)."""
+        The PDF is one document, the marked pages then the worked solutions, so every page has the student's
+        footer and the file's own page numbers; the HTML page's figures and worked solutions are one document."""
         person = self.documents.person(back.index)
         view = self.view(back, person)
-        source = document_environment().get_template("feedback-figures.typ.j2").render(
-            assignment=assignment_view(self.documents.assignment), problems=view.problems, person=person,
-            paper=PAPER, begin=True)
-        pages = _svg_pages(source, self.fonts)
-        return _html(self.documents.assignment, view, pages[:len(view.problems)], pages[len(view.problems):])
-
-    def forget(self, back: Returned) -> None:
-        """Drop what was built for this student."""
-        self.documents.forget([back.index])
+        assignment = self.documents.assignment
+        typeset: concurrent.futures.Future[bytes | str]
+        if fmt == "pdf":
+            source = document_environment().get_template("feedback.typ.j2").render(
+                assignment=assignment_view(assignment), sheet=view, person=person, paper=PAPER,
+                document_title=f"{assignment.title}: {back.name}, graded", begin=False)
+            typeset = pool.submit(_pdf, source, self.fonts)
+        else:
+            source = document_environment().get_template("feedback-figures.typ.j2").render(
+                assignment=assignment_view(assignment), problems=view.problems, person=person, paper=PAPER,
+                begin=True)
+            typeset = pool.submit(_page, assignment, view, source, self.fonts)
+        self.documents.forget([back.index])  # what was built for this student: memory stays flat
+        return typeset
 
 
 def write_feedback(assignment: Assignment, generation: Generation, bank: Mapping[str, Template],
@@ -174,27 +174,51 @@ def write_feedback(assignment: Assignment, generation: Generation, bank: Mapping
                    progress: Callable[[int], None] | None = None) -> list[Path]:
     """Write ``folder/feedback/<file name>.pdf`` (or ``.html``) per student of ``returned`` (file names as
     the students' sheets have them, :func:`~grader.render.documents.file_names`), then ``index.csv``;
-    returns the paths written."""
+    returns the paths written. Students' files are typeset ``JOBS`` at a time while this thread makes the
+    next sources (Typst lets go of the GIL); at most ``AHEAD`` wait, so memory does not grow with the class."""
     out = folder / FOLDER
     out.mkdir(parents=True, exist_ok=True)
     feedback = Feedback(assignment, generation, bank, font_paths(tuple(font_dirs)))
     names = file_names([back.id for back in returned])
-    written = []
-    for count, (back, name) in enumerate(zip(returned, names, strict=True), start=1):
-        target = out / f"{name}.{fmt}"
-        write_atomic(target, feedback.pdf(back) if fmt == "pdf" else feedback.page(back))
-        feedback.forget(back)
+    written: list[Path] = []
+    waiting: deque[tuple[Path, concurrent.futures.Future[bytes | str]]] = deque()
+
+    def write_next() -> None:
+        target, typeset = waiting.popleft()
+        write_atomic(target, typeset.result())
         written.append(target)
-        if count % RELEASE_EVERY == 0:
+        if len(written) % RELEASE_EVERY == 0:
             release_memory()
         if progress:
             progress(1)
+
+    pool = concurrent.futures.ThreadPoolExecutor(max_workers=JOBS)
+    try:
+        for back, name in zip(returned, names, strict=True):
+            waiting.append((out / f"{name}.{fmt}", feedback.submit(back, fmt, pool)))
+            if len(waiting) > AHEAD:
+                write_next()
+        while waiting:
+            write_next()
+    finally:
+        pool.shutdown(wait=True, cancel_futures=True)  # on an error, what has not started is not typeset
     rows: list[list[object]] = [["id", "name", "email", "file", "total"]]
     rows += [[safe_cell(visible(b.id)), safe_cell(visible(b.name)), safe_cell(visible(b.email)), safe_cell(path.name),
               number_cell(b.total)]
              for b, path in zip(returned, written, strict=True)]
     write_atomic(out / INDEX, csv_text(rows))
     return [*written, out / INDEX]
+
+
+def _pdf(source: str, fonts: tuple[str, ...]) -> bytes:
+    """A student's PDF, with its tags for screen readers."""
+    return without_false_suspects(one_pdf(compile_typst(source, fonts=fonts)))
+
+
+def _page(assignment: Assignment, view: SheetView, source: str, fonts: tuple[str, ...]) -> str:
+    """A student's HTML page: ``source`` (a page per problem's figure, then the worked solutions) typeset as SVG."""
+    pages = _svg_pages(source, fonts)
+    return _html(assignment, view, pages[:len(view.problems)], pages[len(view.problems):])
 
 
 # --- HTML ---------------------------------------------------------------------------------------

@@ -17,7 +17,7 @@ from grader.bank.template import Template
 from grader.grade.feedback_rows import key_generation, key_templates, returned
 from grader.grade.grading import Graded
 from grader.render.feedback import FOLDER, Format, write_feedback
-from grader.render.generate import _progress as progress_bar
+from grader.render.generate import progress_bar
 
 __all__ = ["FOLDER", "feedback_writer"]
 

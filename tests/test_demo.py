@@ -20,7 +20,7 @@ import pytest
 import grader.demo
 from grader.assign.assignment import load_assignment, load_roster
 from grader.assign.sample_answers import NUMERIC, SYMBOLIC, SampleAnswer, sample_answers, submissions_csv
-from grader.assign.variants import generate
+from grader.assign.variants import Generation
 from grader.bank.template import Template
 from grader.base.files import MANIFEST
 from grader.base.resources import sample_dir
@@ -36,10 +36,9 @@ REGRADE = ("grader grade --key grader-demo/key.json grader-demo/submissions.csv 
 
 
 @pytest.fixture(scope="module")
-def answers(bank: dict[str, Template]) -> list[SampleAnswer]:
+def answers(bank: dict[str, Template], sample_generation: Generation) -> list[SampleAnswer]:
     """The sample assignment's simulated answers, made in process."""
-    assignment = load_assignment(sample_dir() / "assignment.yaml")
-    return sample_answers(assignment, generate(assignment, load_roster(sample_dir() / "roster.csv"), bank), bank)
+    return sample_answers(load_assignment(sample_dir() / "assignment.yaml"), sample_generation, bank)
 
 
 def rows(path: Path) -> list[dict[str, str]]:

@@ -318,12 +318,6 @@ def test_a_key_from_the_shipped_bank_records_no_folder(demo_run: DemoRun) -> Non
     assert all("bank" not in entry for entry in document["templates"].values())
 
 
-@pytest.fixture
-def sample_key(demo_run: DemoRun) -> Path:
-    """The sample assignment's key.json, as the demo wrote it."""
-    return demo_run.out / "key.json"
-
-
 def test_grader_grade_with_a_bank_that_lacks_the_template_notes_it_and_grades(
         tmp_path: Path, capsys: pytest.CaptureFixture[str], sample_key: Path) -> None:
     student = json.loads(sample_key.read_text(encoding="utf-8"))["students"][0]["id"]

@@ -112,6 +112,33 @@ def test_a_sheet_shows_what_was_typed_read_the_verdicts_sentences_and_the_worked
         assert shown in text, shown
 
 
+def test_every_page_has_the_students_own_footer_the_worked_solutions_too(feedback: Path) -> None:
+    """The worked solutions' pages are the student's file's, not the answer key's: each page of Ben O'Brien's file
+    ends with his name and id and "page k of n" of that file."""
+    from pypdf import PdfReader
+
+    pages = [re.sub(r"\s+", " ", page.extract_text()) for page in PdfReader(feedback / "2026137.pdf").pages]
+    assert len(pages) > 3 and any("Given:" in page for page in pages)
+    for number, page in enumerate(pages, start=1):
+        assert "Ben O'Brien (2026137) · Homework 7: Impact, graded" in page, number
+        assert f"page {number} of {len(pages)}" in page, number
+        assert "answer key" not in page, number
+
+
+def test_each_part_is_described_as_the_students_sheet_describes_it(feedback: Path, demo_run: DemoRun,
+                                                                    bank: dict[str, Template]) -> None:
+    """What a part asks reads as on the sheet the student answered (car-collision's 2c: ``vA'/v for the given p``,
+    printed on both as the template words it)."""
+    key = json.loads((demo_run.out / "key.json").read_text(encoding="utf-8"))
+    sheet, marked = pdf_text(demo_run.out / "students" / "2026137.pdf"), pdf_text(feedback / "2026137.pdf")
+    problems = next(s for s in key["students"] if s["id"] == "2026137")["problems"]
+    parts = [(answer["label"], bank[problem["template"]].answers[name].description)
+             for problem in problems for name, answer in problem["answers"].items()]
+    assert ("2c", "vA'/v for the given p") in parts
+    for label, description in parts:
+        assert description in sheet and description in marked, (label, description)
+
+
 def test_who_submitted_nothing_gets_the_sheet_the_expected_values_and_the_worked_solutions(feedback: Path) -> None:
     absent = [row for row in index_rows(feedback) if "No answers were received" in pdf_text(feedback / row["file"])]
     assert [row["total"] for row in absent] == ["0"]

@@ -22,12 +22,9 @@ Document = dict[str, Any]
 
 
 @pytest.fixture(scope="module")
-def key_document(tmp_path_factory: pytest.TempPathFactory) -> Document:
-    """The sample assignment's key (30 students, 5 problems, no PDFs), as JSON."""
-    out = tmp_path_factory.mktemp("key") / "hw"
-    assert main(["generate", str(sample_dir() / "assignment.yaml"), "--roster", str(sample_dir() / "roster.csv"),
-                 "--out", str(out), "--no-pdf"]) == 0
-    return json.loads((out / "key.json").read_text(encoding="utf-8"))  # type: ignore[no-any-return]
+def key_document(sample_key: Path) -> Document:
+    """The sample assignment's key (30 students, 5 problems), as JSON."""
+    return json.loads(sample_key.read_text(encoding="utf-8"))  # type: ignore[no-any-return]
 
 
 def _relabel(document: Document, problem: int, answer: int, label: str) -> None:

@@ -39,8 +39,8 @@ def assignment() -> Assignment:
 
 
 @pytest.fixture(scope="module")
-def generation(assignment: Assignment, bank: dict[str, Template]) -> Generation:
-    return generate(assignment, load_roster(sample_dir() / "roster.csv"), bank)
+def generation(sample_generation: Generation) -> Generation:
+    return sample_generation
 
 
 @pytest.fixture(scope="module")

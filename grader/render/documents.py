@@ -267,8 +267,12 @@ class Documents:
         blanks = tuple(Blank(part.label, part.description, self._blank_unit(template, part),
                              _points(part.points)) for part in variant.answers)
         return ProblemSheet(variant.key, template.title, _points(sum(p.points for p in variant.answers)),
-                            statement(template, variant),
-                            figure(template, variant, self.solution(student, problem).values), blanks)
+                            statement(template, variant), self.figure(student, problem), blanks)
+
+    def figure(self, student: int, problem: int) -> Typ:
+        """The figure of one student's problem, to the scale of their numbers."""
+        variant = self.generation.students[student].problems[problem]
+        return figure(self.bank[variant.template], variant, self.solution(student, problem).values)
 
     @staticmethod
     def _blank_unit(template: Template, part: AnswerPart) -> str:
@@ -289,7 +293,7 @@ class Documents:
         template = self.bank[variant.template]
         given = Typ(", ".join(f"${g}$" for g in solution.given))
         steps = tuple(_key_step(s) for s in solution.steps)
-        answers = tuple(_key_answer(template, part) for part in variant.answers)
+        answers = tuple(_key_answer(template, part, self._compiled(template)) for part in variant.answers)
         return KeyProblem(variant.key, template.title, variant.variant_seed, given, solution.notes, steps, answers)
 
     def glance(self, position: int, indices: Sequence[int], part: str, continued: bool) -> Glance:
@@ -345,7 +349,7 @@ def _key_step(step: WorkedStep) -> KeyStep:
     return KeyStep(step.relation, _math(f"display({step.equation})" if step.equation else ""), Typ(chain), step.note)
 
 
-def _key_answer(template: Template, part: AnswerPart) -> KeyAnswer:
+def _key_answer(template: Template, part: AnswerPart, compiled: Compiled) -> KeyAnswer:
     source = math(template.answers[part.name].value)
     if part.value is None:
         value = Typ(f"${source}$ {text('undefined: ' + (part.undefined or 'no value'))}")
@@ -353,15 +357,15 @@ def _key_answer(template: Template, part: AnswerPart) -> KeyAnswer:
         value = _math(f"display({source} = {answer_math(part.value, part.unit)})")
     figure, reason = part.tolerance.describe(part.unit), part.tolerance.reason
     return KeyAnswer(part.label, part.description, value, f"{part.points:g}",
-                     f"{figure} (widened)" if reason else figure, _widened(template, part, figure, reason))
+                     f"{figure} (widened)" if reason else figure, _widened(template, part, figure, reason, compiled))
 
 
-def _widened(template: Template, part: AnswerPart, figure: str, reason: str) -> Typ:
+def _widened(template: Template, part: AnswerPart, figure: str, reason: str, compiled: Compiled) -> Typ:
     """Why a part's tolerance was widened, its quantities as math and the answer itself as "it"
     (``rounding v_common and T ... moves loss_pct`` named what only the template knows)."""
     if not reason:
         return NO_NOTE
-    quantities = {*template.parameters, *(step.unknown for step in compiled_for(template).steps)}
+    quantities = {*template.parameters, *(step.unknown for step in compiled.steps)}
     said = re.sub(rf"\bmoves {re.escape(part.name)}\b", "moves it", reason)
     # The reason writes a velocity after as ``v_obj_n′`` (assign/fair.py): the page prints the quantity, v′_(obj, n)
     said = re.sub(r"\b(\w+)\u2032", lambda found: found.group(1) + "_after"
@@ -390,19 +394,23 @@ def _finalize(value: Any) -> Any:
 
 
 @lru_cache(maxsize=1)
-def _environment() -> jinja2.Environment:
+def document_environment() -> jinja2.Environment:
+    """The Jinja2 environment of the document templates in ``templates/`` (sheets, key, feedback): every
+    ``{{ }}`` shown as Typst text unless marked as Typst source (:class:`~grader.render.typst_text.Typ`)."""
     # Not HTML, so no autoescape: _finalize shows every value as a Typst string instead.
     environment = jinja2.Environment(
         loader=jinja2.FileSystemLoader(str(templates_dir())), undefined=jinja2.StrictUndefined,
         finalize=_finalize, trim_blocks=True, lstrip_blocks=True, keep_trailing_newline=True,
-        autoescape=False)  # noqa: S701
+        auto_reload=False, autoescape=False)  # noqa: S701 (the templates are the package's: no file checks a render)
     environment.filters["str"] = string
     environment.filters["int"] = lambda value: Typ(str(int(value)))
     environment.filters["bool"] = lambda value: Typ("true" if value else "false")
     return environment
 
 
-def _assignment_view(assignment: Assignment) -> dict[str, Any]:
+def assignment_view(assignment: Assignment) -> dict[str, Any]:
+    """What a document template shows of the assignment: title, course, due date, instructions, the rounding
+    rule and the widest tolerance."""
     return {"title": assignment.title, "course": assignment.course, "due": assignment.due,
             "instructions": paragraphs(assignment.instructions), "rounding": assignment.grading.rounding_rule,
             "widest": Tolerance(rtol=assignment.grading.max_tolerance).describe()}
@@ -412,8 +420,8 @@ def student_source(documents: Documents, indices: Iterable[int]) -> str:
     """The Typst source of the sheets of the listed students (roster positions), in order."""
     sheets = [documents.sheet(i) for i in indices]
     title = documents.assignment.title + (f": {sheets[0].name}" if len(sheets) == 1 else ": class")
-    return _environment().get_template("student.typ.j2").render(
-        assignment=_assignment_view(documents.assignment), sheets=sheets, paper=PAPER, document_title=title)
+    return document_environment().get_template("student.typ.j2").render(
+        assignment=assignment_view(documents.assignment), sheets=sheets, paper=PAPER, document_title=title)
 
 
 def key_source(documents: Documents, *, cover: Cover | None = None, glances: Sequence[Glance] = (),
@@ -422,8 +430,8 @@ def key_source(documents: Documents, *, cover: Cover | None = None, glances: Seq
     worked solutions of the listed students (roster positions), or any of them in this order; with
     ``numbers``, that many pages of the key's page numbers alone (stamped on the joined key's pages)."""
     assignment = documents.assignment
-    return _environment().get_template("key.typ.j2").render(
-        assignment=_assignment_view(assignment), paper=PAPER, cover=cover, glances=glances, numbers=numbers,
+    return document_environment().get_template("key.typ.j2").render(
+        assignment=assignment_view(assignment), paper=PAPER, cover=cover, glances=glances, numbers=numbers,
         people=[(i + 1, documents.person(i)) for i in people], document_title=f"{assignment.title}: answer key")
 
 

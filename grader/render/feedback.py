@@ -3,9 +3,10 @@
 A student's file shows their sheet's header and total, then per problem their numbers, the figure and each
 part marked (what they typed, what it was read as, the verdict with its credit, the sentence that explains
 it, the expected value within its tolerance, the late deduction), then the worked solutions of their own
-variants exactly as the answer key has them: the key's part for that student
-(:func:`~grader.render.documents.key_source`), typeset on its own and joined after the marked pages
-(:mod:`grader.render.joining`). A student who sent nothing gets the same, saying that no answers were received.
+variants exactly as the answer key has them (``templates/solutions.typ.j2``, the key's own), on pages of the
+key's margins. It is one Typst document, a compile a student: every page has the footer of the student's
+file (their name and id, "page k of n" of that file), and the PDF keeps its tags for screen readers. A
+student who sent nothing gets the same, saying that no answers were received.
 
 Only that student's record (:class:`~grader.assign.returned.Returned`) and their own variants go into a
 file: nothing of another student, and none of the run's notes for the instructor. Sources are made from
@@ -22,7 +23,7 @@ from __future__ import annotations
 import concurrent.futures
 import html
 import re
-import tempfile
+from collections import deque
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -35,21 +36,15 @@ from grader.bank.template import Template
 from grader.base.errors import visible
 from grader.base.files import write_atomic
 from grader.base.spreadsheet import csv_text, number_cell, safe_cell
-from grader.render.documents import (
-    PAPER,
-    Documents,
-    _assignment_view,
-    _environment,
-    file_names,
-    key_source,
-)
-from grader.render.joining import Part, join, read_part
+from grader.render.documents import PAPER, Documents, KeyPerson, assignment_view, document_environment, file_names
+from grader.render.joining import without_false_suspects
 from grader.render.typeset import compile_typst, font_paths, one_pdf, release_memory
 from grader.render.typst_text import Typ, string
 
 FOLDER, INDEX = "feedback", "index.csv"
 Format = Literal["pdf", "html"]
 RELEASE_EVERY = 8  # students between letting Typst's memo go: memory stays flat over a class
+JOBS, AHEAD = 2, 3  # students typeset at once (on 2 cores), and whose sources may wait for a thread
 
 VERDICT_WORDS = {"correct": "correct", "ecf": "correct for your earlier answer (error carried forward)",
                  "mistake": "a common mistake", "incorrect": "incorrect", "invalid": "could not be read",
@@ -126,16 +121,18 @@ class Feedback:
                  fonts: tuple[str, ...] = ()) -> None:
         self.documents, self.fonts = Documents(assignment, generation, bank), fonts
 
-    def view(self, back: Returned) -> SheetView:
-        """What the graded sheet shows for one student."""
-        sheet, person = self.documents.sheet(back.index), self.documents.person(back.index)
+    def view(self, back: Returned, person: KeyPerson) -> SheetView:
+        """What the graded sheet shows for one student (``person``: their section of the key)."""
+        variants = self.documents.generation.students[back.index].problems
         marks = {part.label: part for part in back.parts}
         problems = []
-        for shown, worked in zip(sheet.problems, person.problems, strict=True):
-            parts = [marks[blank.label] for blank in shown.blanks]
-            views = tuple(self._mark(part, blank.description) for part, blank in zip(parts, shown.blanks, strict=True))
+        for number, (variant, worked) in enumerate(zip(variants, person.problems, strict=True)):
+            parts = [marks[answer.label] for answer in variant.answers]
+            views = tuple(self._mark(part, answer.description) for part, answer in zip(parts, variant.answers,
+                                                                                     strict=True))
             score = f"{_points(sum(p.score for p in parts))} of {_points(sum(p.points for p in parts))} points"
-            problems.append(ProblemView(shown.key, shown.title, score, worked.given, shown.figure, views))
+            problems.append(ProblemView(variant.key, worked.title, score, worked.given,
+                                        self.documents.figure(back.index, number), views))
         total = f"{_points(back.total)} of {_points(back.possible)} points"
         return SheetView(back.name, back.id, back.section, total, _late(back), back.submitted, tuple(problems))
 
@@ -148,33 +145,28 @@ class Feedback:
                         _credit(part), typed, part.typed, part.read_as if part.typed is not None else "", part.feedback,
                         part.expected, part.tolerance, late)
 
-    def marked_source(self, back: Returned) -> str:
-        """The Typst source of the marked pages."""
+    def submit(self, back: Returned, fmt: Format,
+               pool: concurrent.futures.Executor) -> concurrent.futures.Future[bytes | str]:
+        """Make the student's Typst source here and typeset it in ``pool``: the future is the file's content.
+
+        The PDF is one document, the marked pages then the worked solutions, so every page has the student's
+        footer and the file's own page numbers; the HTML page's figures and worked solutions are one document."""
+        person = self.documents.person(back.index)
+        view = self.view(back, person)
         assignment = self.documents.assignment
-        return _environment().get_template("feedback.typ.j2").render(
-            assignment=_assignment_view(assignment), sheet=self.view(back), paper=PAPER,
-            document_title=f"{assignment.title}: {back.name}, graded")
-
-    def pdf(self, back: Returned, target: Path, scratch: Path, pool: concurrent.futures.Executor) -> None:
-        """Write the student's PDF: the marked pages, then their worked solutions as in the answer key (the
-        two typeset at once in ``pool``)."""
-        sources = (self.marked_source(back), key_source(self.documents, people=[back.index]))
-        parts = [pool.submit(_typeset_part, source, scratch / f"{number}.pdf", self.fonts)
-                 for number, source in enumerate(sources)]
-        assignment = self.documents.assignment
-        join([part.result() for part in parts], target, title=f"{assignment.title}: {back.name}, graded",
-             author=assignment.course, lang="en")
-
-    def page(self, back: Returned, pool: concurrent.futures.Executor) -> str:
-        """The student's self-contained HTML page (its figures and worked solutions typeset at once in ``pool``)."""
-        view = self.view(back)
-        figures, worked = (pool.submit(_svg_pages, source, self.fonts)
-                           for source in (_figures_source(view), key_source(self.documents, people=[back.index])))
-        return _html(self.documents.assignment, view, figures.result(), worked.result())
-
-    def forget(self, back: Returned) -> None:
-        """Drop what was built for this student."""
-        self.documents.forget([back.index])
+        typeset: concurrent.futures.Future[bytes | str]
+        if fmt == "pdf":
+            source = document_environment().get_template("feedback.typ.j2").render(
+                assignment=assignment_view(assignment), sheet=view, person=person, paper=PAPER,
+                document_title=f"{assignment.title}: {back.name}, graded", begin=False)
+            typeset = pool.submit(_pdf, source, self.fonts)
+        else:
+            source = document_environment().get_template("feedback-figures.typ.j2").render(
+                assignment=assignment_view(assignment), problems=view.problems, person=person, paper=PAPER,
+                begin=True)
+            typeset = pool.submit(_page, assignment, view, source, self.fonts)
+        self.documents.forget([back.index])  # what was built for this student: memory stays flat
+        return typeset
 
 
 def write_feedback(assignment: Assignment, generation: Generation, bank: Mapping[str, Template],
@@ -182,32 +174,51 @@ def write_feedback(assignment: Assignment, generation: Generation, bank: Mapping
                    progress: Callable[[int], None] | None = None) -> list[Path]:
     """Write ``folder/feedback/<file name>.pdf`` (or ``.html``) per student of ``returned`` (file names as
     the students' sheets have them, :func:`~grader.render.documents.file_names`), then ``index.csv``;
-    returns the paths written."""
+    returns the paths written. Students' files are typeset ``JOBS`` at a time while this thread makes the
+    next sources (Typst lets go of the GIL); at most ``AHEAD`` wait, so memory does not grow with the class."""
     out = folder / FOLDER
     out.mkdir(parents=True, exist_ok=True)
     feedback = Feedback(assignment, generation, bank, font_paths(tuple(font_dirs)))
     names = file_names([back.id for back in returned])
-    written = []
-    with tempfile.TemporaryDirectory(prefix=".feedback-", dir=out) as scratch, \
-            concurrent.futures.ThreadPoolExecutor(max_workers=2) as pool:  # Typst lets go of the GIL
-        for count, (back, name) in enumerate(zip(returned, names, strict=True), start=1):
-            target = out / f"{name}.{fmt}"
-            if fmt == "pdf":
-                feedback.pdf(back, target, Path(scratch), pool)
-            else:
-                write_atomic(target, feedback.page(back, pool))
-            feedback.forget(back)
-            written.append(target)
-            if count % RELEASE_EVERY == 0:
-                release_memory()
-            if progress:
-                progress(1)
+    written: list[Path] = []
+    waiting: deque[tuple[Path, concurrent.futures.Future[bytes | str]]] = deque()
+
+    def write_next() -> None:
+        target, typeset = waiting.popleft()
+        write_atomic(target, typeset.result())
+        written.append(target)
+        if len(written) % RELEASE_EVERY == 0:
+            release_memory()
+        if progress:
+            progress(1)
+
+    pool = concurrent.futures.ThreadPoolExecutor(max_workers=JOBS)
+    try:
+        for back, name in zip(returned, names, strict=True):
+            waiting.append((out / f"{name}.{fmt}", feedback.submit(back, fmt, pool)))
+            if len(waiting) > AHEAD:
+                write_next()
+        while waiting:
+            write_next()
+    finally:
+        pool.shutdown(wait=True, cancel_futures=True)  # on an error, what has not started is not typeset
     rows: list[list[object]] = [["id", "name", "email", "file", "total"]]
     rows += [[safe_cell(visible(b.id)), safe_cell(visible(b.name)), safe_cell(visible(b.email)), safe_cell(path.name),
               number_cell(b.total)]
              for b, path in zip(returned, written, strict=True)]
     write_atomic(out / INDEX, csv_text(rows))
     return [*written, out / INDEX]
+
+
+def _pdf(source: str, fonts: tuple[str, ...]) -> bytes:
+    """A student's PDF, with its tags for screen readers."""
+    return without_false_suspects(one_pdf(compile_typst(source, fonts=fonts)))
+
+
+def _page(assignment: Assignment, view: SheetView, source: str, fonts: tuple[str, ...]) -> str:
+    """A student's HTML page: ``source`` (a page per problem's figure, then the worked solutions) typeset as SVG."""
+    pages = _svg_pages(source, fonts)
+    return _html(assignment, view, pages[:len(view.problems)], pages[len(view.problems):])
 
 
 # --- HTML ---------------------------------------------------------------------------------------
@@ -245,21 +256,11 @@ def _e(value: object) -> str:
     return html.escape(str(value), quote=True)
 
 
-def _typeset_part(source: str, path: Path, fonts: tuple[str, ...]) -> Part:
-    path.write_bytes(one_pdf(compile_typst(source, tagged=False, fonts=fonts)))
-    return read_part(path)
-
-
 def _svg_pages(source: str, fonts: tuple[str, ...]) -> list[str]:
     """A source typeset as SVG, a page each."""
     result = compile_typst(source, "svg", fonts=fonts)
     pages = [result] if isinstance(result, bytes) else result
     return [page.decode("utf-8") for page in pages]
-
-
-def _figures_source(view: SheetView) -> str:
-    """A Typst document of the student's numbers and figure of each problem, one problem a page."""
-    return _environment().get_template("feedback-figures.typ.j2").render(problems=view.problems)
 
 
 def _html(assignment: Assignment, view: SheetView, figures: Sequence[str], worked: Sequence[str]) -> str:

@@ -102,7 +102,7 @@ def _write_pdfs(job: Job, assignment: Assignment, generation: Generation, bank: 
     people = [(s.student.id, s.student.name) for s in generation.students]
     for warning in missing_glyph_warnings(people, font_paths(job.font_dirs)):
         print(warning, file=sys.stderr)
-    with _progress(len(generation.students) + 2, "PDFs") as advance:
+    with progress_bar(len(generation.students) + 2, "PDFs") as advance:
         return len(render_all(assignment, generation, bank, staging, jobs=job.jobs, keep_source=job.keep_source,
                               progress=advance, font_dirs=job.font_dirs))
 
@@ -118,7 +118,7 @@ def _frozen_for_the_run() -> Iterator[None]:
 
 
 @contextmanager
-def _progress(total: int, label: str) -> Iterator[Callable[[int], None]]:
+def progress_bar(total: int, label: str) -> Iterator[Callable[[int], None]]:
     """A progress bar on stderr when it is a terminal; silent otherwise."""
     if not sys.stderr.isatty():
         yield lambda _: None

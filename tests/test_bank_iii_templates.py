@@ -168,6 +168,17 @@ def ref_package_bounce(m, m_p, h, e, k):
     return {"v_up": v0 * (e * m_p - m) / mass, "V": platform, "extra": 1000 * platform * mp.sqrt(m_p / k)}
 
 
+def ref_pile_driver(m_ram, m_pile, h_drop, h_rebound):
+    """The asked quantities issue 27 adds: the ram falls h_drop and comes back up at sqrt(2 g h_rebound); momentum
+    gives the pile's velocity; the energy lost is T - T' and the impulse the pile's momentum after (in kJ, kN s)."""
+    m_ram, m_pile, h_drop, h_rebound = (mp.mpf(x) for x in (m_ram, m_pile, h_drop, h_rebound))
+    v_ram, v_back = mp.sqrt(2 * G * h_drop), mp.sqrt(2 * G * h_rebound)
+    v_pile = m_ram * (v_ram + v_back) / m_pile
+    before, after = m_ram * v_ram**2 / 2, (m_ram * v_back**2 + m_pile * v_pile**2) / 2
+    return {"v_pile": v_pile, "e": (v_pile + v_back) / v_ram, "energy_lost": (before - after) / 1000,
+            "loss_pct": 100 * (before - after) / before, "impulse": m_pile * v_pile / 1000}
+
+
 REFERENCES = {
     "bullet-block-spring": ref_bullet_block_spring, "package-on-platform": ref_package_on_platform,
     "ramp-slide": ref_ramp_slide, "incline-slide": ref_incline_slide,
@@ -176,6 +187,7 @@ REFERENCES = {
     "cushion-stop": ref_cushion_stop, "oblique-moving-spheres": ref_oblique_moving_spheres,
     "head-on-approach": ref_head_on_approach, "spring-carts": ref_spring_carts, "ramp-strike": ref_ramp_strike,
     "ramp-strike-inverse": ref_ramp_strike_inverse, "package-bounce": ref_package_bounce,
+    "pile-driver": ref_pile_driver,
 }
 
 
@@ -231,6 +243,10 @@ KNOWN = [
     # v_A = sqrt(2(9.81)(1.1)) = 4.646 m/s; v_B' = sqrt(2(0.28)(9.81)(2)) = 3.315 m/s; e = 3.315(4.4)/(2.2(4.646)) - 1
     ("ramp-strike-inverse", {"m_A": 2.2, "m_B": 2.2, "h": 1.1, "mu_k": 0.28, "d": 2},
      {"v_A": 4.646, "vB_out": 3.315, "e": 0.427}),
+    # Sample Problem 3/28: v = sqrt(2(9.81)(2)) = 6.264 down, 1.401 back up; v_pile = 800(7.665)/2400 = 2.555 m/s;
+    # T = 15 696 J, T' = 784.8 + 7834 = 8619 J: 7.078 kJ lost; the impulse on the pile 2400(2.555) = 6.132 kN s
+    ("pile-driver", {"m_ram": 800, "m_pile": 2400, "h_drop": 2, "h_rebound": 0.1},
+     {"v_pile": 2.555, "e": 0.6315, "energy_lost": 7.078, "loss_pct": 45.09, "impulse": 6.132}),
 ]
 
 
@@ -246,8 +262,15 @@ def drawn(template_id: str, count: int = 20) -> list[dict[str, float]]:
     """``count`` draws from the template's sampling ranges, rounded to its printed decimals."""
     raw = yaml.safe_load((bank_dir() / f"{template_id}.yaml").read_text(encoding="utf-8"))["parameters"]
     rng = np.random.default_rng(27)
-    return [{name: round(float(rng.uniform(*spec["sample"]["uniform"])), spec["decimals"])
-             for name, spec in raw.items()} for _ in range(count)]
+    return [{name: printed(float(rng.uniform(*spec["sample"]["uniform"])), spec) for name, spec in raw.items()}
+            for _ in range(count)]
+
+
+def printed(value: float, spec: dict[str, Any]) -> float:
+    """``value`` rounded as the sheet prints it: to ``decimals``, or to ``sig_figs`` significant figures."""
+    if "decimals" in spec:
+        return round(value, spec["decimals"])
+    return float(f"{value:.{spec['sig_figs']}g}")
 
 
 @pytest.mark.parametrize("template_id", REFERENCES)
@@ -296,6 +319,8 @@ HARD = [
     ("ramp-strike", {"m_A": 1e6, "m_B": 1e-6, "h": 1e-9, "e": 0, "mu_k": 1e-6}),
     ("ramp-strike-inverse", {"m_A": 2, "m_B": 2, "h": 1, "mu_k": 0.25, "d": 3.9}),  # e a hair below 1
     ("ramp-strike-inverse", {"m_A": 1e6, "m_B": 1e-6, "h": 1e-9, "mu_k": 1e-3, "d": 1.5e-6}),
+    ("pile-driver", {"m_ram": 1e-6, "m_pile": 1e6, "h_drop": 2, "h_rebound": 1.999999}),  # all but elastic
+    ("pile-driver", {"m_ram": 800, "m_pile": 2400, "h_drop": 2, "h_rebound": 0}),  # the ram stops dead
 ]
 
 

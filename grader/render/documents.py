@@ -31,6 +31,7 @@ from typing import Any
 import jinja2
 
 from grader.assign.assignment import Assignment, Student
+from grader.assign.fair import display_name
 from grader.assign.variants import AnswerPart, Generation, ProblemVariant, tolerance
 from grader.bank.markup import paragraphs
 from grader.bank.template import Template, filled_statement
@@ -363,6 +364,9 @@ def _widened(template: Template, part: AnswerPart, figure: str, reason: str) -> 
         return NO_NOTE
     quantities = {*template.parameters, *(step.unknown for step in compiled_for(template).steps)}
     said = re.sub(rf"\bmoves {re.escape(part.name)}\b", "moves it", reason)
+    for quantity in quantities:  # the reason's v2_n′ is the quantity v2_n_after, which the markup knows
+        if display_name(quantity) != quantity:
+            said = re.sub(rf"(?<!\w){re.escape(display_name(quantity))}", quantity, said)
     return Typ(text(f"widened to {figure}: ") + relation_markup(said, quantities))
 
 

@@ -453,3 +453,16 @@ def test_a_ball_on_a_cord_has_the_swings_mistakes(bank):
     got = values(alternatives_for(bank["two-pendulums"]), found[0],
                  {k: np.array([float(v)]) for k, v in bank["two-pendulums"].example.items()})
     assert float(got[0]) == pytest.approx(float(mp.sqrt(2 * G * mp.mpf(1.2) * mp.cos(deg(30)))), rel=1e-9)
+
+
+def test_the_angle_b_swings_to_has_the_swings_mistakes(bank):
+    """The height risen taken as L sin theta in both swings: v_A^2 = 2 g L sin 30, v_B' = 1.08 v_A (the example's
+    m_A (1 + e)/(m_A + m_B)) and sin theta_B = v_B'^2/(2 g L) = 1.08^2 sin 30 = 0.5832: 35.68 degrees. As
+    L cos theta, cos theta_B = 1.08^2 cos 30 > 1: no angle, so that mistake matches no answer."""
+    template = bank["two-pendulums"]
+    found = {a.id: a for a in alternatives_for(template).for_answer("theta_B") if a.kind == "mistake"}
+    params = {k: np.array([float(v)]) for k, v in template.example.items()}
+    by_hand = mp.asin(mp.mpf("1.08") ** 2 * mp.sin(deg(30))) * 180 / mp.pi
+    assert float(values(alternatives_for(template), found["swing.height_sin"], params)[0]) == pytest.approx(
+        float(by_hand), rel=1e-9)
+    assert np.isnan(values(alternatives_for(template), found["swing.height_cos"], params)[0])

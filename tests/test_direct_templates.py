@@ -20,7 +20,7 @@ from tests import references
 G = mp.mpf(9.81)  # the bank's g, as the float the kernels use
 KMH = Fraction(1000, 3600)  # km/h in m/s
 ISSUE = {  # ids, parameters and answers exactly as issue 13's table names them (issue 27 adds energies and impulses)
-    "head-on": (["m1", "m2", "v1", "v2", "e"], ["v1_out", "v2_out", "energy_lost", "loss_pct", "impulse"]),
+    "head-on": (["m1", "m2", "v1", "v2", "e"], ["v1_out", "v2_out", "loss_pct", "energy_lost", "impulse"]),
     "head-on-inverse": (["m1", "m2", "v1", "v2", "v1_out"], ["v2_out", "e", "loss_pct"]),
     "coupling": (["m_A", "m_B", "v_A", "v_B"], ["v_common", "energy_lost", "loss_pct", "impulse"]),
     "moving-plate": (["h", "u", "e"], ["v_out", "h_out"]),

@@ -164,7 +164,9 @@ TOPIC_OF = {
     "shell-explosion": "direct impact", "wall-impulse": "direct impact", "crash-reconstruction": "oblique impact",
     "intersection-crash": "oblique impact", "oblique-moving-spheres": "oblique impact",
     "cushion-stop": "drops and rebounds", "package-on-platform": "drops and rebounds", "spring-carts": "direct impact",
-    "package-bounce": "drops and rebounds",
+    "package-bounce": "drops and rebounds", "two-pendulums": "impact and a swing",
+    "two-pendulums-inverse": "impact and a swing", "billiards-inverse": "oblique impact",
+    "two-walls": "impact with flight", "shell-landing": "impact with flight",
 }
 
 

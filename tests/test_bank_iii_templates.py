@@ -17,6 +17,9 @@ import pytest
 import yaml
 
 from grader.base.resources import bank_dir
+from grader.solve.alternatives import values
+from grader.solve.cache import alternatives_for
+from grader.solve.evaluate import solve_one
 from tests import references
 
 G = mp.mpf(9.81)  # the bank's g, as the float the kernels use
@@ -168,6 +171,69 @@ def ref_package_bounce(m, m_p, h, e, k):
     return {"v_up": v0 * (e * m_p - m) / mass, "V": platform, "extra": 1000 * platform * mp.sqrt(m_p / k)}
 
 
+def ref_pile_driver(m_ram, m_pile, h_drop, h_rebound):
+    """The ram falls h_drop and comes back up at sqrt(2 g h_rebound); momentum gives the pile's velocity; the energy
+    lost is T - T'. (The energy in kJ and the impulse are not asked of pile-driver: see CHANGELOG, issue 27.)"""
+    m_ram, m_pile, h_drop, h_rebound = (mp.mpf(x) for x in (m_ram, m_pile, h_drop, h_rebound))
+    v_ram, v_back = mp.sqrt(2 * G * h_drop), mp.sqrt(2 * G * h_rebound)
+    v_pile = m_ram * (v_ram + v_back) / m_pile
+    before, after = m_ram * v_ram**2 / 2, (m_ram * v_back**2 + m_pile * v_pile**2) / 2
+    return {"v_pile": v_pile, "e": (v_pile + v_back) / v_ram, "loss_pct": 100 * (before - after) / before}
+
+
+def ref_two_pendulums(m_A, m_B, L, theta_A, e):  # noqa: N803
+    """Energy down A's swing, 1/2 v_A^2 = g L (1 - cos theta_A); momentum and e with B at rest,
+    v_B' = m_A (1 + e) v_A / (m_A + m_B); energy up B's swing, cos theta_B = 1 - v_B'^2 / (2 g L)."""
+    m_a, m_b, length, e = (mp.mpf(x) for x in (m_A, m_B, L, e))
+    v_a = mp.sqrt(2 * G * length * (1 - mp.cos(deg(theta_A))))
+    v_b = m_a * (1 + e) * v_a / (m_a + m_b)
+    return {"v_A": v_a, "vB_out": v_b, "theta_B": mp.acos(1 - v_b**2 / (2 * G * length)) * 180 / mp.pi}
+
+
+def ref_two_pendulums_inverse(m_A, m_B, L, theta_A, theta_B):  # noqa: N803
+    """v_A and v_B' from the two swings' energy; A's velocity after from momentum, e = (v_B' - v_A') / v_A."""
+    m_a, m_b, length = (mp.mpf(x) for x in (m_A, m_B, L))
+    v_a = mp.sqrt(2 * G * length * (1 - mp.cos(deg(theta_A))))
+    v_b = mp.sqrt(2 * G * length * (1 - mp.cos(deg(theta_B))))
+    v_a_after = (m_a * v_a - m_b * v_b) / m_a
+    return {"v_A": v_a, "vB_out": v_b, "e": (v_b - v_a_after) / v_a}
+
+
+def ref_billiards_inverse(v, r, b, alpha):
+    """sin theta = b / 2r between the cue ball's velocity and the line of centres n. Equal masses, the object ball
+    at rest: the cue ball keeps v sin theta along t and has v cos theta (1 - e)/2 along n after, so its direction
+    from n is theta + alpha: tan(theta + alpha) = 2 tan theta / (1 - e); the object ball takes v cos theta (1 + e)/2.
+    (The cue ball's speed after is not asked: given it instead, b is a block of nine unknowns that the solver does
+    not reduce, "nothing fixes b", which the inverse walk refuses.)"""
+    v, r, b = mp.mpf(v), mp.mpf(r), mp.mpf(b)
+    theta = mp.asin(b / (2 * r))
+    e = 1 - 2 * mp.tan(theta) / mp.tan(theta + deg(alpha))
+    along_n = v * mp.cos(theta)
+    return {"e": e, "v_obj": along_n * (1 + e) / 2}
+
+
+def ref_two_walls(h0, v0, D, W, e):  # noqa: N803
+    """Smooth walls leave the vertical motion alone: the height after a time t is h0 - g t^2 / 2 throughout. The
+    ball reaches wall A after D / v0, wall B after W / (e v0) more, and then moves away from B at e^2 v0 until it
+    lands at sqrt(2 h0 / g) from the throw."""
+    h0, v0, D, W, e = (mp.mpf(x) for x in (h0, v0, D, W, e))  # noqa: N806
+    t_a, t_b = D / v0, D / v0 + W / (e * v0)
+    return {"y_A": h0 - G * t_a**2 / 2, "y_B": h0 - G * t_b**2 / 2,
+            "x_land": e**2 * v0 * (mp.sqrt(2 * h0 / G) - t_b)}
+
+
+def ref_shell_landing(m_A, m_B, v0, alpha):  # noqa: N803
+    """At the top the shell moves at v0 cos alpha, H = (v0 sin alpha)^2 / 2 g up, after t = v0 sin alpha / g and
+    v0 cos alpha t along; A is left at rest, so momentum gives B (m_A + m_B) v0 cos alpha / m_B; B falls H in
+    the same time t, landing (v0 cos alpha + v_B) t from the gun; the energy added is T' - T."""
+    m_a, m_b, v0 = mp.mpf(m_A), mp.mpf(m_B), mp.mpf(v0)
+    v_x, v_y = v0 * mp.cos(deg(alpha)), v0 * mp.sin(deg(alpha))
+    t = v_y / G
+    v_b = (m_a + m_b) * v_x / m_b
+    return {"H": v_y**2 / (2 * G), "v_B": v_b, "x_land": (v_x + v_b) * t,
+            "E": (m_b * v_b**2 - (m_a + m_b) * v_x**2) / 2 / 1000}
+
+
 REFERENCES = {
     "bullet-block-spring": ref_bullet_block_spring, "package-on-platform": ref_package_on_platform,
     "ramp-slide": ref_ramp_slide, "incline-slide": ref_incline_slide,
@@ -176,6 +242,9 @@ REFERENCES = {
     "cushion-stop": ref_cushion_stop, "oblique-moving-spheres": ref_oblique_moving_spheres,
     "head-on-approach": ref_head_on_approach, "spring-carts": ref_spring_carts, "ramp-strike": ref_ramp_strike,
     "ramp-strike-inverse": ref_ramp_strike_inverse, "package-bounce": ref_package_bounce,
+    "pile-driver": ref_pile_driver, "two-pendulums": ref_two_pendulums,
+    "two-pendulums-inverse": ref_two_pendulums_inverse, "billiards-inverse": ref_billiards_inverse,
+    "two-walls": ref_two_walls, "shell-landing": ref_shell_landing,
 }
 
 
@@ -231,6 +300,28 @@ KNOWN = [
     # v_A = sqrt(2(9.81)(1.1)) = 4.646 m/s; v_B' = sqrt(2(0.28)(9.81)(2)) = 3.315 m/s; e = 3.315(4.4)/(2.2(4.646)) - 1
     ("ramp-strike-inverse", {"m_A": 2.2, "m_B": 2.2, "h": 1.1, "mu_k": 0.28, "d": 2},
      {"v_A": 4.646, "vB_out": 3.315, "e": 0.427}),
+    # Sample Problem 3/28: v = sqrt(2(9.81)(2)) = 6.264 down, 1.401 back up; v_pile = 800(7.665)/2400 = 2.555 m/s;
+    # T = 15 696 J, T' = 784.8 + 7834 = 8619 J: 7077 J, 45.09 % lost
+    ("pile-driver", {"m_ram": 800, "m_pile": 2400, "h_drop": 2, "h_rebound": 0.1},
+     {"v_pile": 2.555, "e": 0.6315, "loss_pct": 45.09}),
+    # v_A = sqrt(2(9.81)(1.2)(1 - cos 30)) = 1.776 m/s; v_B' = 0.6(1.8)(1.776)/1.0 = 1.918 m/s;
+    # cos theta_B = 1 - 1.918^2/(2(9.81)(1.2)) = 0.8437: 32.46 deg
+    ("two-pendulums", {"m_A": 0.6, "m_B": 0.4, "L": 1.2, "theta_A": 30, "e": 0.8},
+     {"v_A": 1.776, "vB_out": 1.918, "theta_B": 32.46}),
+    # v_B' = sqrt(2(9.81)(1.2)(1 - cos 28)) = 1.660 m/s; v_A' = (0.55(1.776) - 0.45(1.660))/0.55 = 0.4178 m/s;
+    # e = (1.660 - 0.4178)/1.776 = 0.6995
+    ("two-pendulums-inverse", {"m_A": 0.55, "m_B": 0.45, "L": 1.2, "theta_A": 30, "theta_B": 28},
+     {"v_A": 1.776, "vB_out": 1.66, "e": 0.6995}),
+    # sin theta = 30/57: theta = 31.76 deg; e = 1 - 2 tan 31.76/tan 79.76 = 1 - 1.238/5.535 = 0.7763;
+    # along n 2 cos 31.76 = 1.701: v_obj = 1.701(1.776)/2 = 1.510 m/s
+    ("billiards-inverse", {"v": 2, "r": 28.5, "b": 30, "alpha": 48}, {"e": 0.7763, "v_obj": 1.51}),
+    # t_A = 2/10.5 = 0.1905 s, y_A = 5.5 - 4.905(0.1905)^2 = 5.322 m; t_B = 0.1905 + 4.5/7.875 = 0.7619 s,
+    # y_B = 5.5 - 4.905(0.7619)^2 = 2.653 m; lands at sqrt(11/9.81) = 1.0589 s: x = 0.5625(10.5)(0.2970) = 1.754 m
+    ("two-walls", {"h0": 5.5, "v0": 10.5, "D": 2, "W": 4.5, "e": 0.75}, {"y_A": 5.322, "y_B": 2.653, "x_land": 1.754}),
+    # v_x = v_y = 80 cos 45 = 56.57 m/s; H = 56.57^2/19.62 = 163.1 m; v_B = 10(56.57)/6 = 94.28 m/s;
+    # t = 56.57/9.81 = 5.766 s: x = (56.57 + 94.28)(5.766) = 869.9 m; E = 3(94.28^2) - 5(56.57^2) = 10.67 kJ
+    ("shell-landing", {"m_A": 4, "m_B": 6, "v0": 80, "alpha": 45},
+     {"H": 163.1, "v_B": 94.28, "x_land": 869.9, "E": 10.67}),
 ]
 
 
@@ -246,14 +337,34 @@ def drawn(template_id: str, count: int = 20) -> list[dict[str, float]]:
     """``count`` draws from the template's sampling ranges, rounded to its printed decimals."""
     raw = yaml.safe_load((bank_dir() / f"{template_id}.yaml").read_text(encoding="utf-8"))["parameters"]
     rng = np.random.default_rng(27)
-    return [{name: round(float(rng.uniform(*spec["sample"]["uniform"])), spec["decimals"])
-             for name, spec in raw.items()} for _ in range(count)]
+    return [{name: printed(float(rng.uniform(*spec["sample"]["uniform"])), spec) for name, spec in raw.items()}
+            for _ in range(count)]
+
+
+def printed(value: float, spec: dict[str, Any]) -> float:
+    """``value`` rounded as the sheet prints it: to ``decimals``, or to ``sig_figs`` significant figures."""
+    if "decimals" in spec:
+        return round(value, spec["decimals"])
+    return float(f"{value:.{spec['sig_figs']}g}")
+
+
+# Where the sampling box holds draws the physics refuses (the check-bank keeps them under 10 %): what the reference
+# says makes a draw impossible; the solver must refuse those, and 20 possible ones are checked.
+IMPOSSIBLE = {"two-pendulums-inverse": lambda params: not 0 <= ref_two_pendulums_inverse(**params)["e"] <= 1}
 
 
 @pytest.mark.parametrize("template_id", REFERENCES)
 def test_twenty_sampled_variants(bank, compiled, template_id):
-    for params in drawn(template_id):
+    impossible = IMPOSSIBLE.get(template_id, lambda params: False)
+    draws = drawn(template_id, 40)
+    possible = [params for params in draws if not impossible(params)][:20]
+    assert len(possible) == 20
+    for params in possible:
         check(bank, compiled, template_id, params)
+    for params in draws:
+        if impossible(params):
+            assert "coefficient of restitution" in str(solve_one(bank[template_id], compiled[template_id],
+                                                                 params).error)
 
 
 # ---- hard cases -------------------------------------------------------------------------------
@@ -296,9 +407,62 @@ HARD = [
     ("ramp-strike", {"m_A": 1e6, "m_B": 1e-6, "h": 1e-9, "e": 0, "mu_k": 1e-6}),
     ("ramp-strike-inverse", {"m_A": 2, "m_B": 2, "h": 1, "mu_k": 0.25, "d": 3.9}),  # e a hair below 1
     ("ramp-strike-inverse", {"m_A": 1e6, "m_B": 1e-6, "h": 1e-9, "mu_k": 1e-3, "d": 1.5e-6}),
+    ("pile-driver", {"m_ram": 1e-6, "m_pile": 1e6, "h_drop": 2, "h_rebound": 1.999999}),  # all but elastic
+    ("pile-driver", {"m_ram": 800, "m_pile": 2400, "h_drop": 2, "h_rebound": 0}),  # the ram stops dead
+    ("two-pendulums", {"m_A": 1, "m_B": 1, "L": 1.2, "theta_A": 30, "e": 1}),  # B swings exactly as high as A fell
+    ("two-pendulums", {"m_A": 1e-6, "m_B": 1e6, "L": 1, "theta_A": 90, "e": 0}),  # B barely moves
+    ("two-pendulums", {"m_A": 1, "m_B": 2, "L": 1e3, "theta_A": 1e-4, "e": 0.5}),  # 1 - cos cancels in float64
+    ("two-pendulums", {"m_A": 1e6, "m_B": 1e-6, "L": 0.5, "theta_A": 40, "e": 1}),  # B leaves at twice A's speed
+    ("two-pendulums-inverse", {"m_A": 1, "m_B": 1, "L": 1, "theta_A": 30, "theta_B": 30}),  # e = 1
+    ("two-pendulums-inverse", {"m_A": 1, "m_B": 1, "L": 1, "theta_A": 30, "theta_B": 14.872}),  # e = 7e-5
+    ("two-pendulums-inverse", {"m_A": 1, "m_B": 3, "L": 1e-3, "theta_A": 1e-3, "theta_B": 0.4e-3}),
+    ("billiards-inverse", {"v": 2, "r": 28.5, "b": 0.01, "alpha": 0.03}),  # all but head-on: barely turned
+    ("billiards-inverse", {"v": 2, "r": 28.5, "b": 56.9, "alpha": 2.5}),  # all but grazing
+    ("billiards-inverse", {"v": 1e-100, "r": 28.5, "b": 30, "alpha": 58.2}),  # e a hair below 1
+    ("billiards-inverse", {"v": 1e100, "r": 1e-6, "b": 1e-6, "alpha": 40}),
+    ("two-walls", {"h0": 5.5, "v0": 10.5, "D": 1e-9, "W": 4.5, "e": 0.75}),  # thrown from the foot of wall A
+    ("two-walls", {"h0": 5.5, "v0": 10.5, "D": 2, "W": 5, "e": 1}),
+    ("two-walls", {"h0": 5e3, "v0": 1e3, "D": 2e3, "W": 3e3, "e": 0.3}),
+    ("shell-landing", {"m_A": 1e-6, "m_B": 1e6, "v0": 80, "alpha": 45}),  # A a crumb: B flies on as the shell would
+    ("shell-landing", {"m_A": 1e6, "m_B": 1e-6, "v0": 80, "alpha": 45}),
+    ("shell-landing", {"m_A": 4, "m_B": 6, "v0": 80, "alpha": 89.999}),  # fired all but straight up
+    ("shell-landing", {"m_A": 4, "m_B": 6, "v0": 1e-3, "alpha": 1e-6}),  # all but level
 ]
 
 
 @pytest.mark.parametrize(("template_id", "params"), HARD, ids=[f"{t}-{i}" for i, (t, _) in enumerate(HARD)])
 def test_hard_cases(bank, compiled, template_id, params):
     check(bank, compiled, template_id, params)
+
+
+# ---- the worked solution and the mistakes ------------------------------------------------------
+def test_ball_a_is_released_at_its_angle_and_swings_down(bank, compiled):
+    """A's swing comes first in two-pendulums: the page says A swings down to the lowest point; B's swing, after
+    the impact, goes up (as the ballistic pendulum's block does)."""
+    from grader.render.worked import page_wording
+
+    said = [page_wording(step, bank["two-pendulums"]) for step in compiled["two-pendulums"].steps]
+    assert any(line.startswith("A, released at rest with the cord") and "swings down" in line for line in said)
+    assert any(line.startswith("B swings up from vB_out") for line in said)
+
+
+def test_a_ball_on_a_cord_has_the_swings_mistakes(bank):
+    """The height risen taken as L cos theta: v_A = sqrt(2 g L cos theta_A), worked by hand on the example."""
+    found = [a for a in alternatives_for(bank["two-pendulums"]).for_answer("v_A") if a.id == "swing.height_cos"]
+    assert len(found) == 1
+    got = values(alternatives_for(bank["two-pendulums"]), found[0],
+                 {k: np.array([float(v)]) for k, v in bank["two-pendulums"].example.items()})
+    assert float(got[0]) == pytest.approx(float(mp.sqrt(2 * G * mp.mpf(1.2) * mp.cos(deg(30)))), rel=1e-9)
+
+
+def test_the_angle_b_swings_to_has_the_swings_mistakes(bank):
+    """The height risen taken as L sin theta in both swings: v_A^2 = 2 g L sin 30, v_B' = 1.08 v_A (the example's
+    m_A (1 + e)/(m_A + m_B)) and sin theta_B = v_B'^2/(2 g L) = 1.08^2 sin 30 = 0.5832: 35.68 degrees. As
+    L cos theta, cos theta_B = 1.08^2 cos 30 > 1: no angle, so that mistake matches no answer."""
+    template = bank["two-pendulums"]
+    found = {a.id: a for a in alternatives_for(template).for_answer("theta_B") if a.kind == "mistake"}
+    params = {k: np.array([float(v)]) for k, v in template.example.items()}
+    by_hand = mp.asin(mp.mpf("1.08") ** 2 * mp.sin(deg(30))) * 180 / mp.pi
+    assert float(values(alternatives_for(template), found["swing.height_sin"], params)[0]) == pytest.approx(
+        float(by_hand), rel=1e-9)
+    assert np.isnan(values(alternatives_for(template), found["swing.height_cos"], params)[0])

@@ -19,10 +19,10 @@ from tests import references
 
 G = mp.mpf(9.81)  # the bank's g, as the float the kernels use
 KMH = Fraction(1000, 3600)  # km/h in m/s
-ISSUE = {  # ids, parameters and answers exactly as issue 13's table names them
-    "head-on": (["m1", "m2", "v1", "v2", "e"], ["v1_out", "v2_out", "loss_pct"]),
+ISSUE = {  # ids, parameters and answers exactly as issue 13's table names them (issue 27 adds energies and impulses)
+    "head-on": (["m1", "m2", "v1", "v2", "e"], ["v1_out", "v2_out", "loss_pct", "energy_lost", "impulse"]),
     "head-on-inverse": (["m1", "m2", "v1", "v2", "v1_out"], ["v2_out", "e", "loss_pct"]),
-    "coupling": (["m_A", "m_B", "v_A", "v_B"], ["v_common", "energy_lost", "loss_pct"]),
+    "coupling": (["m_A", "m_B", "v_A", "v_B"], ["v_common", "energy_lost", "loss_pct", "impulse"]),
     "moving-plate": (["h", "u", "e"], ["v_out", "h_out"]),
     "three-balls": (["m1", "m2", "m3", "v", "e"], ["v1_out", "v2_out", "v3_out"]),
     "two-rebounds": (["h1", "h2"], ["e", "h0", "loss_pct"]),
@@ -45,9 +45,11 @@ def energy(*pairs):
 
 
 def ref_head_on(m1, m2, v1, v2, e):
+    """The energy lost as T - T' and the impulse as cart 2's change of momentum, m2 (v2' - v2)."""
     w1, w2 = after_impact(m1, m2, v1, v2, e)
     before, after = energy((m1, Fraction(v1)), (m2, Fraction(v2))), energy((m1, w1), (m2, w2))
-    return {"v1_out": w1, "v2_out": w2, "loss_pct": 100 * (before - after) / before}
+    return {"v1_out": w1, "v2_out": w2, "energy_lost": before - after, "loss_pct": 100 * (before - after) / before,
+            "impulse": Fraction(m2) * (w2 - Fraction(v2))}
 
 
 def ref_head_on_inverse(m1, m2, v1, v2, v1_out):
@@ -62,7 +64,9 @@ def ref_coupling(m_A, m_B, v_A, v_B):  # noqa: N803 (the template's names)
     masses = (Fraction(m_A) * 1000, Fraction(m_B) * 1000)  # Mg -> kg
     before = energy((masses[0], Fraction(v_A) * KMH), (masses[1], Fraction(v_B) * KMH))
     after = energy((masses[0] + masses[1], common * KMH))
-    return {"v_common": common, "energy_lost": (before - after) / 1000, "loss_pct": 100 * (before - after) / before}
+    impulse = masses[1] * (common - Fraction(v_B)) * KMH / 1000  # B's change of momentum, in kN s
+    return {"v_common": common, "energy_lost": (before - after) / 1000, "loss_pct": 100 * (before - after) / before,
+            "impulse": impulse}
 
 
 def ref_moving_plate(h, u, e):
@@ -108,13 +112,17 @@ def test_ids_parameters_and_answers_are_the_issues(bank):
 
 # ---- known answers, worked by hand to four figures ----------------------------------------------
 @pytest.mark.parametrize("template_id, params, answers", [
-    # p = 2(4) + 3(-2) = 2, v_c = 0.4; v1' = 0.4 - 0.6(3/5)(6), v2' = 0.4 + 0.6(2/5)(6); T = 22, lost 13.824
-    ("head-on", {"m1": 2, "m2": 3, "v1": 4, "v2": -2, "e": 0.6}, {"v1_out": -1.76, "v2_out": 1.84, "loss_pct": 62.84}),
+    # p = 2(4) + 3(-2) = 2, v_c = 0.4; v1' = 0.4 - 0.6(3/5)(6), v2' = 0.4 + 0.6(2/5)(6); T = 22, lost 13.824 J;
+    # the impulse on cart 2: 3(1.84 + 2) = 11.52 N s
+    ("head-on", {"m1": 2, "m2": 3, "v1": 4, "v2": -2, "e": 0.6},
+     {"v1_out": -1.76, "v2_out": 1.84, "energy_lost": 13.82, "loss_pct": 62.84, "impulse": 11.52}),
     # the same impact read backwards: J = 2(4 + 1.76) = 11.52, v2' = -2 + 11.52/3
     ("head-on-inverse", {"m1": 2, "m2": 3, "v1": 4, "v2": -2, "v1_out": -1.76},
      {"v2_out": 1.84, "e": 0.6, "loss_pct": 62.84}),
-    # (60(8) + 40(-2))/100 = 4 km/h; lost 1/2 (24 000 kg)(10/3.6 m/s)^2 = 92.59 kJ of 154.3 kJ
-    ("coupling", {"m_A": 60, "m_B": 40, "v_A": 8, "v_B": -2}, {"v_common": 4, "energy_lost": 92.59, "loss_pct": 60}),
+    # (60(8) + 40(-2))/100 = 4 km/h; lost 1/2 (24 000 kg)(10/3.6 m/s)^2 = 92.59 kJ of 154.3 kJ;
+    # the impulse on B: 40 000 kg (4 + 2)/3.6 m/s = 66.67 kN s
+    ("coupling", {"m_A": 60, "m_B": 40, "v_A": 8, "v_B": -2},
+     {"v_common": 4, "energy_lost": 92.59, "loss_pct": 60, "impulse": 66.67}),
     # v = sqrt(2(9.81)(1.2)) = 4.852; v' = 1.5 + 0.6(4.852 + 1.5) = 5.311; h' = 5.311^2/19.62
     ("moving-plate", {"h": 1.2, "u": 1.5, "e": 0.6}, {"v_out": 5.311, "h_out": 1.438}),
     # 1 -> 2: v1' = 4(0.5 - 1.6)/2.5 = -1.76, v_b = 4(1.8)(0.5)/2.5 = 1.44; 2 -> 3: (2 - 0.64)/2.8, 1.8(2)/2.8

@@ -31,6 +31,7 @@ from typing import Any
 import jinja2
 
 from grader.assign.assignment import Assignment, Student
+from grader.assign.fair import display_name
 from grader.assign.variants import AnswerPart, Generation, ProblemVariant, tolerance
 from grader.bank.markup import paragraphs
 from grader.bank.template import Template, filled_statement
@@ -370,6 +371,9 @@ def _widened(template: Template, part: AnswerPart, figure: str, reason: str, com
     # The reason writes a velocity after as ``v_obj_n′`` (assign/fair.py): the page prints the quantity, v′_(obj, n)
     said = re.sub(r"\b(\w+)\u2032", lambda found: found.group(1) + "_after"
                   if found.group(1) + "_after" in quantities else found.group(0), said)
+    for quantity in quantities:  # the reason's v2_n′ is the quantity v2_n_after, which the markup knows
+        if display_name(quantity) != quantity:
+            said = re.sub(rf"(?<!\w){re.escape(display_name(quantity))}", quantity, said)
     return Typ(text(f"widened to {figure}: ") + relation_markup(said, quantities))
 
 

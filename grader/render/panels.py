@@ -136,12 +136,14 @@ def _claim_impact(stages: Sequence[Stage], i: int) -> int:
 
 
 def _claim_flight(stages: Sequence[Stage], i: int) -> int:
-    """A flight to a wall, the impact there and the flight back to the ground."""
+    """A flight to a wall, the impact there and the flight back to the ground (a flight back to another wall is
+    the next panel's: a ball bouncing between two walls)."""
     flight = stages[i]
     if flight.fields["until"] != "wall" or i + 1 >= len(stages) or stages[i + 1].effect != "impact":
         return 1
     back = stages[i + 2] if i + 2 < len(stages) else None
-    return 3 if back is not None and back.effect == "flight" and back.fields["body"] == flight.fields["body"] else 2
+    return 3 if back is not None and back.effect == "flight" and back.fields["body"] == flight.fields["body"] \
+        and back.fields["until"] == "ground" else 2
 
 
 # --- drawings -----------------------------------------------------------------------------------
@@ -181,7 +183,8 @@ def _draw_impact(canvas: Drawing, scene: SceneView, group: Sequence[Stage]) -> b
 def _draw_flight(canvas: Drawing, scene: SceneView, group: Sequence[Stage]) -> bool:
     flight = group[0]
     if flight.fields["until"] == "wall":
-        return trajectory(canvas, scene, flight, group[2] if len(group) == 3 else None)
+        return trajectory(canvas, scene, flight, group[2] if len(group) == 3 else None,
+                          group[1] if len(group) > 1 else None)
     return _flight(canvas, scene, flight)
 
 

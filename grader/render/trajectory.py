@@ -57,8 +57,10 @@ def _falling(wall: float, start: float, reach: float) -> list[Point]:
     return [(wall - reach * i / 32, start * (1 - (i / 32) ** 2)) for i in range(33)]
 
 
-def trajectory(canvas: Drawing, scene: SceneView, to_wall: Stage, to_ground: Stage | None) -> bool:
-    """The flight ``to_wall`` (x toward the wall) and, after the rebound, ``to_ground`` (x away from it)."""
+def trajectory(canvas: Drawing, scene: SceneView, to_wall: Stage, to_ground: Stage | None,
+               impact: Stage | None = None) -> bool:
+    """The flight ``to_wall`` (x toward the wall), the ``impact`` there and, after the rebound, ``to_ground``
+    (x away from it)."""
     g = scene.values.get("g", _m.nan)
     vx, vy, h0, distance = (scene.value(to_wall.fields[key]) for key in ("horizontal", "vertical", "height",
                                                                           "distance"))
@@ -98,6 +100,7 @@ def trajectory(canvas: Drawing, scene: SceneView, to_wall: Stage, to_ground: Sta
             drawn = [at(p) for p in path]
             canvas.path(drawn, width=0.8, dash=dash)
             canvas.strokes += list(pairwise(drawn))  # labels keep clear of the path
+    if after:  # where it lands
         canvas.circle(at(after[-1]), 0.09, fill=True)
     canvas.circle((wall - 0.09, hit), 0.09, fill=True)
     body = [str(string(to_wall.fields["body"]))]
@@ -109,7 +112,7 @@ def trajectory(canvas: Drawing, scene: SceneView, to_wall: Stage, to_ground: Sta
     horizontal_dimension(canvas, 0.0, wall, -0.5, scene.given(to_wall.fields["distance"]))
     if after and to_ground is not None:
         horizontal_dimension(canvas, after[-1][0] * scale, wall, -1.25, scene.given(to_ground.fields["distance"]))
-    restitution = _restitution(scene)
+    restitution = _restitution(scene, impact)
     if restitution:
         canvas.name((wall + 0.3, max(top * scale, hit + 0.9) + 0.2), "w", restitution[-1], restitution[:-1])
     return True
@@ -136,16 +139,18 @@ def _release(canvas: Drawing, scene: SceneView, stage: Stage, height: float, ang
 
 
 def _launch(scene: SceneView, stage: Stage) -> Sequence[str]:
-    """The velocity of the throw as the statement gives it: ``v_0 = 15.0 m/s`` and ``alpha = 25°``."""
+    """The velocity of the throw as the statement gives it: ``v_0 = 15.0 m/s`` and ``alpha = 25°``, or its
+    horizontal velocity where it starts level (thrown horizontally, or leaving a wall)."""
     for other in scene.template.scene.stages:
         if other.effect == "velocity" and {other.fields["n"], other.fields["t"]} == {stage.fields["horizontal"],
                                                                                       stage.fields["vertical"]}:
             return [*scene.given(other.fields["speed"]), *scene.given(other.fields["angle"])]
-    return []
+    return scene.moving(stage.fields["horizontal"], (1.0, 0.0))[0]
 
 
-def _restitution(scene: SceneView) -> list[str]:
-    for stage in scene.template.scene.stages:
+def _restitution(scene: SceneView, impact: Stage | None) -> list[str]:
+    """``e = 0.7`` and the wall's name: of ``impact``, or of the scene's first impact."""
+    for stage in [impact] if impact is not None else scene.template.scene.stages:
         if stage.effect == "impact":
             return [*scene.given(stage.fields["restitution"]), stage.fields["bodies"][1]]
     return []

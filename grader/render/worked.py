@@ -192,6 +192,17 @@ _FLIGHT_AXES = ((re.compile(r"component along n\b"), "horizontal component"),
                  r"no vertical impulse, so \1's vertical velocity"))
 
 
+def _released_at_the_angle(template: Template, speed: str) -> bool:
+    """Whether the swing whose lowest-point speed is ``speed`` comes first, before any stage that speaks of that
+    speed: then the body is released at its angle and swings down (two pendulums' ball A), not up."""
+    for stage in template.scene.stages:
+        if stage.effect == "swing" and stage.fields["speed"] == Sym(speed):
+            return True
+        if speed in stage.quantities:
+            return False
+    return False
+
+
 def page_wording(step: Step, template: Template) -> str:
     """A step's relation as the page says it: bodies by their printed names (``cart 1``); no axis n in a
     problem on one line, where n is never drawn or defined; a swing names the speed it starts from (a
@@ -217,9 +228,15 @@ def page_wording(step: Step, template: Template) -> str:
     swing = _SWING.fullmatch(label)
     if swing and isinstance(step.equation[0], Sym):
         body, length, angle = swing.groups()
-        label = (f"{body} swings up from {step.equation[0].name}, its speed at the lowest point, until the cord "
-                 f"(of length {length}) is at {angle} to the vertical, rising {length}(1 − cos {angle}): conservation "
-                 "of energy (the cord does no work)")
+        speed = step.equation[0].name
+        if _released_at_the_angle(template, speed):
+            label = (f"{body}, released at rest with the cord (of length {length}) at {angle} to the vertical, swings "
+                     f"down {length}(1 − cos {angle}) to the lowest point, where its speed is {speed}: conservation "
+                     "of energy (the cord does no work)")
+        else:
+            label = (f"{body} swings up from {speed}, its speed at the lowest point, until the cord (of length "
+                     f"{length}) is at {angle} to the vertical, rising {length}(1 − cos {angle}): conservation of "
+                     "energy (the cord does no work)")
     return label
 
 

@@ -65,6 +65,9 @@ def _energy(stage: Stage, ctx: Context, height: str = "1 - cos") -> list[Relatio
         # sin(theta/2) = v/(2 sqrt(g L)), written with atan2: the kernels have no asin.
         reach = 2 * sp.sqrt(g * length)
         solutions[angle] = 2 * sp.atan2(speed, sp.sqrt((reach - speed) * (reach + speed)))
+    elif isinstance(angle, sp.Symbol):  # as the mistake writes it: cos theta (or sin theta) = v**2/(2 g L)
+        rise, across = speed**2, sp.sqrt((2 * g * length - speed**2) * (2 * g * length + speed**2))
+        solutions[angle] = sp.atan2(across, rise) if height == "cos" else sp.atan2(rise, across)
     degrees = angle * 180 / sp.pi
     return [Relation(
         f"conservation of energy in the swing of {body} on its cord of length {stage.text('length')} (the cord "

@@ -176,6 +176,7 @@ REFUSED_EXPRESSIONS = [
     ("p^(2^10)", "larger than 64"), ("p^100", "larger than 64"), ("__import__('os')", "unknown name __import__"),
     ("p.__class__", "unexpected character"), ("=2p", "spreadsheet formula"), ("p +", "not a valid expression"),
     ("open(p)", "unknown name open"), ("2 3 p", "two numbers"),
+    ("p^" + "9" * 400, "9… is larger than 64"),  # float() of the exponent overflowed: a traceback
 ]
 
 

@@ -197,8 +197,9 @@ def _call(node: ast.Call, allow_compare: bool, depth: int) -> Node:
 
 
 def _check_exponent(exponent: Node) -> None:
-    if isinstance(exponent, Num) and abs(float(exponent.value)) > MAX_EXPONENT:
-        raise ExpressionError(f"exponent {to_text(exponent)} is larger than {MAX_EXPONENT}")
+    if isinstance(exponent, Num) and abs(exponent.value) > MAX_EXPONENT:
+        shown = to_text(exponent)  # a number of 400 digits is said by its first digits
+        raise ExpressionError(f"exponent {shown if len(shown) <= 24 else shown[:20] + '…'} is larger than {MAX_EXPONENT}")
 
 
 def names(node: Node) -> set[str]:

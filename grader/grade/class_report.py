@@ -170,7 +170,7 @@ def _figures(summary: ClassSummary) -> dict[str, str]:
     figures = {"histogram": score_histogram(summary), "verdicts": verdict_bars(summary)}
     for number, problem in enumerate(summary.problems, 1):
         if problem.drawn and problem.attempted.any():
-            figures[f"problem-{number}"] = difficulty(problem, f"problem-{number}")
+            figures[f"problem-{number}"] = difficulty(problem)
     return figures
 
 

@@ -40,8 +40,9 @@ from typing import Any, NamedTuple
 import numpy as np
 import numpy.typing as npt
 
+from grader.grade.cells import typed_place
 from grader.grade.compare import accepted_distance, errors
-from grader.grade.grading import Graded
+from grader.grade.grading import Graded, Row
 from grader.grade.integrity_chance import UNRELATED, Spread, class_density
 from grader.model.tolerance import Tolerance
 
@@ -69,7 +70,8 @@ class Match(NamedTuple):
 class Pair(NamedTuple):
     """A student's wrong answers against another student's key: the parts matched, how many of the first
     student's parts were wrong (and so could match), the chance of so many matches by accident, and that
-    chance corrected for the pairs examined."""
+    chance corrected for the pairs examined; and what the chance counted: the closest matches, how many, and
+    how close the least close of them is, in half-units of the student's typed answers (inf: not read)."""
 
     student: int
     partner: int
@@ -77,6 +79,8 @@ class Pair(NamedTuple):
     wrong: int
     chance: float
     corrected: float
+    closest: int = 0
+    closeness: float = math.inf
 
 
 @dataclass(frozen=True)
@@ -130,6 +134,23 @@ class _Part:
         return _PERIOD.get(self.unit)
 
 
+class _Answers(NamedTuple):
+    """The class's answers the check compares: per part label, the students whose answer was wrong, each
+    student's number (NaN: none) and the half-unit of its last typed digit in the sheet's unit (inf: not a
+    plain number, so no closeness can be read from it); and each student's count of wrong parts."""
+
+    wrong: Mapping[str, Ints]
+    numbers: Mapping[str, Floats]
+    steps: Mapping[str, Floats]
+    per_student: Ints
+
+    def answered(self, label: str) -> npt.NDArray[np.bool_]:
+        """Per student, whether their answer to the part is one of the wrong ones."""
+        found = np.zeros(len(self.per_student), dtype=bool)
+        found[self.wrong[label]] = True
+        return found
+
+
 def check(graded: Graded) -> Integrity:
     """The integrity check of a grading run (the key's numeric parts; symbolic ones are left out)."""
     key = graded.key
@@ -150,23 +171,41 @@ def check(graded: Graded) -> Integrity:
     per_student = np.zeros(students, dtype=np.int64)
     for members in wrong.values():
         per_student[members] += 1
+    steps = {part.label: _steps(graded.columns[part.label], wrong[part.label], graded.numbers[part.label])
+             for part in parts}
     spread = Spread.of(np.concatenate([graded.numbers[p.label][wrong[p.label]] for p in parts] or [np.zeros(0)]),
                        np.concatenate([p.values[wrong[p.label]] for p in parts] or [np.zeros(0)]),
                        np.concatenate([wrong[p.label] for p in parts] or [np.zeros(0, np.int64)]), students)
     examined = int(np.count_nonzero(per_student >= 2)) * max(students - 1, 0)
     found = [_found(part, wrong[part.label], graded.numbers[part.label]) for part in parts]
-    pairs = _pairs(parts, wrong, graded.numbers, spread, found, per_student, examined)
+    answers = _Answers(wrong, graded.numbers, steps, per_student)
+    pairs = _pairs(parts, answers, spread, found, examined)
     matches = _listed(parts, wrong, graded.numbers, found, pairs)
     # Every listed match has its pair's figures.
     others = sorted({(match.student, match.partner) for match in matches} - pairs.keys())
     if others:
         owners, partners = np.array(others, dtype=np.int64).T
         pairs.update(((pair.student, pair.partner), pair) for pair in _figures(
-            parts, wrong, graded.numbers, spread, owners, partners, per_student, examined))
+            parts, answers, spread, owners, partners, examined))
     ranked = sorted(pairs.values(), key=lambda pair: (pair.corrected, pair.chance, pair.student, pair.partner))
     return Integrity(tuple(matches), tuple(ranked), examined, key.integrity_threshold,
                      sum(len(members) for members in wrong.values()),
                      sum(int(np.count_nonzero(counts)) for counts, _ in found))
+
+
+def _steps(rows: Sequence[Row], wrong: Ints, numbers: Floats) -> Floats:
+    """Per student, the half-unit of the last digit of their wrong answer as typed, in the sheet's unit: the
+    place value of the typed number times the unit's factor (the number read over the number typed)."""
+    steps = np.full(len(rows), np.inf)
+    for student in wrong.tolist():
+        text = rows[student].submitted
+        typed = _typed_place(text) if text is not None else None
+        if typed is not None and typed[0] != 0:
+            steps[student] = 0.5 * typed[1] * abs(float(numbers[student]) / typed[0])
+    return steps
+
+
+_typed_place = functools.lru_cache(maxsize=1 << 16)(typed_place)
 
 
 def _number(value: object) -> float:
@@ -216,13 +255,18 @@ def _ranges(part: _Part, numbers: Floats) -> Iterator[tuple[Ints, Ints]]:
 def _accepts(part: _Part, owners: Ints, partners: Ints, numbers: Floats) -> npt.NDArray[np.bool_]:
     """Whether each partner's band holds the owner's number, the partner being another student whose value
     the owner's own band does not hold."""
+    return _distances(part, owners, partners, numbers)[0]
+
+
+def _distances(part: _Part, owners: Ints, partners: Ints, numbers: Floats) -> tuple[npt.NDArray[np.bool_], Floats]:
+    """As :func:`_accepts`, and each owner's number's distance from the partner's value."""
     unit = part.unit if part.period is not None else None
     distance = errors(numbers[owners], part.values[partners], angle_unit=unit)[0]
     reach = part.reach[partners]
     inside = np.where(part.strict[partners], distance < reach, distance <= reach)
     own = errors(part.values[partners], part.values[owners], angle_unit=unit)[0]
     mine = np.where(part.strict[owners], own < part.reach[owners], own <= part.reach[owners])
-    return np.asarray(inside & ~mine & (owners != partners), dtype=bool)
+    return np.asarray(inside & ~mine & (owners != partners), dtype=bool), distance
 
 
 def _expanded(starts: Ints, ends: Ints) -> Iterator[tuple[Ints, Ints]]:
@@ -272,20 +316,19 @@ def _found(part: _Part, wrong: Ints, numbers: Floats) -> tuple[Ints, list[tuple[
     return counts, ranges
 
 
-def _pairs(parts: Sequence[_Part], wrong: Mapping[str, Ints], numbers: Mapping[str, Floats], spread: Spread,
-           found: Sequence[tuple[Ints, list[tuple[Ints, Ints]]]], per_student: Ints,
-           examined: int) -> dict[tuple[int, int], Pair]:
+def _pairs(parts: Sequence[_Part], answers: _Answers, spread: Spread,
+           found: Sequence[tuple[Ints, list[tuple[Ints, Ints]]]], examined: int) -> dict[tuple[int, int], Pair]:
     """Every pair with two or more matched parts whose corrected chance is below :data:`KEPT`.
 
     A pair needs as many matched parts as the fewest whose chance could be that small (:func:`_needed`); a
     partner that matches ``n`` of a student's parts is in the band search of at least one part other than
     the ``n - 1`` that matched the most students: those searches alone are expanded."""
-    students = len(per_student)
+    wrong, students = answers.wrong, len(answers.per_student)
     counts = np.zeros((students, len(parts)), dtype=np.int64)  # per student and part, the students matched
     for index, (part, (found_counts, _)) in enumerate(zip(parts, found, strict=True)):
         counts[wrong[part.label], index] = found_counts
     matched = np.count_nonzero(counts, axis=1)
-    needed = _needed(parts, wrong, students, examined)
+    needed = _needed(parts, answers, examined)
     # Each part's rank among the student's, most students matched first: the needed - 1 first are not searched.
     rank = np.argsort(np.argsort(-counts, axis=1, kind="stable"), axis=1, kind="stable")
     keys = []
@@ -296,79 +339,121 @@ def _pairs(parts: Sequence[_Part], wrong: Mapping[str, Ints], numbers: Mapping[s
         for starts, ends in ranges:
             for which, positions in _expanded(starts[chosen], ends[chosen]):
                 owners, partners = members[chosen[which]], part.order[positions]
-                ok = _accepts(part, owners, partners, numbers[part.label])
+                ok = _accepts(part, owners, partners, answers.numbers[part.label])
                 keys.append(np.unique(owners[ok] * students + partners[ok]))
     if not keys:
         return {}
     pairs = np.unique(np.concatenate(keys))
     return {(pair.student, pair.partner): pair
-            for pair in _figures(parts, wrong, numbers, spread, pairs // students, pairs % students, per_student,
-                                 examined, 2, KEPT)}
+            for pair in _figures(parts, answers, spread, pairs // students, pairs % students, examined, 2, KEPT)}
 
 
-def _needed(parts: Sequence[_Part], wrong: Mapping[str, Ints], students: int, examined: int) -> Ints:
+def _needed(parts: Sequence[_Part], answers: _Answers, examined: int) -> Ints:
     """Per student, the fewest matched parts (at least 2) whose corrected chance could be under :data:`KEPT`
-    (more than their wrong parts: none could). Each part's chance is at least the unrelated kind's share
-    times the least class density of the part, so ``k`` matches have a chance of at least the product of the
-    ``k`` least of those over the student's wrong parts."""
+    (more than their wrong parts: none could). A part's chance is at least the unrelated kind's share times
+    its class density, the band narrowed to the closeness of the pair's matches, never below the half-unit
+    of the student's typed answer (:func:`_chance`): at least ``UNRELATED * min(c, h * c / reach)`` over the
+    part's bands ``c``; ``k`` matches have a chance of at least the product of the ``k`` least of those, and
+    the correction for the pairs examined is at least ``examined * (wrong parts - 1)``."""
+    students = len(answers.per_student)
     least = np.full((students, max(len(parts), 1)), np.inf)
     for index, part in enumerate(parts):
-        finite = part.chance[np.isfinite(part.chance)]
-        least[wrong[part.label], index] = UNRELATED * float(finite.min()) if len(finite) else 0.0
+        members = answers.wrong[part.label]
+        finite = np.isfinite(part.chance)
+        if not finite.any():
+            least[members, index] = 0.0
+            continue
+        widths = finite & (part.reach > 0)
+        per_width = float((part.chance[widths] / part.reach[widths]).min()) if widths.any() else math.inf
+        narrowest = np.minimum(float(part.chance[finite].min()), answers.steps[part.label][members] * per_width)
+        least[members, index] = UNRELATED * np.nan_to_num(narrowest, nan=0.0)
     # log 0 = -inf (a part no chance bounds) then log inf (a part not wrong) make NaN: not possible, as meant.
     with np.errstate(divide="ignore", invalid="ignore"):
-        bound = math.log(max(examined, 1)) + np.cumsum(np.log(np.sort(least, axis=1)), axis=1)
+        counts = np.log(max(examined, 1) * np.maximum(answers.per_student - 1, 1))
+        bound = counts[:, None] + np.cumsum(np.log(np.sort(least, axis=1)), axis=1)
     possible = (bound < math.log(KEPT)) & (np.arange(least.shape[1]) >= 1)
     return np.where(possible.any(axis=1), np.argmax(possible, axis=1) + 1, least.shape[1] + 1).astype(np.int64)
 
 
-def _figures(parts: Sequence[_Part], wrong: Mapping[str, Ints], numbers: Mapping[str, Floats], spread: Spread,
-             owners: Ints, partners: Ints, per_student: Ints, examined: int, least: int = 0,
-             below: float = math.inf) -> list[Pair]:
-    """Each pair's matched parts and chances: the Poisson binomial distribution of the number of matches
-    among the owner's wrong parts, built a part at a time; only the pairs with ``least`` matched parts or
-    more and a corrected chance under ``below``."""
-    count = len(owners)
-    most = int(per_student[owners].max()) if count else 0
-    distribution = np.zeros((count, most + 1))
-    distribution[:, 0] = 1.0
-    hits = np.zeros((count, len(parts)), dtype=bool)
+def _figures(parts: Sequence[_Part], answers: _Answers, spread: Spread, owners: Ints, partners: Ints,
+             examined: int, least: int = 0, below: float = math.inf) -> list[Pair]:
+    """Each pair's matched parts and chances; only the pairs with ``least`` matched parts or more and a
+    corrected chance under ``below``. For ``j`` from 2 to the matches (1 for a pair of one match): the chance
+    that ``j`` or more of the owner's wrong parts land by accident as close to the partner's values as the
+    pair's ``j`` closest matches, closeness counted in half-units of the owner's typed answers (the
+    least close of those ``j`` sets it for every part); the pair's chance is the least of these."""
+    per_student = answers.per_student
+    hits = np.zeros((len(owners), len(parts)), dtype=bool)
+    units = np.full((len(owners), len(parts)), np.inf)
     for index, part in enumerate(parts):
-        answered = np.zeros(len(part.values), dtype=bool)
-        answered[wrong[part.label]] = True
-        rows = np.flatnonzero(answered[owners])
-        if not len(rows):
-            continue
-        chance = _chance(part, spread, owners[rows], partners[rows])[:, None]
-        shifted = np.zeros((len(rows), most + 1))
-        shifted[:, 1:] = distribution[rows, :-1]
-        distribution[rows] = distribution[rows] * (1 - chance) + shifted * chance
-        hits[rows, index] = _accepts(part, owners[rows], partners[rows], numbers[part.label])
+        rows = np.flatnonzero(answers.answered(part.label)[owners])
+        hit, distance = _distances(part, owners[rows], partners[rows], answers.numbers[part.label])
+        hits[rows, index] = hit
+        # inf / inf (a number typed as arithmetic) is NaN: such a match claims no closeness (0 sets none).
+        with np.errstate(divide="ignore", invalid="ignore"):
+            closeness = np.nan_to_num(distance / answers.steps[part.label][owners[rows]], nan=0.0, posinf=np.inf)
+        units[rows, index] = np.where(hit, closeness, np.inf)
     matched = hits.sum(axis=1)
-    tails = np.cumsum(distribution[:, ::-1], axis=1)[:, ::-1][np.arange(count), np.minimum(matched, most)]
-    tails = np.minimum(tails, 1.0)
-    corrected = np.minimum(tails * max(examined, 1), 1.0)
-    kept = (matched >= least) & (corrected < below)
-    owners, partners, hits, tails, corrected = owners[kept], partners[kept], hits[kept], tails[kept], corrected[kept]
+    kept = matched >= least  # the chances are worked out only for the pairs that could be kept
+    owners, partners, hits, units, matched = owners[kept], partners[kept], hits[kept], units[kept], matched[kept]
+    ordered = np.sort(units, axis=1)
+    chances, counted, closeness = np.ones(len(owners)), matched.copy(), np.full(len(owners), np.inf)
+    for closest in range(1, int(matched.max()) + 1 if len(matched) else 1):
+        rows = np.flatnonzero((matched >= closest) & ((closest >= 2) | (matched == 1)))
+        tails = _tails(parts, answers, spread, owners[rows], partners[rows], ordered[rows, closest - 1], closest)
+        better = tails < chances[rows]
+        chances[rows[better]], counted[rows[better]] = tails[better], closest
+        closeness[rows[better]] = ordered[rows[better], closest - 1]
+    # The closeness was read off the matches: paid for once per number of matches a pair could be flagged with.
+    corrected = np.minimum(chances * max(examined, 1) * np.maximum(per_student[owners] - 1, 1), 1.0)
+    kept = corrected < below
+    owners, partners, hits, chances = owners[kept], partners[kept], hits[kept], chances[kept]
+    corrected, counted, closeness = corrected[kept], counted[kept], closeness[kept]
     # The matched parts' labels, worked out once per pattern of parts (a class has a few hundred patterns).
     patterns = hits.astype(np.int64) @ (np.int64(1) << np.arange(len(parts), dtype=np.int64))
     named: dict[int, tuple[str, ...]] = {}
     for pattern in np.unique(patterns).tolist():
         named[pattern] = tuple(part.label for index, part in enumerate(parts) if pattern >> index & 1)
-    return [Pair(owner, partner, named[pattern], wrong, chance, fixed)
-            for owner, partner, pattern, wrong, chance, fixed in zip(
-                owners.tolist(), partners.tolist(), patterns.tolist(), per_student[owners].tolist(), tails.tolist(),
-                corrected.tolist(), strict=True)]
+    return [Pair(owner, partner, named[pattern], wrong, chance, fixed, closest, near)
+            for owner, partner, pattern, wrong, chance, fixed, closest, near in zip(
+                owners.tolist(), partners.tolist(), patterns.tolist(), per_student[owners].tolist(),
+                chances.tolist(), corrected.tolist(), counted.tolist(), closeness.tolist(), strict=True)]
 
 
-def _chance(part: _Part, spread: Spread, owners: Ints, partners: Ints) -> Floats:
-    """The chance that each owner's wrong answer to the part lands in the partner's band by accident
+def _tails(parts: Sequence[_Part], answers: _Answers, spread: Spread, owners: Ints, partners: Ints,
+           closeness: Floats, closest: int) -> Floats:
+    """Per pair, the chance that ``closest`` or more of the owner's wrong parts land within ``closeness``
+    half-units of the partner's values (:func:`_chance`): the Poisson binomial distribution of the count, built a
+    part at a time."""
+    count = len(owners)
+    most = int(answers.per_student[owners].max()) if count else 0
+    distribution = np.zeros((count, most + 1))
+    distribution[:, 0] = 1.0
+    for part in parts:
+        rows = np.flatnonzero(answers.answered(part.label)[owners])
+        if not len(rows):
+            continue
+        chance = _chance(part, spread, owners[rows], partners[rows], closeness[rows],
+                         answers.steps[part.label][owners[rows]])[:, None]
+        shifted = np.zeros((len(rows), most + 1))
+        shifted[:, 1:] = distribution[rows, :-1]
+        distribution[rows] = distribution[rows] * (1 - chance) + shifted * chance
+    tails = np.cumsum(distribution[:, ::-1], axis=1)[:, ::-1][:, min(closest, most)] if count else np.zeros(0)
+    return np.asarray(np.minimum(tails, 1.0))
+
+
+def _chance(part: _Part, spread: Spread, owners: Ints, partners: Ints, closeness: Floats, steps: Floats) -> Floats:
+    """The chance that each owner's wrong answer to the part lands by accident within ``closeness`` half-units
+    ``steps`` of the owner's typed answer from the partner's value, widened by one more (a number rounded as
+    typed is within a half-unit of where it was headed), and never wider than the partner's band
     (:mod:`grader.grade.integrity_chance`; an angle's answers are all taken as unrelated to their own)."""
-    unrelated = np.nan_to_num(part.chance[partners], nan=0.0)
-    if part.period is not None:
-        return unrelated
     middle, reach = part.values[partners], part.reach[partners]
-    related = spread.chance(part.values[owners], middle - reach, middle + reach, owners)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        scale = np.where(reach > 0, np.nan_to_num(np.minimum(1.0, (closeness + 1) * steps / reach), nan=1.0), 1.0)
+    unrelated = np.nan_to_num(part.chance[partners], nan=0.0) * scale
+    if part.period is not None:
+        return np.asarray(unrelated)
+    related = spread.chance(part.values[owners], middle - scale * reach, middle + scale * reach, owners)
     return np.asarray((1 - UNRELATED) * related + UNRELATED * unrelated)
 
 

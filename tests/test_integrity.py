@@ -198,8 +198,8 @@ def test_integrity_csv_guards_what_a_student_typed_and_names_the_partner() -> No
     rows = list(csv.DictReader(io.StringIO(text)))
     assert [(r["student_id"], r["label"], r["submitted"], r["matches_id"], r["matches_value"]) for r in rows] == [
         ("s0", "1a", "'+6", "s5", "6"), ("s0", "1b", "20", "s5", "20"), ("s0", "1c", "125", "s5", "125")]
-    assert {(r["pair_parts"], r["pair_labels"], r["wrong_parts"], r["flagged"]) for r in rows} == {
-        ("3", "1a 1b 1c", "3", "yes")}
+    assert {(r["pair_parts"], r["pair_labels"], r["wrong_parts"], r["close_parts"], r["closeness"], r["flagged"])
+            for r in rows} == {("3", "1a 1b 1c", "3", "3", "0", "yes")}
     assert all(0 < float(r["chance"]) <= float(r["corrected_chance"]) <= 1 for r in rows)
 
 
@@ -414,3 +414,25 @@ def test_a_flagged_pair_changes_no_grade_and_is_in_no_feedback_file(tmp_path: Pa
     differ = sorted(name for name in checked if checked[name] != unchecked.get(name))
     assert set(differ) <= {"integrity.csv", "report.html", ".grader-manifest.json"}, differ
     assert any(name.startswith("feedback/") for name in checked)
+
+
+def test_the_bound_on_how_few_matches_a_pair_needs_drops_no_pair_it_should_keep(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    """The pairs kept (corrected chance under 1) are the same when every student's pairs are searched from
+    two matches on: the bound on each part's chance (the least over the bands that may hold the answer,
+    however close) is never above the chance worked out."""
+    from grader.grade import integrity
+
+    found = []
+    for seed in range(3):
+        key, values, typed = slipping_class(seed)
+        copied = typed | {("s0", label): f"{values[1, j]:.4g}" for j, label in enumerate(("1a", "1b", "1c"))}
+        found.append({(p.student, p.partner, p.labels, p.corrected) for p in check(graded(key, copied)).pairs
+                      if len(p.labels) >= 2})
+    monkeypatch.setattr(integrity, "_needed", lambda parts, answers, *_: np.full(len(answers.per_student), 2))
+    for seed in range(3):
+        key, values, typed = slipping_class(seed)
+        copied = typed | {("s0", label): f"{values[1, j]:.4g}" for j, label in enumerate(("1a", "1b", "1c"))}
+        assert {(p.student, p.partner, p.labels, p.corrected) for p in check(graded(key, copied)).pairs
+                if len(p.labels) >= 2} == found[seed]
+    assert sum(len(pairs) for pairs in found) >= 3

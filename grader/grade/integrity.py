@@ -14,10 +14,14 @@ matches by accident (docs/grading.md, *Answers from another student's variant*):
 - per part, ``p``: the chance that a wrong answer lands in a given student's accepted band by accident, that
   band's width times the density of the class's key values around it (counted over the ``√n`` nearest
   values on each side), and never less than the share of the class's values inside the band;
-- for the pair, the chance of at least ``k`` matches among the answering student's wrong parts, each a
-  coin with its own ``p`` (a Poisson binomial tail);
-- corrected for the pairs examined (Bonferroni): times the number of ordered pairs whose first student has
-  two or more wrong parts (only those can match twice), at most 1.
+- how close: each match's distance in half-units of the last digit the answering student typed (a copy typed
+  as its source typed it is within one); for the ``j`` closest matches, the least close of them narrows
+  every part's band to the partner's value ± (that many half-units + 1), and ``p`` is taken over it;
+- for the pair, the chance of at least ``j`` of the answering student's wrong parts in their narrowed bands,
+  each a coin with its own ``p`` (a Poisson binomial tail), the least over ``j`` from 2 to the matches;
+- corrected for the choice of ``j`` (times the wrong parts less one) and for the pairs examined
+  (Bonferroni: times the number of ordered pairs whose first student has two or more wrong parts, only
+  those can match twice), at most 1.
 
 A pair whose corrected chance is at most the assignment's ``grading.integrity_threshold`` is flagged.
 
@@ -328,7 +332,7 @@ def _pairs(parts: Sequence[_Part], answers: _Answers, spread: Spread,
     for index, (part, (found_counts, _)) in enumerate(zip(parts, found, strict=True)):
         counts[wrong[part.label], index] = found_counts
     matched = np.count_nonzero(counts, axis=1)
-    needed = _needed(parts, answers, examined)
+    needed = _needed(parts, answers, spread, found, examined)
     # Each part's rank among the student's, most students matched first: the needed - 1 first are not searched.
     rank = np.argsort(np.argsort(-counts, axis=1, kind="stable"), axis=1, kind="stable")
     keys = []
@@ -348,31 +352,79 @@ def _pairs(parts: Sequence[_Part], answers: _Answers, spread: Spread,
             for pair in _figures(parts, answers, spread, pairs // students, pairs % students, examined, 2, KEPT)}
 
 
-def _needed(parts: Sequence[_Part], answers: _Answers, examined: int) -> Ints:
+def _needed(parts: Sequence[_Part], answers: _Answers, spread: Spread,
+            found: Sequence[tuple[Ints, list[tuple[Ints, Ints]]]], examined: int) -> Ints:
     """Per student, the fewest matched parts (at least 2) whose corrected chance could be under :data:`KEPT`
-    (more than their wrong parts: none could). A part's chance is at least the unrelated kind's share times
-    its class density, the band narrowed to the closeness of the pair's matches, never below the half-unit
-    of the student's typed answer (:func:`_chance`): at least ``UNRELATED * min(c, h * c / reach)`` over the
-    part's bands ``c``; ``k`` matches have a chance of at least the product of the ``k`` least of those, and
-    the correction for the pairs examined is at least ``examined * (wrong parts - 1)``."""
+    (more than their wrong parts: none could). ``k`` matches have a chance of at least the product of the
+    ``k`` least of their parts' chances (:func:`_least`), and the correction is at least ``examined * (wrong
+    parts - 1)``."""
     students = len(answers.per_student)
     least = np.full((students, max(len(parts), 1)), np.inf)
-    for index, part in enumerate(parts):
+    for index, (part, (_, ranges)) in enumerate(zip(parts, found, strict=True)):
         members = answers.wrong[part.label]
-        finite = np.isfinite(part.chance)
-        if not finite.any():
-            least[members, index] = 0.0
-            continue
-        widths = finite & (part.reach > 0)
-        per_width = float((part.chance[widths] / part.reach[widths]).min()) if widths.any() else math.inf
-        narrowest = np.minimum(float(part.chance[finite].min()), answers.steps[part.label][members] * per_width)
-        least[members, index] = UNRELATED * np.nan_to_num(narrowest, nan=0.0)
-    # log 0 = -inf (a part no chance bounds) then log inf (a part not wrong) make NaN: not possible, as meant.
+        least[members, index] = _least(part, spread, members, answers.numbers[part.label][members],
+                                       answers.steps[part.label][members], ranges)
+    # log 0 = -inf (a part no chance bounds) then log inf (a part that matches nobody) make NaN: not possible.
     with np.errstate(divide="ignore", invalid="ignore"):
         counts = np.log(max(examined, 1) * np.maximum(answers.per_student - 1, 1))
         bound = counts[:, None] + np.cumsum(np.log(np.sort(least, axis=1)), axis=1)
-    possible = (bound < math.log(KEPT)) & (np.arange(least.shape[1]) >= 1)
+    possible = ((bound < math.log(KEPT)) | (KEPT > 1)) & (np.arange(least.shape[1]) >= 1)  # > 1: every pair
     return np.where(possible.any(axis=1), np.argmax(possible, axis=1) + 1, least.shape[1] + 1).astype(np.int64)
+
+
+def _least(part: _Part, spread: Spread, owners: Ints, numbers: Floats, steps: Floats,
+           ranges: Sequence[tuple[Ints, Ints]]) -> Floats:
+    """Per wrong answer, at most the chance (:func:`_chance`) of the answer in the band of any student whose
+    band may hold it (the search's range: inf where it is empty), however close the pair's matches are.
+
+    The band narrowed to ``(λ + 1) h`` around the partner's value holds the answer with ``h`` to spare, or is
+    the whole band, which holds it with at least half its width to spare on one side: either way it holds
+    ``[a - η, a]`` or ``[a, a + η]`` with ``η = min(h, the least reach in the range)``, so the related kind's
+    chance is at least its mass over the lighter of the two (halved against the grid's rounding); the
+    unrelated kind's is at least the least of ``c`` and ``h c / reach`` in the range."""
+    order = part.order
+    chance, reach = part.chance[order], part.reach[order]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        per_width = np.where(reach > 0, chance / reach, np.inf)
+    least_chance, least_width, least_reach = (np.full(len(owners), np.inf) for _ in range(3))
+    for starts, ends in ranges:
+        least_chance = np.minimum(least_chance, _range_least(chance, starts, ends))
+        least_width = np.minimum(least_width, _range_least(per_width, starts, ends))
+        least_reach = np.minimum(least_reach, _range_least(reach, starts, ends))
+    with np.errstate(invalid="ignore"):
+        unrelated = np.nan_to_num(np.minimum(least_chance, steps * least_width), nan=0.0, posinf=0.0)
+    related = np.zeros(len(owners))
+    if part.period is None:
+        spread_out = np.minimum(steps, least_reach)
+        inside = np.isfinite(spread_out)
+        own, number, width = part.values[owners][inside], numbers[inside], spread_out[inside]
+        related[inside] = 0.5 * np.minimum(spread.chance(own, number - width, number, owners[inside]),
+                                           spread.chance(own, number, number + width, owners[inside]))
+    found = (1 - UNRELATED) * related + UNRELATED * unrelated
+    return np.where(np.isfinite(least_reach), found, np.inf)
+
+
+def _range_least(values: Floats, starts: Ints, ends: Ints) -> Floats:
+    """The least of ``values[start:end]`` per range (inf: empty), from a table of the least of each run of
+    ``2^k`` values (a sparse table: two look-ups a range).
+
+    >>> _range_least(np.array([5.0, 3.0, 4.0, 1.0, 2.0]), np.array([0, 0, 2, 4, 3]), np.array([1, 3, 4, 5, 3]))
+    array([ 5.,  3.,  1.,  2., inf])
+    """
+    found = np.full(len(starts), np.inf)
+    sizes = ends - starts
+    if not len(values) or not (sizes > 0).any():
+        return found
+    levels = [values]
+    while 2 ** len(levels) <= len(values):
+        run = 2 ** (len(levels) - 1)
+        levels.append(np.minimum(levels[-1][:-run], levels[-1][run:]))
+    some = np.flatnonzero(sizes > 0)
+    level = np.floor(np.log2(sizes[some])).astype(np.int64)
+    for k in np.unique(level).tolist():
+        rows = some[level == k]
+        found[rows] = np.minimum(levels[k][starts[rows]], levels[k][ends[rows] - 2 ** k])
+    return found
 
 
 def _figures(parts: Sequence[_Part], answers: _Answers, spread: Spread, owners: Ints, partners: Ints,

@@ -436,3 +436,18 @@ def test_the_bound_on_how_few_matches_a_pair_needs_drops_no_pair_it_should_keep(
         assert {(p.student, p.partner, p.labels, p.corrected) for p in check(graded(key, copied)).pairs
                 if len(p.labels) >= 2} == found[seed]
     assert sum(len(pairs) for pairs in found) >= 3
+
+
+def test_a_copy_typed_as_its_source_typed_it_is_measured_from_what_the_source_typed() -> None:
+    # Values 1.0004 to 5.0004, ±1 %; student 2 types 3.000 (right: 0.0004 off their 3.0004) and student 0 types
+    # the same 3.000 in 1a and 1b, and 100 in 1c. Measured from what student 2 typed, with as many digits as
+    # student 0's, the distance is 0: the band narrows to 3.000 ± 0.0005 (the half-unit), a width of 0.001, at
+    # the class density of 0.25 per unit (as above): p = u * 0.25 * 0.001 (from student 2's value it would be
+    # 0.8 half-units off: 3.000 ± 0.0009). "100": the whole band, q = u * 0.25 * 0.060008.
+    key = make_key([[1.0004 + i] * 3 for i in range(5)])
+    typed = {("s2", "1a"): "3.000", ("s2", "1b"): "3.000", ("s0", "1a"): "3.000", ("s0", "1b"): "3.000",
+             ("s0", "1c"): "100"}
+    (pair,) = [pair for pair in check(graded(key, typed)).pairs if (pair.student, pair.partner) == (0, 2)]
+    p, q = UNRELATED * 0.25 * 0.001, UNRELATED * 0.25 * 0.060008
+    assert pair.chance == pytest.approx(p**2 + 2 * p * q * (1 - p), rel=1e-6)
+    assert (pair.closest, pair.closeness) == (2, 0.0)

@@ -140,13 +140,26 @@ class _Part:
 
 class _Answers(NamedTuple):
     """The class's answers the check compares: per part label, the students whose answer was wrong, each
-    student's number (NaN: none) and the half-unit of its last typed digit in the sheet's unit (inf: not a
-    plain number, so no closeness can be read from it); and each student's count of wrong parts."""
+    student's number (NaN: none), the half-unit of its last typed digit in the sheet's unit for the wrong and
+    the right ones (inf: not a plain number, so no closeness can be read from it) and the right ones' numbers
+    (NaN: not right); and each student's count of wrong parts."""
 
     wrong: Mapping[str, Ints]
     numbers: Mapping[str, Floats]
     steps: Mapping[str, Floats]
+    right: Mapping[str, Floats]
     per_student: Ints
+
+    def centres(self, part: _Part, owners: Ints, partners: Ints) -> Floats:
+        """Where each owner's answer's closeness to the partner's is measured from: the number the partner
+        typed for the part, when it was right and typed with no fewer digits than the owner's (a copy typed
+        as its source typed it is there exactly), else the partner's value. An angle's is taken within half a
+        turn of the value."""
+        values, typed = part.values[partners], self.right[part.label][partners]
+        steps = self.steps[part.label]
+        found = np.where(np.isfinite(typed) & (steps[partners] <= steps[owners]), typed, values)
+        period = part.period
+        return found if period is None else values + np.mod(found - values + period / 2, period) - period / 2
 
     def answered(self, label: str) -> npt.NDArray[np.bool_]:
         """Per student, whether their answer to the part is one of the wrong ones."""
@@ -161,6 +174,7 @@ def check(graded: Graded) -> Integrity:
     students = len(key.students)
     parts: list[_Part] = []
     wrong: dict[str, Ints] = {}
+    right: dict[str, Floats] = {}
     for label in key.labels:
         first = key.students[0].parts[label] if students else None
         if first is None or first.symbolic or label not in graded.numbers:
@@ -170,19 +184,22 @@ def check(graded: Graded) -> Integrity:
         numbers = graded.numbers[label]
         rows = graded.columns[label]
         incorrect = np.fromiter((row.verdict == "incorrect" for row in rows), dtype=bool, count=len(rows))
+        correct = np.fromiter((row.verdict == "correct" for row in rows), dtype=bool, count=len(rows))
         wrong[label] = np.flatnonzero(incorrect & np.isfinite(numbers) & np.isfinite(values))
+        right[label] = np.where(correct & np.isfinite(numbers), numbers, np.nan)
         parts.append(part)
     per_student = np.zeros(students, dtype=np.int64)
     for members in wrong.values():
         per_student[members] += 1
-    steps = {part.label: _steps(graded.columns[part.label], wrong[part.label], graded.numbers[part.label])
-             for part in parts}
+    steps = {part.label: _steps(graded.columns[part.label], np.union1d(wrong[part.label],
+                                                                      np.flatnonzero(np.isfinite(right[part.label]))),
+                                graded.numbers[part.label]) for part in parts}
     spread = Spread.of(np.concatenate([graded.numbers[p.label][wrong[p.label]] for p in parts] or [np.zeros(0)]),
                        np.concatenate([p.values[wrong[p.label]] for p in parts] or [np.zeros(0)]),
                        np.concatenate([wrong[p.label] for p in parts] or [np.zeros(0, np.int64)]), students)
     examined = int(np.count_nonzero(per_student >= 2)) * max(students - 1, 0)
     found = [_found(part, wrong[part.label], graded.numbers[part.label]) for part in parts]
-    answers = _Answers(wrong, graded.numbers, steps, per_student)
+    answers = _Answers(wrong, graded.numbers, steps, right, per_student)
     pairs = _pairs(parts, answers, spread, found, examined)
     matches = _listed(parts, wrong, graded.numbers, found, pairs)
     # Every listed match has its pair's figures.
@@ -197,11 +214,12 @@ def check(graded: Graded) -> Integrity:
                      sum(int(np.count_nonzero(counts)) for counts, _ in found))
 
 
-def _steps(rows: Sequence[Row], wrong: Ints, numbers: Floats) -> Floats:
-    """Per student, the half-unit of the last digit of their wrong answer as typed, in the sheet's unit: the
-    place value of the typed number times the unit's factor (the number read over the number typed)."""
+def _steps(rows: Sequence[Row], students: Ints, numbers: Floats) -> Floats:
+    """Per student (of ``students``; inf for the others), the half-unit of the last digit of their answer as
+    typed, in the sheet's unit: the place value of the typed number times the unit's factor (the number read
+    over the number typed)."""
     steps = np.full(len(rows), np.inf)
-    for student in wrong.tolist():
+    for student in students.tolist():
         text = rows[student].submitted
         typed = _typed_place(text) if text is not None else None
         if typed is not None and typed[0] != 0:
@@ -259,18 +277,13 @@ def _ranges(part: _Part, numbers: Floats) -> Iterator[tuple[Ints, Ints]]:
 def _accepts(part: _Part, owners: Ints, partners: Ints, numbers: Floats) -> npt.NDArray[np.bool_]:
     """Whether each partner's band holds the owner's number, the partner being another student whose value
     the owner's own band does not hold."""
-    return _distances(part, owners, partners, numbers)[0]
-
-
-def _distances(part: _Part, owners: Ints, partners: Ints, numbers: Floats) -> tuple[npt.NDArray[np.bool_], Floats]:
-    """As :func:`_accepts`, and each owner's number's distance from the partner's value."""
     unit = part.unit if part.period is not None else None
     distance = errors(numbers[owners], part.values[partners], angle_unit=unit)[0]
     reach = part.reach[partners]
     inside = np.where(part.strict[partners], distance < reach, distance <= reach)
     own = errors(part.values[partners], part.values[owners], angle_unit=unit)[0]
     mine = np.where(part.strict[owners], own < part.reach[owners], own <= part.reach[owners])
-    return np.asarray(inside & ~mine & (owners != partners), dtype=bool), distance
+    return np.asarray(inside & ~mine & (owners != partners), dtype=bool)
 
 
 def _expanded(starts: Ints, ends: Ints) -> Iterator[tuple[Ints, Ints]]:
@@ -439,8 +452,11 @@ def _figures(parts: Sequence[_Part], answers: _Answers, spread: Spread, owners: 
     units = np.full((len(owners), len(parts)), np.inf)
     for index, part in enumerate(parts):
         rows = np.flatnonzero(answers.answered(part.label)[owners])
-        hit, distance = _distances(part, owners[rows], partners[rows], answers.numbers[part.label])
+        hit = _accepts(part, owners[rows], partners[rows], answers.numbers[part.label])
         hits[rows, index] = hit
+        centres = answers.centres(part, owners[rows], partners[rows])
+        distance = errors(answers.numbers[part.label][owners[rows]], centres,
+                          angle_unit=part.unit if part.period is not None else None)[0]
         # inf / inf (a number typed as arithmetic) is NaN: such a match claims no closeness (0 sets none).
         with np.errstate(divide="ignore", invalid="ignore"):
             closeness = np.nan_to_num(distance / answers.steps[part.label][owners[rows]], nan=0.0, posinf=np.inf)
@@ -486,7 +502,8 @@ def _tails(parts: Sequence[_Part], answers: _Answers, spread: Spread, owners: In
         if not len(rows):
             continue
         chance = _chance(part, spread, owners[rows], partners[rows], closeness[rows],
-                         answers.steps[part.label][owners[rows]])[:, None]
+                         answers.steps[part.label][owners[rows]],
+                         answers.centres(part, owners[rows], partners[rows]))[:, None]
         shifted = np.zeros((len(rows), most + 1))
         shifted[:, 1:] = distribution[rows, :-1]
         distribution[rows] = distribution[rows] * (1 - chance) + shifted * chance
@@ -494,18 +511,23 @@ def _tails(parts: Sequence[_Part], answers: _Answers, spread: Spread, owners: In
     return np.asarray(np.minimum(tails, 1.0))
 
 
-def _chance(part: _Part, spread: Spread, owners: Ints, partners: Ints, closeness: Floats, steps: Floats) -> Floats:
-    """The chance that each owner's wrong answer to the part lands by accident within ``closeness`` half-units
-    ``steps`` of the owner's typed answer from the partner's value, widened by one more (a number rounded as
-    typed is within a half-unit of where it was headed), and never wider than the partner's band
-    (:mod:`grader.grade.integrity_chance`; an angle's answers are all taken as unrelated to their own)."""
+def _chance(part: _Part, spread: Spread, owners: Ints, partners: Ints, closeness: Floats, steps: Floats,
+            centres: Floats) -> Floats:
+    """The chance that each owner's wrong answer to the part lands by accident in the partner's band and
+    within ``closeness`` half-units ``steps`` of the owner's typed answer from ``centres``
+    (:meth:`_Answers.centres`), widened by one more (a number rounded as typed is within a half-unit of where
+    it was headed): over the band narrowed to that (:mod:`grader.grade.integrity_chance`; an angle's answers
+    are all taken as unrelated to their own, and its chance is the narrowed share of the band's)."""
     middle, reach = part.values[partners], part.reach[partners]
+    with np.errstate(invalid="ignore"):
+        half = np.nan_to_num((closeness + 1) * steps, nan=np.inf)
+    low, high = np.maximum(centres - half, middle - reach), np.minimum(centres + half, middle + reach)
     with np.errstate(divide="ignore", invalid="ignore"):
-        scale = np.where(reach > 0, np.nan_to_num(np.minimum(1.0, (closeness + 1) * steps / reach), nan=1.0), 1.0)
-    unrelated = np.nan_to_num(part.chance[partners], nan=0.0) * scale
+        share = np.where(reach > 0, np.clip((high - low) / (2 * reach), 0.0, 1.0), 1.0)
+    unrelated = np.nan_to_num(part.chance[partners], nan=0.0) * share
     if part.period is not None:
         return np.asarray(unrelated)
-    related = spread.chance(part.values[owners], middle - scale * reach, middle + scale * reach, owners)
+    related = spread.chance(part.values[owners], low, np.maximum(low, high), owners)
     return np.asarray((1 - UNRELATED) * related + UNRELATED * unrelated)
 
 

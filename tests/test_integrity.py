@@ -6,6 +6,7 @@ The benchmark (``benchmarks/integrity.py``) measures how often it is right on 20
 from __future__ import annotations
 
 import csv
+import dataclasses
 import io
 import json
 import math
@@ -264,20 +265,30 @@ def test_the_pair_search_agrees_with_a_comparison_of_every_pair(monkeypatch: pyt
     assert {(p.student, p.partner): p.labels for p in check(result).pairs if len(p.labels) >= 2} == expected
 
 
-def test_answers_counted_by_their_search_range_count_as_those_tested_one_by_one(
+def test_answers_counted_from_the_sorted_band_ends_count_as_those_tested_one_by_one(
         monkeypatch: pytest.MonkeyPatch) -> None:
+    """Slips of 10 % (counted from the ends) and of 1.5 % (near the student's own value, where bands that
+    do not count as matches may hold them: tested one by one), in bands of ±1 % and, for every seventh
+    student, ±3 %."""
     from grader.grade import integrity
 
     rng = np.random.default_rng(7)
     values = rng.uniform(1, 1.2, size=(200, 2))
     key = make_key(values.tolist())
-    typed = {(f"s{i}", label): f"{values[i, j] * (1.1 if i % 3 == 0 else 1):.6g}"
+    wide = {"mode": "rtol", "rtol": 0.03, "atol": 0.0}
+    key = dataclasses.replace(key, students=tuple(
+        dataclasses.replace(student, parts={label: dataclasses.replace(part, tolerance=wide) if i % 7 == 0 else part
+                                            for label, part in student.parts.items()})
+        for i, student in enumerate(key.students)))
+    slips = {0: 1.1, 1: 1.015}
+    typed = {(f"s{i}", label): f"{values[i, j] * slips.get(i % 3, 1):.6g}"
              for i in range(200) for j, label in enumerate(("1a", "1b"))}
     result = graded(key, typed)
-    tested = [(m.student, m.label, m.matches) for m in check(result).matches]
-    monkeypatch.setattr(integrity, "COUNTED", 0)
-    assert [(m.student, m.label, m.matches) for m in check(result).matches] == tested
-    assert max(matches for _, _, matches in tested) > 5
+    counted = [(m.student, m.label, m.matches) for m in check(result).matches]
+    monkeypatch.setattr(integrity, "BY_ENDS", False)
+    assert [(m.student, m.label, m.matches) for m in check(result).matches] == counted
+    assert max(matches for _, _, matches in counted) > 5
+    assert any(student % 3 == 1 for student, _, _ in counted)
 
 
 def test_a_wrong_answer_near_the_float64_limit_makes_no_overflow() -> None:

@@ -14,9 +14,10 @@ matches by accident (docs/grading.md, *Answers from another student's variant*):
 - per part, ``p``: the chance that a wrong answer lands in a given student's accepted band by accident, that
   band's width times the density of the class's key values around it (counted over the ``√n`` nearest
   values on each side), and never less than the share of the class's values inside the band;
-- how close: each match's distance in half-units of the last digit the answering student typed (a copy typed
-  as its source typed it is within one); for the ``j`` closest matches, the least close of them narrows
-  every part's band to the partner's value ± (that many half-units + 1), and ``p`` is taken over it;
+- how close: each match's distance, in half-units of the last digit the answering student typed, from what
+  the partner typed when it was right with no fewer digits (a copy typed as its source typed it is at 0), else
+  from the partner's value; for the ``j`` closest matches, the least close of them narrows every part's band
+  to that point ± (that many half-units + 1), and ``p`` is taken over it;
 - for the pair, the chance of at least ``j`` of the answering student's wrong parts in their narrowed bands,
   each a coin with its own ``p`` (a Poisson binomial tail), the least over ``j`` from 2 to the matches;
 - corrected for the choice of ``j`` (times the wrong parts less one) and for the pairs examined
@@ -56,7 +57,7 @@ Ints = npt.NDArray[np.int64]
 LISTED = 5  # students named per wrong answer in integrity.csv; the rest are counted
 KEPT = 1.0  # pairs with two or more matched parts are kept when their corrected chance is below this
 CHUNK = 1 << 22  # candidate pairs tested at a time: a bounded amount of memory, whatever the class
-COUNTED = 64  # an answer with more candidate bands than this is counted by the size of its search's range
+BY_ENDS = True  # count an answer's matches from the sorted ends of the bands (False: test each candidate)
 _PERIOD = {"deg": 360.0, "rad": 2 * math.pi}
 
 
@@ -119,7 +120,8 @@ class _Part:
     """A numeric part over the class: each student's key value (NaN: none), accepted distance, whether the
     bound is strict (sigfigs, decimals), the chance ``p`` of their band; the students with a value sorted
     by it (angles reduced to one turn), the lowest band start from each sorted position on and the highest
-    band end up to it (a search over them finds a superset of the bands that hold a number)."""
+    band end up to it (a search over them finds a superset of the bands that hold a number); the bands'
+    starts and ends, each sorted, and the widest band's reach."""
 
     label: str
     unit: str
@@ -131,7 +133,9 @@ class _Part:
     sorted_values: Floats
     low: Floats
     high: Floats
-    monotone: bool  # the bands' ends rise with the values: a search's range is exactly the bands holding a number
+    starts: Floats
+    ends: Floats
+    widest: float
 
     @property
     def period(self) -> float | None:
@@ -140,14 +144,15 @@ class _Part:
 
 class _Answers(NamedTuple):
     """The class's answers the check compares: per part label, the students whose answer was wrong, each
-    student's number (NaN: none), the half-unit of its last typed digit in the sheet's unit for the wrong and
-    the right ones (inf: not a plain number, so no closeness can be read from it) and the right ones' numbers
-    (NaN: not right); and each student's count of wrong parts."""
+    student's number (NaN: none), the half-unit of the last typed digit of each wrong one in the sheet's
+    unit (inf: not a plain number, so no closeness can be read from it), the right ones' numbers (NaN: not
+    right) and the verdict rows; and each student's count of wrong parts."""
 
     wrong: Mapping[str, Ints]
     numbers: Mapping[str, Floats]
     steps: Mapping[str, Floats]
     right: Mapping[str, Floats]
+    rows: Mapping[str, Sequence[Row]]
     per_student: Ints
 
     def centres(self, part: _Part, owners: Ints, partners: Ints) -> Floats:
@@ -156,8 +161,11 @@ class _Answers(NamedTuple):
         as its source typed it is there exactly), else the partner's value. An angle's is taken within half a
         turn of the value."""
         values, typed = part.values[partners], self.right[part.label][partners]
-        steps = self.steps[part.label]
-        found = np.where(np.isfinite(typed) & (steps[partners] <= steps[owners]), typed, values)
+        have = np.flatnonzero(np.isfinite(typed))
+        steps = np.full(len(partners), np.inf)  # of the partners' right answers, read only for the pairs asked
+        rows, numbers = self.rows[part.label], self.numbers[part.label]
+        steps[have] = [_step(rows[partner].submitted, float(numbers[partner])) for partner in partners[have].tolist()]
+        found = np.where(np.isfinite(typed) & (steps <= self.steps[part.label][owners]), typed, values)
         period = part.period
         return found if period is None else values + np.mod(found - values + period / 2, period) - period / 2
 
@@ -179,7 +187,8 @@ def check(graded: Graded) -> Integrity:
         first = key.students[0].parts[label] if students else None
         if first is None or first.symbolic or label not in graded.numbers:
             continue
-        values = np.array([_number(student.parts[label].value) for student in key.students])
+        values = np.fromiter((_number(student.parts[label].value) for student in key.students), dtype=np.float64,
+                             count=students)
         part = _part(label, values, [student.parts[label].tolerance for student in key.students], first.unit)
         numbers = graded.numbers[label]
         rows = graded.columns[label]
@@ -191,15 +200,14 @@ def check(graded: Graded) -> Integrity:
     per_student = np.zeros(students, dtype=np.int64)
     for members in wrong.values():
         per_student[members] += 1
-    steps = {part.label: _steps(graded.columns[part.label], np.union1d(wrong[part.label],
-                                                                      np.flatnonzero(np.isfinite(right[part.label]))),
-                                graded.numbers[part.label]) for part in parts}
+    steps = {part.label: _steps(graded.columns[part.label], wrong[part.label], graded.numbers[part.label])
+             for part in parts}
     spread = Spread.of(np.concatenate([graded.numbers[p.label][wrong[p.label]] for p in parts] or [np.zeros(0)]),
                        np.concatenate([p.values[wrong[p.label]] for p in parts] or [np.zeros(0)]),
                        np.concatenate([wrong[p.label] for p in parts] or [np.zeros(0, np.int64)]), students)
     examined = int(np.count_nonzero(per_student >= 2)) * max(students - 1, 0)
     found = [_found(part, wrong[part.label], graded.numbers[part.label]) for part in parts]
-    answers = _Answers(wrong, graded.numbers, steps, right, per_student)
+    answers = _Answers(wrong, graded.numbers, steps, right, graded.columns, per_student)
     pairs = _pairs(parts, answers, spread, found, examined)
     matches = _listed(parts, wrong, graded.numbers, found, pairs)
     # Every listed match has its pair's figures.
@@ -216,15 +224,20 @@ def check(graded: Graded) -> Integrity:
 
 def _steps(rows: Sequence[Row], students: Ints, numbers: Floats) -> Floats:
     """Per student (of ``students``; inf for the others), the half-unit of the last digit of their answer as
-    typed, in the sheet's unit: the place value of the typed number times the unit's factor (the number read
-    over the number typed)."""
+    typed (:func:`_step`)."""
     steps = np.full(len(rows), np.inf)
-    for student in students.tolist():
-        text = rows[student].submitted
-        typed = _typed_place(text) if text is not None else None
-        if typed is not None and typed[0] != 0:
-            steps[student] = 0.5 * typed[1] * abs(float(numbers[student]) / typed[0])
+    steps[students] = [_step(rows[student].submitted, number)
+                       for student, number in zip(students.tolist(), numbers[students].tolist(), strict=True)]
     return steps
+
+
+def _step(text: str | None, number: float) -> float:
+    """The half-unit of the last digit of a number as typed, in the sheet's unit: the place value of the typed
+    number times the unit's factor (the number read over the number typed); inf: not a plain number."""
+    typed = _typed_place(text) if text is not None else None
+    if typed is None or typed[0] == 0:
+        return math.inf
+    return 0.5 * typed[1] * abs(number / typed[0])
 
 
 _typed_place = functools.lru_cache(maxsize=1 << 16)(typed_place)
@@ -256,10 +269,9 @@ def _part(label: str, values: Floats, tolerances: Sequence[Mapping[str, Any]], u
     bands = reach[order]
     low = np.minimum.accumulate((sorted_values - bands)[::-1])[::-1] if len(order) else sorted_values
     high = np.maximum.accumulate(sorted_values + bands) if len(order) else sorted_values
-    monotone = period is None and not strict.any() and bool(np.array_equal(low, sorted_values - bands)
-                                       and np.array_equal(high, sorted_values + bands))
     return _Part(label, unit, values, reach, strict, class_density(values, reach, order, sorted_values), order,
-                 sorted_values, low, high, monotone)
+                 sorted_values, low, high, np.sort(sorted_values - bands), np.sort(sorted_values + bands),
+                 float(bands.max()) if len(bands) else 0.0)
 
 
 def _ranges(part: _Part, numbers: Floats) -> Iterator[tuple[Ints, Ints]]:
@@ -316,17 +328,24 @@ def _matches(part: _Part, owners: Ints, numbers: Floats) -> tuple[Ints, Ints]:
 
 
 def _found(part: _Part, wrong: Ints, numbers: Floats) -> tuple[Ints, list[tuple[Ints, Ints]]]:
-    """Per wrong answer (of ``wrong``), how many students' bands hold it, and its candidate ranges. Where the
-    bands' ends rise with the values (the search's range is then exactly the bands that hold the number), an
-    answer with more than :data:`COUNTED` candidates is counted by its range's size, not tested one by one
-    (in a class of 100,000 a wrong answer may fall in thousands of bands)."""
+    """Per wrong answer (of ``wrong``), how many students' bands hold it, and its candidate ranges.
+
+    Bands closed at both ends (not an angle's, nor a strict bound's) are counted without being listed (in a
+    class of 100,000 a wrong answer may fall in thousands): the bands holding ``a`` are those that start at or
+    below it less those that end below it, two binary searches in the sorted starts and ends. The bands not
+    counted as matches (the student's own, and those of values the student's own band holds) can hold only an
+    answer within the student's reach plus the widest band's of their own value: those answers are tested one
+    by one, as are all of an angle's or a strict bound's."""
     counts = np.zeros(len(wrong), dtype=np.int64)
     ranges = list(_ranges(part, numbers[wrong]))
+    tested = np.arange(len(wrong))
+    if BY_ENDS and part.period is None and not part.strict.any():
+        typed = numbers[wrong]
+        counts = (np.searchsorted(part.starts, typed, side="right")
+                  - np.searchsorted(part.ends, typed, side="left")).astype(np.int64)
+        tested = np.flatnonzero(np.abs(typed - part.values[wrong]) <= part.reach[wrong] + part.widest)
+        counts[tested] = 0
     for starts, ends in ranges:
-        sizes = np.maximum(ends - starts, 0)
-        sized = sizes > COUNTED if part.monotone else np.zeros(len(sizes), dtype=bool)
-        counts[sized] += sizes[sized]
-        tested = np.flatnonzero(~sized)
         for which, positions in _expanded(starts[tested], ends[tested]):
             ok = _accepts(part, wrong[tested[which]], part.order[positions], numbers)
             counts += np.bincount(tested[which[ok]], minlength=len(wrong))

@@ -127,7 +127,7 @@ def test_the_chance_of_the_matches_by_accident_is_the_hand_computation() -> None
     # (the class density, 0.015 as above). Two or more matches among three parts with the same p:
     # 3 p^2 - 2 p^3. "3" typed shows its value to ±0.5, wider than the band (±0.03): no closeness to claim,
     # the whole band counts. Two students have two or more wrong parts: 2 * 4 pairs examined; and the pair
-    # could have been flagged with 2 or 3 matches: times 2.
+    # could have been counted with 2 or 3 matches: the chance with 2, plus at most that of 3 anywhere, p^3.
     key = make_key([[1.0 + i] * 3 for i in range(5)])
     typed = own_answers(key) | {("s0", "1a"): "3", ("s0", "1b"): "3", ("s0", "1c"): "100",
                                 ("s4", "1a"): "6", ("s4", "1b"): "6"}
@@ -140,7 +140,7 @@ def test_the_chance_of_the_matches_by_accident_is_the_hand_computation() -> None
     (pair,) = [pair for pair in result.pairs if (pair.student, pair.partner) == (0, 2)]
     assert pair.labels == ("1a", "1b") and pair.wrong == 3
     assert pair.chance == pytest.approx(3 * p**2 - 2 * p**3, rel=0.05)
-    assert result.examined == 8 and pair.corrected == pytest.approx(8 * 2 * pair.chance, rel=1e-12)
+    assert result.examined == 8 and pair.corrected == pytest.approx(8 * (pair.chance + p**3), rel=1e-4)
 
 
 def test_a_students_own_answers_do_not_make_themselves_likely() -> None:
@@ -340,15 +340,15 @@ def test_the_band_narrows_to_the_closeness_of_the_least_close_match() -> None:
     # the whole band). The least close match is 0.001 / 0.03 of the band from its value; "3.001" shows its
     # value to ±0.0005, so each band narrows to (0.001 + 0.0005) / 0.03 = 0.05 of itself: p = u * 0.015 * 0.05
     # in 1a and 1b; "100" shows ±0.5, more than the band: q = u * 0.015 in 1c. Two or more of three:
-    # p² + 2 p q (1 - p). One student with two or more wrong parts: 4 pairs examined; flagged with 2 or 3
-    # matches: times 2.
+    # p² + 2 p q (1 - p). One student with two or more wrong parts: 4 pairs examined; counted with 2 matches
+    # or 3: plus the chance of 3 anywhere in the bands, q³.
     key = make_key([[1.0 + i] * 3 for i in range(5)])
     typed = own_answers(key) | {("s0", "1a"): "3.001", ("s0", "1b"): "3.001", ("s0", "1c"): "100"}
     result = check(graded(key, typed))
     p, q = UNRELATED * 0.015 * 0.05, UNRELATED * 0.015
     (pair,) = [pair for pair in result.pairs if (pair.student, pair.partner) == (0, 2)]
     assert pair.labels == ("1a", "1b") and pair.chance == pytest.approx(p**2 + 2 * p * q * (1 - p), rel=1e-9)
-    assert pair.corrected == pytest.approx(4 * 2 * pair.chance, rel=1e-12)
+    assert pair.corrected == pytest.approx(4 * (pair.chance + q**3), rel=1e-9)
 
 
 def test_a_coarsely_typed_answer_on_another_students_round_value_claims_no_closeness() -> None:

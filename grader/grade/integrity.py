@@ -388,8 +388,7 @@ def _needed(parts: Sequence[_Part], answers: _Answers, spread: Spread,
             found: Sequence[tuple[Ints, list[tuple[Ints, Ints]]]], examined: int) -> Ints:
     """Per student, the fewest matched parts (at least 2) whose corrected chance could be under :data:`KEPT`
     (more than their wrong parts: none could). ``k`` matches have a chance of at least the product of the
-    ``k`` least of their parts' chances (:func:`_least`), and the correction is at least ``examined * (wrong
-    parts - 1)``."""
+    ``k`` least of their parts' chances (:func:`_least`), and the correction is at least ``examined``."""
     students = len(answers.per_student)
     least = np.full((students, max(len(parts), 1)), np.inf)
     for index, (part, (_, ranges)) in enumerate(zip(parts, found, strict=True)):
@@ -398,8 +397,7 @@ def _needed(parts: Sequence[_Part], answers: _Answers, spread: Spread,
                                        answers.steps[part.label][members], ranges)
     # log 0 = -inf (a part no chance bounds) then log inf (a part that matches nobody) make NaN: not possible.
     with np.errstate(divide="ignore", invalid="ignore"):
-        counts = np.log(max(examined, 1) * np.maximum(answers.per_student - 1, 1))
-        bound = counts[:, None] + np.cumsum(np.log(np.sort(least, axis=1)), axis=1)
+        bound = math.log(max(examined, 1)) + np.cumsum(np.log(np.sort(least, axis=1)), axis=1)
     possible = ((bound < math.log(KEPT)) | (KEPT > 1)) & (np.arange(least.shape[1]) >= 1)  # > 1: every pair
     return np.where(possible.any(axis=1), np.argmax(possible, axis=1) + 1, least.shape[1] + 1).astype(np.int64)
 
@@ -487,12 +485,18 @@ def _figures(parts: Sequence[_Part], answers: _Answers, spread: Spread, owners: 
     chances, counted, closeness = np.ones(len(owners)), matched.copy(), np.full(len(owners), np.inf)
     for closest in range(1, int(matched.max()) + 1 if len(matched) else 1):
         rows = np.flatnonzero((matched >= closest) & ((closest >= 2) | (matched == 1)))
-        tails = _tails(parts, answers, spread, owners[rows], partners[rows], ordered[rows, closest - 1], closest)
+        tails = _tails(parts, answers, spread, owners[rows], partners[rows], ordered[rows, closest - 1])
+        tails = tails[:, min(closest, tails.shape[1] - 1)]
         better = tails < chances[rows]
         chances[rows[better]], counted[rows[better]] = tails[better], closest
         closeness[rows[better]] = ordered[rows[better], closest - 1]
-    # The closeness was read off the matches: paid for once per number of matches a pair could be flagged with.
-    corrected = np.minimum(chances * max(examined, 1) * np.maximum(per_student[owners] - 1, 1), 1.0)
+    # The closeness and the number of matches counted were read off the answers: paid for over every number
+    # ``j`` a pair could be counted with, each at most the chance of ``j`` matches anywhere in the bands.
+    anywhere = _tails(parts, answers, spread, owners, partners, np.full(len(owners), np.inf))
+    first = np.where(matched >= 2, 2, 1)
+    counts = np.arange(anywhere.shape[1])
+    paid = np.where(counts >= first[:, None], np.minimum(chances[:, None], anywhere), 0.0).sum(axis=1)
+    corrected = np.minimum(np.maximum(paid, chances) * max(examined, 1), 1.0)
     kept = corrected < below
     owners, partners, hits, chances = owners[kept], partners[kept], hits[kept], chances[kept]
     corrected, counted, closeness = corrected[kept], counted[kept], closeness[kept]
@@ -508,10 +512,10 @@ def _figures(parts: Sequence[_Part], answers: _Answers, spread: Spread, owners: 
 
 
 def _tails(parts: Sequence[_Part], answers: _Answers, spread: Spread, owners: Ints, partners: Ints,
-           closeness: Floats, closest: int) -> Floats:
-    """Per pair, the chance that ``closest`` or more of the owner's wrong parts land within ``closeness``
-    half-units of the partner's values (:func:`_chance`): the Poisson binomial distribution of the count, built a
-    part at a time."""
+           closeness: Floats) -> Floats:
+    """Per pair (a row), the chance that ``j`` (a column) or more of the owner's wrong parts land within
+    ``closeness`` half-units of the partner's (:func:`_chance`; inf: anywhere in the bands): the tails of the
+    Poisson binomial distribution of the count, built a part at a time."""
     count = len(owners)
     most = int(answers.per_student[owners].max()) if count else 0
     distribution = np.zeros((count, most + 1))
@@ -526,8 +530,7 @@ def _tails(parts: Sequence[_Part], answers: _Answers, spread: Spread, owners: In
         shifted = np.zeros((len(rows), most + 1))
         shifted[:, 1:] = distribution[rows, :-1]
         distribution[rows] = distribution[rows] * (1 - chance) + shifted * chance
-    tails = np.cumsum(distribution[:, ::-1], axis=1)[:, ::-1][:, min(closest, most)] if count else np.zeros(0)
-    return np.asarray(np.minimum(tails, 1.0))
+    return np.asarray(np.minimum(np.cumsum(distribution[:, ::-1], axis=1)[:, ::-1], 1.0))
 
 
 def _chance(part: _Part, spread: Spread, owners: Ints, partners: Ints, closeness: Floats, steps: Floats,

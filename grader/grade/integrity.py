@@ -154,6 +154,7 @@ class _Answers(NamedTuple):
     right: Mapping[str, Floats]
     rows: Mapping[str, Sequence[Row]]
     per_student: Ints
+    read: dict[str, dict[int, float]]  # per part, the half-units of the right answers read so far, by student
 
     def centres(self, part: _Part, owners: Ints, partners: Ints) -> Floats:
         """Where each owner's answer's closeness to the partner's is measured from: the number the partner
@@ -163,8 +164,11 @@ class _Answers(NamedTuple):
         values, typed = part.values[partners], self.right[part.label][partners]
         have = np.flatnonzero(np.isfinite(typed))
         steps = np.full(len(partners), np.inf)  # of the partners' right answers, read only for the pairs asked
-        rows, numbers = self.rows[part.label], self.numbers[part.label]
-        steps[have] = [_step(rows[partner].submitted, float(numbers[partner])) for partner in partners[have].tolist()]
+        rows, numbers, read = self.rows[part.label], self.numbers[part.label], self.read.setdefault(part.label, {})
+        for row, partner in zip(have.tolist(), partners[have].tolist(), strict=True):
+            if partner not in read:
+                read[partner] = _step(rows[partner].submitted, float(numbers[partner]))
+            steps[row] = read[partner]
         found = np.where(np.isfinite(typed) & (steps <= self.steps[part.label][owners]), typed, values)
         period = part.period
         return found if period is None else values + np.mod(found - values + period / 2, period) - period / 2
@@ -207,7 +211,7 @@ def check(graded: Graded) -> Integrity:
                        np.concatenate([wrong[p.label] for p in parts] or [np.zeros(0, np.int64)]), students)
     examined = int(np.count_nonzero(per_student >= 2)) * max(students - 1, 0)
     found = [_found(part, wrong[part.label], graded.numbers[part.label]) for part in parts]
-    answers = _Answers(wrong, graded.numbers, steps, right, graded.columns, per_student)
+    answers = _Answers(wrong, graded.numbers, steps, right, graded.columns, per_student, {})
     pairs = _pairs(parts, answers, spread, found, examined)
     matches = _listed(parts, wrong, graded.numbers, found, pairs)
     # Every listed match has its pair's figures.
@@ -469,18 +473,20 @@ def _figures(parts: Sequence[_Part], answers: _Answers, spread: Spread, owners: 
     units = np.full((len(owners), len(parts)), np.inf)
     for index, part in enumerate(parts):
         rows = np.flatnonzero(answers.answered(part.label)[owners])
-        hit = _accepts(part, owners[rows], partners[rows], answers.numbers[part.label])
-        hits[rows, index] = hit
+        hits[rows, index] = _accepts(part, owners[rows], partners[rows], answers.numbers[part.label])
+    matched = hits.sum(axis=1)
+    kept = matched >= least  # the chances are worked out only for the pairs that could be kept
+    owners, partners, hits, matched = owners[kept], partners[kept], hits[kept], matched[kept]
+    units = np.full(hits.shape, np.inf)
+    for index, part in enumerate(parts):
+        rows = np.flatnonzero(hits[:, index])
         centres = answers.centres(part, owners[rows], partners[rows])
         distance = errors(answers.numbers[part.label][owners[rows]], centres,
                           angle_unit=part.unit if part.period is not None else None)[0]
         # inf / inf (a number typed as arithmetic) is NaN: such a match claims no closeness (0 sets none).
         with np.errstate(divide="ignore", invalid="ignore"):
-            closeness = np.nan_to_num(distance / answers.steps[part.label][owners[rows]], nan=0.0, posinf=np.inf)
-        units[rows, index] = np.where(hit, closeness, np.inf)
-    matched = hits.sum(axis=1)
-    kept = matched >= least  # the chances are worked out only for the pairs that could be kept
-    owners, partners, hits, units, matched = owners[kept], partners[kept], hits[kept], units[kept], matched[kept]
+            units[rows, index] = np.nan_to_num(distance / answers.steps[part.label][owners[rows]], nan=0.0,
+                                               posinf=np.inf)
     ordered = np.sort(units, axis=1)
     chances, counted, closeness = np.ones(len(owners)), matched.copy(), np.full(len(owners), np.inf)
     for closest in range(1, int(matched.max()) + 1 if len(matched) else 1):

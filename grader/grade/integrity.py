@@ -121,7 +121,7 @@ class _Part:
     bound is strict (sigfigs, decimals), the chance ``p`` of their band; the students with a value sorted
     by it (angles reduced to one turn), the lowest band start from each sorted position on and the highest
     band end up to it (a search over them finds a superset of the bands that hold a number); the bands'
-    starts and ends, each sorted, and the widest band's reach."""
+    starts and ends, each sorted."""
 
     label: str
     unit: str
@@ -135,7 +135,6 @@ class _Part:
     high: Floats
     starts: Floats
     ends: Floats
-    widest: float
 
     @property
     def period(self) -> float | None:
@@ -191,13 +190,12 @@ def check(graded: Graded) -> Integrity:
         first = key.students[0].parts[label] if students else None
         if first is None or first.symbolic or label not in graded.numbers:
             continue
-        values = np.fromiter((_number(student.parts[label].value) for student in key.students), dtype=np.float64,
-                             count=students)
-        part = _part(label, values, [student.parts[label].tolerance for student in key.students], first.unit)
+        column = [student.parts[label] for student in key.students]
+        values = np.fromiter((_number(entry.value) for entry in column), dtype=np.float64, count=students)
+        part = _part(label, values, [entry.tolerance for entry in column], first.unit)
         numbers = graded.numbers[label]
-        rows = graded.columns[label]
-        incorrect = np.fromiter((row.verdict == "incorrect" for row in rows), dtype=bool, count=len(rows))
-        correct = np.fromiter((row.verdict == "correct" for row in rows), dtype=bool, count=len(rows))
+        verdicts = np.array([row.verdict for row in graded.columns[label]])
+        incorrect, correct = verdicts == "incorrect", verdicts == "correct"
         wrong[label] = np.flatnonzero(incorrect & np.isfinite(numbers) & np.isfinite(values))
         right[label] = np.where(correct & np.isfinite(numbers), numbers, np.nan)
         parts.append(part)
@@ -248,6 +246,8 @@ _typed_place = functools.lru_cache(maxsize=1 << 16)(typed_place)
 
 
 def _number(value: object) -> float:
+    if type(value) is float:
+        return value
     return float(value) if isinstance(value, float | int) and not isinstance(value, bool) else math.nan
 
 
@@ -256,11 +256,11 @@ def _part(label: str, values: Floats, tolerances: Sequence[Mapping[str, Any]], u
     reach, strict = np.full(len(values), np.nan), np.zeros(len(values), dtype=bool)
     groups: dict[tuple[tuple[str, Any], ...], list[int]] = {}
     mapping: Mapping[str, Any] | None = None
-    written: tuple[tuple[str, Any], ...] = ()
+    members: list[int] = []
     for index, tolerance in enumerate(tolerances):
         if tolerance is not mapping:  # the key shares one mapping between equal rules
-            mapping, written = tolerance, tuple(tolerance.items())
-        groups.setdefault(written, []).append(index)
+            mapping, members = tolerance, groups.setdefault(tuple(tolerance.items()), [])
+        members.append(index)
     for written, members in groups.items():
         rule = Tolerance.from_json(dict(written))
         reach[members] = accepted_distance(values[members], rule)
@@ -274,8 +274,7 @@ def _part(label: str, values: Floats, tolerances: Sequence[Mapping[str, Any]], u
     low = np.minimum.accumulate((sorted_values - bands)[::-1])[::-1] if len(order) else sorted_values
     high = np.maximum.accumulate(sorted_values + bands) if len(order) else sorted_values
     return _Part(label, unit, values, reach, strict, class_density(values, reach, order, sorted_values), order,
-                 sorted_values, low, high, np.sort(sorted_values - bands), np.sort(sorted_values + bands),
-                 float(bands.max()) if len(bands) else 0.0)
+                 sorted_values, low, high, np.sort(sorted_values - bands), np.sort(sorted_values + bands))
 
 
 def _ranges(part: _Part, numbers: Floats) -> Iterator[tuple[Ints, Ints]]:
@@ -338,8 +337,8 @@ def _found(part: _Part, wrong: Ints, numbers: Floats) -> tuple[Ints, list[tuple[
     class of 100,000 a wrong answer may fall in thousands): the bands holding ``a`` are those that start at or
     below it less those that end below it, two binary searches in the sorted starts and ends. The bands not
     counted as matches (the student's own, and those of values the student's own band holds) can hold only an
-    answer within the student's reach plus the widest band's of their own value: those answers are tested one
-    by one, as are all of an angle's or a strict bound's."""
+    answer within the student's reach plus the widest reach of the values their band holds: those answers are
+    tested one by one, as are all of an angle's or a strict bound's."""
     counts = np.zeros(len(wrong), dtype=np.int64)
     ranges = list(_ranges(part, numbers[wrong]))
     tested = np.arange(len(wrong))
@@ -347,7 +346,10 @@ def _found(part: _Part, wrong: Ints, numbers: Floats) -> tuple[Ints, list[tuple[
         typed = numbers[wrong]
         counts = (np.searchsorted(part.starts, typed, side="right")
                   - np.searchsorted(part.ends, typed, side="left")).astype(np.int64)
-        tested = np.flatnonzero(np.abs(typed - part.values[wrong]) <= part.reach[wrong] + part.widest)
+        own, mine = part.values[wrong], part.reach[wrong]
+        widest = -_range_least(-part.reach[part.order], np.searchsorted(part.sorted_values, own - mine, side="left"),
+                               np.searchsorted(part.sorted_values, own + mine, side="right"))
+        tested = np.flatnonzero(np.abs(typed - own) <= mine + np.maximum(widest, 0.0))
         counts[tested] = 0
     for starts, ends in ranges:
         for which, positions in _expanded(starts[tested], ends[tested]):

@@ -6,6 +6,7 @@ The benchmark (``benchmarks/integrity.py``) measures how often it is right on 20
 from __future__ import annotations
 
 import csv
+import dataclasses
 import io
 import json
 import math
@@ -124,7 +125,9 @@ def test_the_chance_of_the_matches_by_accident_is_the_hand_computation() -> None
     # student 0's answers, p = (1 - u) * (the kernel mass of the other students' wrong log-ratios, student
     # 4's two ln 1.2, over the band's, ln 2.97 to ln 3.03, the kernel's width from all five answers) + u *
     # (the class density, 0.015 as above). Two or more matches among three parts with the same p:
-    # 3 p^2 - 2 p^3. Two students have two or more wrong parts: 2 * 4 pairs examined.
+    # 3 p^2 - 2 p^3. "3" typed shows its value to ±0.5, wider than the band (±0.03): no closeness to claim,
+    # the whole band counts. Two students have two or more wrong parts: 2 * 4 pairs examined; and the pair
+    # could have been counted with 2 or 3 matches: the chance with 2, plus at most that of 3 anywhere, p^3.
     key = make_key([[1.0 + i] * 3 for i in range(5)])
     typed = own_answers(key) | {("s0", "1a"): "3", ("s0", "1b"): "3", ("s0", "1c"): "100",
                                 ("s4", "1a"): "6", ("s4", "1b"): "6"}
@@ -137,7 +140,7 @@ def test_the_chance_of_the_matches_by_accident_is_the_hand_computation() -> None
     (pair,) = [pair for pair in result.pairs if (pair.student, pair.partner) == (0, 2)]
     assert pair.labels == ("1a", "1b") and pair.wrong == 3
     assert pair.chance == pytest.approx(3 * p**2 - 2 * p**3, rel=0.05)
-    assert result.examined == 8 and pair.corrected == pytest.approx(8 * pair.chance, rel=1e-12)
+    assert result.examined == 8 and pair.corrected == pytest.approx(8 * (pair.chance + p**3), rel=1e-4)
 
 
 def test_a_students_own_answers_do_not_make_themselves_likely() -> None:
@@ -196,8 +199,8 @@ def test_integrity_csv_guards_what_a_student_typed_and_names_the_partner() -> No
     rows = list(csv.DictReader(io.StringIO(text)))
     assert [(r["student_id"], r["label"], r["submitted"], r["matches_id"], r["matches_value"]) for r in rows] == [
         ("s0", "1a", "'+6", "s5", "6"), ("s0", "1b", "20", "s5", "20"), ("s0", "1c", "125", "s5", "125")]
-    assert {(r["pair_parts"], r["pair_labels"], r["wrong_parts"], r["flagged"]) for r in rows} == {
-        ("3", "1a 1b 1c", "3", "yes")}
+    assert {(r["pair_parts"], r["pair_labels"], r["wrong_parts"], r["close_parts"], r["closeness"], r["flagged"])
+            for r in rows} == {("3", "1a 1b 1c", "3", "3", "0", "yes")}
     assert all(0 < float(r["chance"]) <= float(r["corrected_chance"]) <= 1 for r in rows)
 
 
@@ -262,20 +265,30 @@ def test_the_pair_search_agrees_with_a_comparison_of_every_pair(monkeypatch: pyt
     assert {(p.student, p.partner): p.labels for p in check(result).pairs if len(p.labels) >= 2} == expected
 
 
-def test_answers_counted_by_their_search_range_count_as_those_tested_one_by_one(
+def test_answers_counted_from_the_sorted_band_ends_count_as_those_tested_one_by_one(
         monkeypatch: pytest.MonkeyPatch) -> None:
+    """Slips of 10 % (counted from the ends) and of 1.5 % (near the student's own value, where bands that
+    do not count as matches may hold them: tested one by one), in bands of ±1 % and, for every seventh
+    student, ±3 %."""
     from grader.grade import integrity
 
     rng = np.random.default_rng(7)
     values = rng.uniform(1, 1.2, size=(200, 2))
     key = make_key(values.tolist())
-    typed = {(f"s{i}", label): f"{values[i, j] * (1.1 if i % 3 == 0 else 1):.6g}"
+    wide = {"mode": "rtol", "rtol": 0.03, "atol": 0.0}
+    key = dataclasses.replace(key, students=tuple(
+        dataclasses.replace(student, parts={label: dataclasses.replace(part, tolerance=wide) if i % 7 == 0 else part
+                                            for label, part in student.parts.items()})
+        for i, student in enumerate(key.students)))
+    slips = {0: 1.1, 1: 1.015}
+    typed = {(f"s{i}", label): f"{values[i, j] * slips.get(i % 3, 1):.6g}"
              for i in range(200) for j, label in enumerate(("1a", "1b"))}
     result = graded(key, typed)
-    tested = [(m.student, m.label, m.matches) for m in check(result).matches]
-    monkeypatch.setattr(integrity, "COUNTED", 0)
-    assert [(m.student, m.label, m.matches) for m in check(result).matches] == tested
-    assert max(matches for _, _, matches in tested) > 5
+    counted = [(m.student, m.label, m.matches) for m in check(result).matches]
+    monkeypatch.setattr(integrity, "BY_ENDS", False)
+    assert [(m.student, m.label, m.matches) for m in check(result).matches] == counted
+    assert max(matches for _, _, matches in counted) > 5
+    assert any(student % 3 == 1 for student, _, _ in counted)
 
 
 def test_a_wrong_answer_near_the_float64_limit_makes_no_overflow() -> None:
@@ -284,3 +297,168 @@ def test_a_wrong_answer_near_the_float64_limit_makes_no_overflow() -> None:
 
     spread = Spread.of(np.array([1.6e308, 0.5, 0.45]), np.array([0.47, 0.47, 0.47]), np.arange(3), 3)
     assert np.isfinite(spread.start) and np.isfinite(spread.step)
+
+
+def slipping_class(seed: int) -> tuple[Key, np.ndarray, dict[tuple[str, str], str]]:
+    """40 students, four parts with values 1 to 1.5 (each band ±1 % holds a number of about 2 others'
+    values); 40 % of the answers slip by 6 to 30 % either way, typed to three figures as students do."""
+    rng = np.random.default_rng(seed)
+    values = rng.uniform(1, 1.5, size=(40, 4))
+    typed = {}
+    for i in range(40):
+        for j, label in enumerate(("1a", "1b", "1c", "1d")):
+            slip = rng.uniform(1.06, 1.3) ** rng.choice([-1, 1]) if rng.random() < 0.4 else 1.0
+            typed[f"s{i}", label] = f"{values[i, j] * slip:.3g}"
+    return make_key(values.tolist(), threshold=0.05), values, typed
+
+
+def test_answers_copied_as_typed_are_found_among_slips_that_land_in_the_same_bands() -> None:
+    """Five students each copy three answers of another, typed to four figures as that student typed them:
+    within the typed rounding (±0.05 % of the value) of the other's value, in bands of ±1 % where the class's
+    slips land too. Each pair is flagged; over the whole band (the model before the closeness was read) none of
+    the five was (corrected chances 0.05 to 0.35)."""
+    key, values, typed = slipping_class(3)
+    for copier, source in [(2, 3), (4, 5), (8, 9), (14, 15), (22, 23)]:
+        taken = {(f"s{copier}", label): f"{values[source, j]:.4g}" for j, label in enumerate(("1a", "1b", "1c"))}
+        copied = typed | taken
+        result = check(graded(key, copied))
+        pair = result.pair(copier, source)
+        assert pair is not None and pair in result.flagged, (copier, source, pair)
+
+
+def test_an_honest_class_whose_slips_land_in_other_students_bands_has_no_pair() -> None:
+    """The same kind of class with nobody copying, in five seeds: slips land anywhere in the bands they land in,
+    so no closeness is claimed and no pair is flagged."""
+    for seed in range(5):
+        key, _, typed = slipping_class(seed)
+        assert check(graded(key, typed)).flagged == ()
+
+
+def test_the_band_narrows_to_the_closeness_of_the_least_close_match() -> None:
+    # Values 1 to 5 in three parts, ±1 %; student 0 types 3.001 in 1a and 1b (student 2's value is 3, band
+    # ±0.03) and 100 in 1c; nobody else is wrong, so only the unrelated kind is left (as above: u * 0.015 over
+    # the whole band). The least close match is 0.001 / 0.03 of the band from its value; "3.001" shows its
+    # value to ±0.0005, so each band narrows to (0.001 + 0.0005) / 0.03 = 0.05 of itself: p = u * 0.015 * 0.05
+    # in 1a and 1b; "100" shows ±0.5, more than the band: q = u * 0.015 in 1c. Two or more of three:
+    # p² + 2 p q (1 - p). One student with two or more wrong parts: 4 pairs examined; counted with 2 matches
+    # or 3: plus the chance of 3 anywhere in the bands, q³.
+    key = make_key([[1.0 + i] * 3 for i in range(5)])
+    typed = own_answers(key) | {("s0", "1a"): "3.001", ("s0", "1b"): "3.001", ("s0", "1c"): "100"}
+    result = check(graded(key, typed))
+    p, q = UNRELATED * 0.015 * 0.05, UNRELATED * 0.015
+    (pair,) = [pair for pair in result.pairs if (pair.student, pair.partner) == (0, 2)]
+    assert pair.labels == ("1a", "1b") and pair.chance == pytest.approx(p**2 + 2 * p * q * (1 - p), rel=1e-9)
+    assert pair.corrected == pytest.approx(4 * (pair.chance + q**3), rel=1e-9)
+
+
+def test_a_coarsely_typed_answer_on_another_students_round_value_claims_no_closeness() -> None:
+    """Student 0 types 3 and 4 where students 2 and 3 have exactly 3.0 and 4.0: a distance of 0, but "3" shows
+    its value only to ±0.5, more than the band: the chance is the whole band's, as if the answers lay anywhere
+    in it."""
+    key = make_key([[1.0 + i, 1.0 + i] for i in range(5)])
+    exact = check(graded(key, own_answers(key) | {("s0", "1a"): "3", ("s0", "1b"): "3"}))
+    nearly = check(graded(key, own_answers(key) | {("s0", "1a"): "3.02", ("s0", "1b"): "3.02"}))
+    (pair,) = [pair for pair in exact.pairs if (pair.student, pair.partner) == (0, 2)]
+    (other,) = [pair for pair in nearly.pairs if (pair.student, pair.partner) == (0, 2)]
+    assert pair.chance == pytest.approx((UNRELATED * 0.015) ** 2, rel=1e-9)
+    assert other.chance > pair.chance * 0.4  # 3.02 is 2/3 of the band out, ±0.005: (0.667 + 0.167)² of it
+
+
+@pytest.mark.parametrize(("text", "place"), [("3.41 m/s", (3.41, 0.01)), ("341 cm/s", (341.0, 1.0)),
+                                             ("6.26×10^3", (6260.0, 10.0)), ("1,50", (1.5, 0.01)),
+                                             ("-2.50E-3", (-0.0025, 1e-5)), ("≈ 7.", (7.0, 1.0))])
+def test_the_place_of_the_last_typed_digit(text: str, place: tuple[float, float]) -> None:
+    from grader.grade.cells import typed_place
+
+    assert typed_place(text) == pytest.approx(place, rel=1e-12)
+
+
+@pytest.mark.parametrize("text", ["sqrt(2)", "3/4", "55°30'", "v = 3", "", "1e99999"])
+def test_a_typed_number_that_is_not_plain_shows_no_place(text: str) -> None:
+    from grader.grade.cells import typed_place
+
+    assert typed_place(text) is None
+
+
+def test_a_flagged_pair_changes_no_grade_and_is_in_no_feedback_file(tmp_path: Path,
+                                                                     monkeypatch: pytest.MonkeyPatch) -> None:
+    """The demo's key for four students; the first student types their own values except the first parts of
+    three problems (no earlier answer of theirs carries into them), which are the second student's, typed to
+    four figures. integrity.csv flags the pair; every file of the run but integrity.csv and the report, each
+    student's feedback page included, is the same bytes as when the check finds nothing."""
+    from grader.base.resources import sample_dir
+    from grader.cli import main
+    from grader.grade import report
+    from grader.grade.integrity import Integrity
+
+    roster = (sample_dir() / "roster.csv").read_text(encoding="utf-8").splitlines()[:5]
+    (tmp_path / "roster.csv").write_text("\n".join(roster) + "\n", encoding="utf-8")
+    assert main(["generate", str(sample_dir() / "assignment.yaml"), "--roster", str(tmp_path / "roster.csv"),
+                 "--out", str(tmp_path / "hw"), "--no-pdf"]) == 0
+    document = json.loads((tmp_path / "hw" / "key.json").read_text(encoding="utf-8"))
+    first, second = document["students"][:2]
+    numeric = [(problem["answers"][name]["label"], answer, problem["answers"][name]["value"])
+               for problem, other in zip(first["problems"], second["problems"], strict=True)
+               for name, answer in problem["answers"].items()
+               if isinstance(answer["value"], float) and isinstance(other["answers"][name]["value"], float)
+               for answer in [other["answers"][name]]]
+    rows = ["student_id,label,answer"]
+    copied = [label for label, _, _ in numeric if label.endswith("a")][:3]
+    for label, theirs, mine in numeric:
+        rows.append(f"{first['id']},{label},{theirs['value'] if label in copied else mine:.4g}")
+        rows.append(f"{second['id']},{label},{theirs['value']:.4g}")
+    (tmp_path / "answers.csv").write_text("\n".join(rows) + "\n", encoding="utf-8")
+
+    def graded_into(folder: str) -> dict[str, bytes]:
+        assert main(["grade", "--key", str(tmp_path / "hw" / "key.json"), str(tmp_path / "answers.csv"), "--out",
+                     str(tmp_path / folder), "--feedback-format", "html"]) == 0
+        return {str(path.relative_to(tmp_path / folder)): path.read_bytes()
+                for path in sorted((tmp_path / folder).rglob("*")) if path.is_file()}
+
+    checked = graded_into("checked")
+    flagged = [row for row in csv.DictReader(io.StringIO(checked["integrity.csv"].decode("utf-8")))
+               if row["flagged"] == "yes"]
+    assert {(row["student_id"], row["matches_id"]) for row in flagged} == {(first["id"], second["id"])}
+    assert len(flagged) == 3
+    monkeypatch.setattr(report, "check", lambda graded: Integrity((), (), 0, 0.05, 0, 0))
+    unchecked = graded_into("unchecked")
+    differ = sorted(name for name in checked if checked[name] != unchecked.get(name))
+    assert set(differ) <= {"integrity.csv", "report.html", ".grader-manifest.json"}, differ
+    assert any(name.startswith("feedback/") for name in checked)
+
+
+def test_the_bound_on_how_few_matches_a_pair_needs_drops_no_pair_it_should_keep(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    """The pairs kept (corrected chance under 1) are the same when every student's pairs are searched from
+    two matches on: the bound on each part's chance (the least over the bands that may hold the answer,
+    however close) is never above the chance worked out."""
+    from grader.grade import integrity
+
+    found = []
+    for seed in range(3):
+        key, values, typed = slipping_class(seed)
+        copied = typed | {("s0", label): f"{values[1, j]:.4g}" for j, label in enumerate(("1a", "1b", "1c"))}
+        found.append({(p.student, p.partner, p.labels, p.corrected) for p in check(graded(key, copied)).pairs
+                      if len(p.labels) >= 2})
+    monkeypatch.setattr(integrity, "_needed", lambda parts, answers, *_: np.full(len(answers.per_student), 2))
+    for seed in range(3):
+        key, values, typed = slipping_class(seed)
+        copied = typed | {("s0", label): f"{values[1, j]:.4g}" for j, label in enumerate(("1a", "1b", "1c"))}
+        assert {(p.student, p.partner, p.labels, p.corrected) for p in check(graded(key, copied)).pairs
+                if len(p.labels) >= 2} == found[seed]
+    assert sum(len(pairs) for pairs in found) >= 3
+
+
+def test_a_copy_typed_as_its_source_typed_it_is_measured_from_what_the_source_typed() -> None:
+    # Values 1.0004 to 5.0004, ±1 %; student 2 types 3.000 (right: 0.0004 off their 3.0004) and student 0 types
+    # the same 3.000 in 1a and 1b, and 100 in 1c. Measured from what student 2 typed, with as many digits as
+    # student 0's, the distance is 0: the band narrows to 3.000 ± 0.0005 (the half-unit), a width of 0.001, at
+    # the class density of 0.25 per unit (as above): p = u * 0.25 * 0.001 (from student 2's value it would be
+    # 0.8 half-units off: 3.000 ± 0.0009). "100": the whole band, q = u * 0.25 * 0.060008.
+    key = make_key([[1.0004 + i] * 3 for i in range(5)])
+    typed = {("s2", "1a"): "3.000", ("s2", "1b"): "3.000", ("s0", "1a"): "3.000", ("s0", "1b"): "3.000",
+             ("s0", "1c"): "100"}
+    (pair,) = [pair for pair in check(graded(key, typed)).pairs if (pair.student, pair.partner) == (0, 2)]
+    p, q = UNRELATED * 0.25 * 0.001, UNRELATED * 0.25 * 0.060008
+    assert pair.chance == pytest.approx(p**2 + 2 * p * q * (1 - p), rel=1e-6)
+    assert (pair.closest, pair.closeness) == (2, 0.0)

@@ -283,3 +283,34 @@ def _finite(value: float, text: str) -> float:
         raise ReadError(f"{cut(text, 40)} is too small for a number (below about 5e-324 it would be read as 0); "
                         "write 0 if you mean 0")
     return value
+
+
+def typed_place(text: str) -> tuple[float, float] | None:
+    """What a plain or scientific number as typed shows: its value (before any unit) and the place value of
+    its last digit; None for anything else (arithmetic, a fraction, degrees and minutes, a name before it).
+    The integrity check (:mod:`grader.grade.integrity`) reads how close an answer can claim to be from it.
+
+    >>> typed_place("3.41 m/s"), typed_place("6.26×10^3"), typed_place("1,50"), typed_place("341")
+    ((3.41, 0.01), (6260.0, 10.0), (1.5, 0.01), (341.0, 1.0))
+    >>> typed_place("2.5e-3"), typed_place("sqrt(2)")
+    ((0.0025, 0.0001), None)
+    """
+    cleaned = _clean(text)
+    if not isinstance(cleaned, str):
+        return None
+    try:
+        number = _decimal_commas(_GROUPED.sub(lambda group: group.group().replace(" ", ""),
+                                              _split_unit(cleaned.lstrip(" ≈~"))[0]), ";")
+    except ReadError:
+        return None
+    if plain := _PLAIN.fullmatch(number):
+        sign, (mantissa, _, exponent) = plain["sign"], plain["digits"].lower().partition("e")
+    elif scientific := _SCIENTIFIC.fullmatch(number):
+        sign, mantissa, exponent = scientific["sign"], scientific["mantissa"], scientific["exponent"]
+    else:
+        return None
+    if len(exponent) > 5:  # beyond any float's exponent
+        return None
+    power = int(exponent or 0) - len(mantissa.partition(".")[2])
+    value = float(f"{sign}{mantissa}e{exponent or 0}")
+    return (value, float(f"1e{power}")) if math.isfinite(value) else None

@@ -14,10 +14,15 @@ matches by accident (docs/grading.md, *Answers from another student's variant*):
 - per part, ``p``: the chance that a wrong answer lands in a given student's accepted band by accident, that
   band's width times the density of the class's key values around it (counted over the ``√n`` nearest
   values on each side), and never less than the share of the class's values inside the band;
-- for the pair, the chance of at least ``k`` matches among the answering student's wrong parts, each a
-  coin with its own ``p`` (a Poisson binomial tail);
-- corrected for the pairs examined (Bonferroni): times the number of ordered pairs whose first student has
-  two or more wrong parts (only those can match twice), at most 1.
+- how close: each match's distance, in half-units of the last digit the answering student typed, from what
+  the partner typed when it was right with no fewer digits (a copy typed as its source typed it is at 0), else
+  from the partner's value; for the ``j`` closest matches, the least close of them narrows every part's band
+  to that point ± (that many half-units + 1), and ``p`` is taken over it;
+- for the pair, the chance of at least ``j`` of the answering student's wrong parts in their narrowed bands,
+  each a coin with its own ``p`` (a Poisson binomial tail), the least over ``j`` from 2 to the matches;
+- corrected for the choice of ``j`` (times the wrong parts less one) and for the pairs examined
+  (Bonferroni: times the number of ordered pairs whose first student has two or more wrong parts, only
+  those can match twice), at most 1.
 
 A pair whose corrected chance is at most the assignment's ``grading.integrity_threshold`` is flagged.
 
@@ -40,8 +45,9 @@ from typing import Any, NamedTuple
 import numpy as np
 import numpy.typing as npt
 
+from grader.grade.cells import typed_place
 from grader.grade.compare import accepted_distance, errors
-from grader.grade.grading import Graded
+from grader.grade.grading import Graded, Row
 from grader.grade.integrity_chance import UNRELATED, Spread, class_density
 from grader.model.tolerance import Tolerance
 
@@ -51,7 +57,7 @@ Ints = npt.NDArray[np.int64]
 LISTED = 5  # students named per wrong answer in integrity.csv; the rest are counted
 KEPT = 1.0  # pairs with two or more matched parts are kept when their corrected chance is below this
 CHUNK = 1 << 22  # candidate pairs tested at a time: a bounded amount of memory, whatever the class
-COUNTED = 64  # an answer with more candidate bands than this is counted by the size of its search's range
+BY_ENDS = True  # count an answer's matches from the sorted ends of the bands (False: test each candidate)
 _PERIOD = {"deg": 360.0, "rad": 2 * math.pi}
 
 
@@ -69,7 +75,8 @@ class Match(NamedTuple):
 class Pair(NamedTuple):
     """A student's wrong answers against another student's key: the parts matched, how many of the first
     student's parts were wrong (and so could match), the chance of so many matches by accident, and that
-    chance corrected for the pairs examined."""
+    chance corrected for the pairs examined; and what the chance counted: the closest matches, how many, and
+    how close the least close of them is, in half-units of the student's typed answers (inf: not read)."""
 
     student: int
     partner: int
@@ -77,6 +84,8 @@ class Pair(NamedTuple):
     wrong: int
     chance: float
     corrected: float
+    closest: int = 0
+    closeness: float = math.inf
 
 
 @dataclass(frozen=True)
@@ -111,7 +120,8 @@ class _Part:
     """A numeric part over the class: each student's key value (NaN: none), accepted distance, whether the
     bound is strict (sigfigs, decimals), the chance ``p`` of their band; the students with a value sorted
     by it (angles reduced to one turn), the lowest band start from each sorted position on and the highest
-    band end up to it (a search over them finds a superset of the bands that hold a number)."""
+    band end up to it (a search over them finds a superset of the bands that hold a number); the bands'
+    starts and ends, each sorted."""
 
     label: str
     unit: str
@@ -123,11 +133,50 @@ class _Part:
     sorted_values: Floats
     low: Floats
     high: Floats
-    monotone: bool  # the bands' ends rise with the values: a search's range is exactly the bands holding a number
+    starts: Floats
+    ends: Floats
 
     @property
     def period(self) -> float | None:
         return _PERIOD.get(self.unit)
+
+
+class _Answers(NamedTuple):
+    """The class's answers the check compares: per part label, the students whose answer was wrong, each
+    student's number (NaN: none), the half-unit of the last typed digit of each wrong one in the sheet's
+    unit (inf: not a plain number, so no closeness can be read from it), the right ones' numbers (NaN: not
+    right) and the verdict rows; and each student's count of wrong parts."""
+
+    wrong: Mapping[str, Ints]
+    numbers: Mapping[str, Floats]
+    steps: Mapping[str, Floats]
+    right: Mapping[str, Floats]
+    rows: Mapping[str, Sequence[Row]]
+    per_student: Ints
+    read: dict[str, dict[int, float]]  # per part, the half-units of the right answers read so far, by student
+
+    def centres(self, part: _Part, owners: Ints, partners: Ints) -> Floats:
+        """Where each owner's answer's closeness to the partner's is measured from: the number the partner
+        typed for the part, when it was right and typed with no fewer digits than the owner's (a copy typed
+        as its source typed it is there exactly), else the partner's value. An angle's is taken within half a
+        turn of the value."""
+        values, typed = part.values[partners], self.right[part.label][partners]
+        have = np.flatnonzero(np.isfinite(typed))
+        steps = np.full(len(partners), np.inf)  # of the partners' right answers, read only for the pairs asked
+        rows, numbers, read = self.rows[part.label], self.numbers[part.label], self.read.setdefault(part.label, {})
+        for row, partner in zip(have.tolist(), partners[have].tolist(), strict=True):
+            if partner not in read:
+                read[partner] = _step(rows[partner].submitted, float(numbers[partner]))
+            steps[row] = read[partner]
+        found = np.where(np.isfinite(typed) & (steps <= self.steps[part.label][owners]), typed, values)
+        period = part.period
+        return found if period is None else values + np.mod(found - values + period / 2, period) - period / 2
+
+    def answered(self, label: str) -> npt.NDArray[np.bool_]:
+        """Per student, whether their answer to the part is one of the wrong ones."""
+        found = np.zeros(len(self.per_student), dtype=bool)
+        found[self.wrong[label]] = True
+        return found
 
 
 def check(graded: Graded) -> Integrity:
@@ -136,40 +185,69 @@ def check(graded: Graded) -> Integrity:
     students = len(key.students)
     parts: list[_Part] = []
     wrong: dict[str, Ints] = {}
+    right: dict[str, Floats] = {}
     for label in key.labels:
         first = key.students[0].parts[label] if students else None
         if first is None or first.symbolic or label not in graded.numbers:
             continue
-        values = np.array([_number(student.parts[label].value) for student in key.students])
-        part = _part(label, values, [student.parts[label].tolerance for student in key.students], first.unit)
+        column = [student.parts[label] for student in key.students]
+        values = np.fromiter((_number(entry.value) for entry in column), dtype=np.float64, count=students)
+        part = _part(label, values, [entry.tolerance for entry in column], first.unit)
         numbers = graded.numbers[label]
-        rows = graded.columns[label]
-        incorrect = np.fromiter((row.verdict == "incorrect" for row in rows), dtype=bool, count=len(rows))
+        verdicts = np.array([row.verdict for row in graded.columns[label]])
+        incorrect, correct = verdicts == "incorrect", verdicts == "correct"
         wrong[label] = np.flatnonzero(incorrect & np.isfinite(numbers) & np.isfinite(values))
+        right[label] = np.where(correct & np.isfinite(numbers), numbers, np.nan)
         parts.append(part)
     per_student = np.zeros(students, dtype=np.int64)
     for members in wrong.values():
         per_student[members] += 1
+    steps = {part.label: _steps(graded.columns[part.label], wrong[part.label], graded.numbers[part.label])
+             for part in parts}
     spread = Spread.of(np.concatenate([graded.numbers[p.label][wrong[p.label]] for p in parts] or [np.zeros(0)]),
                        np.concatenate([p.values[wrong[p.label]] for p in parts] or [np.zeros(0)]),
                        np.concatenate([wrong[p.label] for p in parts] or [np.zeros(0, np.int64)]), students)
     examined = int(np.count_nonzero(per_student >= 2)) * max(students - 1, 0)
     found = [_found(part, wrong[part.label], graded.numbers[part.label]) for part in parts]
-    pairs = _pairs(parts, wrong, graded.numbers, spread, found, per_student, examined)
+    answers = _Answers(wrong, graded.numbers, steps, right, graded.columns, per_student, {})
+    pairs = _pairs(parts, answers, spread, found, examined)
     matches = _listed(parts, wrong, graded.numbers, found, pairs)
     # Every listed match has its pair's figures.
     others = sorted({(match.student, match.partner) for match in matches} - pairs.keys())
     if others:
         owners, partners = np.array(others, dtype=np.int64).T
         pairs.update(((pair.student, pair.partner), pair) for pair in _figures(
-            parts, wrong, graded.numbers, spread, owners, partners, per_student, examined))
+            parts, answers, spread, owners, partners, examined))
     ranked = sorted(pairs.values(), key=lambda pair: (pair.corrected, pair.chance, pair.student, pair.partner))
     return Integrity(tuple(matches), tuple(ranked), examined, key.integrity_threshold,
                      sum(len(members) for members in wrong.values()),
                      sum(int(np.count_nonzero(counts)) for counts, _ in found))
 
 
+def _steps(rows: Sequence[Row], students: Ints, numbers: Floats) -> Floats:
+    """Per student (of ``students``; inf for the others), the half-unit of the last digit of their answer as
+    typed (:func:`_step`)."""
+    steps = np.full(len(rows), np.inf)
+    steps[students] = [_step(rows[student].submitted, number)
+                       for student, number in zip(students.tolist(), numbers[students].tolist(), strict=True)]
+    return steps
+
+
+def _step(text: str | None, number: float) -> float:
+    """The half-unit of the last digit of a number as typed, in the sheet's unit: the place value of the typed
+    number times the unit's factor (the number read over the number typed); inf: not a plain number."""
+    typed = _typed_place(text) if text is not None else None
+    if typed is None or typed[0] == 0:
+        return math.inf
+    return 0.5 * typed[1] * abs(number / typed[0])
+
+
+_typed_place = functools.lru_cache(maxsize=1 << 16)(typed_place)
+
+
 def _number(value: object) -> float:
+    if type(value) is float:
+        return value
     return float(value) if isinstance(value, float | int) and not isinstance(value, bool) else math.nan
 
 
@@ -178,11 +256,11 @@ def _part(label: str, values: Floats, tolerances: Sequence[Mapping[str, Any]], u
     reach, strict = np.full(len(values), np.nan), np.zeros(len(values), dtype=bool)
     groups: dict[tuple[tuple[str, Any], ...], list[int]] = {}
     mapping: Mapping[str, Any] | None = None
-    written: tuple[tuple[str, Any], ...] = ()
+    members: list[int] = []
     for index, tolerance in enumerate(tolerances):
         if tolerance is not mapping:  # the key shares one mapping between equal rules
-            mapping, written = tolerance, tuple(tolerance.items())
-        groups.setdefault(written, []).append(index)
+            mapping, members = tolerance, groups.setdefault(tuple(tolerance.items()), [])
+        members.append(index)
     for written, members in groups.items():
         rule = Tolerance.from_json(dict(written))
         reach[members] = accepted_distance(values[members], rule)
@@ -195,10 +273,8 @@ def _part(label: str, values: Floats, tolerances: Sequence[Mapping[str, Any]], u
     bands = reach[order]
     low = np.minimum.accumulate((sorted_values - bands)[::-1])[::-1] if len(order) else sorted_values
     high = np.maximum.accumulate(sorted_values + bands) if len(order) else sorted_values
-    monotone = period is None and not strict.any() and bool(np.array_equal(low, sorted_values - bands)
-                                       and np.array_equal(high, sorted_values + bands))
     return _Part(label, unit, values, reach, strict, class_density(values, reach, order, sorted_values), order,
-                 sorted_values, low, high, monotone)
+                 sorted_values, low, high, np.sort(sorted_values - bands), np.sort(sorted_values + bands))
 
 
 def _ranges(part: _Part, numbers: Floats) -> Iterator[tuple[Ints, Ints]]:
@@ -255,37 +331,46 @@ def _matches(part: _Part, owners: Ints, numbers: Floats) -> tuple[Ints, Ints]:
 
 
 def _found(part: _Part, wrong: Ints, numbers: Floats) -> tuple[Ints, list[tuple[Ints, Ints]]]:
-    """Per wrong answer (of ``wrong``), how many students' bands hold it, and its candidate ranges. Where the
-    bands' ends rise with the values (the search's range is then exactly the bands that hold the number), an
-    answer with more than :data:`COUNTED` candidates is counted by its range's size, not tested one by one
-    (in a class of 100,000 a wrong answer may fall in thousands of bands)."""
+    """Per wrong answer (of ``wrong``), how many students' bands hold it, and its candidate ranges.
+
+    Bands closed at both ends (not an angle's, nor a strict bound's) are counted without being listed (in a
+    class of 100,000 a wrong answer may fall in thousands): the bands holding ``a`` are those that start at or
+    below it less those that end below it, two binary searches in the sorted starts and ends. The bands not
+    counted as matches (the student's own, and those of values the student's own band holds) can hold only an
+    answer within the student's reach plus the widest reach of the values their band holds: those answers are
+    tested one by one, as are all of an angle's or a strict bound's."""
     counts = np.zeros(len(wrong), dtype=np.int64)
     ranges = list(_ranges(part, numbers[wrong]))
+    tested = np.arange(len(wrong))
+    if BY_ENDS and part.period is None and not part.strict.any():
+        typed = numbers[wrong]
+        counts = (np.searchsorted(part.starts, typed, side="right")
+                  - np.searchsorted(part.ends, typed, side="left")).astype(np.int64)
+        own, mine = part.values[wrong], part.reach[wrong]
+        widest = -_range_least(-part.reach[part.order], np.searchsorted(part.sorted_values, own - mine, side="left"),
+                               np.searchsorted(part.sorted_values, own + mine, side="right"))
+        tested = np.flatnonzero(np.abs(typed - own) <= mine + np.maximum(widest, 0.0))
+        counts[tested] = 0
     for starts, ends in ranges:
-        sizes = np.maximum(ends - starts, 0)
-        sized = sizes > COUNTED if part.monotone else np.zeros(len(sizes), dtype=bool)
-        counts[sized] += sizes[sized]
-        tested = np.flatnonzero(~sized)
         for which, positions in _expanded(starts[tested], ends[tested]):
             ok = _accepts(part, wrong[tested[which]], part.order[positions], numbers)
             counts += np.bincount(tested[which[ok]], minlength=len(wrong))
     return counts, ranges
 
 
-def _pairs(parts: Sequence[_Part], wrong: Mapping[str, Ints], numbers: Mapping[str, Floats], spread: Spread,
-           found: Sequence[tuple[Ints, list[tuple[Ints, Ints]]]], per_student: Ints,
-           examined: int) -> dict[tuple[int, int], Pair]:
+def _pairs(parts: Sequence[_Part], answers: _Answers, spread: Spread,
+           found: Sequence[tuple[Ints, list[tuple[Ints, Ints]]]], examined: int) -> dict[tuple[int, int], Pair]:
     """Every pair with two or more matched parts whose corrected chance is below :data:`KEPT`.
 
     A pair needs as many matched parts as the fewest whose chance could be that small (:func:`_needed`); a
     partner that matches ``n`` of a student's parts is in the band search of at least one part other than
     the ``n - 1`` that matched the most students: those searches alone are expanded."""
-    students = len(per_student)
+    wrong, students = answers.wrong, len(answers.per_student)
     counts = np.zeros((students, len(parts)), dtype=np.int64)  # per student and part, the students matched
     for index, (part, (found_counts, _)) in enumerate(zip(parts, found, strict=True)):
         counts[wrong[part.label], index] = found_counts
     matched = np.count_nonzero(counts, axis=1)
-    needed = _needed(parts, wrong, students, examined)
+    needed = _needed(parts, answers, spread, found, examined)
     # Each part's rank among the student's, most students matched first: the needed - 1 first are not searched.
     rank = np.argsort(np.argsort(-counts, axis=1, kind="stable"), axis=1, kind="stable")
     keys = []
@@ -296,79 +381,183 @@ def _pairs(parts: Sequence[_Part], wrong: Mapping[str, Ints], numbers: Mapping[s
         for starts, ends in ranges:
             for which, positions in _expanded(starts[chosen], ends[chosen]):
                 owners, partners = members[chosen[which]], part.order[positions]
-                ok = _accepts(part, owners, partners, numbers[part.label])
+                ok = _accepts(part, owners, partners, answers.numbers[part.label])
                 keys.append(np.unique(owners[ok] * students + partners[ok]))
     if not keys:
         return {}
     pairs = np.unique(np.concatenate(keys))
     return {(pair.student, pair.partner): pair
-            for pair in _figures(parts, wrong, numbers, spread, pairs // students, pairs % students, per_student,
-                                 examined, 2, KEPT)}
+            for pair in _figures(parts, answers, spread, pairs // students, pairs % students, examined, 2, KEPT)}
 
 
-def _needed(parts: Sequence[_Part], wrong: Mapping[str, Ints], students: int, examined: int) -> Ints:
+def _needed(parts: Sequence[_Part], answers: _Answers, spread: Spread,
+            found: Sequence[tuple[Ints, list[tuple[Ints, Ints]]]], examined: int) -> Ints:
     """Per student, the fewest matched parts (at least 2) whose corrected chance could be under :data:`KEPT`
-    (more than their wrong parts: none could). Each part's chance is at least the unrelated kind's share
-    times the least class density of the part, so ``k`` matches have a chance of at least the product of the
-    ``k`` least of those over the student's wrong parts."""
+    (more than their wrong parts: none could). ``k`` matches have a chance of at least the product of the
+    ``k`` least of their parts' chances (:func:`_least`), and the correction is at least ``examined``."""
+    students = len(answers.per_student)
     least = np.full((students, max(len(parts), 1)), np.inf)
-    for index, part in enumerate(parts):
-        finite = part.chance[np.isfinite(part.chance)]
-        least[wrong[part.label], index] = UNRELATED * float(finite.min()) if len(finite) else 0.0
-    # log 0 = -inf (a part no chance bounds) then log inf (a part not wrong) make NaN: not possible, as meant.
+    for index, (part, (_, ranges)) in enumerate(zip(parts, found, strict=True)):
+        members = answers.wrong[part.label]
+        least[members, index] = _least(part, spread, members, answers.numbers[part.label][members],
+                                       answers.steps[part.label][members], ranges)
+    # log 0 = -inf (a part no chance bounds) then log inf (a part that matches nobody) make NaN: not possible.
     with np.errstate(divide="ignore", invalid="ignore"):
         bound = math.log(max(examined, 1)) + np.cumsum(np.log(np.sort(least, axis=1)), axis=1)
-    possible = (bound < math.log(KEPT)) & (np.arange(least.shape[1]) >= 1)
+    possible = ((bound < math.log(KEPT)) | (KEPT > 1)) & (np.arange(least.shape[1]) >= 1)  # > 1: every pair
     return np.where(possible.any(axis=1), np.argmax(possible, axis=1) + 1, least.shape[1] + 1).astype(np.int64)
 
 
-def _figures(parts: Sequence[_Part], wrong: Mapping[str, Ints], numbers: Mapping[str, Floats], spread: Spread,
-             owners: Ints, partners: Ints, per_student: Ints, examined: int, least: int = 0,
-             below: float = math.inf) -> list[Pair]:
-    """Each pair's matched parts and chances: the Poisson binomial distribution of the number of matches
-    among the owner's wrong parts, built a part at a time; only the pairs with ``least`` matched parts or
-    more and a corrected chance under ``below``."""
-    count = len(owners)
-    most = int(per_student[owners].max()) if count else 0
-    distribution = np.zeros((count, most + 1))
-    distribution[:, 0] = 1.0
-    hits = np.zeros((count, len(parts)), dtype=bool)
+def _least(part: _Part, spread: Spread, owners: Ints, numbers: Floats, steps: Floats,
+           ranges: Sequence[tuple[Ints, Ints]]) -> Floats:
+    """Per wrong answer, at most the chance (:func:`_chance`) of the answer in the band of any student whose
+    band may hold it (the search's range: inf where it is empty), however close the pair's matches are.
+
+    The band narrowed to ``(λ + 1) h`` around the partner's value holds the answer with ``h`` to spare, or is
+    the whole band, which holds it with at least half its width to spare on one side: either way it holds
+    ``[a - η, a]`` or ``[a, a + η]`` with ``η = min(h, the least reach in the range)``, so the related kind's
+    chance is at least its mass over the lighter of the two (halved against the grid's rounding); the
+    unrelated kind's is at least the least of ``c`` and ``h c / reach`` in the range."""
+    order = part.order
+    chance, reach = part.chance[order], part.reach[order]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        per_width = np.where(reach > 0, chance / reach, np.inf)
+    least_chance, least_width, least_reach = (np.full(len(owners), np.inf) for _ in range(3))
+    for starts, ends in ranges:
+        least_chance = np.minimum(least_chance, _range_least(chance, starts, ends))
+        least_width = np.minimum(least_width, _range_least(per_width, starts, ends))
+        least_reach = np.minimum(least_reach, _range_least(reach, starts, ends))
+    with np.errstate(invalid="ignore"):
+        unrelated = np.nan_to_num(np.minimum(least_chance, steps * least_width), nan=0.0, posinf=0.0)
+    related = np.zeros(len(owners))
+    if part.period is None:
+        spread_out = np.minimum(steps, least_reach)
+        inside = np.isfinite(spread_out)
+        own, number, width = part.values[owners][inside], numbers[inside], spread_out[inside]
+        related[inside] = 0.5 * np.minimum(spread.chance(own, number - width, number, owners[inside]),
+                                           spread.chance(own, number, number + width, owners[inside]))
+    found = (1 - UNRELATED) * related + UNRELATED * unrelated
+    return np.where(np.isfinite(least_reach), found, np.inf)
+
+
+def _range_least(values: Floats, starts: Ints, ends: Ints) -> Floats:
+    """The least of ``values[start:end]`` per range (inf: empty), from a table of the least of each run of
+    ``2^k`` values (a sparse table: two look-ups a range).
+
+    >>> _range_least(np.array([5.0, 3.0, 4.0, 1.0, 2.0]), np.array([0, 0, 2, 4, 3]), np.array([1, 3, 4, 5, 3]))
+    array([ 5.,  3.,  1.,  2., inf])
+    """
+    found = np.full(len(starts), np.inf)
+    sizes = ends - starts
+    if not len(values) or not (sizes > 0).any():
+        return found
+    levels = [values]
+    while 2 ** len(levels) <= len(values):
+        run = 2 ** (len(levels) - 1)
+        levels.append(np.minimum(levels[-1][:-run], levels[-1][run:]))
+    some = np.flatnonzero(sizes > 0)
+    level = np.floor(np.log2(sizes[some])).astype(np.int64)
+    for k in np.unique(level).tolist():
+        rows = some[level == k]
+        found[rows] = np.minimum(levels[k][starts[rows]], levels[k][ends[rows] - 2 ** k])
+    return found
+
+
+def _figures(parts: Sequence[_Part], answers: _Answers, spread: Spread, owners: Ints, partners: Ints,
+             examined: int, least: int = 0, below: float = math.inf) -> list[Pair]:
+    """Each pair's matched parts and chances; only the pairs with ``least`` matched parts or more and a
+    corrected chance under ``below``. For ``j`` from 2 to the matches (1 for a pair of one match): the chance
+    that ``j`` or more of the owner's wrong parts land by accident as close to the partner's values as the
+    pair's ``j`` closest matches, closeness counted in half-units of the owner's typed answers (the
+    least close of those ``j`` sets it for every part); the pair's chance is the least of these."""
+    per_student = answers.per_student
+    hits = np.zeros((len(owners), len(parts)), dtype=bool)
+    units = np.full((len(owners), len(parts)), np.inf)
     for index, part in enumerate(parts):
-        answered = np.zeros(len(part.values), dtype=bool)
-        answered[wrong[part.label]] = True
-        rows = np.flatnonzero(answered[owners])
-        if not len(rows):
-            continue
-        chance = _chance(part, spread, owners[rows], partners[rows])[:, None]
-        shifted = np.zeros((len(rows), most + 1))
-        shifted[:, 1:] = distribution[rows, :-1]
-        distribution[rows] = distribution[rows] * (1 - chance) + shifted * chance
-        hits[rows, index] = _accepts(part, owners[rows], partners[rows], numbers[part.label])
+        rows = np.flatnonzero(answers.answered(part.label)[owners])
+        hits[rows, index] = _accepts(part, owners[rows], partners[rows], answers.numbers[part.label])
     matched = hits.sum(axis=1)
-    tails = np.cumsum(distribution[:, ::-1], axis=1)[:, ::-1][np.arange(count), np.minimum(matched, most)]
-    tails = np.minimum(tails, 1.0)
-    corrected = np.minimum(tails * max(examined, 1), 1.0)
-    kept = (matched >= least) & (corrected < below)
-    owners, partners, hits, tails, corrected = owners[kept], partners[kept], hits[kept], tails[kept], corrected[kept]
+    kept = matched >= least  # the chances are worked out only for the pairs that could be kept
+    owners, partners, hits, matched = owners[kept], partners[kept], hits[kept], matched[kept]
+    units = np.full(hits.shape, np.inf)
+    for index, part in enumerate(parts):
+        rows = np.flatnonzero(hits[:, index])
+        centres = answers.centres(part, owners[rows], partners[rows])
+        distance = errors(answers.numbers[part.label][owners[rows]], centres,
+                          angle_unit=part.unit if part.period is not None else None)[0]
+        # inf / inf (a number typed as arithmetic) is NaN: such a match claims no closeness (0 sets none).
+        with np.errstate(divide="ignore", invalid="ignore"):
+            units[rows, index] = np.nan_to_num(distance / answers.steps[part.label][owners[rows]], nan=0.0,
+                                               posinf=np.inf)
+    ordered = np.sort(units, axis=1)
+    chances, counted, closeness = np.ones(len(owners)), matched.copy(), np.full(len(owners), np.inf)
+    for closest in range(1, int(matched.max()) + 1 if len(matched) else 1):
+        rows = np.flatnonzero((matched >= closest) & ((closest >= 2) | (matched == 1)))
+        tails = _tails(parts, answers, spread, owners[rows], partners[rows], ordered[rows, closest - 1])
+        tails = tails[:, min(closest, tails.shape[1] - 1)]
+        better = tails < chances[rows]
+        chances[rows[better]], counted[rows[better]] = tails[better], closest
+        closeness[rows[better]] = ordered[rows[better], closest - 1]
+    # The closeness and the number of matches counted were read off the answers: paid for over every number
+    # ``j`` a pair could be counted with, each at most the chance of ``j`` matches anywhere in the bands.
+    anywhere = _tails(parts, answers, spread, owners, partners, np.full(len(owners), np.inf))
+    first = np.where(matched >= 2, 2, 1)
+    counts = np.arange(anywhere.shape[1])
+    paid = np.where(counts >= first[:, None], np.minimum(chances[:, None], anywhere), 0.0).sum(axis=1)
+    corrected = np.minimum(np.maximum(paid, chances) * max(examined, 1), 1.0)
+    kept = corrected < below
+    owners, partners, hits, chances = owners[kept], partners[kept], hits[kept], chances[kept]
+    corrected, counted, closeness = corrected[kept], counted[kept], closeness[kept]
     # The matched parts' labels, worked out once per pattern of parts (a class has a few hundred patterns).
     patterns = hits.astype(np.int64) @ (np.int64(1) << np.arange(len(parts), dtype=np.int64))
     named: dict[int, tuple[str, ...]] = {}
     for pattern in np.unique(patterns).tolist():
         named[pattern] = tuple(part.label for index, part in enumerate(parts) if pattern >> index & 1)
-    return [Pair(owner, partner, named[pattern], wrong, chance, fixed)
-            for owner, partner, pattern, wrong, chance, fixed in zip(
-                owners.tolist(), partners.tolist(), patterns.tolist(), per_student[owners].tolist(), tails.tolist(),
-                corrected.tolist(), strict=True)]
+    return [Pair(owner, partner, named[pattern], wrong, chance, fixed, closest, near)
+            for owner, partner, pattern, wrong, chance, fixed, closest, near in zip(
+                owners.tolist(), partners.tolist(), patterns.tolist(), per_student[owners].tolist(),
+                chances.tolist(), corrected.tolist(), counted.tolist(), closeness.tolist(), strict=True)]
 
 
-def _chance(part: _Part, spread: Spread, owners: Ints, partners: Ints) -> Floats:
-    """The chance that each owner's wrong answer to the part lands in the partner's band by accident
-    (:mod:`grader.grade.integrity_chance`; an angle's answers are all taken as unrelated to their own)."""
-    unrelated = np.nan_to_num(part.chance[partners], nan=0.0)
-    if part.period is not None:
-        return unrelated
+def _tails(parts: Sequence[_Part], answers: _Answers, spread: Spread, owners: Ints, partners: Ints,
+           closeness: Floats) -> Floats:
+    """Per pair (a row), the chance that ``j`` (a column) or more of the owner's wrong parts land within
+    ``closeness`` half-units of the partner's (:func:`_chance`; inf: anywhere in the bands): the tails of the
+    Poisson binomial distribution of the count, built a part at a time."""
+    count = len(owners)
+    most = int(answers.per_student[owners].max()) if count else 0
+    distribution = np.zeros((count, most + 1))
+    distribution[:, 0] = 1.0
+    for part in parts:
+        rows = np.flatnonzero(answers.answered(part.label)[owners])
+        if not len(rows):
+            continue
+        chance = _chance(part, spread, owners[rows], partners[rows], closeness[rows],
+                         answers.steps[part.label][owners[rows]],
+                         answers.centres(part, owners[rows], partners[rows]))[:, None]
+        shifted = np.zeros((len(rows), most + 1))
+        shifted[:, 1:] = distribution[rows, :-1]
+        distribution[rows] = distribution[rows] * (1 - chance) + shifted * chance
+    return np.asarray(np.minimum(np.cumsum(distribution[:, ::-1], axis=1)[:, ::-1], 1.0))
+
+
+def _chance(part: _Part, spread: Spread, owners: Ints, partners: Ints, closeness: Floats, steps: Floats,
+            centres: Floats) -> Floats:
+    """The chance that each owner's wrong answer to the part lands by accident in the partner's band and
+    within ``closeness`` half-units ``steps`` of the owner's typed answer from ``centres``
+    (:meth:`_Answers.centres`), widened by one more (a number rounded as typed is within a half-unit of where
+    it was headed): over the band narrowed to that (:mod:`grader.grade.integrity_chance`; an angle's answers
+    are all taken as unrelated to their own, and its chance is the narrowed share of the band's)."""
     middle, reach = part.values[partners], part.reach[partners]
-    related = spread.chance(part.values[owners], middle - reach, middle + reach, owners)
+    with np.errstate(invalid="ignore"):
+        half = np.nan_to_num((closeness + 1) * steps, nan=np.inf)
+    low, high = np.maximum(centres - half, middle - reach), np.minimum(centres + half, middle + reach)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        share = np.where(reach > 0, np.clip((high - low) / (2 * reach), 0.0, 1.0), 1.0)
+    unrelated = np.nan_to_num(part.chance[partners], nan=0.0) * share
+    if part.period is not None:
+        return np.asarray(unrelated)
+    related = spread.chance(part.values[owners], low, np.maximum(low, high), owners)
     return np.asarray((1 - UNRELATED) * related + UNRELATED * unrelated)
 
 

@@ -91,7 +91,8 @@ def details_csv(graded: Graded, students_per_piece: int = 2000) -> Iterator[str]
 
 
 INTEGRITY_HEADER = ("student_id", "label", "submitted", "parsed", "matches_id", "matches_value", "students_matched",
-                    "pair_parts", "pair_labels", "wrong_parts", "chance", "corrected_chance", "flagged")
+                    "pair_parts", "pair_labels", "wrong_parts", "close_parts", "closeness", "chance",
+                    "corrected_chance", "flagged")
 
 
 def integrity_csv(graded: Graded, integrity: Integrity) -> Iterator[str]:
@@ -99,8 +100,10 @@ def integrity_csv(graded: Graded, integrity: Integrity) -> Iterator[str]:
     :data:`~grader.grade.integrity.LISTED` per answer): what was typed and read, whose variant it matches
     and that variant's value (6 significant figures, as ``details.csv``'s ``expected``), how many students'
     values it matches in all; and the pair's figures: how many parts (and which) the student's wrong answers
-    match that student's values in, how many parts the student had wrong, the chance of so many matches by
-    accident and that chance corrected for the pairs examined, and whether the pair is flagged (``yes``: at
+    match that student's values in, how many parts the student had wrong, how many of the closest matches the
+    chance counts and how close the least close of them is (in half-units of the last digit the student typed;
+    empty: not read), the chance of so many matches so close by accident and that chance corrected for the
+    pairs examined, and whether the pair is flagged (``yes``: at
     most the assignment's ``integrity_threshold``). In pieces, as :func:`_csv_pieces`. A report: it changes
     no grade."""
     students = graded.key.students
@@ -111,9 +114,10 @@ def integrity_csv(graded: Graded, integrity: Integrity) -> Iterator[str]:
         for match in integrity.matches:
             row = graded.columns[match.label][match.student]
             pair = integrity.pair(match.student, match.partner)
-            figures: list[object] = [None] * 6 if pair is None else [
-                len(pair.labels), " ".join(pair.labels), pair.wrong, _chance(pair.chance), _chance(pair.corrected),
-                "yes" if pair in flagged else "no"]
+            figures: list[object] = [None] * 8 if pair is None else [
+                len(pair.labels), " ".join(pair.labels), pair.wrong, pair.closest,
+                number_cell(pair.closeness, 3) if math.isfinite(pair.closeness) else None, _chance(pair.chance),
+                _chance(pair.corrected), "yes" if pair in flagged else "no"]
             yield [students[match.student].id, match.label, row.submitted, row.parsed, students[match.partner].id,
                    number_text(match.value), match.matches, *figures]
 

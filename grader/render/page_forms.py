@@ -107,8 +107,25 @@ def inverse_trig(steps: list[Step], positive: dict[str, Node]) -> list[Step]:
             # The kernel's atan2(y, x) is the principal value only where x > 0 (sin⁻¹, tan⁻¹) or y > 0 (cos⁻¹)
             positive[step.unknown] = step.solved.args[0 if inverse == "acos" else 1]
             step = replace(step, solved=Op(inverse, (rhs,)))
+        swing = _SWING_ANGLE.fullmatch(step.relation)
+        if swing and step.unknown == swing.group(2) and isinstance(lhs, Sym) and _is_half_angle(step.solved):
+            # v = √(2gL(1 − cos θ)): θ = cos⁻¹(1 − v²/(2gL)), the kernel's 2 atan2(v, √(4gL − v²)) where v > 0
+            positive[step.unknown] = lhs
+            height = Op("div", (Op("pow", (lhs, Num(Fraction(2)))),
+                                Op("mul", (Op("mul", (Num(Fraction(2)), Sym("g"))), Sym(swing.group(1))))))
+            step = replace(step, solved=Op("acos", (Op("sub", (_ONE, height)),)))
         result.append(step)
     return result
+
+
+_SWING_ANGLE = re.compile(r"conservation of energy in the swing of \S+ on its cord of length (\w+) .*"
+                          r"to stop at (\w+) from the vertical")
+
+
+def _is_half_angle(node: Node) -> bool:
+    """``2 atan2(...)``: the kernel's stable form of an angle from its half-angle's tangent."""
+    return (isinstance(node, Op) and node.op == "mul" and node.args[0] == Num(Fraction(2))
+            and isinstance(node.args[1], Op) and node.args[1].op == "atan2")
 
 
 def magnitudes(steps: list[Step]) -> list[Step]:

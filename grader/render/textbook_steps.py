@@ -256,7 +256,8 @@ def _one_impact(template: Template, steps: list[Step], extra: list[Step], impuls
     members = [s for s in steps if s.unknown in pair.after_names and _MOMENTUM_OF.fullmatch(s.relation)
                and impulse in names(s.equation[0]) | names(s.equation[1])]
     others = [s for s in steps if s is not found and s not in members]
-    if any(_uses(s, impulse) for s in others) or impulse in answers:
+    asked = impulse in answers
+    if any(_uses(s, impulse) for s in others) or (asked and found.block):
         return None
     if found.block:
         return _first_before(steps, found, members, pair)
@@ -267,6 +268,9 @@ def _one_impact(template: Template, steps: list[Step], extra: list[Step], impuls
     forms = pair.both_after()
     shown = [Step(block[0], pair.relation(), momentum, forms[0], block),
              Step(block[1], pair.restitution_relation(), restitution, forms[1], block)]
+    if asked:  # the impulse asked: from the first body's change of momentum, once its velocity after is known
+        change = _mul(pair.masses[0], _sub(pair.before[0] or _ZERO, pair.after[0]))
+        shown.append(Step(impulse, f"impulse-momentum for {pair.first} along n", (Sym(impulse), change), change))
     chain = {s.unknown for s in steps}
     extra += [s for s in shown if s.unknown not in chain]
     index = steps.index(found)

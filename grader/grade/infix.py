@@ -103,7 +103,7 @@ class _Reader:
             return base
         self.at += 1
         exponent = self.factor()  # Python's power: a primary, '**', a factor (-p**2 is -(p**2), p**-2 is p**(-2))
-        if isinstance(exponent, Num) and abs(exponent.value) > MAX_EXPONENT:
+        if isinstance(exponent, Num) and not -MAX_EXPONENT <= exponent.value <= MAX_EXPONENT:
             raise _UnusualError
         return Op("pow", (base, exponent))
 

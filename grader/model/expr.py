@@ -197,7 +197,7 @@ def _call(node: ast.Call, allow_compare: bool, depth: int) -> Node:
 
 
 def _check_exponent(exponent: Node) -> None:
-    if isinstance(exponent, Num) and abs(exponent.value) > MAX_EXPONENT:
+    if isinstance(exponent, Num) and not -MAX_EXPONENT <= exponent.value <= MAX_EXPONENT:
         shown = to_text(exponent)
         shown = shown if len(shown) <= 24 else shown[:20] + "…"  # a number of 400 digits by its first digits
         raise ExpressionError(f"exponent {shown} is larger than {MAX_EXPONENT}")

@@ -74,8 +74,9 @@ def oblique_spheres(xp: Any, v1: Any, theta: Any, e: Any, m1: Any, m2: Any) -> d
 
 def head_on(xp: Any, m1: Any, m2: Any, v1: Any, v2: Any, e: Any) -> dict[str, Any]:
     v1_out, v2_out = _line(v1, m1, m2, e, v2)
-    return {"v1_out": v1_out, "v2_out": v2_out,
-            "loss_pct": _loss_pct(m1 * v1**2 + m2 * v2**2, m1 * v1_out**2 + m2 * v2_out**2)}
+    before, after = (m1 * v1**2 + m2 * v2**2) / 2, (m1 * v1_out**2 + m2 * v2_out**2) / 2
+    return {"v1_out": v1_out, "v2_out": v2_out, "loss_pct": _loss_pct(before, after), "energy_lost": before - after,
+            "impulse": abs(m1 * (v1 - v1_out))}  # N·s: cart 1's change of momentum
 
 
 def head_on_inverse(xp: Any, m1: Any, m2: Any, v1: Any, v2: Any, v1_out: Any) -> dict[str, Any]:
@@ -89,7 +90,8 @@ def coupling(xp: Any, m_A: Any, m_B: Any, v_A: Any, v_B: Any) -> dict[str, Any]:
     v_common = (m_A * v_A + m_B * v_B) / (m_A + m_B)
     before = (m_A * (v_A / 3.6) ** 2 + m_B * (v_B / 3.6) ** 2) / 2
     after = (m_A + m_B) * (v_common / 3.6) ** 2 / 2
-    return {"v_common": v_common, "energy_lost": before - after, "loss_pct": _loss_pct(before, after)}
+    return {"v_common": v_common, "energy_lost": before - after, "loss_pct": _loss_pct(before, after),
+            "impulse": abs(m_A * (v_A - v_common) / 3.6)}  # kN·s: (1000 m_A) (Δv/3.6) N·s, over 1000
 
 
 def moving_plate(xp: Any, h: Any, u: Any, e: Any) -> dict[str, Any]:

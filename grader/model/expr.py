@@ -215,6 +215,17 @@ def names(node: Node) -> set[str]:
     return set()
 
 
+def bottom_up(node: Node, rule: Callable[[Op], Node]) -> Node:
+    """``node`` rewritten from its leaves up: ``rule`` meets each operation with its arguments rewritten already.
+
+    >>> to_text(bottom_up(parse("Max(0, h - r)/h"), lambda op: op.args[1] if op.op == "Max" else op))
+    '(h - r)/h'
+    """
+    if not isinstance(node, Op):
+        return node
+    return rule(Op(node.op, tuple(bottom_up(arg, rule) for arg in node.args)))
+
+
 def substitute(node: Node, values: Mapping[str, Node]) -> Node:
     """Replace names by trees."""
     if isinstance(node, Sym):

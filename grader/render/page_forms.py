@@ -21,7 +21,7 @@ from dataclasses import replace
 from fractions import Fraction
 from typing import Any
 
-from grader.model.expr import Node, Num, Op, Sym, fold
+from grader.model.expr import Node, Num, Op, Sym, bottom_up, fold
 from grader.model.kernel import evaluate
 from grader.solve.compiled import Step
 
@@ -54,12 +54,13 @@ def page_value(node: Node, env: Mapping[str, Any]) -> Any:
 
 
 def _kernel_form(node: Node) -> Node:
-    if not isinstance(node, Op):
-        return node
-    args = tuple(_kernel_form(a) for a in node.args)
+    return bottom_up(node, _as_atan2)
+
+
+def _as_atan2(node: Op) -> Node:
     if node.op not in INVERSE_TRIG:
-        return Op(node.op, args)
-    (x,) = args
+        return node
+    (x,) = node.args
     other = Op("sqrt", (Op("sub", (_ONE, Op("pow", (x, Num(Fraction(2))))),),))
     return Op("atan2", {"asin": (x, other), "acos": (other, x), "atan": (x, _ONE)}[node.op])
 
@@ -171,9 +172,11 @@ def combine_reciprocals(node: Node) -> Node:
     >>> to_text(combine_reciprocals(parse("v*(1 + e)/(1/m + 1/(m*p))")))
     'v*(1 + e)*(m*(m*p))/(m*p + m)'
     """
-    if not isinstance(node, Op):
-        return node
-    args = tuple(combine_reciprocals(a) for a in node.args)
+    return bottom_up(node, _one_fraction)
+
+
+def _one_fraction(node: Op) -> Node:
+    args = node.args
     if node.op == "add" and all(isinstance(a, Op) and a.op == "div" for a in args):
         (c1, a), (c2, b) = (arg.args for arg in args)  # type: ignore[union-attr]
         if c1 == c2:
@@ -184,7 +187,7 @@ def combine_reciprocals(node: Node) -> Node:
     if node.op == "mul" and isinstance(args[1], Op) and args[1].op == "div" and isinstance(args[0], Op) \
             and args[0].op == "div":
         return Op("div", (Op("mul", (args[0].args[0], args[1].args[0])), Op("mul", (args[0].args[1], args[1].args[1]))))
-    return Op(node.op, args)
+    return node
 
 
 def folded(step: Step) -> Step:

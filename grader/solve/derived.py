@@ -15,7 +15,7 @@ import sympy as sp
 
 from grader.bank.template import Template
 from grader.base.errors import SYMPY_FAILURES, TemplateError, unworkable
-from grader.model.expr import Node, Num, Op, names
+from grader.model.expr import Node, Num, Op, bottom_up, names
 from grader.model.kernel import evaluate
 from grader.physics.effects import CATALOGUE, Mistake, Relation
 from grader.physics.symbolic import from_node, to_node
@@ -154,12 +154,7 @@ def _unclipped(tree: Node) -> Node:
     >>> to_text(_unclipped(parse("100*Max(0, h - r)/h")))
     '100*(h - r)/h'
     """
-    if not isinstance(tree, Op):
-        return tree
-    args = tuple(_unclipped(arg) for arg in tree.args)
-    if tree.op == "Max" and args[0] == Num(Fraction(0)):
-        return args[1]
-    return Op(tree.op, args)
+    return bottom_up(tree, lambda op: op.args[1] if op.op == "Max" and op.args[0] == Num(Fraction(0)) else op)
 
 
 def _composed(chain: list[_Solved], main: Mapping[Any, Any]) -> dict[Any, Any]:

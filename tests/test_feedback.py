@@ -127,14 +127,14 @@ def test_every_page_has_the_students_own_footer_the_worked_solutions_too(feedbac
 
 def test_each_part_is_described_as_the_students_sheet_describes_it(feedback: Path, demo_run: DemoRun,
                                                                     bank: dict[str, Template]) -> None:
-    """What a part asks reads as on the sheet the student answered (car-collision's 2c: ``vA'/v for the given p``,
-    printed on both as the template words it)."""
+    """What a part asks reads as on the sheet the student answered (car-collision's 2c, "car A's velocity ... as
+    a fraction of v", printed on both as the template words it)."""
     key = json.loads((demo_run.out / "key.json").read_text(encoding="utf-8"))
     sheet, marked = pdf_text(demo_run.out / "students" / "2026137.pdf"), pdf_text(feedback / "2026137.pdf")
     problems = next(s for s in key["students"] if s["id"] == "2026137")["problems"]
     parts = [(answer["label"], bank[problem["template"]].answers[name].description)
              for problem in problems for name, answer in problem["answers"].items()]
-    assert ("2c", "vA'/v for the given p") in parts
+    assert ("2c", "car A's velocity just after the impact as a fraction of v, for the given p") in parts
     for label, description in parts:
         assert description in sheet and description in marked, (label, description)
 

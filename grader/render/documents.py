@@ -356,9 +356,20 @@ def _key_answer(template: Template, part: AnswerPart, compiled: Compiled) -> Key
         value = Typ(f"${source}$ {text('undefined: ' + (part.undefined or 'no value'))}")
     else:
         value = _math(f"display({source} = {answer_math(part.value, part.unit)})")
-    figure, reason = part.tolerance.describe(part.unit), part.tolerance.reason
+    figure, reason = _tolerance_shown(part, part.tolerance), part.tolerance.reason
     return KeyAnswer(part.label, part.description, value, f"{part.points:g}",
                      f"{figure} (widened)" if reason else figure, _widened(template, part, figure, reason, compiled))
+
+
+def _tolerance_shown(part: AnswerPart, configured: Tolerance) -> str:
+    """A part's tolerance as the key prints it: an expression is marked right when it is the key's expression
+    (:func:`grader.grade.equivalence.equivalent`: equal at sampled points to 1e-6, else exactly), whatever the
+    part's numeric tolerance."""
+    return SAME_EXPRESSION if isinstance(part.value, str) else configured.describe(part.unit)
+
+
+SAME_EXPRESSION = "equivalent"
+"""The tolerance column of a part answered by an expression."""
 
 
 def _widened(template: Template, part: AnswerPart, figure: str, reason: str, compiled: Compiled) -> Typ:
@@ -449,7 +460,7 @@ def cover(documents: Documents, contents: Sequence[tuple[Typ, int]]) -> Cover:
         for number, answer in enumerate(first.answers):
             configured = tolerance(spec, template, answer.name)
             parts.append((answer.label, answer.description, _unit_text(answer.unit), f"{answer.points:g}",
-                          configured.describe(answer.unit)))
+                          _tolerance_shown(answer, configured)))
             found = widening((s.problems[position].answers[number].tolerance, 1) for s in students)
             if found is not None:
                 widened.append((answer.label, found.describe("student", answer.unit)))

@@ -115,11 +115,11 @@ def test_the_issues_ballistic_pendulum_says_what_v_is_where_it_first_computes_it
 def test_a_part_answered_by_an_expression_has_no_numeric_tolerance_in_the_key(pages: dict[str, list[str]]) -> None:
     """Issue 32: car-collision's expression answers said "±1 %" in the key, a tolerance grading never applies to
     an expression (it is marked right when it is the key's expression). Each of its expression parts reads
-    "equivalent" in its row, and its numeric parts keep their tolerance."""
+    "equal expressions" in its row, as details.csv says, and its numeric parts keep their tolerance."""
     number = ORDER.index("car-collision") + 1
     key = "\n".join(pages["answer-key.pdf"])
-    rows = re.findall(rf"(?m)^{number}([a-d]) .*?(equivalent|±\d+ %)$", key)
+    rows = re.findall(rf"(?m)^{number}([a-d]) .*?(equal expressions|±\d+ %)$", key)
     expressions = {name for name, spec in BANK["car-collision"].answers.items() if spec.symbolic}
     assert len(expressions) == 2 and rows, rows
-    assert {label for label, tolerance in rows if tolerance == "equivalent"} == {"a", "b"}, rows
-    assert {label for label, tolerance in rows if tolerance != "equivalent"} == {"c", "d"}, rows
+    assert {label for label, tolerance in rows if tolerance == "equal expressions"} == {"a", "b"}, rows
+    assert {label for label, tolerance in rows if tolerance != "equal expressions"} == {"c", "d"}, rows

@@ -37,7 +37,7 @@ from grader.grade.lateness import deductions, intervals, late_by, minutes, part_
 from grader.grade.notation import cut
 from grader.grade.submissions import Answer, RowProblem, Submissions
 from grader.grade.timestamps import instant
-from grader.model.tolerance import Tolerance
+from grader.model.tolerance import EQUAL_EXPRESSIONS, Tolerance
 
 VERDICTS = ("correct", "ecf", "mistake", "incorrect", "invalid", "missing")
 """The kinds of verdict: right; right for the student's own earlier answer (error carried forward); a
@@ -371,7 +371,7 @@ def _grade_column(cells: Sequence[tuple[KeyPart, Answer | None]], key: Key) -> _
             group.typed.append(_converted(outcome, part, answer))
             group.words.append(words)
         else:
-            rows[index] = _row(part, answer, _expected(part), "equal expressions" if part.symbolic else words,
+            rows[index] = _row(part, answer, _expected(part), EQUAL_EXPRESSIONS if part.symbolic else words,
                                *outcome)
     numbers, right = np.full(len(cells), np.nan), np.full(len(cells), np.nan)
     wrong = []

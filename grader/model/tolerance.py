@@ -35,6 +35,10 @@ SYMBOL_RANGE = (1.0, 10.0)
 """Where a symbolic answer's name with no sampled range (a symbol such as a speed v, or any name of a
 version 1 key) is drawn to compare expressions, when the key is written and when it is read."""
 
+EQUAL_EXPRESSIONS = "equal expressions"
+"""The tolerance of a part answered by an expression, in words (details.csv, the answer key): it is right when
+it is the key's expression (:func:`grader.grade.equivalence.equivalent`), whatever the numeric tolerance."""
+
 
 class ToleranceError(GraderError, ValueError):
     """A tolerance that is not one of the accepted forms; ``field`` names the entry (``""``: the whole),

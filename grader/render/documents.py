@@ -37,7 +37,7 @@ from grader.bank.markup import paragraphs
 from grader.bank.template import Template, filled_statement
 from grader.base.errors import GraderError
 from grader.base.resources import templates_dir
-from grader.model.tolerance import Tolerance, widening
+from grader.model.tolerance import EQUAL_EXPRESSIONS, Tolerance, widening
 from grader.render.figures import figure
 from grader.render.typeset import compile_typst, font_paths
 from grader.render.typst_math import math, name
@@ -365,11 +365,7 @@ def _tolerance_shown(part: AnswerPart, configured: Tolerance) -> str:
     """A part's tolerance as the key prints it: an expression is marked right when it is the key's expression
     (:func:`grader.grade.equivalence.equivalent`: equal at sampled points to 1e-6, else exactly), whatever the
     part's numeric tolerance."""
-    return SAME_EXPRESSION if isinstance(part.value, str) else configured.describe(part.unit)
-
-
-SAME_EXPRESSION = "equivalent"
-"""The tolerance column of a part answered by an expression."""
+    return EQUAL_EXPRESSIONS if isinstance(part.value, str) else configured.describe(part.unit)
 
 
 def _widened(template: Template, part: AnswerPart, figure: str, reason: str, compiled: Compiled) -> Typ:

@@ -103,15 +103,16 @@ def trajectory(canvas: Drawing, scene: SceneView, to_wall: Stage, to_ground: Sta
     if after:  # where it lands
         canvas.circle(at(after[-1]), 0.09, fill=True)
     canvas.circle((wall - 0.09, hit), 0.09, fill=True)
-    body = [str(string(to_wall.fields["body"]))]
-    spots = [((wall - 0.3, hit + 0.2), "se"), ((wall - 0.3, hit - 0.2), "ne"), ((wall * 0.5, -0.9), "n")]
-    canvas.name(*next((spot for spot in spots if canvas.fits(*spot, body)), spots[-1]), to_wall.fields["body"])
     _release(canvas, scene, to_wall, h0 * scale, _m.atan2(vy, vx), (left, top * scale + 0.3), min(1.1, 0.7 * wall))
     canvas.dimension((wall + 0.5, 0.0), (wall + 0.5, hit), scene.given(to_wall.fields["end_height"]), "right")
     canvas.line((wall, hit), (wall + 0.65, hit), width=0.3)
     horizontal_dimension(canvas, 0.0, wall, -0.5, scene.given(to_wall.fields["distance"]))
     if after and to_ground is not None:
         horizontal_dimension(canvas, after[-1][0] * scale, wall, -1.25, scene.given(to_ground.fields["distance"]))
+    body = [str(string(to_wall.fields["body"]))]  # named where it strikes, clear of the paths and dimensions
+    spots = [((wall - 0.3, hit + 0.2), "se"), ((wall - 0.3, hit - 0.2), "ne"), ((wall - 0.3, hit + 0.6), "se"),
+             ((wall - 0.3, hit - 0.6), "ne"), ((wall * 0.5, -0.9), "n")]
+    canvas.name(*next((spot for spot in spots if canvas.fits(*spot, body)), spots[-1]), to_wall.fields["body"])
     restitution = _restitution(scene, impact)
     if restitution:
         canvas.name((wall + 0.3, max(top * scale, hit + 0.9) + 0.2), "w", restitution[-1], restitution[:-1])

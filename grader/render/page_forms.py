@@ -36,7 +36,8 @@ _COMPONENT = re.compile(r"(\w+): component along ([nt])")
 _ONE = Num(Fraction(1))
 
 
-def _is_zero(node: Node | None) -> bool:
+def is_zero(node: Node | None) -> bool:
+    """No node (at rest, nothing given) or the number 0."""
     return node is None or (isinstance(node, Num) and node.value == 0)
 
 
@@ -134,7 +135,7 @@ def magnitudes(steps: list[Step]) -> list[Step]:
     v cos θ`` and ``v_t = v sin θ``), and the root of one component and a zero is that component's size."""
     known: dict[frozenset[Node], Node] = {}
     components: dict[str, dict[str, str]] = {}
-    zero = {s.unknown for s in steps if _is_zero(s.solved)}
+    zero = {s.unknown for s in steps if is_zero(s.solved)}
     result = []
     for original in steps:
         step = replace(original, equation=tuple(_speeds(side, known, zero) for side in original.equation),  # type: ignore[arg-type]
@@ -158,7 +159,7 @@ def _speeds(node: Node, known: Mapping[frozenset[Node], Node], zero: set[str]) -
     if node.op == "hypot":
         if frozenset(args) in known:
             return known[frozenset(args)]
-        kept = [a for a in args if not (isinstance(a, Sym) and a.name in zero) and not _is_zero(a)]
+        kept = [a for a in args if not (isinstance(a, Sym) and a.name in zero) and not is_zero(a)]
         if len(kept) == 1:
             return Op("abs", (kept[0],))
     return Op(node.op, args)

@@ -26,7 +26,7 @@ from typing import Any
 from grader.bank.template import Template
 from grader.model.expr import Node, Num, Op, Sym, names
 from grader.model.scene import Stage, Velocity
-from grader.render.page_forms import bounce_heights, folded, inverse_trig, magnitudes, one_fraction
+from grader.render.page_forms import bounce_heights, folded, inverse_trig, is_zero, magnitudes, one_fraction
 from grader.solve.compiled import Compiled, Step
 
 _IMPULSE = re.compile(r"impulse along n in the impact of (\S+) and (\S+), with restitution .+")
@@ -49,12 +49,8 @@ class Route:
 
 # --- building trees ------------------------------------------------------------------------------
 
-def _is_zero(node: Node | None) -> bool:
-    return node is None or (isinstance(node, Num) and node.value == 0)
-
-
 def _add(*terms: Node | None) -> Node:
-    kept = [t for t in terms if t is not None and not _is_zero(t)]
+    kept = [t for t in terms if t is not None and not is_zero(t)]
     if not kept:
         return _ZERO
     total = kept[0]
@@ -65,7 +61,7 @@ def _add(*terms: Node | None) -> Node:
 
 
 def _mul(*factors: Node) -> Node:
-    if any(_is_zero(f) for f in factors):
+    if any(is_zero(f) for f in factors):
         return _ZERO
     kept = [f for f in factors if f != _ONE]
     if not kept:
@@ -85,9 +81,9 @@ def _div(numerator: Node, denominator: Node) -> Node:
 
 
 def _sub(left: Node | None, right: Node | None) -> Node:
-    if right is None or _is_zero(right):
+    if right is None or is_zero(right):
         return left if left is not None else _ZERO
-    if left is None or _is_zero(left):
+    if left is None or is_zero(left):
         return _neg(right)
     return Op("sub", (left, right))
 
@@ -216,8 +212,8 @@ def _pair(template: Template, first: str, second: str) -> _Pair | None:
 
 def _along_n(velocity: Any) -> Node | None:
     if isinstance(velocity, Velocity):
-        return None if _is_zero(velocity.n) else velocity.n
-    return None if velocity is None or _is_zero(velocity) else velocity
+        return None if is_zero(velocity.n) else velocity.n
+    return None if velocity is None or is_zero(velocity) else velocity
 
 
 def _uses(step: Step, quantity: str) -> bool:

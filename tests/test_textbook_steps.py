@@ -25,12 +25,12 @@ from grader.bank.template import Template, load_bank
 from grader.base.resources import sample_dir
 from grader.model.expr import Num, Sym, parse, substitute
 from grader.model.kernel import evaluate
-from grader.render.page_forms import page_value
 from grader.render.readable import readable
-from grader.render.textbook_steps import textbook_route
 from grader.render.typst_math import math as typst_math
 from grader.render.worked import answer_math, chain_values, reader_names, si_parameters, worked, worked_form
 from grader.solve.cache import compiled_for
+from grader.solve.page_forms import page_value
+from grader.solve.textbook_steps import textbook_route
 
 BANK = load_bank()
 ORDER = sorted(BANK)

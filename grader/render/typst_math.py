@@ -78,7 +78,7 @@ def number(value: float, figures: int = 4) -> str:
 _LEVEL = {"add": 4, "sub": 4, "mul": 5, "div": 5, "neg": 6, "pow": 7}
 _CALLS = {"sqrt": "sqrt", "sin": "sin", "cos": "cos", "tan": "tan", "sind": "sin", "cosd": "cos",
           "log": "ln", "abs": "abs", "Max": "max", "Min": "min", "atan2": 'op("atan2")',
-          # the worked solutions' inverse functions (render/textbook_steps.py), which no template or student writes
+          # the worked solutions' inverse functions (solve/textbook_steps.py), which no template or student writes
           "asin": "sin^(-1)", "acos": "cos^(-1)", "atan": "tan^(-1)"}
 _TRIG = {"sin", "cos", "tan", "sind", "cosd"}
 

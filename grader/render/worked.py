@@ -26,13 +26,13 @@ from grader.model.expr import Node, Num, Sym, format_number, names, parse
 from grader.model.kernel import evaluate
 from grader.model.quantities import ACCELERATION, ANGLE, Dimension, dimension_of, si_unit
 from grader.model.roots import TOLERANCE_TEXT
-from grader.render.page_forms import page_value, tidy_signs
 from grader.render.readable import Names, readable
-from grader.render.textbook_steps import textbook_route
 from grader.render.typst_math import math, name, number
 from grader.render.typst_text import Typ, body_name, string, text
 from grader.solve.cache import compiled_for
 from grader.solve.compiled import Compiled, Step
+from grader.solve.page_forms import page_value, tidy_signs
+from grader.solve.textbook_steps import textbook_route
 
 
 def _significant(printed: str) -> int:

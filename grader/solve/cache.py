@@ -105,7 +105,7 @@ def routes_for(template: Template) -> Routes:
     def compile_now() -> Routes:
         from grader.solve.derived_routes import compile_routes
 
-        return compile_routes(template)
+        return compile_routes(template, compiled_for(template))
 
     return _cached(template, "-routes", Routes.from_json, compile_now)
 

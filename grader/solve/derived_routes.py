@@ -1,33 +1,43 @@
 """The sympy side of :mod:`grader.solve.routes`: each answer's routes derived from the scene, and the
 slope of the answer in each value written down along them.
 
+The worked solution's route is the one the page prints (:func:`grader.solve.textbook_steps.textbook_route`): the
+values a student copies from it are the ones the page computes, in its order (head-on's velocities after from
+momentum and restitution, then the impulse from one of them), each from the form the page writes. Where the page
+solves a block numerically, the route is the solver's chain, as the page's numeric block is.
+
 Imported only when routes are compiled (the cache spares later runs the sympy import).
 """
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from typing import Any
 
 import sympy as sp
 
 from grader.bank.template import Template
 from grader.base.errors import TemplateError, unworkable
-from grader.model.expr import Node
+from grader.model.expr import Node, names
 from grader.physics.effects import CATALOGUE
 from grader.physics.symbolic import INNER, cosd, from_node, hypot, sind, to_node
+from grader.solve.compiled import Compiled
 from grader.solve.derived import _FAILURES
+from grader.solve.page_forms import kernel_form
 from grader.solve.routes import Route, Routes
-from grader.solve.solver import _Compiler, _needed, _si_factor, _Solved, derive
+from grader.solve.solver import _Compiler, _needed, _si_factor, _Solved, compile_template, derive
 from grader.solve.stable import numeric_order
+from grader.solve.textbook_steps import textbook_route
 
 RATIO = "ratio"
 """The name of the ratio a square-root route writes down first (no step of a chain is named so)."""
 
 
-def compile_routes(template: Template) -> Routes:
-    """Derive and compile a template's routes (sympy; then cached, see :func:`grader.solve.cache.routes_for`).
-    A route the solver cannot derive or differentiate is left out; the chain of the worked solution never is."""
-    compiler = RouteCompiler(template)
+def compile_routes(template: Template, compiled: Compiled | None = None) -> Routes:
+    """Derive and compile a template's routes (sympy; then cached, see :func:`grader.solve.cache.routes_for`);
+    ``compiled``: the template's compiled form, if the caller has it (else it is compiled here). A route the solver
+    cannot derive or differentiate is left out; the worked solution's never is."""
+    compiler = RouteCompiler(template, compiled or compile_template(template))
     return Routes(template.id, template.source_hash,
                   {"g": float(template.scene.gravity.si)} if template.scene.gravity else {},
                   tuple(compiler.routes()), tuple(template.symbols))
@@ -36,8 +46,10 @@ def compile_routes(template: Template) -> Routes:
 class RouteCompiler(_Compiler):
     """Compiles one template's routes."""
 
-    def __init__(self, template: Template) -> None:
+    def __init__(self, template: Template, compiled: Compiled) -> None:
         super().__init__(template)
+        self.printed = textbook_route(template, compiled)
+        self.kernel_forms = {step.unknown: step.solved for step in compiled.steps}
         self.stages = [CATALOGUE[stage.effect].relations(stage, self.ctx) for stage in template.scene.stages]
         self.numeric = [name for name, spec in template.answers.items() if not spec.symbolic]
 
@@ -108,12 +120,76 @@ class RouteCompiler(_Compiler):
             steps.append((solved.unknown, self._user_units(expr)))
         return steps, self._user_units(wanted.xreplace(alias)) / self._unit(name)
 
+    def _changed(self, chain: list[_Solved]) -> dict[str, _Solved]:
+        """The steps of a declared route's chain found from the relations the route changes, by unknown."""
+        real = {(r.label, r.lhs, r.rhs) for relations in self.stages for r in relations}
+        return {str(s.unknown): s for s in chain if (s.relation.label, s.relation.lhs, s.relation.rhs) not in real}
+
+    def _printed(self, name: str, route: list[_Solved] | None = None) -> tuple[list[tuple[Any, Any]], Any] | None:
+        """The values the worked solution's page writes down on its way to ``name``, in its order, each from the
+        form it prints (template units in), and the answer over them; with a declared ``route``'s chain, the values
+        found from the relations it changes as it finds them instead (and those the page never writes, as it
+        finds them), and only if the answer needs one of them. None where the page solves a value it needs numerically, or does not reach the
+        answer. An angle the page writes ``tan⁻¹(y/x)`` is the kernel's ``atan2(y, x)``: the same values written
+        down, and the angle where ``x < 0`` too."""
+        symbols = dict(self.ctx.symbols)
+        wanted = from_node(self.template.answers[name].value, symbols)
+        changed = self._changed(route) if route is not None else {}
+        forms: dict[str, Any] = {}
+        numeric = set()
+        for step in self.printed.steps:
+            if step.unknown in forms:
+                continue
+            if step.numeric:  # a root(...) tree: the route cannot be written down to it
+                numeric.add(step.unknown)
+                forms[step.unknown] = sp.S.Zero
+                continue
+            form = self.kernel_forms[step.unknown] if step.unknown in self.printed.positive else step.solved
+            forms[step.unknown] = from_node(kernel_form(form), symbols)
+        for solved in route or ():  # the route's own values, and those the page never writes (T′)
+            unknown = str(solved.unknown)
+            if unknown in changed or unknown not in forms:
+                forms.pop(unknown, None)
+                forms[unknown] = solved.display.doit()
+        inputs = {str(symbol) for symbol in self.inputs}
+        needed: set[str] = set()
+        frontier = {str(symbol) for symbol in wanted.free_symbols} - inputs
+        while frontier:
+            quantity = frontier.pop()
+            if quantity not in forms or quantity in numeric:
+                return None
+            needed.add(quantity)
+            frontier |= {str(symbol) for symbol in forms[quantity].free_symbols} - inputs - needed
+        if route is not None and not needed & set(changed):
+            return None
+        alias: dict[Any, Any] = {}
+        steps = []
+        valueless = {self.ctx.symbols[symbol] for symbol in self.template.symbols}
+        for unknown in _in_order([n for n in forms if n in needed], forms):
+            expr = forms[unknown].xreplace(alias)
+            symbol = symbols.setdefault(unknown, sp.Symbol(unknown, real=True))
+            # as on the chain: a copy, a number or a multiple of a symbol without value is not written down
+            if expr.is_Symbol or expr.is_number or (-expr).is_Symbol or expr.free_symbols & valueless:
+                alias[symbol] = expr
+                continue
+            steps.append((symbol, self._user_units(expr)))
+        return steps, self._user_units(wanted.xreplace(alias)) / self._unit(name)
+
     def _route(self, name: str, id: str, says: str, chain: list[_Solved]) -> Route | None:
-        written = self._written(name, chain)
+        if id == "chain":
+            written = self._printed(name) or self._written(name, chain)
+        else:  # a declared route counts for an answer that needs a value it finds its own way
+            written = self._printed(name, chain)
+            if written is None and {str(s.unknown) for s in _needed(chain, [self._wanted(name)])} \
+                    & set(self._changed(chain)):
+                written = self._written(name, chain)
         if written is None:
             return None
         steps, answer = written
         return self._compiled(name, id, says, steps, answer)
+
+    def _wanted(self, name: str) -> Any:
+        return from_node(self.template.answers[name].value, self.ctx.symbols)
 
     def _ratio_route(self, name: str, chain: list[_Solved]) -> Route | None:
         """``e`` from ``√(h_rebound/h_drop)``: for an answer with a square root whose square is a rational
@@ -151,6 +227,19 @@ class RouteCompiler(_Compiler):
                              .replace(sp.DiracDelta, lambda *args: 0)) for slope in slopes]
         return Route(name, id, says, tuple(str(s) for s, _ in steps), tuple(_tree(e) for _, e in steps), _tree(answer),
                      tuple(_tree(c) for c in composed), tuple(slope_trees))
+
+
+def _in_order(quantities: list[str], forms: Mapping[str, Any]) -> list[str]:
+    """``quantities`` in their order, each moved after those its form uses (a value a declared route finds its own
+    way comes after the page's values it is found from)."""
+    done: list[str] = []
+    waiting = list(quantities)
+    while waiting:
+        ready = next(q for q in waiting
+                     if not {str(s) for s in forms[q].free_symbols} & (set(waiting) - {q}))
+        waiting.remove(ready)
+        done.append(ready)
+    return done
 
 
 def _composition(steps: list[tuple[Any, Any]]) -> dict[Any, Any]:

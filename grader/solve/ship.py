@@ -17,7 +17,7 @@ from typing import Any
 
 from grader.bank.template import Template, load_bank
 from grader.base import caching
-from grader.solve.cache import KINDS, SHIPPED, entry_name
+from grader.solve.cache import KINDS, SHIPPED, compiled_for, entry_name
 
 BUILD_COMMAND = "python -m grader.solve.ship"
 
@@ -38,7 +38,9 @@ def compilers() -> dict[str, Callable[[Template], Any]]:
     from grader.solve.derived_routes import compile_routes
     from grader.solve.solver import compile_template
 
-    return {"": compile_template, "-alternatives": compile_alternatives, "-routes": compile_routes}
+    # the routes follow the worked solution's page, made from the compiled form just written
+    return {"": compile_template, "-alternatives": compile_alternatives,
+            "-routes": lambda template: compile_routes(template, compiled_for(template))}
 
 
 def build(templates: Iterable[Template]) -> tuple[int, int]:

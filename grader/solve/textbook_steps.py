@@ -1,0 +1,324 @@
+"""The answer key's routes: the steps a textbook writes, where the solver's chain takes a stable route.
+
+The kernels keep their stable forms (docs/design.md, Numerics): an impact in impulse form with inverse
+masses, ``J = (1 + e) v/(1/m1 + 1/m2)``, angles from ``atan2``, magnitudes from ``hypot``. A student, and the
+textbook, write the same physics another way, and the worked solution shows that way, each value still the
+kernel's (``tests/test_textbook_steps.py`` evaluates every form on the page against the kernel's value to 1e-9):
+two bodies that both move after an impact are worked with **conservation of momentum** and **the restitution
+equation** as two labelled equations, then their simultaneous solution (Sample Problems 3/28 and 3/30), whichever
+way round the scene lists them; a velocity after found from the other's is conservation of momentum alone (the
+pile driver's ``v_p'``). The other forms (``e = √(h′/h)``, inverse trigonometric functions, speeds by name, one
+fraction for a reciprocal sum) are :mod:`grader.solve.page_forms`'.
+
+The impacts are found by their relations' wording (:mod:`grader.physics.effects.impact`): "impulse along n in
+the impact of A and B, with restitution e" and "impulse-momentum for A along n". An impact this module does not
+recognise keeps the chain's steps.
+"""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from fractions import Fraction
+from typing import Any
+
+from grader.bank.template import Template
+from grader.model.expr import Node, Num, Op, Sym, names
+from grader.model.scene import Stage, Velocity
+from grader.solve.compiled import Compiled, Step
+from grader.solve.page_forms import bounce_heights, folded, inverse_trig, is_zero, magnitudes, one_fraction
+
+_IMPULSE = re.compile(r"impulse along n in the impact of (\S+) and (\S+), with restitution .+")
+_MOMENTUM_OF = re.compile(r"impulse-momentum for (\S+) along n")
+_ZERO, _ONE = Num(Fraction(0)), Num(Fraction(1))
+
+
+@dataclass(frozen=True)
+class Route:
+    """A template's worked solution as the page shows it: its ``steps`` (each a chain quantity or one of
+    ``extra``, in the order a student writes them), and ``extra``, the quantities the route names that the
+    kernels' chain never computes (the struck block's rebound, for a momentum balance), evaluated after it.
+    ``positive`` names, per step, the quantity that must be positive at a variant for its form to hold
+    (``tan⁻¹(y/x)`` is the angle only where ``x > 0``): elsewhere the page shows the kernel's form."""
+
+    steps: tuple[Step, ...]
+    extra: tuple[Step, ...] = ()
+    positive: Mapping[str, Node] = field(default_factory=dict)
+
+
+# --- building trees ------------------------------------------------------------------------------
+
+def _add(*terms: Node | None) -> Node:
+    kept = [t for t in terms if t is not None and not is_zero(t)]
+    if not kept:
+        return _ZERO
+    total = kept[0]
+    for term in kept[1:]:
+        negative = isinstance(term, Op) and term.op == "neg"
+        total = Op("sub", (total, term.args[0])) if isinstance(term, Op) and negative else Op("add", (total, term))
+    return total
+
+
+def _mul(*factors: Node) -> Node:
+    if any(is_zero(f) for f in factors):
+        return _ZERO
+    kept = [f for f in factors if f != _ONE]
+    if not kept:
+        return _ONE
+    product = kept[0]
+    for factor in kept[1:]:
+        product = Op("mul", (product, factor))
+    return product
+
+
+def _neg(node: Node) -> Node:
+    return node.args[0] if isinstance(node, Op) and node.op == "neg" else Op("neg", (node,))
+
+
+def _div(numerator: Node, denominator: Node) -> Node:
+    return numerator if denominator == _ONE else Op("div", (numerator, denominator))
+
+
+def _sub(left: Node | None, right: Node | None) -> Node:
+    if right is None or is_zero(right):
+        return left if left is not None else _ZERO
+    if left is None or is_zero(left):
+        return _neg(right)
+    return Op("sub", (left, right))
+
+
+def _factors(node: Node) -> list[Node]:
+    if isinstance(node, Op) and node.op == "mul":
+        return _factors(node.args[0]) + _factors(node.args[1])
+    return [node]
+
+
+def _without_common(masses: tuple[Node, Node], valueless: set[str]) -> tuple[Node, Node]:
+    """The two masses with the valueless factors they share taken out (``m`` and ``p m`` are 1 and ``p``),
+    as a student cancels them."""
+    first, second = (_factors(m) for m in masses)
+    for factor in list(first):
+        if isinstance(factor, Sym) and factor.name in valueless and factor in second:
+            first.remove(factor)
+            second.remove(factor)
+    return _mul(*first) if first else _ONE, _mul(*second) if second else _ONE
+
+
+# --- the impact: momentum and restitution ----------------------------------------------------------
+
+@dataclass(frozen=True)
+class _Pair:
+    """An impact of two bodies that both move, as the momentum balance names it. Its velocities along n are
+    expressions: a scene written the other way round has n turned, and names a velocity after ``-v1_out``."""
+
+    first: str
+    second: str
+    masses: tuple[Node, Node]  # as the scene gives them
+    cancelled: tuple[Node, Node]  # with the factors they share and that have no value taken out
+    before: tuple[Node | None, Node | None]  # along n (None: at rest)
+    after: tuple[Node, Node]  # along n: a name, or a name with its sign turned
+    e: Node
+
+    @property
+    def after_names(self) -> tuple[str, str]:
+        return (_named(self.after[0]) or "", _named(self.after[1]) or "")
+
+    def momentum(self) -> tuple[Node, Node]:
+        (m1, m2), (u1, u2), (a1, a2) = self.masses, self.before, self.after
+        return (_add(_mul(m1, u1) if u1 is not None else None, _mul(m2, u2) if u2 is not None else None),
+                _add(_mul(m1, a1), _mul(m2, a2)))
+
+    def restitution(self) -> tuple[Node, Node]:
+        (u1, u2), (a1, a2) = self.before, self.after
+        return self.e, _div(_sub(a2, a1), _sub(u1 or _ZERO, u2))
+
+    def relation(self) -> str:
+        return f"conservation of momentum along n for {self.first} and {self.second}"
+
+    def restitution_relation(self) -> str:
+        return f"coefficient of restitution for {self.first} and {self.second}"
+
+    def both_after(self) -> tuple[Node, Node]:
+        """Simultaneous solution of the momentum and restitution equations for both velocities after, each
+        solved for its name."""
+        (m1, m2), (u1, u2), e = self.cancelled, self.before, self.e
+        total = _add(m1, m2)
+        if u2 is None and u1 is not None:  # the second at rest: v1' = v1 (m1 - e m2)/(m1 + m2)
+            forms = (_div(_mul(u1, _sub(m1, _mul(e, m2))), total), _div(_mul(m1, u1, _add(_ONE, e)), total))
+        else:
+            momentum = _add(_mul(m1, u1) if u1 is not None else None, _mul(m2, u2) if u2 is not None else None)
+            approach = _sub(u1 or _ZERO, u2)
+            forms = (_div(_sub(momentum, _mul(e, m2, approach)), total),
+                     _div(_add(momentum, _mul(e, m1, approach)), total))
+        return _solved_for(self.after[0], forms[0]), _solved_for(self.after[1], forms[1])
+
+    def one_after(self, known: int) -> Node:
+        """The momentum balance solved for the name of the velocity after of the body other than ``known``."""
+        other = 1 - known
+        masses, before = self.cancelled, self.before
+        if before[other] is None:
+            form = _div(_mul(masses[known], _sub(before[known] or _ZERO, self.after[known])), masses[other])
+        else:
+            balance = _add(_mul(masses[0], before[0]) if before[0] is not None else None,
+                           _mul(masses[1], before[1]) if before[1] is not None else None)
+            form = _div(_sub(balance, _mul(masses[known], self.after[known])), masses[other])
+        return _solved_for(self.after[other], form)
+
+    def first_before(self) -> Node:
+        """The momentum and restitution equations solved for the first body's velocity before, the second's
+        after unknown too: ``v1 = ((m1 + m2) v1' - (1 + e) m2 v2)/(m1 - e m2)``."""
+        (m1, m2), (u1, u2), e = self.cancelled, self.before, self.e
+        given = _mul(_add(m1, m2), self.after[0])
+        form = _div(_sub(given, _mul(_add(_ONE, e), m2, u2) if u2 is not None else None), _sub(m1, _mul(e, m2)))
+        return _solved_for(u1 or _ZERO, form)
+
+    def second_after_from_restitution(self) -> Node:
+        """``v2' = v1' + e (v1 - v2)``, solved for the name of ``v2'``."""
+        form = _add(self.after[0], _mul(self.e, _sub(self.before[0] or _ZERO, self.before[1])))
+        return _solved_for(self.after[1], form)
+
+
+def _named(node: Node | None) -> str | None:
+    """The name in ``v`` or ``-v``."""
+    if isinstance(node, Op) and node.op == "neg":
+        node = node.args[0]
+    return node.name if isinstance(node, Sym) else None
+
+
+def _solved_for(expression: Node, form: Node) -> Node:
+    """The name in ``expression`` (``v`` or ``-v``) from ``expression = form``."""
+    return form if isinstance(expression, Sym) else _neg(form)
+
+
+def _pair(template: Template, first: str, second: str) -> _Pair | None:
+    """The impact of ``first`` and ``second`` that both move, if the scene has exactly one."""
+    stages = [s for s in template.scene.stages if s.effect == "impact" and tuple(s.fields["bodies"]) == (first, second)]
+    if len(stages) != 1:
+        return None
+    stage: Stage = stages[0]
+    bodies = template.scene.bodies
+    masses = (bodies[first].mass, bodies[second].mass)
+    after = stage.fields.get("after", {})
+    along = [after.get(b).n if isinstance(after.get(b), Velocity) else None for b in (first, second)]
+    if masses[0] is None or masses[1] is None or along[0] is None or along[1] is None \
+            or _named(along[0]) is None or _named(along[1]) is None:
+        return None
+    before = tuple(_along_n(stage.fields.get("before", {}).get(b)) for b in (first, second))
+    valueless = set(template.symbols)
+    return _Pair(first, second, (masses[0], masses[1]), _without_common((masses[0], masses[1]), valueless),
+                 (before[0], before[1]), (along[0], along[1]), stage.fields["restitution"])
+
+
+def _along_n(velocity: Any) -> Node | None:
+    if isinstance(velocity, Velocity):
+        return None if is_zero(velocity.n) else velocity.n
+    return None if velocity is None or is_zero(velocity) else velocity
+
+
+def _uses(step: Step, quantity: str) -> bool:
+    return quantity in names(step.solved)
+
+
+def _impacts(template: Template, compiled: Compiled, steps: list[Step], extra: list[Step]) -> list[Step]:
+    """The impulse form of every impact of two moving bodies, as momentum and restitution."""
+    answers = set().union(*(names(spec.value) for spec in template.answers.values()))
+    # An impulse is the unknown of its impact's impulse relation, or of a body's impulse-momentum solved for it
+    # (whose equation gives the body's velocity after: v' = v - J/m)
+    for impulse in [s.unknown for s in steps if _IMPULSE.fullmatch(s.relation) or
+                    (_MOMENTUM_OF.fullmatch(s.relation) and s.equation[0] != Sym(s.unknown))]:
+        steps = _one_impact(template, steps, extra, impulse, answers) or steps
+    return steps
+
+
+def _one_impact(template: Template, steps: list[Step], extra: list[Step], impulse: str,
+                answers: set[str]) -> list[Step] | None:
+    """``steps`` with the impulse ``impulse`` of one impact worked out of them (None: they keep it, because a step
+    or an answer other than the bodies' velocities uses it, or the impact is not one this module knows)."""
+    defining = [s for s in steps if s.unknown == impulse]
+    if len(defining) != 1:
+        return None
+    found = defining[0]
+    bodies = _IMPULSE.fullmatch(found.relation)
+    if bodies is None:  # found from one body's impulse-momentum; the impact step says which two
+        labels = [_IMPULSE.fullmatch(s.relation) for s in steps if impulse in names(s.equation[0])]
+        bodies = next((b for b in labels if b), None)
+        if bodies is None:
+            first_body = _MOMENTUM_OF.fullmatch(found.relation)
+            return _momentum_only(template, steps, found, first_body.group(1) if first_body else "", impulse, answers)
+    pair = _pair(template, bodies.group(1), bodies.group(2))
+    if pair is None:
+        return None
+    members = [s for s in steps if s.unknown in pair.after_names and _MOMENTUM_OF.fullmatch(s.relation)
+               and impulse in names(s.equation[0]) | names(s.equation[1])]
+    others = [s for s in steps if s is not found and s not in members]
+    asked = impulse in answers
+    if any(_uses(s, impulse) for s in others) or (asked and found.block):
+        return None
+    if found.block:
+        return _first_before(steps, found, members, pair)
+    if not members or any(m.block for m in members):
+        return None
+    block = pair.after_names
+    momentum, restitution = pair.momentum(), pair.restitution()
+    forms = pair.both_after()
+    shown = [Step(block[0], pair.relation(), momentum, forms[0], block),
+             Step(block[1], pair.restitution_relation(), restitution, forms[1], block)]
+    if asked:  # the impulse asked: from the first body's change of momentum, once its velocity after is known
+        change = _mul(pair.masses[0], _sub(pair.before[0] or _ZERO, pair.after[0]))
+        shown.append(Step(impulse, f"impulse-momentum for {pair.first} along n", (Sym(impulse), change), change))
+    chain = {s.unknown for s in steps}
+    extra += [s for s in shown if s.unknown not in chain]
+    index = steps.index(found)
+    rest = [s for s in steps if s is not found and s not in members]
+    return rest[:index] + shown + rest[index:]
+
+
+def _momentum_only(template: Template, steps: list[Step], found: Step, body: str, impulse: str,
+                   answers: set[str]) -> list[Step] | None:
+    """A velocity after from the other body's: the impulse found from one body's momentum change and given to
+    the other's is the momentum balance of the two, solved for one velocity."""
+    users = [s for s in steps if s is not found and _uses(s, impulse)]
+    if len(users) != 1 or impulse in answers or not _MOMENTUM_OF.fullmatch(users[0].relation):
+        return None
+    other = _MOMENTUM_OF.fullmatch(users[0].relation).group(1)  # type: ignore[union-attr]
+    pair = _pair(template, body, other) or _pair(template, other, body)
+    if pair is None or users[0].unknown not in pair.after_names:
+        return None
+    known = pair.after_names.index(users[0].unknown) ^ 1
+    step = Step(users[0].unknown, pair.relation(), pair.momentum(), pair.one_after(known))
+    index = steps.index(found)
+    rest = [s for s in steps if s is not found and s is not users[0]]
+    return [*rest[:index], step, *rest[index:]]
+
+
+def _first_before(steps: list[Step], found: Step, members: list[Step], pair: _Pair) -> list[Step] | None:
+    """A block that finds the first body's velocity before and the impulse, the second's velocity after then
+    from the impulse: the momentum and restitution equations in the first's velocity before and the second's
+    after."""
+    block = [s for s in steps if s.block == found.block]
+    first = _named(pair.before[0])
+    if first is None or set(found.block) != {first, found.unknown}:
+        return None
+    after = [m for m in members if not m.block]
+    if len(after) != 1 or after[0].unknown != pair.after_names[1]:
+        return None
+    unknowns = (first, pair.after_names[1])
+    shown = [Step(unknowns[0], pair.relation(), pair.momentum(), pair.first_before(), unknowns),
+             Step(unknowns[1], pair.restitution_relation(), pair.restitution(), pair.second_after_from_restitution(),
+                  unknowns)]
+    index = steps.index(block[0])
+    rest = [s for s in steps if s not in block and s is not after[0]]
+    return rest[:index] + shown + rest[index:]
+
+
+def textbook_route(template: Template, compiled: Compiled) -> Route:
+    """The steps of ``template``'s worked solution as the page shows them (see the module's docstring)."""
+    extra: list[Step] = []
+    positive: dict[str, Node] = {}
+    steps = _impacts(template, compiled, list(compiled.steps), extra)
+    steps = bounce_heights(steps)
+    steps = magnitudes(steps)
+    steps = inverse_trig(steps, positive)
+    steps = [one_fraction(s) for s in steps]
+    return Route(tuple(folded(s) for s in steps), tuple(folded(s) for s in extra), positive)

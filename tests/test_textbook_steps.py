@@ -23,7 +23,7 @@ from grader.assign.assignment import load_assignment, load_roster
 from grader.assign.variants import ProblemVariant, generate
 from grader.bank.template import Template, load_bank
 from grader.base.resources import sample_dir
-from grader.model.expr import Num, Sym, parse, substitute
+from grader.model.expr import Num, Sym, parse, substitute, to_text
 from grader.model.kernel import evaluate
 from grader.render.readable import readable
 from grader.render.typst_math import math as typst_math
@@ -115,6 +115,47 @@ def test_two_bodies_that_both_move_are_worked_with_momentum_and_restitution_solv
     assert any("conservation of momentum" in r for r in relations), template_id
     assert any("coefficient of restitution" in r for r in relations), template_id
     assert not any("impulse along n" in r or "impulse in the impact" in r for r in relations), (template_id, relations)
+
+
+TOGETHER = [t for t in ORDER if any("move on together" in step.relation for step in compiled_for(BANK[t]).steps)]
+"""Every shipped template with a plastic impact (the bodies move on together)."""
+
+
+@pytest.mark.parametrize("template_id", TOGETHER)
+def test_a_plastic_impact_opens_with_momentum_and_finds_the_impulse_from_it(template_id: str) -> None:
+    """The cars move on together: m_A v_A + m_B v_B = (m_A + m_B) v′, then J = m_B (v′ − v_B) on B; no impulse
+    form before the momentum balance."""
+    steps = textbook_route(BANK[template_id], compiled_for(BANK[template_id])).steps
+    balance = next(index for index, step in enumerate(steps) if "move on together" in step.relation)
+    assert not any(step.relation.startswith("impulse along n") for step in steps), template_id
+    impulses = [step for step in steps if step.unknown == "J"]
+    for step in impulses:
+        assert steps.index(step) > balance and step.relation.startswith("impulse-momentum for "), str(step)
+
+
+def test_couplings_impulse_is_the_change_of_car_bs_momentum() -> None:
+    steps = {s.unknown: s for s in textbook_route(BANK["coupling"], compiled_for(BANK["coupling"])).steps}
+    assert "coupling" in TOGETHER and to_text(steps["J"].solved) == "m_B*(v_common - v_B)"
+    assert steps["J"].relation == "impulse-momentum for B along n"
+
+
+def test_a_fall_from_rest_is_the_root_of_2h_over_g_not_a_quadratic() -> None:
+    steps = {s.unknown: s for s in textbook_route(BANK["shell-landing"], compiled_for(BANK["shell-landing"])).steps}
+    assert to_text(steps["t_fall"].solved) == "sqrt(2*H/g)"
+    assert "±" not in steps["t_fall"].relation and "0²" not in steps["t_fall"].relation
+    # A's velocity after, with the mass it shares with the reduced mass cancelled: v_x − u m_B/(m_A + m_B) = 0
+    assert to_text(steps["u_rel"].equation[1]) == "v_x - u_rel*m_B/(m_A + m_B)"
+    assert to_text(steps["u_rel"].solved) == "v_x*(m_A + m_B)/m_B"
+
+
+@pytest.mark.parametrize("template_id", ORDER)
+def test_no_equation_is_labelled_in_two_blocks(template_id: str) -> None:
+    """A block's equations are labelled once (billiards-inverse's momentum and restitution are the numeric block's
+    (b) and (c), and their solution follows from it, not from a block of their own)."""
+    steps = worked_form(BANK[template_id]).steps
+    labelled = [str(member.relation) for index, step in enumerate(steps) if step.block and step.unknown == step.block[0]
+                for member in steps[index:index + len(step.block)]]
+    assert len(labelled) == len(set(labelled)), (template_id, labelled)
 
 
 @pytest.mark.parametrize("template_id", ["pile-driver", "head-on-inverse", "ramp-strike-inverse"])

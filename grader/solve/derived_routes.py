@@ -18,7 +18,7 @@ import sympy as sp
 
 from grader.bank.template import Template
 from grader.base.errors import TemplateError, unworkable
-from grader.model.expr import Node, names
+from grader.model.expr import Node
 from grader.physics.effects import CATALOGUE
 from grader.physics.symbolic import INNER, cosd, from_node, hypot, sind, to_node
 from grader.solve.compiled import Compiled
@@ -129,9 +129,9 @@ class RouteCompiler(_Compiler):
         """The values the worked solution's page writes down on its way to ``name``, in its order, each from the
         form it prints (template units in), and the answer over them; with a declared ``route``'s chain, the values
         found from the relations it changes as it finds them instead (and those the page never writes, as it
-        finds them), and only if the answer needs one of them. None where the page solves a value it needs numerically, or does not reach the
-        answer. An angle the page writes ``tan⁻¹(y/x)`` is the kernel's ``atan2(y, x)``: the same values written
-        down, and the angle where ``x < 0`` too."""
+        finds them), and only if the answer needs one of them. None where the page solves a value it needs
+        numerically, or does not reach the answer. An angle the page writes ``tan⁻¹(y/x)`` is the kernel's
+        ``atan2(y, x)``: the same values written down, and the angle where ``x < 0`` too."""
         symbols = dict(self.ctx.symbols)
         wanted = from_node(self.template.answers[name].value, symbols)
         changed = self._changed(route) if route is not None else {}

@@ -6,7 +6,8 @@
   two velocities ``cos⁻¹`` of their dot product over their speeds, where the inverse's principal value is the
   kernel's ``atan2``; a speed already found stands for its components' root (``v`` for ``√(v_n² + v_t²)``), and a
   speed with one component zero is that component's size;
-- reciprocal sums combined: ``1/(1/m1 + 1/m2)`` is ``m1 m2/(m1 + m2)``;
+- reciprocal sums combined: ``1/(1/m1 + 1/m2)`` is ``m1 m2/(m1 + m2)``, and a factor shared by a fraction's
+  denominator cancelled; square roots multiplied together under one: ``√(2H/g)``;
 - numbers put in without a double sign: ``−(−3.072)`` is ``3.072``.
 
 ``asin``, ``acos`` and ``atan`` are functions only the page knows (:func:`page_value` evaluates them): no template
@@ -177,8 +178,44 @@ def combine_reciprocals(node: Node) -> Node:
     return bottom_up(node, _one_fraction)
 
 
+def _factors(node: Node) -> list[Node]:
+    if isinstance(node, Op) and node.op == "mul":
+        return _factors(node.args[0]) + _factors(node.args[1])
+    return [node]
+
+
+def _product(factors: list[Node]) -> Node:
+    if not factors:
+        return _ONE
+    product = factors[0]
+    for factor in factors[1:]:
+        product = Op("mul", (product, factor))
+    return product
+
+
+def _cancelled(top: list[Node], bottom: list[Node]) -> Node | None:
+    """``top/bottom`` with the factors they share taken out, or None where they share none."""
+    top, bottom = list(top), list(bottom)
+    shared = False
+    for factor in list(top):
+        if factor in bottom and not isinstance(factor, Num):
+            top.remove(factor)
+            bottom.remove(factor)
+            shared = True
+    if not shared:
+        return None
+    return _product(top) if not bottom else Op("div", (_product(top), _product(bottom)))
+
+
 def _one_fraction(node: Op) -> Node:
     args = node.args
+    if node.op == "mul" and any(isinstance(a, Op) and a.op == "div" for a in args):
+        # m_A (m_A + m_B)/(m_A m_B) is (m_A + m_B)/m_B: a factor over the fraction's denominator cancels
+        fraction, other = (args[1], args[0]) if isinstance(args[1], Op) and args[1].op == "div" else args
+        top, bottom = fraction.args  # type: ignore[union-attr]
+        cancelled = _cancelled(_factors(other) + _factors(top), _factors(bottom))
+        if cancelled is not None:
+            return cancelled
     if node.op == "add" and all(isinstance(a, Op) and a.op == "div" for a in args):
         (c1, a), (c2, b) = (arg.args for arg in args)  # type: ignore[union-attr]
         if c1 == c2:
@@ -192,6 +229,26 @@ def _one_fraction(node: Op) -> Node:
     return node
 
 
+def one_root(node: Node) -> Node:
+    """A product or quotient of square roots as one root, as a textbook writes it: ``√2 √H/√g`` is ``√(2H/g)``.
+
+    >>> from grader.model.expr import parse, to_text
+    >>> to_text(one_root(parse("sqrt(2)*sqrt(H)/sqrt(g)"))), to_text(one_root(parse("v*sqrt(2)")))
+    ('sqrt(2*H/g)', 'v*sqrt(2)')
+    """
+    return bottom_up(node, _one_root)
+
+
+def _one_root(node: Op) -> Node:
+    if node.op not in ("mul", "div"):
+        return node
+    roots = [a for a in node.args if isinstance(a, Op) and a.op == "sqrt"]
+    if len(roots) != 2:
+        return node
+    (left,), (right,) = (a.args for a in roots)
+    return Op("sqrt", (Op(node.op, (left, right)),))
+
+
 def folded(step: Step) -> Step:
     """Whole numbers added up (``1 + 1`` is 2) where a route put them side by side."""
     if step.numeric:
@@ -200,13 +257,15 @@ def folded(step: Step) -> Step:
 
 
 def one_fraction(step: Step) -> Step:
-    """Reciprocal sums combined; an equation that only said the unknown is a nested fraction is the solved form."""
+    """Reciprocal sums combined, and roots multiplied together (:func:`one_root`); an equation that only said the
+    unknown is a nested fraction is the solved form."""
     if step.numeric:
         return step
-    lhs, rhs = (combine_reciprocals(side) for side in step.equation)
+    lhs, rhs = (one_root(combine_reciprocals(side)) for side in step.equation)
+    solved = one_root(combine_reciprocals(step.solved))
     if lhs == Sym(step.unknown) and rhs != step.equation[1]:
-        rhs = combine_reciprocals(step.solved)
-    return replace(step, equation=(lhs, rhs), solved=combine_reciprocals(step.solved))
+        rhs = solved
+    return replace(step, equation=(lhs, rhs), solved=solved)
 
 
 _DOUBLE_NEGATIVE = (

@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import re
 from collections.abc import Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from fractions import Fraction
 from typing import Any
 
@@ -31,6 +31,7 @@ from grader.solve.page_forms import bounce_heights, folded, inverse_trig, is_zer
 
 _IMPULSE = re.compile(r"impulse along n in the impact of (\S+) and (\S+), with restitution .+")
 _MOMENTUM_OF = re.compile(r"impulse-momentum for (\S+) along n")
+_TOGETHER = re.compile(r"conservation of momentum along n: (\S+) and (\S+) move on together")
 _ZERO, _ONE = Num(Fraction(0)), Num(Fraction(1))
 
 
@@ -312,11 +313,54 @@ def _first_before(steps: list[Step], found: Step, members: list[Step], pair: _Pa
     return rest[:index] + shown + rest[index:]
 
 
+def _plastic(template: Template, steps: list[Step]) -> list[Step]:
+    """The impulse of a plastic impact (the bodies move on together) after the momentum balance, as the change of
+    the second body's momentum, ``J = m_B (v′ − v_B)``, not the impulse form before it."""
+    for found in [s for s in steps if _IMPULSE.fullmatch(s.relation)]:
+        first, second = _IMPULSE.fullmatch(found.relation).groups()  # type: ignore[union-attr]
+        stages = [s for s in template.scene.stages
+                  if s.effect == "impact" and tuple(s.fields["bodies"]) == (first, second)]
+        balance = [s for s in steps if (m := _TOGETHER.fullmatch(s.relation)) and {*m.groups()} == {first, second}]
+        if len(stages) != 1 or len(balance) != 1 or template.scene.bodies[second].mass is None:
+            continue
+        after = stages[0].fields.get("after", {})
+        common = _along_n(after.get(first))
+        if _named(common) is None or common != _along_n(after.get(second)):
+            continue
+        at, to = steps.index(found), steps.index(balance[0])
+        known = set(template.parameters) | set(template.symbols) | {"g"} | {s.unknown for s in steps[:to + 1]}
+        change = _mul(template.scene.bodies[second].mass,  # type: ignore[arg-type]
+                      _sub(common, _along_n(stages[0].fields.get("before", {}).get(second))))
+        if at > to or any(_uses(s, found.unknown) for s in steps[at + 1:to + 1]) or not names(change) <= known:
+            continue
+        moved = Step(found.unknown, f"impulse-momentum for {second} along n", (Sym(found.unknown), change), change)
+        steps = [*steps[:at], *steps[at + 1:to + 1], moved, *steps[to + 1:]]
+    return steps
+
+
+def _numeric_blocks(steps: list[Step]) -> list[Step]:
+    """A block solved numerically is shown as its equations, its own step's and those of the steps after it, one per
+    unknown (:mod:`grader.render.worked`). Where an impact's momentum and restitution follow it as a block of their
+    own, with as many equations as the numeric block has besides its first, they are the numeric block's equations
+    ((b) and (c)), and their unknowns follow from its solution, not from a second block of the same equations."""
+    result = list(steps)
+    for index, step in enumerate(result):
+        pair = result[index + 1:index + len(step.block)]
+        if not (step.numeric and pair and pair[0].block and not pair[0].numeric
+                and pair[0].block == tuple(s.unknown for s in pair) and len(pair) == len(step.block) - 1):
+            continue
+        block = (step.unknown, *pair[0].block)
+        result[index] = replace(step, block=block)
+        for at, member in enumerate(pair, start=index + 1):
+            result[at] = replace(member, block=block)
+    return result
+
+
 def textbook_route(template: Template, compiled: Compiled) -> Route:
     """The steps of ``template``'s worked solution as the page shows them (see the module's docstring)."""
     extra: list[Step] = []
     positive: dict[str, Node] = {}
-    steps = _impacts(template, compiled, list(compiled.steps), extra)
+    steps = _numeric_blocks(_plastic(template, _impacts(template, compiled, list(compiled.steps), extra)))
     steps = bounce_heights(steps)
     steps = magnitudes(steps)
     steps = inverse_trig(steps, positive)

@@ -102,6 +102,9 @@ def _flight(stage: Stage, ctx: Context, law: str = "y0 + vy t - g t^2/2", root: 
                  f"({text['vertical']} ± √({text['vertical']}² + 2 g {fallen}))/g;"
                  f" the landing is the root with +, since the root with − is not positive (at or before the start: "
                  f"where the path, run backwards, meets {'the ground' if ground else 'that height'})")
+        if vy == 0:  # no vertical velocity at the start: the fall alone, ½ g t² = h, with no quadratic to solve
+            label = (f"vertical motion of {body} until it lands {where}: it starts with no vertical velocity, so it "
+                     f"falls {fallen} in the time {t} under gravity alone")
         requires = (Condition(sp.Ge(drop, 0), f"{body} starts below the height it is to land at "
                               f"({text['height']} < {text['end_height']})"),)
     return [

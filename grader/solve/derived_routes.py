@@ -12,6 +12,7 @@ Imported only when routes are compiled (the cache spares later runs the sympy im
 from __future__ import annotations
 
 from collections.abc import Mapping
+from dataclasses import replace
 from typing import Any
 
 import sympy as sp
@@ -21,7 +22,7 @@ from grader.base.errors import TemplateError, unworkable
 from grader.model.expr import Node
 from grader.physics.effects import CATALOGUE
 from grader.physics.symbolic import INNER, cosd, from_node, hypot, sind, to_node
-from grader.solve.compiled import Compiled
+from grader.solve.compiled import Compiled, Step
 from grader.solve.derived import _FAILURES
 from grader.solve.page_forms import kernel_form
 from grader.solve.routes import Route, Routes
@@ -48,6 +49,7 @@ class RouteCompiler(_Compiler):
 
     def __init__(self, template: Template, compiled: Compiled) -> None:
         super().__init__(template)
+        self.compiled = compiled
         self.printed = textbook_route(template, compiled)
         self.kernel_forms = {step.unknown: step.solved for step in compiled.steps}
         self.stages = [CATALOGUE[stage.effect].relations(stage, self.ctx) for stage in template.scene.stages]
@@ -146,11 +148,13 @@ class RouteCompiler(_Compiler):
                 continue
             form = self.kernel_forms[step.unknown] if step.unknown in self.printed.positive else step.solved
             forms[step.unknown] = from_node(kernel_form(form), symbols)
-        for solved in route or ():  # the route's own values, and those the page never writes (T′)
-            unknown = str(solved.unknown)
-            if unknown in changed or unknown not in forms:
-                forms.pop(unknown, None)
-                forms[unknown] = solved.display.doit()
+        if route is not None:  # the route's own values, and those the page never writes (T′), as a page writes them
+            own = self._as_printed(route)
+            for solved in route:
+                unknown = str(solved.unknown)
+                if unknown in changed or unknown not in forms:
+                    forms.pop(unknown, None)
+                    forms[unknown] = own.get(unknown, solved.display.doit())
         inputs = {str(symbol) for symbol in self.inputs}
         needed: set[str] = set()
         frontier = {str(symbol) for symbol in wanted.free_symbols} - inputs
@@ -174,6 +178,24 @@ class RouteCompiler(_Compiler):
                 continue
             steps.append((symbol, self._user_units(expr)))
         return steps, self._user_units(wanted.xreplace(alias)) / self._unit(name)
+
+    def _as_printed(self, chain: list[_Solved]) -> dict[str, Any]:
+        """A declared route's values as a page would write them (:func:`textbook_route` over its chain: a velocity
+        after from momentum and restitution, not from the impulse form), over the inputs and earlier values (SI);
+        empty where its chain has a form a page cannot take."""
+        try:
+            steps = tuple(Step(str(s.unknown), s.relation.label,
+                               (to_node(sp.sympify(s.relation.lhs)), to_node(sp.sympify(s.relation.rhs))),
+                               to_node(sp.sympify(s.display.doit())), tuple(str(b) for b in s.block)) for s in chain)
+        except _FAILURES as error:
+            if not unworkable(error):
+                raise
+            return {}
+        page = textbook_route(self.template, replace(self.compiled, steps=steps))
+        kernel = {step.unknown: step.solved for step in steps}
+        symbols = dict(self.ctx.symbols)
+        return {step.unknown: from_node(kernel_form(kernel[step.unknown] if step.unknown in page.positive
+                                                    else step.solved), symbols) for step in page.steps}
 
     def _route(self, name: str, id: str, says: str, chain: list[_Solved]) -> Route | None:
         if id == "chain":

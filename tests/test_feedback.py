@@ -97,7 +97,8 @@ def test_no_file_holds_anything_of_another_student_nor_the_instructors_notes(fee
 
 def test_a_sheet_shows_what_was_typed_read_the_verdicts_sentences_and_the_worked_solutions(feedback: Path) -> None:
     """Ben O'Brien (2026137) of the demo: 18 of 28; 3c right for his wrong 3b (error carried forward); 4b the
-    angle in radians; 5c's tolerance widened, with why; then his worked solutions, as the answer key has them."""
+    angle in radians; then his worked solutions, as the answer key has them. Another student's 5d (oblique-spheres'
+    loss) has its tolerance widened, with why."""
     text = pdf_text(feedback / "2026137.pdf")
     for shown in ("Total: 18 of 28 points", "Name Ben O'Brien", "ID 2026137 Section L02",
                   "You typed 5.72×10^1 read as 57.2 %",
@@ -107,9 +108,10 @@ def test_a_sheet_shows_what_was_typed_read_the_verdicts_sentences_and_the_worked
                   "a common mistake · 0 of 2 points",
                   "your answer matches the angle in radians where degrees were asked",
                   "Expected 0.595688 accepted ±1 %",
-                  "accepted ±1.1 %: rounding J to 4 figures along the worked solution moves theta1_out by up to 0.35 %",
                   "Problem 3: Pile driver ram striking a pile", "Given:"):
         assert shown in text, shown
+    widened = "accepted ±1.1 %: rounding T to 4 figures along the energy route (T − T′) moves loss_pct by up to 0.41 %"
+    assert widened in pdf_text(feedback / "2026174.pdf")
 
 
 def test_every_page_has_the_students_own_footer_the_worked_solutions_too(feedback: Path) -> None:

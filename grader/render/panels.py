@@ -287,7 +287,7 @@ PANELS: dict[str, PanelKind] = {
                            "driven plate with its velocity, or a pile drawn under it), the height dimensioned, to "
                            "scale when given; with the impact it ends in and the rises after it (a rebound dashed at "
                            "its height, two or more as arcs); onto a fixed surface it strikes obliquely, an incline "
-                           "at its angle"),
+                           "at its angle, n and t drawn at the contact"),
     "rise": PanelKind(_one, _draw_rise,
                       "after a fall and its impact: in the fall's panel, the body dashed at its rebound height; "
                       "alone: the body, its speed up, and dashed at the height it rises to, dimensioned"),

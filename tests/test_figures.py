@@ -327,7 +327,7 @@ def test_a_dimensions_label_keeps_clear_of_its_arrows(length: float) -> None:
     assert placed[0] >= 1.0 + 0.2  # beside the line, not on it
 
 
-# --- what the contact sheet showed (docs/make_contact_sheet.py) -------------------------------------
+# --- what the contact sheet showed (docs/contact_sheet.py) ------------------------------------------
 
 def test_a_separation_shows_before_and_after_side_by_side_and_no_line_joins_them(
         figures: dict[str, tuple[str, FigureRecord, dict[str, str]]]) -> None:
@@ -377,23 +377,23 @@ def test_a_label_keeps_its_gap_when_its_drawing_is_shrunk() -> None:
 
 @pytest.mark.slow
 def test_the_contact_sheet_shows_every_effects_panel(tmp_path: Path) -> None:
-    """docs/make_contact_sheet.py (docs/images/figures.png): every template's figure, and among them a panel
+    """docs/contact_sheet.py (docs/images/figures.png): every template's figure, and among them a panel
     of each effect that has one; its Typst source compiles."""
     import importlib.util
 
     from grader.render.panels import PANELS
     from grader.render.typeset import compile_typst
 
-    spec = importlib.util.spec_from_file_location("make_contact_sheet", Path(__file__).parents[1] / "docs" /
-                                                  "make_contact_sheet.py")
+    spec = importlib.util.spec_from_file_location("contact_sheet", Path(__file__).parents[1] / "docs" /
+                                                  "contact_sheet.py")
     assert spec is not None and spec.loader is not None
     sheet = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(sheet)
     chosen = sheet.sections()
     assert sum(len(templates) for _, templates in chosen) == len(BANK)
-    _, shown = sheet.source(chosen)
+    _, shown = sheet.figures_source(chosen)
     assert shown == set(PANELS)
-    compile_typst(sheet.source([(heading, templates[:1]) for heading, templates in chosen])[0], tagged=False)
+    compile_typst(sheet.figures_source([(heading, templates[:1]) for heading, templates in chosen])[0], tagged=False)
 
 
 @pytest.mark.parametrize("beta", ["15", "30", "60"])

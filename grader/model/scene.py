@@ -18,7 +18,6 @@ from typing import Any
 
 from grader.model.expr import Node, names
 
-
 SHAPES = ("block", "sphere", "particle")
 """How a figure may draw a body: a block (a rectangle), a sphere (a circle), a particle (a small dot)."""
 

@@ -178,7 +178,8 @@ def incline(canvas: Drawing, scene: SceneView, impact: Stage) -> bool:
     out = (_m.sin(slope), _m.cos(slope))  # -n: out of the incline
     length, radius, drop = 4.4, 0.25, 2.6
     # The contact a little above the incline's middle: deep enough under it for the n-t axes there.
-    top, bottom = (-0.45 * length * down[0], -0.45 * length * down[1]), (0.55 * length * down[0], 0.55 * length * down[1])
+    top = (-0.45 * length * down[0], -0.45 * length * down[1])
+    bottom = (0.55 * length * down[0], 0.55 * length * down[1])
     corner = (top[0], bottom[1])
     canvas.polygon([top, bottom, corner], fill="luma(215)")
     canvas.path([corner, top, bottom, corner], width=0.6)

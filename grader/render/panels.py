@@ -295,10 +295,10 @@ PANELS: dict[str, PanelKind] = {
                         "direct: the bodies in a line (a run of direct impacts, one line), blocks unless the scene "
                         "gives them a shape, areas following the masses (a fixed one a hatched wall; balls that "
                         "hang from cords level on their line of centres), each with its velocity before as an "
-                        "arrow the way it moves; oblique against a fixed body: the surface with the incoming and rebound "
-                        "velocities at their angles; oblique between two bodies: two touching circles with n, t and "
-                        "the incoming velocity; with the slide to rest after it, the skid; with the struck body's "
-                        "swing after it, the pendulum and the striking body"),
+                        "arrow the way it moves; oblique against a fixed body: the surface with the incoming and "
+                        "rebound velocities at their angles; oblique between two bodies: two touching circles with "
+                        "n, t and the incoming velocity; with the slide to rest after it, the skid; with the struck "
+                        "body's swing after it, the pendulum and the striking body"),
     "swing": PanelKind(_one, _draw_swing,
                        "the cord at rest and at its greatest angle, to scale, and the arc between, the body a "
                        "block unless the scene gives it a shape; a body that "

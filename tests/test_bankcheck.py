@@ -95,6 +95,9 @@ BROKEN = {
     "bad-typst": ("Find the coefficient of restitution $e$", "Find the coefficient of restitution $e",
                   "FAIL  typesetting the sheet (statement, figure): Typst could not typeset a document: unclosed "
                   "delimiter"),
+    "bad-shape": ("ball: {mass: m}", "ball: {mass: m, shape: ball}",
+                  "FAIL  load: {folder}/bad-shape.yaml: bodies.ball.shape: expected one of block, sphere, particle, "
+                  "got 'ball'"),
     "boolean-arithmetic": ("require: h_rebound <= h_drop", "require: -(h_rebound > h_drop) >= 0",
                            "FAIL  load: {folder}/boolean-arithmetic.yaml: constraints[0].require: expected a "
                            "comparison like 'h_rebound <= h_drop', or comparisons joined by and/or"),

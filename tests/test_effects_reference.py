@@ -152,5 +152,5 @@ def test_swing_shows_its_stable_form_and_force_law(capsys: pytest.CaptureFixture
     """The half-angle form the kernels use, and the pendulum the simulation integrates."""
     _, out, _ = run(capsys, "effects", "swing")
     assert "v = sqrt(2*g*L*(1 - cos(theta)))" in out
-    assert "v = 2*sqrt(g*L)*sin(1/2*theta)" in out
+    assert "v = 2*sqrt(g*L)*sin(theta/2)" in out
     assert "Force law in simulation: a pendulum" in out

@@ -327,7 +327,7 @@ def test_a_dimensions_label_keeps_clear_of_its_arrows(length: float) -> None:
     assert placed[0] >= 1.0 + 0.2  # beside the line, not on it
 
 
-# --- what the contact sheet showed (docs/make_contact_sheet.py) -------------------------------------
+# --- what the contact sheet showed (docs/contact_sheet.py) ------------------------------------------
 
 def test_a_separation_shows_before_and_after_side_by_side_and_no_line_joins_them(
         figures: dict[str, tuple[str, FigureRecord, dict[str, str]]]) -> None:
@@ -377,20 +377,53 @@ def test_a_label_keeps_its_gap_when_its_drawing_is_shrunk() -> None:
 
 @pytest.mark.slow
 def test_the_contact_sheet_shows_every_effects_panel(tmp_path: Path) -> None:
-    """docs/make_contact_sheet.py (docs/images/figures.png): every template's figure, and among them a panel
+    """docs/contact_sheet.py (docs/images/figures.png): every template's figure, and among them a panel
     of each effect that has one; its Typst source compiles."""
     import importlib.util
 
     from grader.render.panels import PANELS
     from grader.render.typeset import compile_typst
 
-    spec = importlib.util.spec_from_file_location("make_contact_sheet", Path(__file__).parents[1] / "docs" /
-                                                  "make_contact_sheet.py")
+    spec = importlib.util.spec_from_file_location("contact_sheet", Path(__file__).parents[1] / "docs" /
+                                                  "contact_sheet.py")
     assert spec is not None and spec.loader is not None
     sheet = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(sheet)
     chosen = sheet.sections()
     assert sum(len(templates) for _, templates in chosen) == len(BANK)
-    _, shown = sheet.source(chosen)
+    _, shown = sheet.figures_source(chosen)
     assert shown == set(PANELS)
-    compile_typst(sheet.source([(heading, templates[:1]) for heading, templates in chosen])[0], tagged=False)
+    compile_typst(sheet.figures_source([(heading, templates[:1]) for heading, templates in chosen])[0], tagged=False)
+
+
+@pytest.mark.parametrize("beta", ["15", "30", "60"])
+def test_the_issues_incline_bounce_draws_n_and_t_at_the_contact(beta: str) -> None:
+    """Issue 32: incline-bounce's n-t glyph sat up the slope, away from the point of contact where n and t
+    are defined. Both arrows now start at the contact (the panel's origin) and their labels sit within
+    a centimetre of it, at every slope the template samples."""
+    from grader.render.panels import _panel
+    from grader.render.scene_view import SceneView
+
+    template = BANK["incline-bounce"]
+    printed = {**example_variant(template).printed, "beta": beta}
+    variant = ProblemVariant("1", template.id, "v", {n: float(v) for n, v in printed.items()}, printed, ())
+    scene = SceneView(template, variant, _values(template, variant))
+    canvas = _panel(scene, panel_groups(template.scene.stages)[0])
+    axes = [call for call in canvas.calls if call[0] == "fig-label" and call[3].endswith(("($n$,)", "($t$,)"))]
+    assert len(axes) == 2
+    assert all((call[1][0][0] ** 2 + call[1][0][1] ** 2) ** 0.5 < 1.0 for call in axes), axes
+    assert sum(1 for tail, _ in canvas.strokes if tail == (0.0, 0.0)) == 2
+
+
+@pytest.mark.parametrize(("template_id", "circles", "rects"), [
+    ("two-pendulums", 6, 0),   # each swing: the ball at rest (dashed) and at its angle; the impact: two balls
+    ("three-balls", 3, 0),
+    ("ramp-slide", 0, 2),      # on the ramp, solid at its top and dashed at its foot (the floor panel: outlines)
+    ("ballistic-pendulum", 0, 3),  # no shape given: the block on its cord, dashed at rest; the bullet a slug
+])
+def test_a_body_is_drawn_as_its_shape(template_id: str, circles: int, rects: int) -> None:
+    """Issue 32: two-pendulums drew its balls as blocks. A body's `shape` decides; left out, the panel's own."""
+    typst = str(figure_record(BANK[template_id], example_variant(BANK[template_id]),
+                              _values(BANK[template_id], example_variant(BANK[template_id])))[0])
+    radii = [float(r) for r in re.findall(r"fig-circle\(\([-0-9.]+, [-0-9.]+\), ([0-9.]+)", typst)]
+    assert (sum(r > 0.1 for r in radii), typst.count("fig-rect(")) == (circles, rects)  # not a cord's pivot

@@ -270,7 +270,7 @@ def test_answers_counted_from_the_sorted_band_ends_count_as_those_tested_one_by_
     """Slips of 10 % (counted from the ends) and of 1.5 % (near the student's own value, where bands that
     do not count as matches may hold them: tested one by one), in bands of ±1 % and, for every seventh
     student, ±3 %."""
-    from grader.grade import integrity
+    from grader.grade import integrity_search
 
     rng = np.random.default_rng(7)
     values = rng.uniform(1, 1.2, size=(200, 2))
@@ -285,7 +285,7 @@ def test_answers_counted_from_the_sorted_band_ends_count_as_those_tested_one_by_
              for i in range(200) for j, label in enumerate(("1a", "1b"))}
     result = graded(key, typed)
     counted = [(m.student, m.label, m.matches) for m in check(result).matches]
-    monkeypatch.setattr(integrity, "BY_ENDS", False)
+    monkeypatch.setattr(integrity_search, "BY_ENDS", False)
     assert [(m.student, m.label, m.matches) for m in check(result).matches] == counted
     assert max(matches for _, _, matches in counted) > 5
     assert any(student % 3 == 1 for student, _, _ in counted)

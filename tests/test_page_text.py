@@ -2,8 +2,8 @@
 solution, generated for two students and extracted from the PDFs, holds none of the forms an instructor
 reading the key found: an internal identifier (an answer's, a quantity's or a body's name as the
 template spells it), "along n" in a problem on one line (n is never defined there), a hyphen for a
-minus sign, ``L(1 − cos θ)`` for a swing to θ_max, a unit split across lines, a double space in a page's
-header; and no problem's worked solution titles two steps alike."""
+minus sign, ``L(1 − cos θ)`` for a swing to θ_max, a unit split across lines, ``1/4 p`` for ``p/4``, a double
+space in a page's header; and no problem's worked solution titles two steps alike."""
 
 from __future__ import annotations
 
@@ -72,6 +72,8 @@ FORBIDDEN = {
     "a number and its unit on two lines": re.compile(r"\d\s*\n\s*(?:m|ft|km)/(?:s|h)\b"),
     "an identifier's underscore": re.compile(r"[A-Za-z0-9]_[A-Za-z0-9{]"),
     "a subscript of internal words": re.compile(r"\d,\s*between"),
+    "a fraction's number before a name (1/4 p for p/4)": re.compile(
+        r"(?<![\d.,])1 (?:[3-9]|[1-9]\d+) ?[\U0001D44E-\U0001D467\U0001D6FC-\U0001D71B]"),
 }
 
 

@@ -192,6 +192,14 @@ NAMES = Names({"m": (0, 1, 0, 0), "M": (0, 1, 0, 0), "g": (1, 0, -2, 0), "h": (1
     ("v*(1 - 0.1*p)/(p + 1)", "v*(1 - 0.1*p)/(1 + p)"),  # the data's decimals stay decimals
     ("0.3*m*v", "0.3*m*v"),
     ("h", "h"),
+    # Issue 32: the key printed "1/4 p" and left a mass above and below uncancelled
+    ("p/4", "p/4"),
+    ("v*(1 - p/4)/(p + 1)", "v*(1 - p/4)/(1 + p)"),
+    ("3*e*v/4", "3*e*v/4"),
+    ("m*v/2", "m*v/2"),  # a half that is not an energy's
+    ("m*M/(m*(m + M))", "M/(m + M)"),
+    ("m**2*v/(m*M)", "m*v/M"),
+    ("m*v*(1 + e)/(m*(m + M))", "v*(1 + e)/(m + M)"),
 ])
 def test_readable_rewrites(source: str, expected: str) -> None:
     assert to_text(readable(parse(source), NAMES)) == expected

@@ -15,7 +15,7 @@ from typing import Any
 from grader.bank.folders import NAME
 from grader.base.errors import ExpressionError, TemplateError, shown
 from grader.model.expr import Node, names, parse
-from grader.model.scene import Body, Gravity, Scene, Stage, Velocity
+from grader.model.scene import SHAPES, Body, Gravity, Scene, Stage, Velocity
 from grader.physics.effects import CATALOGUE, Effect, Field
 
 
@@ -37,18 +37,33 @@ def _parse_bodies(raw: Any, where: str) -> dict[str, Body]:
         key = f"bodies.{name}"
         if not NAME.match(str(name)):
             raise TemplateError(where, key, "a name of letters, digits and _", shown(name))
-        if not isinstance(spec, Mapping) or set(spec) - {"mass", "fixed", "radius"}:
-            raise TemplateError(where, key, "{mass: EXPR} or {fixed: true}, and optionally radius: EXPR", shown(spec))
+        if not isinstance(spec, Mapping) or set(spec) - {"mass", "fixed", "radius", "shape"}:
+            raise TemplateError(where, key, "{mass: EXPR} or {fixed: true}, and optionally radius: EXPR and "
+                                f"shape: {'|'.join(SHAPES)}", shown(spec))
         radius = _expr(spec["radius"], where, f"{key}.radius") if "radius" in spec else None
+        shape = _shape(spec, radius, where, key)
         if spec.get("fixed") is True:
             if "mass" in spec:
                 raise TemplateError(where, key, "either a mass or fixed: true, not both", shown(spec))
-            bodies[name] = Body(name, None, radius)
+            bodies[name] = Body(name, None, radius, shape)
         elif "mass" in spec:
-            bodies[name] = Body(name, _expr(spec["mass"], where, f"{key}.mass"), radius)
+            bodies[name] = Body(name, _expr(spec["mass"], where, f"{key}.mass"), radius, shape)
         else:
             raise TemplateError(where, key, "a mass or fixed: true", shown(spec))
     return bodies
+
+
+def _shape(spec: Mapping[str, Any], radius: Node | None, where: str, key: str) -> str | None:
+    """A body's ``shape``: one of :data:`SHAPES`; a body with a radius is a sphere."""
+    if "shape" not in spec:
+        return None
+    shape = spec["shape"]
+    if shape not in SHAPES:
+        raise TemplateError(where, f"{key}.shape", f"one of {', '.join(SHAPES)}", shown(shape))
+    if radius is not None and shape != "sphere":
+        raise TemplateError(where, f"{key}.shape", "sphere for a body with a radius (or leave shape out)",
+                            shown(shape))
+    return str(shape)
 
 
 def _parse_stage(raw: Any, index: int, where: str, bodies: Mapping[str, Body]) -> Stage:

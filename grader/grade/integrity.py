@@ -26,39 +26,28 @@ matches by accident (docs/grading.md, *Answers from another student's variant*):
 
 A pair whose corrected chance is at most the assignment's ``grading.integrity_threshold`` is flagged.
 
->>> from grader.model.tolerance import Tolerance
->>> tolerance = Tolerance().to_json()
->>> part = _part("1a", np.array([2.0, 3.0, 5.0]), [tolerance] * 3, "m/s")
->>> owners, partners = _matches(part, np.array([0]), np.array([4.98]))
->>> owners.tolist(), partners.tolist()
-([0], [2])
+The band search (which students' bands hold an answer) is :mod:`grader.grade.integrity_search`.
 """
 
 from __future__ import annotations
 
 import functools
 import math
-from collections.abc import Iterator, Mapping, Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
-from typing import Any, NamedTuple
+from typing import NamedTuple
 
 import numpy as np
 import numpy.typing as npt
 
 from grader.grade.cells import typed_place
-from grader.grade.compare import accepted_distance, errors
+from grader.grade.compare import errors
 from grader.grade.grading import Graded, Row
-from grader.grade.integrity_chance import UNRELATED, Spread, class_density
-from grader.model.tolerance import Tolerance
-
-Floats = npt.NDArray[np.float64]
-Ints = npt.NDArray[np.int64]
+from grader.grade.integrity_chance import UNRELATED, Spread
+from grader.grade.integrity_search import Bands, Floats, Ints, accepts, bands, expanded, holding, nearest, range_least
 
 LISTED = 5  # students named per wrong answer in integrity.csv; the rest are counted
 KEPT = 1.0  # pairs with two or more matched parts are kept when their corrected chance is below this
-CHUNK = 1 << 22  # candidate pairs tested at a time: a bounded amount of memory, whatever the class
-BY_ENDS = True  # count an answer's matches from the sorted ends of the bands (False: test each candidate)
-_PERIOD = {"deg": 360.0, "rad": 2 * math.pi}
 
 
 class Match(NamedTuple):
@@ -115,32 +104,6 @@ class Integrity:
         return {(pair.student, pair.partner): pair for pair in self.pairs}
 
 
-@dataclass(frozen=True)
-class _Part:
-    """A numeric part over the class: each student's key value (NaN: none), accepted distance, whether the
-    bound is strict (sigfigs, decimals), the chance ``p`` of their band; the students with a value sorted
-    by it (angles reduced to one turn), the lowest band start from each sorted position on and the highest
-    band end up to it (a search over them finds a superset of the bands that hold a number); the bands'
-    starts and ends, each sorted."""
-
-    label: str
-    unit: str
-    values: Floats
-    reach: Floats
-    strict: npt.NDArray[np.bool_]
-    chance: Floats
-    order: Ints
-    sorted_values: Floats
-    low: Floats
-    high: Floats
-    starts: Floats
-    ends: Floats
-
-    @property
-    def period(self) -> float | None:
-        return _PERIOD.get(self.unit)
-
-
 class _Answers(NamedTuple):
     """The class's answers the check compares: per part label, the students whose answer was wrong, each
     student's number (NaN: none), the half-unit of the last typed digit of each wrong one in the sheet's
@@ -155,7 +118,7 @@ class _Answers(NamedTuple):
     per_student: Ints
     read: dict[str, dict[int, float]]  # per part, the half-units of the right answers read so far, by student
 
-    def centres(self, part: _Part, owners: Ints, partners: Ints) -> Floats:
+    def centres(self, part: Bands, owners: Ints, partners: Ints) -> Floats:
         """Where each owner's answer's closeness to the partner's is measured from: the number the partner
         typed for the part, when it was right and typed with no fewer digits than the owner's (a copy typed
         as its source typed it is there exactly), else the partner's value. An angle's is taken within half a
@@ -183,7 +146,7 @@ def check(graded: Graded) -> Integrity:
     """The integrity check of a grading run (the key's numeric parts; symbolic ones are left out)."""
     key = graded.key
     students = len(key.students)
-    parts: list[_Part] = []
+    parts: list[Bands] = []
     wrong: dict[str, Ints] = {}
     right: dict[str, Floats] = {}
     for label in key.labels:
@@ -192,7 +155,7 @@ def check(graded: Graded) -> Integrity:
             continue
         column = [student.parts[label] for student in key.students]
         values = np.fromiter((_number(entry.value) for entry in column), dtype=np.float64, count=students)
-        part = _part(label, values, [entry.tolerance for entry in column], first.unit)
+        part = bands(label, values, [entry.tolerance for entry in column], first.unit)
         numbers = graded.numbers[label]
         verdicts = np.array([row.verdict for row in graded.columns[label]])
         incorrect, correct = verdicts == "incorrect", verdicts == "correct"
@@ -208,7 +171,7 @@ def check(graded: Graded) -> Integrity:
                        np.concatenate([p.values[wrong[p.label]] for p in parts] or [np.zeros(0)]),
                        np.concatenate([wrong[p.label] for p in parts] or [np.zeros(0, np.int64)]), students)
     examined = int(np.count_nonzero(per_student >= 2)) * max(students - 1, 0)
-    found = [_found(part, wrong[part.label], graded.numbers[part.label]) for part in parts]
+    found = [holding(part, wrong[part.label], graded.numbers[part.label]) for part in parts]
     answers = _Answers(wrong, graded.numbers, steps, right, graded.columns, per_student, {})
     pairs = _pairs(parts, answers, spread, found, examined)
     matches = _listed(parts, wrong, graded.numbers, found, pairs)
@@ -251,114 +214,7 @@ def _number(value: object) -> float:
     return float(value) if isinstance(value, float | int) and not isinstance(value, bool) else math.nan
 
 
-def _part(label: str, values: Floats, tolerances: Sequence[Mapping[str, Any]], unit: str) -> _Part:
-    """A part's bands: each student's accepted distance (worked out per tolerance: a part has a few)."""
-    reach, strict = np.full(len(values), np.nan), np.zeros(len(values), dtype=bool)
-    groups: dict[tuple[tuple[str, Any], ...], list[int]] = {}
-    mapping: Mapping[str, Any] | None = None
-    members: list[int] = []
-    for index, tolerance in enumerate(tolerances):
-        if tolerance is not mapping:  # the key shares one mapping between equal rules
-            mapping, members = tolerance, groups.setdefault(tuple(tolerance.items()), [])
-        members.append(index)
-    for written, members in groups.items():
-        rule = Tolerance.from_json(dict(written))
-        reach[members] = accepted_distance(values[members], rule)
-        strict[members] = rule.mode != "rtol"
-    period = _PERIOD.get(unit)
-    have = np.flatnonzero(np.isfinite(values) & np.isfinite(reach))
-    placed = values[have] if period is None else np.mod(values[have], period)
-    order = have[np.argsort(placed, kind="stable")]
-    sorted_values = np.sort(placed, kind="stable")
-    bands = reach[order]
-    low = np.minimum.accumulate((sorted_values - bands)[::-1])[::-1] if len(order) else sorted_values
-    high = np.maximum.accumulate(sorted_values + bands) if len(order) else sorted_values
-    return _Part(label, unit, values, reach, strict, class_density(values, reach, order, sorted_values), order,
-                 sorted_values, low, high, np.sort(sorted_values - bands), np.sort(sorted_values + bands))
-
-
-def _ranges(part: _Part, numbers: Floats) -> Iterator[tuple[Ints, Ints]]:
-    """For each number, the positions in the part's sorted order that may hold it in their band: one
-    range, or, for an angle, one for each neighbouring turn."""
-    period = part.period
-    shifts = (0.0,) if period is None else (0.0, -period, period)
-    placed = numbers if period is None else np.mod(numbers, period)
-    for shift in shifts:
-        target = placed + shift
-        yield (np.searchsorted(part.high, target, side="left").astype(np.int64),
-               np.searchsorted(part.low, target, side="right").astype(np.int64))
-
-
-def _accepts(part: _Part, owners: Ints, partners: Ints, numbers: Floats) -> npt.NDArray[np.bool_]:
-    """Whether each partner's band holds the owner's number, the partner being another student whose value
-    the owner's own band does not hold."""
-    unit = part.unit if part.period is not None else None
-    distance = errors(numbers[owners], part.values[partners], angle_unit=unit)[0]
-    reach = part.reach[partners]
-    inside = np.where(part.strict[partners], distance < reach, distance <= reach)
-    own = errors(part.values[partners], part.values[owners], angle_unit=unit)[0]
-    mine = np.where(part.strict[owners], own < part.reach[owners], own <= part.reach[owners])
-    return np.asarray(inside & ~mine & (owners != partners), dtype=bool)
-
-
-def _expanded(starts: Ints, ends: Ints) -> Iterator[tuple[Ints, Ints]]:
-    """Each range's index and the positions in it, in blocks of about :data:`CHUNK` positions."""
-    sizes = np.maximum(ends - starts, 0)
-    begin = 0
-    while begin < len(sizes):
-        total = np.cumsum(sizes[begin:])
-        end = begin + max(1, int(np.searchsorted(total, CHUNK, side="right")))
-        block = sizes[begin:end]
-        owner = np.repeat(np.arange(begin, end), block)
-        offsets = np.arange(int(block.sum())) - np.repeat(np.cumsum(block) - block, block)
-        yield owner, starts[owner] + offsets
-        begin = end
-
-
-def _matches(part: _Part, owners: Ints, numbers: Floats) -> tuple[Ints, Ints]:
-    """Every (owner, partner) whose partner's band holds ``numbers`` (one per owner); for a test's eyes."""
-    full = np.full(len(part.values), np.nan)
-    full[owners] = numbers
-    found_owners, found_partners = [], []
-    for starts, ends in _ranges(part, numbers):
-        for which, positions in _expanded(starts, ends):
-            who, partner = owners[which], part.order[positions]
-            ok = _accepts(part, who, partner, full)
-            found_owners.append(who[ok])
-            found_partners.append(partner[ok])
-    return np.concatenate(found_owners or [np.zeros(0, np.int64)]), np.concatenate(found_partners or
-                                                                                  [np.zeros(0, np.int64)])
-
-
-def _found(part: _Part, wrong: Ints, numbers: Floats) -> tuple[Ints, list[tuple[Ints, Ints]]]:
-    """Per wrong answer (of ``wrong``), how many students' bands hold it, and its candidate ranges.
-
-    Bands closed at both ends (not an angle's, nor a strict bound's) are counted without being listed (in a
-    class of 100,000 a wrong answer may fall in thousands): the bands holding ``a`` are those that start at or
-    below it less those that end below it, two binary searches in the sorted starts and ends. The bands not
-    counted as matches (the student's own, and those of values the student's own band holds) can hold only an
-    answer within the student's reach plus the widest reach of the values their band holds: those answers are
-    tested one by one, as are all of an angle's or a strict bound's."""
-    counts = np.zeros(len(wrong), dtype=np.int64)
-    ranges = list(_ranges(part, numbers[wrong]))
-    tested = np.arange(len(wrong))
-    if BY_ENDS and part.period is None and not part.strict.any():
-        typed = numbers[wrong]
-        counts = (np.searchsorted(part.starts, typed, side="right")
-                  - np.searchsorted(part.ends, typed, side="left")).astype(np.int64)
-        own, mine = part.values[wrong], part.reach[wrong]
-        widest = -_range_least(-part.reach[part.order], np.searchsorted(part.sorted_values, own - mine, side="left"),
-                               np.searchsorted(part.sorted_values, own + mine, side="right"))
-        tested = np.flatnonzero(np.abs(typed - own) <= mine + np.maximum(widest, 0.0))
-        counts[tested] = 0
-    for starts, ends in ranges:
-        for which, positions in _expanded(starts[tested], ends[tested]):
-            ok = _accepts(part, wrong[tested[which]], part.order[positions], numbers)
-            counts += np.bincount(tested[which[ok]], minlength=len(wrong))
-    return counts, ranges
-
-
-def _pairs(parts: Sequence[_Part], answers: _Answers, spread: Spread,
+def _pairs(parts: Sequence[Bands], answers: _Answers, spread: Spread,
            found: Sequence[tuple[Ints, list[tuple[Ints, Ints]]]], examined: int) -> dict[tuple[int, int], Pair]:
     """Every pair with two or more matched parts whose corrected chance is below :data:`KEPT`.
 
@@ -379,9 +235,9 @@ def _pairs(parts: Sequence[_Part], answers: _Answers, spread: Spread,
         chosen = np.flatnonzero((found_counts > 0) & (matched[members] >= needed[members])
                                 & (rank[members, index] >= needed[members] - 1))
         for starts, ends in ranges:
-            for which, positions in _expanded(starts[chosen], ends[chosen]):
+            for which, positions in expanded(starts[chosen], ends[chosen]):
                 owners, partners = members[chosen[which]], part.order[positions]
-                ok = _accepts(part, owners, partners, answers.numbers[part.label])
+                ok = accepts(part, owners, partners, answers.numbers[part.label])
                 keys.append(np.unique(owners[ok] * students + partners[ok]))
     if not keys:
         return {}
@@ -390,7 +246,7 @@ def _pairs(parts: Sequence[_Part], answers: _Answers, spread: Spread,
             for pair in _figures(parts, answers, spread, pairs // students, pairs % students, examined, 2, KEPT)}
 
 
-def _needed(parts: Sequence[_Part], answers: _Answers, spread: Spread,
+def _needed(parts: Sequence[Bands], answers: _Answers, spread: Spread,
             found: Sequence[tuple[Ints, list[tuple[Ints, Ints]]]], examined: int) -> Ints:
     """Per student, the fewest matched parts (at least 2) whose corrected chance could be under :data:`KEPT`
     (more than their wrong parts: none could). ``k`` matches have a chance of at least the product of the
@@ -408,7 +264,7 @@ def _needed(parts: Sequence[_Part], answers: _Answers, spread: Spread,
     return np.where(possible.any(axis=1), np.argmax(possible, axis=1) + 1, least.shape[1] + 1).astype(np.int64)
 
 
-def _least(part: _Part, spread: Spread, owners: Ints, numbers: Floats, steps: Floats,
+def _least(part: Bands, spread: Spread, owners: Ints, numbers: Floats, steps: Floats,
            ranges: Sequence[tuple[Ints, Ints]]) -> Floats:
     """Per wrong answer, at most the chance (:func:`_chance`) of the answer in the band of any student whose
     band may hold it (the search's range: inf where it is empty), however close the pair's matches are.
@@ -424,9 +280,9 @@ def _least(part: _Part, spread: Spread, owners: Ints, numbers: Floats, steps: Fl
         per_width = np.where(reach > 0, chance / reach, np.inf)
     least_chance, least_width, least_reach = (np.full(len(owners), np.inf) for _ in range(3))
     for starts, ends in ranges:
-        least_chance = np.minimum(least_chance, _range_least(chance, starts, ends))
-        least_width = np.minimum(least_width, _range_least(per_width, starts, ends))
-        least_reach = np.minimum(least_reach, _range_least(reach, starts, ends))
+        least_chance = np.minimum(least_chance, range_least(chance, starts, ends))
+        least_width = np.minimum(least_width, range_least(per_width, starts, ends))
+        least_reach = np.minimum(least_reach, range_least(reach, starts, ends))
     with np.errstate(invalid="ignore"):
         unrelated = np.nan_to_num(np.minimum(least_chance, steps * least_width), nan=0.0, posinf=0.0)
     related = np.zeros(len(owners))
@@ -440,30 +296,7 @@ def _least(part: _Part, spread: Spread, owners: Ints, numbers: Floats, steps: Fl
     return np.where(np.isfinite(least_reach), found, np.inf)
 
 
-def _range_least(values: Floats, starts: Ints, ends: Ints) -> Floats:
-    """The least of ``values[start:end]`` per range (inf: empty), from a table of the least of each run of
-    ``2^k`` values (a sparse table: two look-ups a range).
-
-    >>> _range_least(np.array([5.0, 3.0, 4.0, 1.0, 2.0]), np.array([0, 0, 2, 4, 3]), np.array([1, 3, 4, 5, 3]))
-    array([ 5.,  3.,  1.,  2., inf])
-    """
-    found = np.full(len(starts), np.inf)
-    sizes = ends - starts
-    if not len(values) or not (sizes > 0).any():
-        return found
-    levels = [values]
-    while 2 ** len(levels) <= len(values):
-        run = 2 ** (len(levels) - 1)
-        levels.append(np.minimum(levels[-1][:-run], levels[-1][run:]))
-    some = np.flatnonzero(sizes > 0)
-    level = np.floor(np.log2(sizes[some])).astype(np.int64)
-    for k in np.unique(level).tolist():
-        rows = some[level == k]
-        found[rows] = np.minimum(levels[k][starts[rows]], levels[k][ends[rows] - 2 ** k])
-    return found
-
-
-def _figures(parts: Sequence[_Part], answers: _Answers, spread: Spread, owners: Ints, partners: Ints,
+def _figures(parts: Sequence[Bands], answers: _Answers, spread: Spread, owners: Ints, partners: Ints,
              examined: int, least: int = 0, below: float = math.inf) -> list[Pair]:
     """Each pair's matched parts and chances; only the pairs with ``least`` matched parts or more and a
     corrected chance under ``below``. For ``j`` from 2 to the matches (1 for a pair of one match): the chance
@@ -475,7 +308,7 @@ def _figures(parts: Sequence[_Part], answers: _Answers, spread: Spread, owners: 
     units = np.full((len(owners), len(parts)), np.inf)
     for index, part in enumerate(parts):
         rows = np.flatnonzero(answers.answered(part.label)[owners])
-        hits[rows, index] = _accepts(part, owners[rows], partners[rows], answers.numbers[part.label])
+        hits[rows, index] = accepts(part, owners[rows], partners[rows], answers.numbers[part.label])
     matched = hits.sum(axis=1)
     kept = matched >= least  # the chances are worked out only for the pairs that could be kept
     owners, partners, hits, matched = owners[kept], partners[kept], hits[kept], matched[kept]
@@ -519,7 +352,7 @@ def _figures(parts: Sequence[_Part], answers: _Answers, spread: Spread, owners: 
                 chances.tolist(), corrected.tolist(), counted.tolist(), closeness.tolist(), strict=True)]
 
 
-def _tails(parts: Sequence[_Part], answers: _Answers, spread: Spread, owners: Ints, partners: Ints,
+def _tails(parts: Sequence[Bands], answers: _Answers, spread: Spread, owners: Ints, partners: Ints,
            closeness: Floats) -> Floats:
     """Per pair (a row), the chance that ``j`` (a column) or more of the owner's wrong parts land within
     ``closeness`` half-units of the partner's (:func:`_chance`; inf: anywhere in the bands): the tails of the
@@ -541,7 +374,7 @@ def _tails(parts: Sequence[_Part], answers: _Answers, spread: Spread, owners: In
     return np.asarray(np.minimum(np.cumsum(distribution[:, ::-1], axis=1)[:, ::-1], 1.0))
 
 
-def _chance(part: _Part, spread: Spread, owners: Ints, partners: Ints, closeness: Floats, steps: Floats,
+def _chance(part: Bands, spread: Spread, owners: Ints, partners: Ints, closeness: Floats, steps: Floats,
             centres: Floats) -> Floats:
     """The chance that each owner's wrong answer to the part lands by accident in the partner's band and
     within ``closeness`` half-units ``steps`` of the owner's typed answer from ``centres``
@@ -561,7 +394,7 @@ def _chance(part: _Part, spread: Spread, owners: Ints, partners: Ints, closeness
     return np.asarray((1 - UNRELATED) * related + UNRELATED * unrelated)
 
 
-def _listed(parts: Sequence[_Part], wrong: Mapping[str, Ints], numbers: Mapping[str, Floats],
+def _listed(parts: Sequence[Bands], wrong: Mapping[str, Ints], numbers: Mapping[str, Floats],
             found: Sequence[tuple[Ints, list[tuple[Ints, Ints]]]],
             pairs: Mapping[tuple[int, int], Pair]) -> list[Match]:
     """Each wrong answer that matches anyone, with up to :data:`LISTED` of the students it matches: the
@@ -574,11 +407,11 @@ def _listed(parts: Sequence[_Part], wrong: Mapping[str, Ints], numbers: Mapping[
     for part, (counts, _) in zip(parts, found, strict=True):
         members = wrong[part.label]
         some = np.flatnonzero(counts > 0)
-        nearest = _nearest(part, members[some], numbers[part.label])
+        closest = nearest(part, members[some], numbers[part.label], LISTED)
         for row, index in enumerate(some):
             student = int(members[index])
             chosen = partners_of.get((student, part.label), [])[:LISTED]
-            nearer = [int(other) for other in nearest[row] if other >= 0 and other not in chosen]
+            nearer = [int(other) for other in closest[row] if other >= 0 and other not in chosen]
             chosen += nearer[:LISTED - len(chosen)]
             matches += [Match(student, part.label, other, float(part.values[other]), int(counts[index]))
                         for other in chosen]
@@ -586,27 +419,3 @@ def _listed(parts: Sequence[_Part], wrong: Mapping[str, Ints], numbers: Mapping[
     return matches
 
 
-def _nearest(part: _Part, owners: Ints, numbers: Floats) -> Ints:
-    """Per owner, up to :data:`LISTED` students whose bands hold the owner's number, nearest first (by
-    distance over the band), among the values sorted next to it (-1: none)."""
-    if not len(owners) or not len(part.order):
-        return np.full((len(owners), LISTED), -1, dtype=np.int64)
-    period = part.period
-    placed = numbers[owners] if period is None else np.mod(numbers[owners], period)
-    middle = np.searchsorted(part.sorted_values, placed)
-    positions = np.clip(middle[:, None] + np.arange(-2 * LISTED, 2 * LISTED)[None, :], 0, len(part.order) - 1)
-    partners = part.order[positions]
-    who = np.repeat(owners, positions.shape[1])
-    ok = _accepts(part, who, partners.ravel(), numbers).reshape(positions.shape)
-    unit = part.unit if period is not None else None
-    with np.errstate(divide="ignore", invalid="ignore"):
-        score = errors(numbers[who], part.values[partners.ravel()], angle_unit=unit)[0].reshape(positions.shape)
-        score = score / part.reach[partners]
-    score = np.where(ok, score, np.inf)
-    # Clipped positions repeat the ends: a repeated partner is listed once (the first of equal scores).
-    first = np.ones(positions.shape, dtype=bool)
-    first[:, 1:] = positions[:, 1:] != positions[:, :-1]
-    score = np.where(first, score, np.inf)
-    best = np.argsort(score, axis=1, kind="stable")[:, :LISTED]
-    chosen = np.take_along_axis(partners, best, axis=1)
-    return np.where(np.isfinite(np.take_along_axis(score, best, axis=1)), chosen, -1)

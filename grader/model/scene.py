@@ -18,15 +18,20 @@ from typing import Any
 
 from grader.model.expr import Node, names
 
+SHAPES = ("block", "sphere", "particle")
+"""How a figure may draw a body: a block (a rectangle), a sphere (a circle), a particle (a small dot)."""
+
 
 @dataclass(frozen=True)
 class Body:
-    """A body: its mass expression, or ``None`` for a fixed surface (infinite mass), and the radius of
-    a sphere where the scene's geometry needs one (``None``: a point body)."""
+    """A body: its mass expression, or ``None`` for a fixed surface (infinite mass), the radius of
+    a sphere where the scene's geometry needs one (``None``: a point body), and the shape its figures draw
+    (one of :data:`SHAPES`; ``None``: each panel's own, a block in a line of impacts or on a cord)."""
 
     name: str
     mass: Node | None
     radius: Node | None = None
+    shape: str | None = None
 
 
 @dataclass(frozen=True)

@@ -1,6 +1,7 @@
 """The panels of direct impacts of bodies on a line (see :mod:`grader.render.panels`), and of bodies
-side by side, named: blocks whose areas follow the masses, each with its velocity before as an arrow
-the way it moves, lengths in the ratio of the speeds.
+side by side, named: blocks whose areas follow the masses (spheres, or particles, where the scene's
+bodies say so), each with its velocity before as an arrow the way it moves, lengths in the ratio of the
+speeds.
 """
 
 from __future__ import annotations
@@ -9,9 +10,9 @@ import math as _m
 from collections.abc import Sequence
 
 from grader.model.scene import Stage, Velocity
-from grader.render.drawing import Drawing, Point
-from grader.render.scene_view import SceneView
-from grader.render.typst_text import string
+from grader.render.drawing import CHAR, LINE, PARTICLE, Drawing, Point
+from grader.render.scene_view import SceneView, find_stage
+from grader.render.typst_text import body_name, string
 
 
 def _line_of_bodies(impacts: Sequence[Stage]) -> list[str]:
@@ -38,6 +39,15 @@ def direct(canvas: Drawing, scene: SceneView, impacts: Sequence[Stage]) -> bool:
     speeds = [abs(scene.value(v.n)) for v in before.values() if v is not None]
     fastest = max((v for v in speeds if _m.isfinite(v)), default=0.0)
     gap = 2.2 if len(bodies) < 3 else 1.9
+    # Balls that hang from cords (each swings in the scene) meet with their centres level, on no floor.
+    stages = scene.template.scene.stages
+    hanging = all(find_stage(stages, "swing", body=body) is not None for body in bodies)
+    level = max(sides.values(), default=1.1) / 2 if hanging else None
+    if level is not None:  # first, so that the spheres cover it
+        end = sum(sides.values()) + gap * (len(bodies) - 1)
+        canvas.line((-0.3, level), (end + 0.3, level), width=0.4, dash="dashed", gray=True)
+    # Spheres are all named inside, or all above when one is too small for its name.
+    inside = all(len(body_name(b)) * CHAR < 0.8 * sides[b] for b in masses if scene.shape(b, "block") == "sphere")
     x = 0.0
     for index, body in enumerate(bodies):
         if index:
@@ -48,14 +58,28 @@ def direct(canvas: Drawing, scene: SceneView, impacts: Sequence[Stage]) -> bool:
                 canvas.line((x, y), (x + 0.16, y + 0.16), width=0.4)
             canvas.name((x + 0.3, 1.0), "w", body, [])
             continue
-        side = sides[body]
-        canvas.rect((x, 0.0), (x + side, side))
-        canvas.name((x + side / 2, side / 2), "c", body, [])
+        side, shape = sides[body], scene.shape(body, "block")
+        top = _body(canvas, shape, body, x, side, side / 2 if level is None else level, inside)
         canvas.label((x + side / 2, -0.12), "n", scene.mass(body))
-        _horizontal_velocity(canvas, scene, (x + side / 2, side + 0.3), before[body], fastest)
+        _horizontal_velocity(canvas, scene, (x + side / 2, top + 0.3), before[body], fastest)
         x += side
-    canvas.line((-0.3, 0.0), (x + 0.3, 0.0), width=1.0)
+    if level is None:
+        canvas.line((-0.3, 0.0), (x + 0.3, 0.0), width=1.0)
     return True
+
+
+def _body(canvas: Drawing, shape: str, body: str, x: float, side: float, middle: float, inside: bool) -> float:
+    """A body on the line from ``x``, ``side`` wide, its centre ``middle`` high: a block named inside, a
+    sphere inside or above it (``inside``), a particle (a dot) named above; the height its velocity's arrow
+    goes above."""
+    centre = (x + side / 2, middle if shape != "particle" else PARTICLE)
+    canvas.body_shape(shape, centre, (side / 2, side / 2))
+    top = centre[1] + (side / 2 if shape != "particle" else PARTICLE)
+    if shape == "block" or (shape == "sphere" and inside):
+        canvas.name(centre, "c", body, [])
+        return top
+    canvas.name((centre[0], top + 0.1), "s", body, [])
+    return top + 0.1 + LINE
 
 
 def _horizontal_velocity(canvas: Drawing, scene: SceneView, at: Point, velocity: Velocity | None,

@@ -25,6 +25,7 @@ MAX_WIDTH = 7.6
 CHAR = 0.15  # cm per character of a label at the figure's text size, an estimate for the bounding box
 LINE = 0.42  # cm per line of a label
 GAP = 0.15  # cm between a label and what it labels that a drawing scaled down keeps
+PARTICLE = 0.09  # cm: the radius of a particle's dot
 
 
 @dataclass(frozen=True)
@@ -78,6 +79,19 @@ class Drawing:
         """A rectangle between two corners (a block, a plate)."""
         self._add("fig-rect", [(low[0], high[1]), (high[0], low[1])], f"{_stroke(0.8, dash, False)}, fill: {fill}")
         self.occupied.append((low[0], low[1], high[0], high[1]))
+
+    def body_shape(self, shape: str, center: Point, half: tuple[float, float], dash: str | None = None,
+                   filled: bool = True) -> None:
+        """A body drawn as its shape (see ``grader.model.scene.SHAPES``) about ``center``: a ``block``, the
+        rectangle ``half`` (width, height) out from it either way; a ``sphere``, the circle of the smaller
+        half; a ``particle``, a small dot (filled unless dashed)."""
+        if shape == "block":
+            low, high = (center[0] - half[0], center[1] - half[1]), (center[0] + half[0], center[1] + half[1])
+            self.rect(low, high, dash, "luma(235)" if filled else "none")
+        elif shape == "sphere":
+            self.circle(center, min(half), dash, fill=filled)
+        else:
+            self.circle(center, PARTICLE, dash, fill=filled and dash is None)
 
     def reserve(self, low: Point, high: Point) -> None:
         """Keep the box between two corners clear of the labels placed where they :meth:`fits` (a sphere)."""

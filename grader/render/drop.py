@@ -10,7 +10,7 @@ from collections.abc import Sequence
 
 from grader.model.expr import Node
 from grader.model.scene import Stage
-from grader.render.drawing import Drawing, Point
+from grader.render.drawing import PARTICLE, Drawing, Point
 from grader.render.scene_view import SceneView
 from grader.render.typst_text import string
 
@@ -31,12 +31,13 @@ def drop(canvas: Drawing, scene: SceneView, fall: Stage, impact: Stage | None, r
     fixed = second is None or scene.template.scene.bodies[second].mass is None
     x_body, x_ghost = 2.6, 4.0
 
+    # A ball onto a floor; falling alone or onto a pile, a block (as the other panels draw it).
+    shape = scene.shape(first, "sphere" if fixed and second is not None else "block")
+    half = {"sphere": (0.3, 0.3), "block": (0.4, 0.25), "particle": (PARTICLE, PARTICLE)}[shape]
+
     def body(x: float, bottom: float, dash: str | None) -> float:
-        if fixed and second is not None:  # a ball onto a floor; falling alone, a block (as the other panels draw it)
-            canvas.circle((x, bottom + 0.3), 0.3, dash, fill=dash is None)
-            return bottom + 0.6
-        canvas.rect((x - 0.4, bottom), (x + 0.4, bottom + 0.5), dash, "luma(235)" if dash is None else "none")
-        return bottom + 0.5
+        canvas.body_shape(shape, (x, bottom + half[1]), half, dash, filled=dash is None)
+        return bottom + 2 * half[1]
 
     top = body(x_body, drop * scale, None)
     canvas.name((x_body, top + 0.15), "s", first, [*scene.mass(first)])

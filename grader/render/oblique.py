@@ -177,7 +177,9 @@ def incline(canvas: Drawing, scene: SceneView, impact: Stage) -> bool:
     down = (_m.cos(slope), -_m.sin(slope))  # t: down the slope
     out = (_m.sin(slope), _m.cos(slope))  # -n: out of the incline
     length, radius, drop = 4.4, 0.25, 2.6
-    top, bottom = (-0.6 * length * down[0], -0.6 * length * down[1]), (0.4 * length * down[0], 0.4 * length * down[1])
+    # The contact a little above the incline's middle: deep enough under it for the n-t axes there.
+    top = (-0.45 * length * down[0], -0.45 * length * down[1])
+    bottom = (0.55 * length * down[0], 0.55 * length * down[1])
     corner = (top[0], bottom[1])
     canvas.polygon([top, bottom, corner], fill="luma(215)")
     canvas.path([corner, top, bottom, corner], width=0.6)
@@ -186,6 +188,7 @@ def incline(canvas: Drawing, scene: SceneView, impact: Stage) -> bool:
     center = (radius * out[0], radius * out[1])
     release = (center[0], center[1] + drop)
     canvas.reserve((center[0] - radius, center[1] - radius), (center[0] + radius, center[1] + radius))
+    _contact_axes(canvas, out, down, bottom)  # before the incline's angle, whose label then keeps clear of them
     incoming = velocity_stage(stages, before)
     if incoming is not None:  # a wider arc for a flat incline: its label then fits inside the wedge
         _angle_mark(canvas, bottom, (-down[0], -down[1]), [(1.0, 0.0)], 0.9 if slope > 0.45 else 1.4,
@@ -215,14 +218,22 @@ def incline(canvas: Drawing, scene: SceneView, impact: Stage) -> bool:
                  _speed_label(scene, rebound, "v'"))
     if rebound is not None:
         _angle_mark(canvas, center, ray, [down], 1.0, _angle_label(scene, rebound))
-    # n and t beside the contact they are defined at: up the slope from it, above the surface, where
-    # neither the fall nor the rebound is drawn; else at the top of the incline.
-    near_contact = [(center[0] - d * down[0] + h * out[0], center[1] - d * down[1] + h * out[1])
-                    for d, h in ((1.2, 0.95), (1.6, 0.95), (2.0, 0.95), (1.6, 1.3))]
-    origin = next((o for o in near_contact if _axes_fit(canvas, o, (-out[0], -out[1]), down)),
-                  (top[0] - 0.9, top[1] - 0.2))
-    _axes(canvas, origin, (-out[0], -out[1]), down)
     return True
+
+
+def _contact_axes(canvas: Drawing, out: Point, down: Point, bottom: Point) -> None:
+    """n and t at the point of contact (the origin), where they are defined: t along the surface down the
+    slope, n into the incline, as long as the incline is deep there (it is shallow on a gentle slope),
+    their labels beside their tips where they are clear (inside the incline, n's up the slope)."""
+    depth = abs(bottom[1]) * out[1]  # from the contact to the incline's base, at right angles to it
+    reach = max(0.25, min(0.6, depth - 0.2))
+    for direction, length in ((down, 0.6), ((-out[0], -out[1]), reach)):
+        canvas.arrow((0.0, 0.0), (length * direction[0], length * direction[1]), width=0.5, head=0.13)
+    t_tip, n_tip = (0.6 * down[0], 0.6 * down[1]), (-reach * out[0], -reach * out[1])
+    n_beside = ((-0.2, 0.0), (-0.4, 0.0), (-0.6, 0.0), (0.2, 0.0), (-0.25, 0.15), (-0.5, 0.2))  # (down, out)
+    for tip, label, offsets in ((t_tip, "t", ((0.0, -0.2), (0.2, -0.15), (0.15, 0.2))), (n_tip, "n", n_beside)):
+        beside = [(tip[0] + a * down[0] + b * out[0], tip[1] + a * down[1] + b * out[1]) for a, b in offsets]
+        canvas.label(next((at for at in beside if canvas.fits(at, "c", [label])), beside[0]), "c", [label])
 
 
 def _axes_fit(canvas: Drawing, origin: Point, n: Point, t: Point, margin: float = 0.12) -> bool:

@@ -287,19 +287,21 @@ PANELS: dict[str, PanelKind] = {
                            "driven plate with its velocity, or a pile drawn under it), the height dimensioned, to "
                            "scale when given; with the impact it ends in and the rises after it (a rebound dashed at "
                            "its height, two or more as arcs); onto a fixed surface it strikes obliquely, an incline "
-                           "at its angle"),
+                           "at its angle, n and t drawn at the contact"),
     "rise": PanelKind(_one, _draw_rise,
                       "after a fall and its impact: in the fall's panel, the body dashed at its rebound height; "
                       "alone: the body, its speed up, and dashed at the height it rises to, dimensioned"),
     "impact": PanelKind(_claim_impact, _draw_impact,
-                        "direct: the bodies as blocks in a line (a run of direct impacts, one line), areas following "
-                        "the masses (a fixed one a hatched wall), each with its velocity before as an arrow the way "
-                        "it moves; oblique against a fixed body: the surface with the incoming and rebound "
-                        "velocities at their angles; oblique between two bodies: two touching circles with n, t and "
-                        "the incoming velocity; with the slide to rest after it, the skid; with the struck body's "
-                        "swing after it, the pendulum and the striking body"),
+                        "direct: the bodies in a line (a run of direct impacts, one line), blocks unless the scene "
+                        "gives them a shape, areas following the masses (a fixed one a hatched wall; balls that "
+                        "hang from cords level on their line of centres), each with its velocity before as an "
+                        "arrow the way it moves; oblique against a fixed body: the surface with the incoming and "
+                        "rebound velocities at their angles; oblique between two bodies: two touching circles with "
+                        "n, t and the incoming velocity; with the slide to rest after it, the skid; with the struck "
+                        "body's swing after it, the pendulum and the striking body"),
     "swing": PanelKind(_one, _draw_swing,
-                       "the cord at rest and at its greatest angle, to scale, and the arc between; a body that "
+                       "the cord at rest and at its greatest angle, to scale, and the arc between, the body a "
+                       "block unless the scene gives it a shape; a body that "
                        "strikes the hanging one (the impact before the swing) comes in from the left with its "
                        "velocity"),
     "slide": PanelKind(_one, _draw_slide,

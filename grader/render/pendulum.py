@@ -12,12 +12,12 @@ from __future__ import annotations
 import math as _m
 
 from grader.model.scene import Stage
-from grader.render.drawing import Drawing
+from grader.render.drawing import PARTICLE, Drawing
 from grader.render.scene_view import SceneView
 from grader.render.typst_math import math
 
 CORD = 3.6  # cm: the cord's length on the page
-HALF_WIDTH, HALF_HEIGHT = 0.42, 0.3  # cm: the block hanging from it
+HALF_WIDTH, HALF_HEIGHT = 0.42, 0.3  # cm: the block hanging from it (a sphere: radius HALF_HEIGHT)
 ASKED_ANGLE = _m.radians(35)  # how an asked angle is drawn
 
 
@@ -34,12 +34,13 @@ def swing_figure(canvas: Drawing, scene: SceneView, swing: Stage, impact: Stage 
     canvas.circle((0.0, 0.0), 0.06)
     low = (0.0, -CORD)
     high = (CORD * _m.sin(theta), -CORD * _m.cos(theta))
-    canvas.line((0.0, 0.0), (low[0], low[1] + HALF_HEIGHT), width=0.4, dash="dashed", gray=True)
-    canvas.rect((low[0] - HALF_WIDTH, low[1] - HALF_HEIGHT), (low[0] + HALF_WIDTH, low[1] + HALF_HEIGHT), "dashed",
-                "none")
+    shape = scene.shape(body, "block")
+    reach = HALF_WIDTH if shape == "block" else HALF_HEIGHT if shape == "sphere" else PARTICLE  # right of centre
+    canvas.line((0.0, 0.0), (low[0], low[1] + min(reach, HALF_HEIGHT)), width=0.4, dash="dashed", gray=True)
+    canvas.body_shape(shape, low, (HALF_WIDTH, HALF_HEIGHT), "dashed", filled=False)
     canvas.line((0.0, 0.0), high, width=0.6)
-    canvas.rect((high[0] - HALF_WIDTH, high[1] - HALF_HEIGHT), (high[0] + HALF_WIDTH, high[1] + HALF_HEIGHT))
-    canvas.name((high[0] + HALF_WIDTH + 0.12, high[1]), "w", body, [*scene.mass(body)])
+    canvas.body_shape(shape, high, (HALF_WIDTH, HALF_HEIGHT))
+    canvas.name((high[0] + reach + 0.12, high[1]), "w", body, [*scene.mass(body)])
     steps = max(6, int(theta / 0.05))
     canvas.path([(CORD * _m.sin(theta * i / steps), -CORD * _m.cos(theta * i / steps)) for i in range(steps + 1)],
                 width=0.4, dash="dashed")
@@ -61,8 +62,13 @@ def _striker(canvas: Drawing, scene: SceneView, impact: Stage, target: tuple[flo
     """The first body of the impact, small, coming in from the left at the block's height."""
     first = impact.fields["bodies"][0]
     x = target[0] - HALF_WIDTH - 1.9
-    canvas.rect((x - 0.2, target[1] - 0.06), (x + 0.2, target[1] + 0.06), fill="luma(120)")
-    canvas.name((x, target[1] - 0.15), "n", first, [*scene.mass(first)])
+    shape = scene.template.scene.bodies[first].shape
+    if shape is None:  # a slug, as a bullet is drawn
+        canvas.rect((x - 0.2, target[1] - 0.06), (x + 0.2, target[1] + 0.06), fill="luma(120)")
+    else:
+        canvas.body_shape(shape, (x, target[1]), (0.2, 0.15))
+    canvas.name((x, target[1] - (0.15 if shape is None or shape == "particle" else 0.25)), "n", first,
+                [*scene.mass(first)])
     velocity = impact.fields["before"].get(first)
     lines = [math(velocity.n)] if velocity is not None else []
     canvas.velocity((x + 0.35, target[1]), (x + 1.35, target[1]), lines, (1.0, 0.0), width=0.7, head=0.18)

@@ -16,8 +16,10 @@ textbook writes, and :func:`readable` rewrites a tree into that, changing its va
   terms before compound ones), so signs sit in front and ``-J/m + v`` reads ``v - J/m``;
 - a minus sign in front of a product: ``-(e - 1)`` is ``1 - e``, and ``(1 + e)(1 - e)`` is ``1 - e²``;
 - the square of a root is its radicand: ``hypot(a, b)²`` is ``a² + b²``;
-- a product with a fraction for its number leads with it (``1/2 m v²``), unless it has a denominator
-  already (``v²/(2 g)``) or the number is a decimal of the problem's data (``0.1 p``).
+- a factor above and below cancels: ``m_A m_B/(m_A (m_A + m_B))`` is ``m_B/(m_A + m_B)``;
+- a product with a fraction for its number writes it above and below (``p/4``, ``3 p/4``, ``v²/(2 g)``),
+  except the half of an energy, which leads (``1/2 m v²``), and a decimal of the problem's data (``0.1 p``,
+  ``0.05 p``).
 
 >>> from grader.model.expr import parse, to_text
 >>> names = Names({"g": (1, 0, -2, 0), "h": (1, 0, 0, 0), "m": (0, 1, 0, 0), "v_n": (1, 0, -1, 0),
@@ -130,6 +132,7 @@ def _product(node: Node, names: Names) -> Node:
     product.take(node, names)
     if product.coefficient == 0:
         return Num(Fraction(0))
+    product.numerator, product.denominator = _cancelled(product.numerator, product.denominator)
     product.numerator = [_unsquared(f, names) for f in _powers(_one_root(product.numerator, names))]
     product.denominator = [_unsquared(f, names) for f in _powers(_one_root(product.denominator, names))]
     _root_of_quotient(product, names)
@@ -139,6 +142,35 @@ def _product(node: Node, names: Names) -> Node:
     product.numerator = _difference_of_squares(product.numerator, names)
     key = _factor_key(names)
     return _built(product, sorted(product.numerator, key=key), sorted(product.denominator, key=key))
+
+
+def _cancelled(numerator: list[Node], denominator: list[Node]) -> tuple[list[Node], list[Node]]:
+    """A factor above and below cancels (a whole power counted as its factors): ``m_A m_B/(m_A (m_A + m_B))``
+    is ``m_B/(m_A + m_B)``.
+
+    >>> from grader.model.expr import parse
+    >>> [[to_text(f) for f in side] for side in _cancelled([parse("m**2"), parse("v")], [parse("m")])]
+    [['m', 'v'], []]
+    """
+    above, below = _one_by_one(numerator), _one_by_one(denominator)
+    for factor in list(above):
+        if factor in below:
+            above.remove(factor)
+            below.remove(factor)
+    return above, below
+
+
+def _one_by_one(factors: list[Node]) -> list[Node]:
+    """Factors with each whole power (up to the ninth) written out as its factors: ``v²`` is ``v v``."""
+    result: list[Node] = []
+    for factor in factors:
+        exponent = factor.args[1] if isinstance(factor, Op) and factor.op == "pow" else None
+        if isinstance(factor, Op) and isinstance(exponent, Num) and isinstance(exponent.value, Fraction) and \
+                exponent.value.denominator == 1 and 1 <= exponent.value <= 9:
+            result += [factor.args[0]] * int(exponent.value)
+        else:
+            result.append(factor)
+    return result
 
 
 def _root_of_quotient(product: _Product, names: Names) -> None:
@@ -163,12 +195,15 @@ def _built(product: _Product, numerator: list[Node], denominator: list[Node]) ->
     coefficient = product.coefficient
     if _decimal(coefficient):  # a number of the problem's data (0.1 p), not of the physics (1/2 m v^2)
         numerator.insert(0, Num(coefficient))
-    elif isinstance(coefficient, Fraction) and coefficient.denominator != 1 and denominator:
+    elif isinstance(coefficient, Fraction) and coefficient == _HALF and not denominator and _squared(numerator):
+        # 1/2 m v^2, 1/2 k x^2: the half of an energy leads, kept apart (as a quotient of two numbers)
+        numerator.insert(0, Op("div", (Num(Fraction(1)), Num(Fraction(2)))))
+    elif isinstance(coefficient, Fraction) and coefficient.denominator != 1 and numerator:
+        # p/4, 3 p/4, m v/(2 (1 + p)): a fraction's number above and below, as the textbook writes it
         if coefficient.numerator != 1:
             numerator.insert(0, Num(Fraction(coefficient.numerator)))
         denominator.insert(0, Num(Fraction(coefficient.denominator)))
     elif isinstance(coefficient, Fraction) and coefficient.denominator != 1:
-        # 1/2 m v^2: a leading fraction, kept apart from the factors (as a quotient of two numbers)
         numerator.insert(0, Op("div", (Num(Fraction(coefficient.numerator)), Num(Fraction(coefficient.denominator)))))
     elif coefficient != 1:
         numerator.insert(0, Num(coefficient))
@@ -177,13 +212,29 @@ def _built(product: _Product, numerator: list[Node], denominator: list[Node]) ->
     return Op("neg", (result,)) if product.negative else result
 
 
+def _squared(factors: Sequence[Node]) -> bool:
+    """Whether a factor is a square or a sum of them (the ``v²`` of ``1/2 m v²``, ``1/2 m (u² + v²)``)."""
+    def square(node: Node) -> bool:
+        if isinstance(node, Op) and node.op in ("add", "sub"):
+            return any(square(term) for term in node.args)
+        return isinstance(node, Op) and node.op == "pow" and node.args[1] == Num(Fraction(2))
+    return any(square(factor) for factor in factors)
+
+
 def _decimal(value: Fraction | float) -> bool:
-    """A fraction whose denominator is a power of ten, such as a value printed with decimals."""
-    if not isinstance(value, Fraction) or value.denominator == 1:
+    """A value printed with decimals: a fraction that is a decimal of two places or more (its denominator
+    at least 10, of twos and fives: 0.42 is 21/50, 0.05 is 1/20); a half, a quarter or an eighth is a
+    fraction (``p/4``).
+
+    >>> _decimal(Fraction(21, 50)), _decimal(Fraction(1, 20)), _decimal(Fraction(1, 4)), _decimal(Fraction(1, 3))
+    (True, True, False, False)
+    """
+    if not isinstance(value, Fraction) or value.denominator < 10:
         return False
     denominator = value.denominator
-    while denominator % 10 == 0:
-        denominator //= 10
+    for prime in (2, 5):
+        while denominator % prime == 0:
+            denominator //= prime
     return denominator == 1
 
 

@@ -63,6 +63,10 @@ class SceneView:
         asked is never drawn to scale."""
         return names(node) <= set(self.template.parameters)
 
+    def shape(self, body: str, default: str) -> str:
+        """How a figure draws ``body``: the template's ``shape`` for it, else the panel's ``default``."""
+        return self.template.scene.bodies[body].shape or default
+
     def mass_value(self, body: str) -> list[str]:
         """A body's mass as its printed value and unit (``1.5 kg``) when a parameter gives it."""
         mass = self.template.scene.bodies[body].mass

@@ -271,13 +271,14 @@ def _ramp(canvas: Drawing, scene: SceneView, stage: Stage) -> bool:
     canvas.line((-0.4, 0.0), (run, 0.0), width=0.4, dash="dotted")
     top, bottom = (0.0, height + 0.3), (run + 0.5, 0.3)
     start, end = (bottom, top) if up else (top, bottom)
-    canvas.circle(start, 0.3)
-    canvas.circle(end, 0.3, "dashed", fill=False)
+    shape = scene.shape(fields["body"], "sphere")
+    canvas.body_shape(shape, start, (0.35, 0.3))
+    canvas.body_shape(shape, end, (0.35, 0.3), "dashed", filled=False)
     names = [fields["body"], *([fields["with"]] if "with" in fields else [])]
     if up:
         canvas.name((start[0], start[1] + 0.4), "s", names[0])
     else:  # above it to the left: above it, the name ran into the speed's label
-        canvas.name((start[0] - 0.2, start[1] + 0.3), "se", names[0])
+        canvas.name((start[0] - 0.2, start[1] + (0.3 if shape == "sphere" else 0.38)), "se", names[0])
     canvas.bodies += names[1:]
     for at, node in ((start, fields["speed"]), (end, fields.get("end_speed"))):
         if node is None:
@@ -411,10 +412,10 @@ def impulse(canvas: Drawing, scene: SceneView, stage: Stage) -> bool:
         canvas.label((0.0, -0.3), "c", [str(string("cushion"))])  # inside: beside it, it widened the panel
         canvas.dimension((-1.2, -0.6), (-1.2, 0.0), scene.given(fields["distance"]), "left")
         centre = (0.0, 0.3)
-        canvas.rect((-0.6, 0.0), (0.6, 0.6))
+        canvas.body_shape(scene.shape(body, "block"), centre, (0.6, 0.3))
     else:
         centre = (0.0, 0.0)
-        canvas.circle(centre, 0.35)
+        canvas.body_shape(scene.shape(body, "sphere"), centre, (0.35, 0.35))
     canvas.name(centre, "c", body)
     # before and after beside the body (above and below it, or right of it when n is up), each centred
     rows = ((centre[0] + 1.2, centre[1] + 0.4), (centre[0] + 1.2, centre[1] + 1.8)) if up else \

@@ -1,0 +1,219 @@
+"""The band search of the integrity check (:mod:`grader.grade.integrity`): which students' accepted bands hold
+a wrong answer, never over all pairs.
+
+A part's key values are sorted once (angles reduced to one turn); with the lowest band start from each sorted
+position on and the highest band end up to it, two binary searches (``numpy.searchsorted``) give, for each
+answer, a range of sorted positions whose bands may hold it, and only those candidates are tested; bands closed
+at both ends are counted from their sorted starts and ends without being listed. A class of 100,000 costs a few
+seconds.
+
+>>> from grader.model.tolerance import Tolerance
+>>> tolerance = Tolerance().to_json()
+>>> part = bands("1a", np.array([2.0, 3.0, 5.0]), [tolerance] * 3, "m/s")
+>>> owners, partners = matches(part, np.array([0]), np.array([4.98]))
+>>> owners.tolist(), partners.tolist()
+([0], [2])
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterator, Mapping, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+
+from grader.grade.compare import accepted_distance, errors
+from grader.grade.integrity_chance import class_density
+from grader.model.tolerance import Tolerance
+
+Floats = npt.NDArray[np.float64]
+Ints = npt.NDArray[np.int64]
+
+CHUNK = 1 << 22  # candidate pairs tested at a time: a bounded amount of memory, whatever the class
+BY_ENDS = True  # count an answer's matches from the sorted ends of the bands (False: test each candidate)
+PERIOD = {"deg": 360.0, "rad": 2 * math.pi}
+
+
+@dataclass(frozen=True)
+class Bands:
+    """A numeric part over the class: each student's key value (NaN: none), accepted distance, whether the
+    bound is strict (sigfigs, decimals), the chance ``p`` of their band; the students with a value sorted
+    by it (angles reduced to one turn), the lowest band start from each sorted position on and the highest
+    band end up to it (a search over them finds a superset of the bands that hold a number); the bands'
+    starts and ends, each sorted."""
+
+    label: str
+    unit: str
+    values: Floats
+    reach: Floats
+    strict: npt.NDArray[np.bool_]
+    chance: Floats
+    order: Ints
+    sorted_values: Floats
+    low: Floats
+    high: Floats
+    starts: Floats
+    ends: Floats
+
+    @property
+    def period(self) -> float | None:
+        return PERIOD.get(self.unit)
+
+
+def bands(label: str, values: Floats, tolerances: Sequence[Mapping[str, Any]], unit: str) -> Bands:
+    """A part's bands: each student's accepted distance (worked out per tolerance: a part has a few)."""
+    reach, strict = np.full(len(values), np.nan), np.zeros(len(values), dtype=bool)
+    groups: dict[tuple[tuple[str, Any], ...], list[int]] = {}
+    mapping: Mapping[str, Any] | None = None
+    members: list[int] = []
+    for index, tolerance in enumerate(tolerances):
+        if tolerance is not mapping:  # the key shares one mapping between equal rules
+            mapping, members = tolerance, groups.setdefault(tuple(tolerance.items()), [])
+        members.append(index)
+    for written, members in groups.items():
+        rule = Tolerance.from_json(dict(written))
+        reach[members] = accepted_distance(values[members], rule)
+        strict[members] = rule.mode != "rtol"
+    period = PERIOD.get(unit)
+    have = np.flatnonzero(np.isfinite(values) & np.isfinite(reach))
+    placed = values[have] if period is None else np.mod(values[have], period)
+    order = have[np.argsort(placed, kind="stable")]
+    sorted_values = np.sort(placed, kind="stable")
+    bands = reach[order]
+    low = np.minimum.accumulate((sorted_values - bands)[::-1])[::-1] if len(order) else sorted_values
+    high = np.maximum.accumulate(sorted_values + bands) if len(order) else sorted_values
+    return Bands(label, unit, values, reach, strict, class_density(values, reach, order, sorted_values), order,
+                 sorted_values, low, high, np.sort(sorted_values - bands), np.sort(sorted_values + bands))
+
+
+def _ranges(part: Bands, numbers: Floats) -> Iterator[tuple[Ints, Ints]]:
+    """For each number, the positions in the part's sorted order that may hold it in their band: one
+    range, or, for an angle, one for each neighbouring turn."""
+    period = part.period
+    shifts = (0.0,) if period is None else (0.0, -period, period)
+    placed = numbers if period is None else np.mod(numbers, period)
+    for shift in shifts:
+        target = placed + shift
+        yield (np.searchsorted(part.high, target, side="left").astype(np.int64),
+               np.searchsorted(part.low, target, side="right").astype(np.int64))
+
+
+def accepts(part: Bands, owners: Ints, partners: Ints, numbers: Floats) -> npt.NDArray[np.bool_]:
+    """Whether each partner's band holds the owner's number, the partner being another student whose value
+    the owner's own band does not hold."""
+    unit = part.unit if part.period is not None else None
+    distance = errors(numbers[owners], part.values[partners], angle_unit=unit)[0]
+    reach = part.reach[partners]
+    inside = np.where(part.strict[partners], distance < reach, distance <= reach)
+    own = errors(part.values[partners], part.values[owners], angle_unit=unit)[0]
+    mine = np.where(part.strict[owners], own < part.reach[owners], own <= part.reach[owners])
+    return np.asarray(inside & ~mine & (owners != partners), dtype=bool)
+
+
+def expanded(starts: Ints, ends: Ints) -> Iterator[tuple[Ints, Ints]]:
+    """Each range's index and the positions in it, in blocks of about :data:`CHUNK` positions."""
+    sizes = np.maximum(ends - starts, 0)
+    begin = 0
+    while begin < len(sizes):
+        total = np.cumsum(sizes[begin:])
+        end = begin + max(1, int(np.searchsorted(total, CHUNK, side="right")))
+        block = sizes[begin:end]
+        owner = np.repeat(np.arange(begin, end), block)
+        offsets = np.arange(int(block.sum())) - np.repeat(np.cumsum(block) - block, block)
+        yield owner, starts[owner] + offsets
+        begin = end
+
+
+def matches(part: Bands, owners: Ints, numbers: Floats) -> tuple[Ints, Ints]:
+    """Every (owner, partner) whose partner's band holds ``numbers`` (one per owner); for a test's eyes."""
+    full = np.full(len(part.values), np.nan)
+    full[owners] = numbers
+    found_owners, found_partners = [], []
+    for starts, ends in _ranges(part, numbers):
+        for which, positions in expanded(starts, ends):
+            who, partner = owners[which], part.order[positions]
+            ok = accepts(part, who, partner, full)
+            found_owners.append(who[ok])
+            found_partners.append(partner[ok])
+    return np.concatenate(found_owners or [np.zeros(0, np.int64)]), np.concatenate(found_partners or
+                                                                                  [np.zeros(0, np.int64)])
+
+
+def holding(part: Bands, wrong: Ints, numbers: Floats) -> tuple[Ints, list[tuple[Ints, Ints]]]:
+    """Per wrong answer (of ``wrong``), how many students' bands hold it, and its candidate ranges.
+
+    Bands closed at both ends (not an angle's, nor a strict bound's) are counted without being listed (in a
+    class of 100,000 a wrong answer may fall in thousands): the bands holding ``a`` are those that start at or
+    below it less those that end below it, two binary searches in the sorted starts and ends. The bands not
+    counted as matches (the student's own, and those of values the student's own band holds) can hold only an
+    answer within the student's reach plus the widest reach of the values their band holds: those answers are
+    tested one by one, as are all of an angle's or a strict bound's."""
+    counts = np.zeros(len(wrong), dtype=np.int64)
+    ranges = list(_ranges(part, numbers[wrong]))
+    tested = np.arange(len(wrong))
+    if BY_ENDS and part.period is None and not part.strict.any():
+        typed = numbers[wrong]
+        counts = (np.searchsorted(part.starts, typed, side="right")
+                  - np.searchsorted(part.ends, typed, side="left")).astype(np.int64)
+        own, mine = part.values[wrong], part.reach[wrong]
+        widest = -range_least(-part.reach[part.order], np.searchsorted(part.sorted_values, own - mine, side="left"),
+                               np.searchsorted(part.sorted_values, own + mine, side="right"))
+        tested = np.flatnonzero(np.abs(typed - own) <= mine + np.maximum(widest, 0.0))
+        counts[tested] = 0
+    for starts, ends in ranges:
+        for which, positions in expanded(starts[tested], ends[tested]):
+            ok = accepts(part, wrong[tested[which]], part.order[positions], numbers)
+            counts += np.bincount(tested[which[ok]], minlength=len(wrong))
+    return counts, ranges
+
+
+def range_least(values: Floats, starts: Ints, ends: Ints) -> Floats:
+    """The least of ``values[start:end]`` per range (inf: empty), from a table of the least of each run of
+    ``2^k`` values (a sparse table: two look-ups a range).
+
+    >>> range_least(np.array([5.0, 3.0, 4.0, 1.0, 2.0]), np.array([0, 0, 2, 4, 3]), np.array([1, 3, 4, 5, 3]))
+    array([ 5.,  3.,  1.,  2., inf])
+    """
+    found = np.full(len(starts), np.inf)
+    sizes = ends - starts
+    if not len(values) or not (sizes > 0).any():
+        return found
+    levels = [values]
+    while 2 ** len(levels) <= len(values):
+        run = 2 ** (len(levels) - 1)
+        levels.append(np.minimum(levels[-1][:-run], levels[-1][run:]))
+    some = np.flatnonzero(sizes > 0)
+    level = np.floor(np.log2(sizes[some])).astype(np.int64)
+    for k in np.unique(level).tolist():
+        rows = some[level == k]
+        found[rows] = np.minimum(levels[k][starts[rows]], levels[k][ends[rows] - 2 ** k])
+    return found
+
+
+def nearest(part: Bands, owners: Ints, numbers: Floats, count: int) -> Ints:
+    """Per owner, up to ``count`` students whose bands hold the owner's number, nearest first (by
+    distance over the band), among the values sorted next to it (-1: none)."""
+    if not len(owners) or not len(part.order):
+        return np.full((len(owners), count), -1, dtype=np.int64)
+    period = part.period
+    placed = numbers[owners] if period is None else np.mod(numbers[owners], period)
+    middle = np.searchsorted(part.sorted_values, placed)
+    positions = np.clip(middle[:, None] + np.arange(-2 * count, 2 * count)[None, :], 0, len(part.order) - 1)
+    partners = part.order[positions]
+    who = np.repeat(owners, positions.shape[1])
+    ok = accepts(part, who, partners.ravel(), numbers).reshape(positions.shape)
+    unit = part.unit if period is not None else None
+    with np.errstate(divide="ignore", invalid="ignore"):
+        score = errors(numbers[who], part.values[partners.ravel()], angle_unit=unit)[0].reshape(positions.shape)
+        score = score / part.reach[partners]
+    score = np.where(ok, score, np.inf)
+    # Clipped positions repeat the ends: a repeated partner is listed once (the first of equal scores).
+    first = np.ones(positions.shape, dtype=bool)
+    first[:, 1:] = positions[:, 1:] != positions[:, :-1]
+    score = np.where(first, score, np.inf)
+    best = np.argsort(score, axis=1, kind="stable")[:, :count]
+    chosen = np.take_along_axis(partners, best, axis=1)
+    return np.where(np.isfinite(np.take_along_axis(score, best, axis=1)), chosen, -1)

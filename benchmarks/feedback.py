@@ -10,7 +10,8 @@ Each is timed from a fresh start (its worked solutions computed again). Printed 
 over the rounds of the wall time, and of the CPU time (this process's, Typst's threads included: what a
 shared machine's other work does not inflate as much). Target (issue 30): a student's feedback "in the
 time the answer key takes per student"; the file holds their part of the key and their marked sheet, so
-the sheet and the key together are printed too. The machine's load average is printed with the figures.
+the sheet and the key together are printed too, and each as a ratio to the key. The machine's load average
+is printed with the figures; they are also written to ``benchmarks/results/feedback.md``.
 """
 
 from __future__ import annotations
@@ -18,6 +19,7 @@ from __future__ import annotations
 import argparse
 import csv
 import os
+import platform
 import resource
 import statistics
 import tempfile
@@ -37,6 +39,8 @@ from grader.render.feedback import write_feedback
 from grader.render.generate import Job, load_inputs, write_outputs
 from grader.render.pdfs import STUDENTS_PER_PART
 from grader.render.typeset import compile_typst
+
+RESULTS = Path(__file__).resolve().parent / "results"
 
 
 def main() -> None:
@@ -78,12 +82,20 @@ def main() -> None:
             for what, run in timed.items():
                 figures[what].append(_timed(run, number))
             loads.append(os.getloadavg()[0])
-    print(f"{count} students, {arguments.rounds} rounds; load average {min(loads):.1f} to {max(loads):.1f}")
-    print(f"{'':16} {'wall':>6} {'CPU':>6}  (ms a student, median of the rounds)")
     medians = {what: tuple(statistics.median(f[i] for f in found) for i in (0, 1)) for what, found in figures.items()}
     medians["sheet + key"] = tuple(medians["answer key"][i] + medians["sheets"][i] for i in (0, 1))
-    for what, (wall, cpu) in medians.items():
-        print(f"{what:16} {1000 * wall / count:6.0f} {1000 * cpu / count:6.0f}")
+    key_wall, key_cpu = medians["answer key"]
+    lines = [f"{count} students, {arguments.rounds} rounds; load average {min(loads):.1f} to {max(loads):.1f}",
+             f"{'':16} {'wall':>6} {'CPU':>6} {'wall/key':>9} {'CPU/key':>8}  (ms a student, median of the rounds)"]
+    lines += [f"{what:16} {1000 * wall / count:6.0f} {1000 * cpu / count:6.0f} {wall / key_wall:8.2f}x "
+              f"{cpu / key_cpu:7.2f}x" for what, (wall, cpu) in medians.items()]
+    print("\n".join(lines))
+    RESULTS.mkdir(exist_ok=True)
+    (RESULTS / "feedback.md").write_text(
+        f"# Feedback benchmark\n\nPython {platform.python_version()}, {os.cpu_count()} CPUs, "
+        f"{time.strftime('%d %B %Y', time.gmtime())}. `python benchmarks/feedback.py --students {count} "
+        f"--rounds {arguments.rounds}`; target (issue 30): the feedback in the time the answer key takes per student "
+        "(wall/key at most 1.00x).\n\n```\n" + "\n".join(lines) + "\n```\n", encoding="utf-8")
 
 
 def _cpu() -> float:

@@ -165,8 +165,8 @@ def _columns(raw: Any, digest: str) -> bytes:
     if type(raw) is not dict or type(raw.get("students")) is not list:
         raise _UnusualKeyError
     texts: dict[str, int] = {}
-    tolerances: dict[str, int] = {}
-    shapes: dict[str, int] = {}
+    tolerances: dict[Any, tuple[dict[str, Any], int]] = {}
+    shapes: dict[tuple[Any, ...], int] = {}
     people: dict[str, list[Any]] = {"ids": [], "names": [], "emails": [], "sections": [], "dues": []}
     shape, value, points, code, params = [], [], [], [], []
     for student in raw["students"]:
@@ -189,20 +189,20 @@ def _columns(raw: Any, digest: str) -> bytes:
                 number, text = _value(_object(answer))
                 value.append(number)
                 points.append(_number(answer.get("points")))
-                tolerance = json.dumps(_object(answer.get("tolerance")), ensure_ascii=False)
+                tolerance = _object(answer.get("tolerance"))
                 undefined = answer.get("undefined")
                 code.append((NUMBER if text is None and answer["value"] is not None else
                              NONE if text is None else _index(texts, text),
                              _index(texts, _string(answer.get("unit", ""))),
                              _index(texts, _string(answer.get("label"))),
-                             tolerances.setdefault(tolerance, len(tolerances)),
+                             _tolerance(tolerances, tolerance),
                              NONE if undefined is None else _index(texts, _string(undefined))))
             params.extend(_number(number) for number in printed.values())
-        shape.append(shapes.setdefault(json.dumps(layout, ensure_ascii=False), len(shapes)))
+        shape.append(shapes.setdefault(tuple((key, tuple(names), tuple(params)) for key, names, params in layout),
+                                       len(shapes)))
     meta = {"format": FORMAT, "version": VERSION, "key_sha256": digest,
             "header": {name: entry for name, entry in raw.items() if name != "students"}, **people,
-            "shapes": [json.loads(layout) for layout in shapes], "texts": list(texts),
-            "tolerances": [json.loads(tolerance) for tolerance in tolerances]}
+            "shapes": list(shapes), "texts": list(texts), "tolerances": [entry for entry, _ in tolerances.values()]}
     return _npz({"meta": np.frombuffer(json.dumps(meta, ensure_ascii=False).encode("utf-8"), np.uint8),
                  "shape": np.array(shape, np.int32), "value": np.array(value, np.float64),
                  "points": np.array(points, np.float64), "code": np.array(code, np.int32).reshape(-1, 5),
@@ -221,6 +221,16 @@ def _npz(arrays: Mapping[str, np.ndarray]) -> bytes:
 
 def _no_constant(name: str) -> float:
     raise ValueError(f"{name} is no number a key holds")
+
+
+def _tolerance(table: dict[Any, tuple[dict[str, Any], int]], tolerance: dict[str, Any]) -> int:
+    """The tolerance's index in ``table``, by value (``True`` is not ``1``: the types are part of it)."""
+    try:
+        key: Any = (tuple(tolerance.items()), tuple(map(type, tolerance.values())))
+        hash(key)
+    except TypeError:  # a list or an object among the values: by its text
+        key = json.dumps(tolerance, ensure_ascii=False)
+    return table.setdefault(key, (tolerance, len(table)))[1]
 
 
 def _index(table: dict[str, int], text: str) -> int:

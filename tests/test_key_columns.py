@@ -183,3 +183,20 @@ def test_generating_twice_gives_the_same_sidecar(tmp_path: Path) -> None:
     first = sidecar(key).read_bytes()
     assert write_key_columns(key)
     assert sidecar(key).read_bytes() == first
+
+
+def test_a_sidecar_compressed_or_larger_than_its_key_is_passed_over_unread(tmp_path: Path) -> None:
+    """A zip whose members unpack to more than the file (a zip bomb), or a file bigger than its key's
+    columns could be, is no sidecar grader wrote: key.json is read."""
+    key = tmp_path / "key.json"
+    key.write_text(json.dumps({"schema": "grader-key", "version": 2, "students": []}), encoding="utf-8")
+    assert write_key_columns(key)
+    with zipfile.ZipFile(sidecar(key)) as archive:
+        members = {name: archive.read(name) for name in archive.namelist()}
+    assert read_key_columns(key, key.read_bytes()) is not None
+    with zipfile.ZipFile(sidecar(key), "w", zipfile.ZIP_DEFLATED) as archive:
+        for name, content in members.items():
+            archive.writestr(name, content)
+    assert read_key_columns(key, key.read_bytes()) is None
+    sidecar(key).write_bytes(b"\0" * (len(key.read_bytes()) + (1 << 16) + 1))
+    assert read_key_columns(key, key.read_bytes()) is None

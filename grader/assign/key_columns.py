@@ -113,8 +113,12 @@ def read_key_columns(key: Path, data: bytes) -> KeyColumns | None:
     """The sidecar of ``key``, whose bytes are ``data``, if there is one made from these bytes and it reads
     whole; else None (grading reads ``key.json``)."""
     try:
-        stored = sidecar(key).read_bytes()
+        with open(sidecar(key), "rb") as stream:
+            # The columns are smaller than the JSON they come from: a bigger file is no sidecar of it.
+            stored = stream.read(_most(data) + 1)
     except OSError:
+        return None
+    if len(stored) > _most(data) or not _stored_whole(stored):
         return None
     try:
         with np.load(io.BytesIO(stored), allow_pickle=False) as archive:
@@ -126,8 +130,24 @@ def read_key_columns(key: Path, data: bytes) -> KeyColumns | None:
                 return None
             arrays = {name: archive[name] for name in _ARRAYS[1:]}
         return _checked(meta, arrays)
-    except (OSError, ValueError, KeyError, TypeError, EOFError, zipfile.BadZipFile, UnicodeDecodeError):
+    except (OSError, ValueError, KeyError, TypeError, EOFError, MemoryError, zipfile.BadZipFile):
         return None  # a sidecar cut short, altered, or of another layout: key.json is read instead
+
+
+def _most(data: bytes) -> int:
+    """The largest sidecar of a key of these bytes (the zip's own entries aside, its columns take at most the
+    JSON's length)."""
+    return len(data) + (1 << 16)
+
+
+def _stored_whole(stored: bytes) -> bool:
+    """Whether the zip holds its arrays as they are (no compression: no member unpacks to more than the file)."""
+    try:
+        with zipfile.ZipFile(io.BytesIO(stored)) as archive:
+            return all(entry.compress_type == zipfile.ZIP_STORED and entry.file_size <= len(stored)
+                       for entry in archive.infolist())
+    except (zipfile.BadZipFile, ValueError, EOFError, OSError):
+        return False
 
 
 def _checked(meta: dict[str, Any], arrays: Mapping[str, np.ndarray]) -> KeyColumns | None:
@@ -168,7 +188,11 @@ def _columns(raw: Any, digest: str) -> bytes:
     tolerances: dict[Any, tuple[dict[str, Any], int]] = {}
     shapes: dict[tuple[Any, ...], int] = {}
     people: dict[str, list[Any]] = {"ids": [], "names": [], "emails": [], "sections": [], "dues": []}
-    shape, value, points, code, params = [], [], [], [], []
+    shape: list[int] = []
+    value: list[float] = []
+    points: list[float] = []
+    code: list[tuple[int, int, int, int, int]] = []
+    params: list[float] = []
     for student in raw["students"]:
         if type(student) is not dict:
             raise _UnusualKeyError

@@ -111,8 +111,8 @@ def test_a_missing_stale_or_damaged_sidecar_is_passed_over(graded_class: Path, t
     assert load_key(edited).students[0].parts[answer["label"]].value == answer["value"]
     # Damaged: cut short, bytes flipped inside an array, not a zip at all, an empty file; or missing.
     middle = len(good) // 2
-    for number, damaged in enumerate((good[:middle], good[:middle] + bytes([good[middle] ^ 0xFF]) + good[middle + 1:], b"not a zip",
-                    b"", None)):
+    flipped = good[:middle] + bytes([good[middle] ^ 0xFF]) + good[middle + 1:]
+    for number, damaged in enumerate((good[:middle], flipped, b"not a zip", b"", None)):
         if damaged is None:
             sidecar(key).unlink()
         else:

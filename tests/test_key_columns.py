@@ -200,3 +200,27 @@ def test_a_sidecar_compressed_or_larger_than_its_key_is_passed_over_unread(tmp_p
     assert read_key_columns(key, key.read_bytes()) is None
     sidecar(key).write_bytes(b"\0" * (len(key.read_bytes()) + (1 << 16) + 1))
     assert read_key_columns(key, key.read_bytes()) is None
+
+
+def test_a_key_laid_out_a_student_a_line_is_read_a_line_at_a_time_to_the_same_sidecar(
+        graded_class: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """grader generate's layout is read line by line (a big class's key is never held whole); the same key
+    written on one line is decoded whole; both give the same sidecar, but for the hash of the bytes."""
+    import grader.assign.key_columns as key_columns
+
+    key = tmp_path / "key.json"
+    shutil.copyfile(graded_class / "hw" / "key.json", key)
+    whole = []
+    decode_text = key_columns.decode_text
+    monkeypatch.setattr(key_columns, "decode_text", lambda *given: whole.append(1) or decode_text(*given))
+    assert write_key_columns(key) and not whole
+    by_line = read_key_columns(key, key.read_bytes())
+    compact = tmp_path / "compact.json"
+    compact.write_text(json.dumps(json.loads(key.read_text(encoding="utf-8")), ensure_ascii=False), encoding="utf-8")
+    assert write_key_columns(compact) and whole
+    decoded = read_key_columns(compact, compact.read_bytes())
+    assert by_line is not None and decoded is not None
+    for name in ("header", "ids", "names", "emails", "sections", "dues", "shapes", "texts", "tolerances"):
+        assert getattr(by_line, name) == getattr(decoded, name), name
+    for name in ("shape", "value", "points", "code", "params"):
+        assert getattr(by_line, name).tobytes() == getattr(decoded, name).tobytes(), name

@@ -34,14 +34,16 @@ from __future__ import annotations
 
 import hashlib
 import io
+import itertools
 import json
 import re
 import sys
 import zipfile
-from collections.abc import Mapping
+from array import array
+from collections.abc import Iterable, Iterator, Mapping
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, BinaryIO
 
 import numpy as np
 
@@ -94,19 +96,93 @@ class _UnusualKeyError(Exception):
 
 def write_key_columns(key: Path) -> bool:
     """Write the sidecar of the key file ``key`` from its bytes on disk; returns whether one was written
-    (a key not as grader generate writes keys gets none, and an old sidecar of it is removed)."""
-    data = key.read_bytes()
-    text = decode_text(data, key)
+    (a key not as grader generate writes keys gets none, and an old sidecar of it is removed). A key laid out
+    as :func:`grader.assign.keyfile.key_json` lays it out is read a line, a student, at a time (a big
+    class's key is never held whole); any other is decoded whole."""
     try:
-        if _ESCAPED_SURROGATE.search(text):
-            raise _UnusualKeyError
-        raw = json.loads(text, parse_constant=_no_constant)
-        payload = _columns(raw, hashlib.sha256(data).hexdigest())
+        try:
+            with open(key, "rb") as stream:
+                digest = hashlib.sha256()
+                header, students = _by_line(stream, digest)
+                payload = _columns(header, students, digest)
+        except _LayoutError:
+            data = key.read_bytes()
+            text = decode_text(data, key)
+            if _ESCAPED_SURROGATE.search(text):
+                raise _UnusualKeyError from None
+            raw = json.loads(text, parse_constant=_no_constant)
+            if type(raw) is not dict or type(raw.get("students")) is not list:
+                raise _UnusualKeyError from None
+            payload = _columns(raw, raw["students"], hashlib.sha256(data))
     except (GraderError, ValueError, RecursionError, _UnusualKeyError):
         sidecar(key).unlink(missing_ok=True)
         return False
     write_atomic(sidecar(key), payload)
     return True
+
+
+class _LayoutError(Exception):
+    """The key is not laid out a student a line: it is decoded whole."""
+
+
+_STUDENTS = b' "students": [\n'
+
+
+def _by_line(stream: BinaryIO, digest: Any) -> tuple[dict[str, Any], Iterator[Any]]:
+    """The header of a key laid out by ``key_json`` and its students, decoded one line at a time as they
+    are iterated; ``digest`` takes every byte read. :class:`_LayoutError` where the layout differs."""
+    lines = _hashed(stream, digest)
+    head = list(itertools.takewhile(lambda line: line != _STUDENTS, lines))
+    text = _decoded(b"".join(head)).rstrip()
+    if not text.startswith("{") or not text.endswith(","):
+        raise _LayoutError
+    header = _loaded(text[:-1] + "}")
+    if type(header) is not dict:
+        raise _LayoutError
+    return header, _students(lines)
+
+
+def _students(lines: Iterator[bytes]) -> Iterator[Any]:
+    """The students of the lines after ``"students": [``, each line one (a comma after all but the last),
+    then `` ]`` and ``}`` and the end of the file."""
+    last = None  # the last student's line
+    for line in lines:
+        text = _decoded(line).strip()
+        if text == "]":
+            break
+        if (last is not None and not last.endswith(",")) or not text.startswith("{"):
+            raise _LayoutError
+        last = text
+        yield _loaded(text.removesuffix(","))
+    else:
+        raise _LayoutError
+    if (last is not None and last.endswith(",")) or _decoded(b"".join(lines)).strip() != "}":
+        raise _LayoutError
+
+
+def _hashed(stream: BinaryIO, digest: Any) -> Iterator[bytes]:
+    for line in stream:
+        digest.update(line)
+        yield line
+
+
+def _decoded(data: bytes) -> str:
+    """UTF-8 without a byte-order mark, NUL or half a character escaped: else the whole file is decoded, as
+    grading decodes it."""
+    try:
+        text = data.decode("utf-8")
+    except UnicodeDecodeError:
+        raise _LayoutError from None
+    if text.startswith("\ufeff") or "\0" in text or _ESCAPED_SURROGATE.search(text):
+        raise _LayoutError
+    return text
+
+
+def _loaded(text: str) -> Any:
+    try:
+        return json.loads(text, parse_constant=_no_constant)
+    except (ValueError, RecursionError):
+        raise _LayoutError from None
 
 
 def read_key_columns(key: Path, data: bytes) -> KeyColumns | None:
@@ -179,21 +255,17 @@ def _checked(meta: dict[str, Any], arrays: Mapping[str, np.ndarray]) -> KeyColum
     return columns
 
 
-def _columns(raw: Any, digest: str) -> bytes:
-    """The sidecar's bytes for the decoded ``key.json`` ``raw``; :class:`_UnusualKeyError` where a student is not
-    shaped as grader generate writes them."""
-    if type(raw) is not dict or type(raw.get("students")) is not list:
-        raise _UnusualKeyError
+def _columns(header: Mapping[str, Any], students: Iterable[Any], digest: Any) -> bytes:
+    """The sidecar's bytes for the key's ``header`` (its entries; ``students`` among them is left out) and
+    its ``students``, decoded; ``digest``, of the file's bytes, is read once every student is. Raises
+    :class:`_UnusualKeyError` where a student is not shaped as grader generate writes them."""
     texts: dict[str, int] = {}
     tolerances: dict[Any, tuple[dict[str, Any], int]] = {}
     shapes: dict[tuple[Any, ...], int] = {}
     people: dict[str, list[Any]] = {"ids": [], "names": [], "emails": [], "sections": [], "dues": []}
-    shape: list[int] = []
-    value: list[float] = []
-    points: list[float] = []
-    code: list[tuple[int, int, int, int, int]] = []
-    params: list[float] = []
-    for student in raw["students"]:
+    # Typed arrays, not lists of Python numbers: a million students have five million answers.
+    shape, value, points, code, params = array("i"), array("d"), array("d"), array("i"), array("d")
+    for student in students:
         if type(student) is not dict:
             raise _UnusualKeyError
         for entry, field in (("ids", "id"), ("names", "name"), ("emails", "email"), ("sections", "section")):
@@ -215,22 +287,22 @@ def _columns(raw: Any, digest: str) -> bytes:
                 points.append(_number(answer.get("points")))
                 tolerance = _object(answer.get("tolerance"))
                 undefined = answer.get("undefined")
-                code.append((NUMBER if text is None and answer["value"] is not None else
+                code.extend((NUMBER if text is None and answer["value"] is not None else
                              NONE if text is None else _index(texts, text),
                              _index(texts, _string(answer.get("unit", ""))),
                              _index(texts, _string(answer.get("label"))),
                              _tolerance(tolerances, tolerance),
                              NONE if undefined is None else _index(texts, _string(undefined))))
             params.extend(_number(number) for number in printed.values())
-        shape.append(shapes.setdefault(tuple((key, tuple(names), tuple(params)) for key, names, params in layout),
+        shape.append(shapes.setdefault(tuple((key, tuple(answers), tuple(printed)) for key, answers, printed in layout),
                                        len(shapes)))
-    meta = {"format": FORMAT, "version": VERSION, "key_sha256": digest,
-            "header": {name: entry for name, entry in raw.items() if name != "students"}, **people,
+    meta = {"format": FORMAT, "version": VERSION, "key_sha256": digest.hexdigest(),
+            "header": {name: entry for name, entry in header.items() if name != "students"}, **people,
             "shapes": list(shapes), "texts": list(texts), "tolerances": [entry for entry, _ in tolerances.values()]}
     return _npz({"meta": np.frombuffer(json.dumps(meta, ensure_ascii=False).encode("utf-8"), np.uint8),
-                 "shape": np.array(shape, np.int32), "value": np.array(value, np.float64),
-                 "points": np.array(points, np.float64), "code": np.array(code, np.int32).reshape(-1, 5),
-                 "params": np.array(params, np.float64)})
+                 "shape": np.frombuffer(shape, np.int32), "value": np.frombuffer(value, np.float64),
+                 "points": np.frombuffer(points, np.float64), "code": np.frombuffer(code, np.int32).reshape(-1, 5),
+                 "params": np.frombuffer(params, np.float64)})
 
 
 def _npz(arrays: Mapping[str, np.ndarray]) -> bytes:

@@ -224,3 +224,17 @@ def test_a_key_laid_out_a_student_a_line_is_read_a_line_at_a_time_to_the_same_si
         assert getattr(by_line, name) == getattr(decoded, name), name
     for name in ("shape", "value", "points", "code", "params"):
         assert getattr(by_line, name).tobytes() == getattr(decoded, name).tobytes(), name
+
+
+def test_the_sidecar_is_an_output_like_any_other_for_the_manifest(tmp_path: Path,
+                                                                   capsys: pytest.CaptureFixture[str]) -> None:
+    """Listed in the manifest: altered by hand, generate --force refuses to replace the folder, naming it."""
+    out = tmp_path / "hw"
+    arguments = ["generate", str(sample_dir() / "assignment.yaml"), "--roster", str(sample_dir() / "roster.csv"),
+                 "--out", str(out), "--no-pdf"]
+    assert main(arguments) == 0
+    assert "key.columns.npz" in json.loads((out / ".grader-manifest.json").read_text(encoding="utf-8"))["files"]
+    sidecar(out / "key.json").write_bytes(b"edited")
+    capsys.readouterr()
+    assert main([*arguments, "--force"]) == 2
+    assert "key.columns.npz (changed since grader wrote it)" in capsys.readouterr().err

@@ -57,7 +57,7 @@ def three_figures(text: str) -> bool:
 def test_the_demo_exits_0_and_says_how_the_class_graded_and_how_to_grade_again(demo_run: DemoRun) -> None:
     assert demo_run.code == 0, demo_run.stderr
     lines = demo_run.stdout.splitlines()
-    assert lines[0].startswith("30 students x 5 problems -> grader-demo (75 files, ")
+    assert lines[0].startswith("30 students x 5 problems -> grader-demo (76 files, ")
     assert lines[1] == ("submissions.csv (simulated answers) graded: 30 students (29 submitted), 450 parts graded "
                         "(344 correct, 9 ecf, 28 mistake, 35 incorrect, 1 invalid, 33 missing); 1 row set aside "
                         "(superseded or not a student), 0 rows not graded (see problems.csv) -> grader-demo/grades")

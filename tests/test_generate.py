@@ -157,7 +157,8 @@ def test_an_existing_output_folder_is_kept_unless_forced(tmp_path: Path, capsys:
     code, _, err = run(capsys, "generate", ASSIGNMENT, "--roster", ROSTER, "--out", out, "--no-pdf")
     assert code == 2 and "exists and is not empty" in err
     assert run(capsys, "generate", ASSIGNMENT, "--roster", ROSTER, "--out", out, "--no-pdf", "--force")[0] == 0
-    assert sorted(p.name for p in out.iterdir()) == [".grader-manifest.json", "key.csv", "key.json"]
+    assert sorted(p.name for p in out.iterdir()) == [".grader-manifest.json", "key.columns.npz", "key.csv",
+                                                        "key.json"]
     assert [p.name for p in tmp_path.iterdir()] == ["out"]
 
 

@@ -282,12 +282,17 @@ class CsvStream:
     text: str = field(repr=False)  # from the header's line on
     skipped: int = 0  # blank lines before the header's
 
-    def rows(self) -> Iterator[CsvRow]:
-        """The non-blank data rows, as :func:`read_csv` describes them."""
+    def records(self) -> Iterator[tuple[int, list[str]]]:
+        """The non-blank data rows as the csv module reads them: the line each starts on and its cells, as
+        they are (not stripped, nor measured: :meth:`rows` does that)."""
         records = _records(_lines(self.text), self.path, self.delimiter, self.skipped)
         next(records)  # the header
+        return records
+
+    def rows(self) -> Iterator[CsvRow]:
+        """The non-blank data rows, as :func:`read_csv` describes them."""
         header, width = self.header, len(self.header)
-        for line, cells in records:
+        for line, cells in self.records():
             problem = None
             longest = max(map(len, cells))
             if longest > CELL_CHARS:

@@ -35,12 +35,20 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from datetime import UTC, datetime, tzinfo
 from pathlib import Path
-from typing import Any, TypeVar
+from typing import Any, NamedTuple, TypeVar
 
 import numpy as np
 
 from grader.assign.assignment import MAX_POINTS, Grading, grading_from
 from grader.assign.deadlines import DEFAULT_ZONE, LatePolicy, late_from, zone_from
+from grader.assign.key_columns import (
+    NONE,
+    NUMBER,
+    TEXT,
+    UNIT,
+    KeyColumns,
+    read_key_columns,
+)
 from grader.base.errors import GraderError, TemplateError, shown
 from grader.base.inputs import CELL_CHARS, decode_text, read_bytes
 from grader.grade.notation import ReadError, check_powers
@@ -175,7 +183,13 @@ class Key:
 def load_key(path: Path) -> Key:
     """Read and check a key file; a file that is not a grader key is refused with the reason."""
     where = str(path)
-    text = decode_text(read_bytes(path, KEY_BYTES), path)
+    data = read_bytes(path, KEY_BYTES)
+    columns = read_key_columns(path, data)  # the sidecar grader generate wrote, if it was made from these bytes
+    key = None if columns is None else _key_from_columns(columns, where)
+    if key is not None:
+        return key
+    text = decode_text(data, path)
+    del data
     try:
         if _ESCAPED_SURROGATE.search(text):  # rare: JSON escapes a character beyond U+FFFF as two; one alone is none
             _refuse_lone_surrogates(json.loads(text), where)
@@ -540,7 +554,7 @@ def _student(raw: Mapping[str, Any], symbols: Mapping[str, Mapping[str, tuple[fl
             parts[part.label] = part
         printed = problem.get("params")
         for name, value in printed.items() if isinstance(printed, dict) else ():
-            if type(value) in (int, float) and abs(value) < 1.7e308:  # not bool, NaN or beyond float64
+            if type(value) in (int, float) and _printable(value):  # not bool
                 parameters.append((key, str(name)))
                 values.append(_one(shared, float(value)))
     name, email, section = (_text(raw.get(entry, ""), f"student {student_id}: {entry}")
@@ -639,3 +653,126 @@ def _tolerance(raw: Any, name: str, shared: dict[Any, Any]) -> Mapping[str, Any]
         if key is not None:
             shared[key] = found
     return found
+
+
+def _printable(value: float) -> bool:
+    """Whether a printed parameter is kept: not NaN, nor beyond float64."""
+    return abs(value) < 1.7e308
+
+
+# --- the sidecar: the same students from columns (grader.assign.key_columns) ------------------------
+
+def _key_from_columns(columns: KeyColumns, where: str) -> Key | None:
+    """The key the sidecar's columns hold, checked as :func:`load_key` checks ``key.json``; None where any
+    check fails: ``key.json`` is then read, and refused with its own message, in its own order."""
+    header = columns.header
+    version = header.get("version") if type(header) is dict else None
+    if type(header) is not dict or header.get("schema") != "grader-key" or type(version) is not int \
+            or version not in VERSIONS:
+        return None
+    try:
+        students = _columns_students(columns, _symbols(_field(header, "problems", "the key")))
+        return _key({**header, "students": students}, where, version)
+    except _EntryError:
+        return None
+
+
+class _PartShape(NamedTuple):
+    """What the parts of many students share: all of a :class:`KeyPart` but its value."""
+
+    problem: str
+    name: str
+    label: str
+    unit: str
+    points: float
+    tolerance: Mapping[str, Any]
+    undefined: str | None
+    symbols: Mapping[str, tuple[float, float]]
+
+
+def _columns_students(columns: KeyColumns, symbols: Mapping[str, Mapping[str, tuple[float, float]]]
+                      ) -> list[KeyStudent]:
+    """The students of the columns, each entry checked as :func:`_student` checks it (once per distinct
+    text, unit, tolerance and points); :class:`_EntryError` where one fails."""
+    shared: dict[Any, Any] = {}
+    texts, values = columns.texts, columns.value
+    numbers = columns.code[:, TEXT] == NUMBER
+    if not np.isfinite(values[numbers]).all():
+        raise _EntryError("a value that is not finite")
+    shapes: dict[tuple[Any, ...], _PartShape] = {}
+    layouts = [_layout(shape, shared) for shape in columns.shapes]
+    value_list, points, codes = values.tolist(), columns.points.tolist(), columns.code.tolist()
+    params, every_printed = columns.params.tolist(), bool((np.abs(columns.params) < 1.7e308).all())
+    dues: dict[str, datetime] = {}
+    students, answer, parameter = [], 0, 0
+    for student_id, name, email, section, due, shape in zip(columns.ids, columns.names, columns.emails,
+                                                            columns.sections, columns.dues, columns.shape.tolist(),
+                                                            strict=True):
+        if not _text(student_id, "a student's id").strip():
+            raise _EntryError("a student's id: expected an id")
+        parts: dict[str, KeyPart] = {}
+        for problem, answers in layouts[shape][0]:
+            for answer_name in answers:
+                code, value = codes[answer], value_list[answer]
+                key = (problem, answer_name, *code[UNIT:], points[answer])
+                part = shapes.get(key)
+                if part is None:
+                    part = shapes[key] = _part_shape(key, texts, columns.tolerances, symbols, shared)
+                if code[TEXT] == NUMBER:
+                    parts[part.label] = KeyPart(part.problem, part.name, part.label, value, part.unit, part.points,
+                                                part.tolerance, part.undefined, part.symbols)
+                else:
+                    parts[part.label] = _part_valued(part, None if code[TEXT] == NONE else texts[code[TEXT]], shared)
+                answer += 1
+        if len(parts) != layouts[shape][2]:
+            raise _EntryError(f"student {student_id}: a label appears twice")
+        names, count = layouts[shape][1], len(layouts[shape][1])
+        printed = params[parameter:parameter + count]
+        parameter += count
+        if not every_printed:
+            names = tuple(pair for pair, number in zip(names, printed, strict=True) if _printable(number))
+            printed = [number for number in printed if _printable(number)]
+            names = _one(shared, ("parameters", names))[1]
+        when = None if due is None else dues.get(due) or dues.setdefault(due, _instant(due, "due"))
+        students.append(KeyStudent(student_id, _text(name, "name"), _text(email, "email"), _text(section, "section"),
+                                   parts, names, tuple(printed), when))
+    return students
+
+
+def _layout(shape: list[tuple[str, list[str], list[str]]], shared: dict[Any, Any]
+            ) -> tuple[list[tuple[str, list[str]]], tuple[tuple[str, str], ...], int]:
+    """A shape of the columns: its problems' keys (each once) and answers' names, its parameters (shared by
+    the students of the shape) and how many parts it has."""
+    keys = [key for key, _, _ in shape]
+    if len(set(keys)) != len(keys):
+        raise _EntryError("a problem key appears twice")
+    parameters = tuple((_one(shared, key), name) for key, _, names in shape for name in names)
+    return ([(_one(shared, key), answers) for key, answers, _ in shape], _one(shared, ("parameters", parameters))[1],
+            sum(len(answers) for _, answers, _ in shape))
+
+
+def _part_shape(key: tuple[Any, ...], texts: list[str], tolerances: list[Any],
+                symbols: Mapping[str, Mapping[str, tuple[float, float]]], shared: dict[Any, Any]) -> _PartShape:
+    """A part's entries but its value, checked as :func:`_part` checks them."""
+    problem, name, unit, label, tolerance, undefined, points = key
+    label = _one(shared, _text(texts[label], f"answer {name}", "label"))
+    return _PartShape(problem, _one(shared, name), label, _unit(texts[unit], name, shared),
+                      _one(shared, _points(points, name)), _tolerance(tolerances[tolerance], name, shared),
+                      None if undefined == NONE else texts[undefined], symbols.get(label, {}))
+
+
+def _part_valued(part: _PartShape, value: str | None, shared: dict[Any, Any]) -> KeyPart:
+    """A part whose value is an expression (its names checked, and drawn where :func:`_part` draws them) or
+    null."""
+    domains = part.symbols
+    if isinstance(value, str):
+        used = shared.get(("names", value))
+        if used is None:
+            used = shared[("names", value)] = _names(value, part.name)
+        if not domains:
+            domains = shared.get(("symbols", value)) or shared.setdefault(
+                ("symbols", value), dict.fromkeys(sorted(used), SYMBOL_RANGE))
+        elif not used <= domains.keys():
+            raise _EntryError(f"answer {part.name}: the expression uses names not among its symbols")
+    return KeyPart(part.problem, part.name, part.label, value, part.unit, part.points, part.tolerance, part.undefined,
+                   domains)

@@ -40,7 +40,7 @@ from __future__ import annotations
 
 import os
 from collections import defaultdict
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Container, Sequence
 from dataclasses import dataclass
 from datetime import UTC, datetime, tzinfo
 from functools import lru_cache
@@ -112,6 +112,7 @@ def read_submissions(paths: Sequence[Path], students: Sequence[StudentRef], labe
     ignored: dict[str, None] = {}
     notes: list[str] = []
     shown_as = [shown_path(name) for name in names or paths]
+    plain: list[Answer] | None = None
     for index, (path, name) in enumerate(zip(paths, shown_as, strict=True)):
         table = open_csv(path, exports=True)
         layout = find_layout(table, labels, fmt, reader.roster.known)
@@ -119,16 +120,43 @@ def read_submissions(paths: Sequence[Path], students: Sequence[StudentRef], labe
         if table.encoding == "Windows-1252":
             notes.append(f"{name}: not UTF-8; read as Windows-1252 (Latin-1): check accented text, or save the "
                          'file as "CSV UTF-8"')
-        for row in table.rows():
+        # One file whose rows are all plain answers (the usual file) is read without the rows' machinery.
+        plain = _plain_answers(table, layout, reader.roster.ids, labels, name) if len(paths) == 1 else None
+        for row in table.rows() if plain is None else ():
             reader.read(name, index, row, table, layout)
         del table  # its rows are read: the next file's text need not wait beside it
-    answers = reader.contests.answers(labels)
+    answers = reader.contests.answers(labels) if plain is None else plain
     problems = reader.log.problems()
     order = {name: index for index, name in enumerate(shown_as)}
     position = {label: index for index, label in enumerate(labels)}
     return Submissions(tuple(sorted(answers, key=lambda a: (order[a.file], a.line, position[a.label]))),
                        tuple(sorted(problems, key=lambda p: (order[p.file], p.rows > 1, p.line, p.caveat, p.label))),
                        tuple(ignored), (*notes, *reader.notes()))
+
+
+def _plain_answers(table: CsvStream, layout: Layout, ids: Container[str], labels: Sequence[str],
+                   name: str) -> list[Answer] | None:
+    """The answers of a long file without timestamps each of whose rows has a cell per column, none too
+    long, and names a student of the key by their id and a label as they are written, each student's label
+    once: an answer a row, in the file's order, as :class:`_Reader` would read them (with no problem and no
+    note). None for any other file, whose rows are then read one by one."""
+    if layout.wide or layout.by_email or layout.timestamp is not None or layout.label is None \
+            or layout.answer is None:
+        return None
+    header, known = table.header, set(labels)
+    width, student, label, answer = (len(header), header.index(layout.student), header.index(layout.label),
+                                     header.index(layout.answer))
+    answers: list[Answer] = []
+    seen: set[tuple[str, str]] = set()
+    for line, cells in table.records():
+        if len(cells) != width or max(map(len, cells)) > CELL_CHARS:
+            return None
+        who, part = cells[student].strip(), cells[label].strip()
+        if who not in ids or part not in known or (who, part) in seen:
+            return None
+        seen.add((who, part))
+        answers.append(Answer(name, line, who, part, cells[answer].strip(), table.delimiter, None))
+    return answers
 
 
 def _refuse_repeated(paths: Sequence[Path]) -> None:

@@ -24,6 +24,7 @@ from grader.assign.assignment import (
     load_assignment,
     load_roster,
 )
+from grader.assign.key_columns import write_key_columns
 from grader.assign.keyfile import key_csv, key_document, key_json
 from grader.assign.variants import Generation, generate
 from grader.bank.template import Template
@@ -89,8 +90,9 @@ def write_outputs(job: Job, assignment: Assignment, roster: Sequence[Student], b
         with collector_paused(keep_frozen=True):
             generation = generate(assignment, roster, bank)
             write_atomic(staging / "key.json", key_json(key_document(assignment, generation, bank, job.out)))
+            columns = write_key_columns(staging / "key.json")  # the sidecar grading reads in its place
             write_atomic(staging / "key.csv", key_csv(generation))
-        written = 2 + (_write_pdfs(job, assignment, generation, bank, staging) if job.pdf else 0)
+        written = 2 + columns + (_write_pdfs(job, assignment, generation, bank, staging) if job.pdf else 0)
     return generation, written
 
 

@@ -1,0 +1,70 @@
+"""The usual submissions file (long, no timestamps, every row a known student's answer to a label, once)
+is read without the rows' machinery (issue 29): what it reads is what the row-by-row reader reads, and any
+other file is read row by row."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+import grader.grade.submissions as submissions
+from grader.grade.submissions import StudentRef, Submissions, read_submissions
+
+STUDENTS = [StudentRef("007", "ana@x.edu"), StudentRef("042", "ben@x.edu"), StudentRef("100", "cy@x.edu")]
+LABELS = ("1a", "1b", "2a")
+
+PLAIN = {  # read as plain answers
+    "usual": "student_id,label,answer\n007,1a,6.2\n007,1b,165 cm/s\n042,1a,\n042,2a,\"1,234\"\n100,1b,six\n",
+    "byte-order mark, CRLF, spaces": "\ufeffstudent_id,label,answer\r\n 007 , 1a ,  6.2 m/s \r\n042,1b,=1+1\r\n",
+    "semicolons and a decimal comma": "id;label;answer\n007;1a;6,2\n042;2a;\"6;2\"\n",
+    "blank lines and a cell over two lines": "student_id,label,answer\n\n007,1a,\"6.2\n m/s\"\n\n\n042,1a,7\n",
+    "other columns": "name,student_id,label,answer,note\nAna,007,1a,6.2,x\nBen,042,1b,7,\n",
+}
+ROW_BY_ROW = {  # anything else: read row by row
+    "twice": "student_id,label,answer\n007,1a,6.2\n007,1a,6.3\n",
+    "unknown student": "student_id,label,answer\n007,1a,6.2\n999,1a,6.3\n",
+    "leading zeros lost": "student_id,label,answer\n7,1a,6.2\n",
+    "label in another case": "student_id,label,answer\n007,1A,6.2\n",
+    "unknown label": "student_id,label,answer\n007,9z,6.2\n",
+    "timestamps": "student_id,label,answer,timestamp\n007,1a,6.2,2026-12-01 10:00\n",
+    "too many cells": "student_id,label,answer\n007,1a,6.2,extra\n",
+    "too few cells": "student_id,label,answer\n007,1a\n",
+    "by email": "email,label,answer\nana@x.edu,1a,6.2\n",
+    "wide": "student_id,1a,1b\n007,6.2,7\n",
+    "a long cell": "student_id,label,answer\n007,1a," + "9" * 5000 + "\n",
+    "no student": "student_id,label,answer\n,1a,6.2\n",
+}
+
+
+def _read(path: Path, attempts: str = "latest") -> Submissions:
+    return read_submissions([path], STUDENTS, LABELS, attempts=attempts)
+
+
+@pytest.mark.parametrize("attempts", ["latest", "first", "best"])
+@pytest.mark.parametrize("name", [*PLAIN, *ROW_BY_ROW])
+def test_the_plain_reading_reads_what_the_row_by_row_reading_reads(tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
+                                                                   name: str, attempts: str) -> None:
+    path = tmp_path / "answers.csv"
+    path.write_bytes((PLAIN | ROW_BY_ROW)[name].encode("utf-8"))
+    used = []
+    plain_answers = submissions._plain_answers
+    monkeypatch.setattr(submissions, "_plain_answers", lambda *given: used.append(plain_answers(*given)) or used[-1])
+    fast = _read(path, attempts)
+    assert (used[-1] is not None) == (name in PLAIN)
+    monkeypatch.setattr(submissions, "_plain_answers", lambda *given: None)
+    assert fast == _read(path, attempts)
+
+
+def test_plain_answers_keep_their_lines_and_text(tmp_path: Path) -> None:
+    path = tmp_path / "answers.csv"
+    path.write_text(PLAIN["blank lines and a cell over two lines"], encoding="utf-8")
+    assert [(a.line, a.student_id, a.label, a.text) for a in _read(path).answers] == [
+        (3, "007", "1a", "6.2\n m/s"), (7, "042", "1a", "7")]
+
+
+def test_a_quote_left_open_is_refused_naming_its_line_as_before(tmp_path: Path) -> None:
+    path = tmp_path / "answers.csv"
+    path.write_text('student_id,label,answer\n007,1a,6.2\n042,1a,"7\n', encoding="utf-8")
+    with pytest.raises(Exception, match="line 3"):
+        _read(path)

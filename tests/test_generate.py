@@ -575,3 +575,18 @@ def test_a_key_written_a_piece_at_a_time_is_the_key_written_whole(tmp_path: Path
         assert draws.collisions()[problem.key] == whole.collisions[problem.key] == shared
     if size == 64:
         assert any(whole.collisions.values())  # the case that counts: some students do share their numbers
+
+
+@pytest.mark.skipif(not Path("/dev/full").exists(), reason="needs /dev/full")
+def test_a_full_disk_while_the_students_lines_wait_names_key_json(tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
+                                                                   capsys: pytest.CaptureFixture[str]) -> None:
+    """key.json's students wait in an unnamed temporary file while the class is drawn; a write to it that fails
+    (ENOSPC from /dev/full) names no file by itself: the message names key.json, and nothing is left."""
+    import grader.assign.keyfile
+
+    monkeypatch.setattr(grader.assign.keyfile.tempfile, "TemporaryFile", lambda dir: open("/dev/full", "w+b"))  # noqa: SIM115
+    err = _one_line_error(*run(capsys, "generate", ASSIGNMENT, "--roster", ROSTER, "--out", tmp_path / "out",
+                               "--no-pdf"))
+    monkeypatch.undo()
+    assert f"{tmp_path / 'out' / 'key.json'}: No space left on device; nothing was written to" in err
+    assert list(tmp_path.iterdir()) == []

@@ -42,6 +42,7 @@ import os
 import shutil
 import tempfile
 from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
+from contextlib import contextmanager
 from functools import lru_cache
 from pathlib import Path
 from typing import Any
@@ -125,18 +126,20 @@ def write_key_files(folder: Path, assignment: Assignment, chunks: Iterable[Seque
         for chunk in chunks:
             if not chunk:
                 continue
+            separator = b"" if first is None else b",\n  "
             if first is None:
                 first = chunk[0].problems
                 tolerances = _shared_tolerances(first)
-            else:
-                students.write(b",\n  ")
-            students.write(",\n  ".join(json.dumps(_student(s, assignment, tolerances), ensure_ascii=False,
-                                                    allow_nan=False) for s in chunk).encode("utf-8"))
+            lines = ",\n  ".join(json.dumps(_student(s, assignment, tolerances), ensure_ascii=False, allow_nan=False)
+                                 for s in chunk)
+            with _blamed_on(folder / "key.json"):  # the students' lines are key.json's, not key.csv's, whose
+                students.write(separator + lines.encode("utf-8"))  # block would otherwise take a failed write
             for piece in csv_pieces(_csv_rows(chunk)):
                 table.write(piece.encode("utf-8"))
         head = json.dumps(_head(assignment, first or (), collisions(), bank, key_folder), ensure_ascii=False,
                           indent=1, allow_nan=False)
-        students.seek(0)
+        with _blamed_on(folder / "key.json"):
+            students.seek(0)  # writes what is buffered
         with atomic_file(folder / "key.json") as key:
             key.write(f'{head[:-2]},\n "students": [\n  '.encode())
             shutil.copyfileobj(students, key, COPY_BLOCK)
@@ -144,6 +147,17 @@ def write_key_files(folder: Path, assignment: Assignment, chunks: Iterable[Seque
 
 
 COPY_BLOCK = 1 << 20  # bytes of the students' lines copied at a time into key.json
+
+
+@contextmanager
+def _blamed_on(path: Path) -> Iterator[None]:
+    """An ``OSError`` that names no file (a failed ``write()``) names ``path``."""
+    try:
+        yield
+    except OSError as error:
+        if error.filename is not None:
+            raise
+        raise OSError(error.errno, error.strerror, str(path)) from None
 
 
 def _bank_folder(template: Template, key_folder: Path | None) -> dict[str, str]:

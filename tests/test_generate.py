@@ -5,6 +5,7 @@ from __future__ import annotations
 import errno
 import json
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -420,14 +421,14 @@ def test_an_output_that_appears_during_the_run_is_not_replaced(tmp_path: Path, m
     import grader.render.generate
 
     out = tmp_path / "out"
-    real = grader.render.generate.generate
+    real = grader.render.generate.write_key
 
     def racing(*args: object) -> object:
         out.mkdir()
         _write(out / "key.json", "the other run")
         return real(*args)  # type: ignore[arg-type]
 
-    monkeypatch.setattr(grader.render.generate, "generate", racing)
+    monkeypatch.setattr(grader.render.generate, "write_key", racing)
     err = _one_line_error(*run(capsys, "generate", ASSIGNMENT, "--roster", ROSTER, "--out", out, "--no-pdf"))
     assert f"{out}: appeared while this run was writing it" in err
     assert _tree(out) == {"key.json": b"the other run"}
@@ -506,7 +507,8 @@ def test_a_read_only_parent_folder_is_one_line(tmp_path: Path, capsys: pytest.Ca
 @pytest.mark.skipif(not Path("/dev/full").exists(), reason="needs /dev/full")
 def test_a_full_disk_while_writing_the_key_is_one_line_and_leaves_nothing(
         tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]) -> None:
-    """Every atomic write goes to /dev/full (ENOSPC from the kernel): the path, the reason, nothing left."""
+    """Every atomic write goes to /dev/full (ENOSPC from the kernel): the path, the reason, nothing left (key.csv
+    and key.json are written side by side, a piece of the class at a time: the first to fill names itself)."""
     import grader.base.files
 
     def full(handle: int, mode: str = "rb") -> object:
@@ -517,7 +519,8 @@ def test_a_full_disk_while_writing_the_key_is_one_line_and_leaves_nothing(
     err = _one_line_error(*run(capsys, "generate", ASSIGNMENT, "--roster", ROSTER, "--out", tmp_path / "out",
                                "--no-pdf"))
     monkeypatch.undo()
-    assert f"{tmp_path / 'out' / 'key.json'}: No space left on device; nothing was written to" in err
+    assert re.search(f"{re.escape(str(tmp_path / 'out'))}/key\\.(json|csv): No space left on device; nothing was "
+                     "written to", err)
     assert list(tmp_path.iterdir()) == []
 
 
@@ -543,3 +546,48 @@ def test_a_roster_of_ids_and_names_only_is_enough(tmp_path: Path, capsys: pytest
     students = json.loads((tmp_path / "out" / "key.json").read_text(encoding="utf-8"))["students"]
     assert [(s["id"], s["name"], s["email"], s["section"]) for s in students] == [("1", "Ann Lee", "", ""),
                                                                                   ("2", "Bo Chan", "", "")]
+
+
+@pytest.mark.parametrize("size", [1, 64, 1000], ids=["one-student-a-piece", "uneven-pieces", "one-piece"])
+def test_a_key_written_a_piece_at_a_time_is_the_key_written_whole(tmp_path: Path, bank: dict[str, Template],
+                                                                   size: int) -> None:
+    """key.json and key.csv written as the class is drawn, a piece at a time (how `generate --no-pdf` writes a big
+    class), are the bytes of the class drawn whole and encoded at once; the collisions counted over the pieces
+    are the students whose printed numbers another student has too, counted over the whole class here."""
+    from collections import Counter
+
+    from grader.assign.assignment import Student
+    from grader.assign.keyfile import key_csv, key_document, key_json, write_key_files
+    from grader.assign.variants import ClassDraws
+
+    assignment = load_assignment(ASSIGNMENT)
+    roster = (load_roster(ROSTER) + tuple(Student(f"90{i:04d}", f"Student {i}", f"s{i}@example.edu", "L02")
+                                          for i in range(270)))[:300 if size != 1 else 40]
+    whole = generate(assignment, roster, bank)
+    draws = ClassDraws(assignment, roster, bank)
+    write_key_files(tmp_path, assignment, draws.chunks(size), draws.collisions, bank, tmp_path)
+    assert (tmp_path / "key.json").read_text(encoding="utf-8") == key_json(key_document(assignment, whole, bank,
+                                                                                         tmp_path))
+    assert (tmp_path / "key.csv").read_text(encoding="utf-8") == key_csv(whole)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["key.csv", "key.json"]  # no temporary file left
+    for index, problem in enumerate(assignment.problems):
+        printed = Counter(tuple(s.problems[index].printed.values()) for s in whole.students)
+        shared = sum(printed[tuple(s.problems[index].printed.values())] > 1 for s in whole.students)
+        assert draws.collisions()[problem.key] == whole.collisions[problem.key] == shared
+    if size == 64:
+        assert any(whole.collisions.values())  # the case that counts: some students do share their numbers
+
+
+@pytest.mark.skipif(not Path("/dev/full").exists(), reason="needs /dev/full")
+def test_a_full_disk_while_the_students_lines_wait_names_key_json(tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
+                                                                   capsys: pytest.CaptureFixture[str]) -> None:
+    """key.json's students wait in an unnamed temporary file while the class is drawn; a write to it that fails
+    (ENOSPC from /dev/full) names no file by itself: the message names key.json, and nothing is left."""
+    import grader.assign.keyfile
+
+    monkeypatch.setattr(grader.assign.keyfile.tempfile, "TemporaryFile", lambda dir: open("/dev/full", "w+b"))  # noqa: SIM115
+    err = _one_line_error(*run(capsys, "generate", ASSIGNMENT, "--roster", ROSTER, "--out", tmp_path / "out",
+                               "--no-pdf"))
+    monkeypatch.undo()
+    assert f"{tmp_path / 'out' / 'key.json'}: No space left on device; nothing was written to" in err
+    assert list(tmp_path.iterdir()) == []

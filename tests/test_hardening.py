@@ -546,7 +546,7 @@ def test_an_interrupted_run_is_one_line_and_leaves_nothing(tmp_path: Path, capsy
             raise KeyboardInterrupt
         os.kill(os.getpid(), signal.SIGTERM)
 
-    monkeypatch.setattr(job, "generate", stop)
+    monkeypatch.setattr(job, "ClassDraws", stop)  # while the class is drawn (without PDFs, a piece at a time)
     a = write(tmp_path / "a.yaml", ONE_PROBLEM)
     code, out, err = run(capsys, "generate", a, "--roster", ROSTER, "--out", tmp_path / "out", "--no-pdf")
     assert (code, out) == (130, "") and err == "grader: error: interrupted; nothing was left half-written\n"

@@ -36,9 +36,13 @@ and the tolerance's ``mode``: its tolerances are ``{"rtol", "atol"}``; a version
 from __future__ import annotations
 
 import hashlib
+import itertools
 import json
 import os
-from collections.abc import Iterator, Mapping, Sequence
+import shutil
+import tempfile
+from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
+from contextlib import contextmanager
 from functools import lru_cache
 from pathlib import Path
 from typing import Any
@@ -46,22 +50,30 @@ from typing import Any
 from grader import __version__
 from grader.assign.assignment import Assignment, ProblemSpec, Student
 from grader.assign.deadlines import student_due, zone
-from grader.assign.variants import AnswerPart, Generation
+from grader.assign.variants import AnswerPart, Generation, ProblemVariant, StudentVariants
 from grader.bank.template import Template
+from grader.base.files import atomic_file
 from grader.base.resources import bank_dir
-from grader.base.spreadsheet import csv_text, number_cell, safe_cell
+from grader.base.spreadsheet import csv_pieces, csv_text, number_cell, safe_cell
 from grader.model.tolerance import SYMBOL_RANGE, Tolerance
 
 SCHEMA, VERSION = "grader-key", 2
+
+
 def key_document(assignment: Assignment, generation: Generation, bank: Mapping[str, Template],
                  key_folder: Path | None = None) -> dict[str, Any]:
     """The key as a JSON-ready dictionary; ``key_folder``, where it is written: the bank folders of the
     templates are recorded relative to it (grading finds them again from the key)."""
-    used = {p.template: bank[p.template] for p in assignment.problems}
     first = generation.students[0].problems if generation.students else ()
-    # One tolerance dict per distinct tolerance (and reason: equality leaves it out), shared by every
-    # student's part (the encoder only reads it).
-    tolerances = {(t, t.reason): t.to_json() for s in first for t in {a.tolerance for a in s.answers}}
+    tolerances = _shared_tolerances(first)
+    return {**_head(assignment, first, generation.collisions, bank, key_folder),
+            "students": [_student(s, assignment, tolerances) for s in generation.students]}
+
+
+def _head(assignment: Assignment, first: Sequence[ProblemVariant], collisions: Mapping[str, int],
+          bank: Mapping[str, Template], key_folder: Path | None) -> dict[str, Any]:
+    """Everything in the key before its students; ``first``, the first student's variants."""
+    used = {p.template: bank[p.template] for p in assignment.problems}
     return {
         "schema": SCHEMA, "version": VERSION, "generator": f"grader {__version__}",
         "assignment": {"title": assignment.title, "course": assignment.course, "seed": assignment.seed,
@@ -80,15 +92,72 @@ def key_document(assignment: Assignment, generation: Generation, bank: Mapping[s
                       "parameters": {name: p.unit.text for name, p in used[v.template].parameters.items()},
                       "answers": [_part(a, used[v.template], spec) for a in v.answers]}
                      for v, spec in zip(first, assignment.problems, strict=False)],
-        "collisions": dict(generation.collisions),
-        "students": [{"id": s.student.id, "name": s.student.name, "email": s.student.email,
-                      "section": s.student.section, **_extension(s.student, assignment),
-                      "problems": [{"key": v.key, "template": v.template, "variant_seed": v.variant_seed,
-                                    "params": v.params, "printed": v.printed,
-                                    "answers": {a.name: _answer(a, tolerances) for a in v.answers}}
-                                   for v in s.problems]}
-                     for s in generation.students],
+        "collisions": dict(collisions),
     }
+
+
+def _shared_tolerances(first: Sequence[ProblemVariant]) -> dict[tuple[Tolerance, str], dict[str, Any]]:
+    """One tolerance dict per distinct tolerance (and reason: equality leaves it out) of the first student's
+    parts, shared by every student's part that has it (the encoder only reads it)."""
+    return {(t, t.reason): t.to_json() for s in first for t in {a.tolerance for a in s.answers}}
+
+
+def _student(entry: StudentVariants, assignment: Assignment,
+             tolerances: dict[tuple[Tolerance, str], dict[str, Any]]) -> dict[str, Any]:
+    s = entry.student
+    return {"id": s.id, "name": s.name, "email": s.email, "section": s.section, **_extension(s, assignment),
+            "problems": [{"key": v.key, "template": v.template, "variant_seed": v.variant_seed,
+                          "params": v.params, "printed": v.printed,
+                          "answers": {a.name: _answer(a, tolerances) for a in v.answers}}
+                         for v in entry.problems]}
+
+
+def write_key_files(folder: Path, assignment: Assignment, chunks: Iterable[Sequence[StudentVariants]],
+                    collisions: Callable[[], Mapping[str, int]], bank: Mapping[str, Template],
+                    key_folder: Path | None = None) -> None:
+    """Write ``folder/key.json`` and ``folder/key.csv`` a piece of the class at a time, as ``chunks`` come
+    (:class:`grader.assign.variants.ClassDraws`), the same bytes as :func:`key_json` and :func:`key_csv` of the
+    class drawn whole. ``collisions`` is asked after the last piece: key.json's head, which holds them, is
+    written then, before the students' lines, which wait in an unnamed temporary file in ``folder``."""
+    first: Sequence[ProblemVariant] | None = None
+    tolerances: dict[tuple[Tolerance, str], dict[str, Any]] = {}
+    with tempfile.TemporaryFile(dir=folder) as students, atomic_file(folder / "key.csv") as table:
+        table.write(csv_text([KEY_CSV_HEADER]).encode("utf-8"))
+        for chunk in chunks:
+            if not chunk:
+                continue
+            separator = b"" if first is None else b",\n  "
+            if first is None:
+                first = chunk[0].problems
+                tolerances = _shared_tolerances(first)
+            lines = ",\n  ".join(json.dumps(_student(s, assignment, tolerances), ensure_ascii=False, allow_nan=False)
+                                 for s in chunk)
+            with _blamed_on(folder / "key.json"):  # the students' lines are key.json's, not key.csv's, whose
+                students.write(separator + lines.encode("utf-8"))  # block would otherwise take a failed write
+            for piece in csv_pieces(_csv_rows(chunk)):
+                table.write(piece.encode("utf-8"))
+        head = json.dumps(_head(assignment, first or (), collisions(), bank, key_folder), ensure_ascii=False,
+                          indent=1, allow_nan=False)
+        with _blamed_on(folder / "key.json"):
+            students.seek(0)  # writes what is buffered
+        with atomic_file(folder / "key.json") as key:
+            key.write(f'{head[:-2]},\n "students": [\n  '.encode())
+            shutil.copyfileobj(students, key, COPY_BLOCK)
+            key.write(b"\n ]\n}\n")
+
+
+COPY_BLOCK = 1 << 20  # bytes of the students' lines copied at a time into key.json
+
+
+@contextmanager
+def _blamed_on(path: Path) -> Iterator[None]:
+    """An ``OSError`` that names no file (a failed ``write()``) names ``path``."""
+    try:
+        yield
+    except OSError as error:
+        if error.filename is not None:
+            raise
+        raise OSError(error.errno, error.strerror, str(path)) from None
 
 
 def _bank_folder(template: Template, key_folder: Path | None) -> dict[str, str]:
@@ -169,21 +238,24 @@ def key_json(document: Mapping[str, Any]) -> str:
     return f'{head[:-2]},\n "students": [\n  {students}\n ]\n}}\n'
 
 
+KEY_CSV_HEADER = ("student_id", "name", "section", "problem", "template", "label", "answer", "value", "unit",
+                  "points", "tolerance", "parameters")
+
+
 def key_csv(generation: Generation) -> str:
     """``key.csv``: one row per student and answer part, for people and spreadsheets."""
-    def rows() -> Iterator[Sequence[object]]:
-        yield ["student_id", "name", "section", "problem", "template", "label", "answer", "value", "unit", "points",
-               "tolerance", "parameters"]
-        for entry in generation.students:
-            student = entry.student
-            who = [safe_cell(student.id), safe_cell(student.name), safe_cell(student.section)]
-            for variant in entry.problems:
-                given = "; ".join(f"{name}={text}" for name, text in variant.printed.items())
-                yield from ([*who, variant.key, variant.template, part.label, part.name, _csv_value(part), part.unit,
-                             part.points, _tolerance_text(part.tolerance, part.unit), given]
-                            for part in variant.answers)
+    return csv_text(itertools.chain([KEY_CSV_HEADER], _csv_rows(generation.students)))
 
-    return csv_text(rows())
+
+def _csv_rows(students: Iterable[StudentVariants]) -> Iterator[Sequence[object]]:
+    for entry in students:
+        student = entry.student
+        who = [safe_cell(student.id), safe_cell(student.name), safe_cell(student.section)]
+        for variant in entry.problems:
+            given = "; ".join(f"{name}={text}" for name, text in variant.printed.items())
+            yield from ([*who, variant.key, variant.template, part.label, part.name, _csv_value(part), part.unit,
+                         part.points, _tolerance_text(part.tolerance, part.unit), given]
+                        for part in variant.answers)
 
 
 VALUE_FIGURES = 12

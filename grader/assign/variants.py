@@ -15,8 +15,7 @@ Parameters print by :func:`grader.model.quantities.printed_text`.
 from __future__ import annotations
 
 import hashlib
-from collections import Counter
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from functools import cached_property
 from typing import Any
@@ -235,24 +234,66 @@ class ProblemDraws:
                           f"refused because {last[first]} ({advice})")
 
 
-def generate(assignment: Assignment, roster: Sequence[Student], bank: Mapping[str, Template]) -> Generation:
-    """Every student's variants for every problem, answers computed from the printed values."""
-    per_problem: list[list[ProblemVariant]] = []
-    collisions = {}
-    for problem in assignment.problems:
-        template = bank[problem.template]
-        maker = ProblemDraws(assignment, problem, template)
-        rows, seeds = maker.draw(roster)
+CHUNK = 10_000
+"""Students drawn together when a class is drawn in pieces (:class:`ClassDraws`): big enough that the vectorised
+solving pays, small enough that a piece's variants (about 8 KiB a student) are a few tens of MiB."""
+
+
+class ClassDraws:
+    """A class's variants drawn a piece of the roster at a time (each problem's pilot and compiled form made
+    once), so that a key can be written as it is drawn and a million students never sit in memory at once.
+    A student's variants do not depend on the piece they are drawn in, so the pieces joined are the class
+    drawn whole; after the last piece, :meth:`collisions` counts the students sharing their numbers.
+    """
+
+    def __init__(self, assignment: Assignment, roster: Sequence[Student], bank: Mapping[str, Template]) -> None:
+        self.assignment, self.roster = assignment, roster
+        self.makers = [ProblemDraws(assignment, problem, bank[problem.template]) for problem in assignment.problems]
+        self._printed: list[list[np.ndarray]] = [[] for _ in self.makers]  # per problem: each piece's rows
+
+    def chunks(self, size: int = CHUNK) -> Iterator[tuple[StudentVariants, ...]]:
+        """The class's variants, ``size`` students at a time, in roster order."""
+        for start in range(0, len(self.roster), size):
+            students = self.roster[start:start + size]
+            per_problem = [self._variants(index, maker, students) for index, maker in enumerate(self.makers)]
+            yield tuple(StudentVariants(s, tuple(p[i] for p in per_problem)) for i, s in enumerate(students))
+
+    def _variants(self, index: int, maker: ProblemDraws, students: Sequence[Student]) -> list[ProblemVariant]:
+        problem, template = maker.problem, maker.template
+        rows, seeds = maker.draw(students)
         answers = _Answers(_blank_parts(problem, template), template, maker.compiled,
                            solve_columns(template, maker.compiled, maker.table(rows)))
         variants = [ProblemVariant(problem.key, template.id, seed, {n: float(v) for n, v in row.items()}, row,
-                                   answers.parts(index, row, maker.tolerances[student.id]))
-                    for index, (row, seed, student) in enumerate(zip(rows, seeds, roster, strict=True))]
-        shared = Counter(tuple(row.values()) for row in rows)
-        collisions[problem.key] = sum(shared[tuple(row.values())] > 1 for row in rows)
-        per_problem.append(variants)
-    students = tuple(StudentVariants(s, tuple(p[i] for p in per_problem)) for i, s in enumerate(roster))
-    return Generation(students, collisions)
+                                   answers.parts(row_index, row, maker.tolerances[student.id]))
+                    for row_index, (row, seed, student) in enumerate(zip(rows, seeds, students, strict=True))]
+        maker.tolerances.clear()
+        # Each row's printed values as one byte string (no printed value holds the separator): the rows of a
+        # million students take tens of MiB, where a counter of tuples takes hundreds.
+        self._printed[index].append(np.array(["\x1f".join(row.values()).encode("utf-8") for row in rows],
+                                             dtype=bytes))
+        return variants
+
+    def collisions(self) -> dict[str, int]:
+        """Per problem, how many students of the pieces drawn so far share their printed numbers with another."""
+        return {maker.problem.key: _shared(np.concatenate(pieces) if pieces else np.array([], dtype=bytes))
+                for maker, pieces in zip(self.makers, self._printed, strict=True)}
+
+
+def _shared(rows: np.ndarray) -> int:
+    """How many of ``rows`` equal another of them.
+
+    >>> _shared(np.array([b"2.10", b"3.00", b"2.10", b"1.5"]))
+    2
+    """
+    _, inverse, counts = np.unique(rows, return_inverse=True, return_counts=True)
+    return int((counts[inverse] > 1).sum())
+
+
+def generate(assignment: Assignment, roster: Sequence[Student], bank: Mapping[str, Template]) -> Generation:
+    """Every student's variants for every problem, answers computed from the printed values."""
+    draws = ClassDraws(assignment, roster, bank)
+    students = tuple(variant for chunk in draws.chunks(max(len(roster), 1)) for variant in chunk)
+    return Generation(students, draws.collisions())
 
 
 def _blank_parts(problem: ProblemSpec, template: Template) -> list[AnswerPart]:

@@ -37,7 +37,7 @@ import tempfile
 from collections.abc import Iterable, Iterator, Sequence
 from contextlib import contextmanager, suppress
 from pathlib import Path
-from typing import Any
+from typing import Any, BinaryIO
 
 from grader.base.errors import GraderError, shown
 
@@ -62,6 +62,29 @@ def write_atomic(path: Path, text: str | bytes | Iterable[str], mode: int = 0o66
     """Write ``text`` (UTF-8), bytes, or text in pieces (written as they come) to ``path`` atomically, with
     the permissions ``mode`` less the umask. An ``OSError`` it raises names a path (a failed ``write()``, say
     on a full disk, names none by itself)."""
+    with atomic_file(path, mode) as stream:
+        if isinstance(text, (str, bytes)):
+            stream.write(text.encode("utf-8") if isinstance(text, str) else text)
+        else:
+            for piece in text:
+                stream.write(piece.encode("utf-8"))
+
+
+@contextmanager
+def atomic_file(path: Path, mode: int = 0o666) -> Iterator[BinaryIO]:
+    """A binary stream to write ``path`` through, in as many pieces as it takes; ``path`` appears, with the
+    permissions ``mode`` less the umask, only when the block ends without an error (two files written side by
+    side, piece by piece, as ``generate`` writes a big key).
+
+    >>> import tempfile, pathlib
+    >>> target = pathlib.Path(tempfile.mkdtemp()) / "key.csv"
+    >>> with atomic_file(target) as stream:
+    ...     _ = stream.write(b"id\\n")
+    ...     target.exists()
+    False
+    >>> target.read_bytes()
+    b'id\\n'
+    """
     path.parent.mkdir(parents=True, exist_ok=True)
     try:
         handle, temporary = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
@@ -69,11 +92,7 @@ def write_atomic(path: Path, text: str | bytes | Iterable[str], mode: int = 0o66
         raise OSError(error.errno, error.strerror, str(path)) from None
     try:
         with os.fdopen(handle, "wb") as stream:
-            if isinstance(text, (str, bytes)):
-                stream.write(text.encode("utf-8") if isinstance(text, str) else text)
-            else:
-                for piece in text:
-                    stream.write(piece.encode("utf-8"))
+            yield stream
         usual_mode(Path(temporary), mode)
         os.replace(temporary, path)
     except BaseException as error:

@@ -25,10 +25,10 @@ from grader.assign.assignment import (
     load_roster,
 )
 from grader.assign.key_columns import write_key_columns
-from grader.assign.keyfile import key_csv, key_document, key_json
-from grader.assign.variants import Generation, generate
+from grader.assign.keyfile import write_key_files
+from grader.assign.variants import ClassDraws, Generation, generate
 from grader.bank.template import Template
-from grader.base.files import output_folder, write_atomic
+from grader.base.files import output_folder
 from grader.base.heap import collector_paused
 
 
@@ -59,13 +59,18 @@ class Summary:
 
 
 def run(job: Job, bank: Mapping[str, Template]) -> Summary:
-    """Generate into ``job.out``."""
+    """Generate into ``job.out``; without PDFs, the key is drawn and written a piece of the class at a time."""
     started = time.perf_counter()
     assignment, roster = load_inputs(job, bank)
     with output_folder(job.out, command="grader generate", inputs=(job.assignment, job.roster),
                        force=job.force) as staging:
-        generation, written = write_outputs(job, assignment, roster, bank, staging)
-    return Summary(job.out, len(roster), len(assignment.problems), generation.collisions, written,
+        if job.pdf:
+            generation, written = write_outputs(job, assignment, roster, bank, staging)
+            collisions = generation.collisions
+        else:
+            collisions = write_key(job, assignment, roster, bank, staging)
+            written = 2 + write_key_columns(staging / "key.json")  # the sidecar grading reads in its place
+    return Summary(job.out, len(roster), len(assignment.problems), collisions, written,
                    time.perf_counter() - started)
 
 
@@ -85,15 +90,25 @@ def load_inputs(job: Job, bank: Mapping[str, Template]) -> tuple[Assignment, tup
 def write_outputs(job: Job, assignment: Assignment, roster: Sequence[Student], bank: Mapping[str, Template],
                   staging: Path) -> tuple[Generation, int]:
     """Generate the variants and write the key files and, unless ``job.pdf`` is off, the PDFs into
-    ``staging``; returns the generation and how many files were written."""
+    ``staging``; returns the generation (all of it, in memory: the documents need it) and how many files were
+    written."""
     with _frozen_for_the_run():
         with collector_paused(keep_frozen=True):
             generation = generate(assignment, roster, bank)
-            write_atomic(staging / "key.json", key_json(key_document(assignment, generation, bank, job.out)))
-            columns = write_key_columns(staging / "key.json")  # the sidecar grading reads in its place
-            write_atomic(staging / "key.csv", key_csv(generation))
+            write_key_files(staging, assignment, [generation.students], lambda: generation.collisions, bank, job.out)
+        columns = write_key_columns(staging / "key.json")  # the sidecar grading reads in its place
         written = 2 + columns + (_write_pdfs(job, assignment, generation, bank, staging) if job.pdf else 0)
     return generation, written
+
+
+def write_key(job: Job, assignment: Assignment, roster: Sequence[Student], bank: Mapping[str, Template],
+              staging: Path) -> Mapping[str, int]:
+    """Draw the class and write key.json and key.csv into ``staging`` a piece at a time (the same bytes as
+    :func:`write_outputs` writes), holding one piece's variants at once; returns the collisions."""
+    with collector_paused():  # a piece's objects are freed by reference counting; no cycles to collect
+        draws = ClassDraws(assignment, roster, bank)
+        write_key_files(staging, assignment, draws.chunks(), draws.collisions, bank, job.out)
+    return draws.collisions()
 
 
 def _write_pdfs(job: Job, assignment: Assignment, generation: Generation, bank: Mapping[str, Template],

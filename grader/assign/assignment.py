@@ -19,6 +19,7 @@ from datetime import datetime
 from pathlib import Path
 from typing import Any
 
+from grader.assign.asked import question_start
 from grader.assign.deadlines import (
     DEFAULT_ZONE,
     LatePolicy,
@@ -29,7 +30,6 @@ from grader.assign.deadlines import (
     zone,
     zone_from,
 )
-from grader.bank.asked import question_start
 from grader.bank.template import Parameter, Template, tolerance_in
 from grader.base.errors import GraderError, TemplateError, refuse_unknown_fields, shown
 from grader.base.inputs import read_csv, read_yaml

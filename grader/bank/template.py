@@ -486,24 +486,22 @@ def _check_statement(template: Template, given: set[str]) -> None:
         raise TemplateError(template.where, "statement", "text and math only", refusal)
 
 
-def filled_statement(template: Template, printed: Mapping[str, str], source: str | None = None) -> str:
-    """The statement (or ``source``, the statement restated for some of its answers) with a variant's printed
-    values (symbols stay their names, ``g`` as the scene gives it): text and ``{{ name }}`` filled in without
-    Jinja2, anything else by the bounded sandbox of :mod:`grader.bank.statement`. Typst code in the result is
-    refused."""
+def filled_statement(template: Template, printed: Mapping[str, str]) -> str:
+    """The statement with a variant's printed values (symbols stay their names, ``g`` as the scene
+    gives it): text and ``{{ name }}`` filled in without Jinja2, anything else by the bounded sandbox
+    of :mod:`grader.bank.statement`. Typst code in the result is refused."""
     from grader.bank.markup import plain_fill, typst_refusal
 
     values = {n: n for n in template.symbols}
     if template.scene.gravity is not None:
         values["g"] = template.scene.gravity.text.split()[0]
     values.update(printed)
-    source = template.statement if source is None else source
-    filled = plain_fill(source, values)
+    filled = plain_fill(template.statement, values)
     if filled is None:
         from grader.bank.statement import StatementRefused, fill_statement
 
         try:
-            filled = fill_statement(source, values)
+            filled = fill_statement(template.statement, values)
         except StatementRefused as error:
             raise GraderError(f"{template.where}: statement: expected values filled in, not code, got {error}") \
                 from None

@@ -30,10 +30,10 @@ from typing import Any
 
 import jinja2
 
+from grader.assign.asked import restated
 from grader.assign.assignment import Assignment, Student
 from grader.assign.fair import display_name
 from grader.assign.variants import AnswerPart, Generation, ProblemVariant, tolerance
-from grader.bank.asked import restated
 from grader.bank.markup import paragraphs
 from grader.bank.template import Template, filled_statement
 from grader.base.errors import GraderError
@@ -394,11 +394,11 @@ def statement(template: Template, variant: ProblemVariant) -> Typ:
     """The template's statement (instructor-written Typst markup, text and math only) with the
     variant's printed values; a unit in its text (``m/s``), and the number before it, kept on one line. When
     the assignment asks only some of the template's answers, its question is restated for those
-    (:mod:`grader.bank.asked`)."""
-    source = None
+    (:mod:`grader.assign.asked`)."""
+    filled = filled_statement(template, variant.printed)
     if [part.name for part in variant.answers] != list(template.answers):
-        source = restated(template.statement, [part.description for part in variant.answers])
-    parts = filled_statement(template, variant.printed, source).split("$")
+        filled = restated(filled, [part.description for part in variant.answers]) or filled
+    parts = filled.split("$")
     return Typ("$".join(_UNIT.sub(r"#box[\1]", part) if index % 2 == 0 else part
                         for index, part in enumerate(parts)))
 

@@ -7,7 +7,8 @@ solver refuses, or whose answer sits near a degenerate point (an answer near zer
 relative tolerance breaks; a derived ``e`` at 0 or 1), or whose tolerance, widened for honest
 rounding along a solution route (:mod:`grader.assign.fair`), would pass ``grading.max_tolerance``,
 is redrawn from the same generator, at most ``MAX_DRAWS`` times. Whether a draw is degenerate or
-too loose never depends on the rest of the class.
+too loose never depends on the rest of the class, nor on an answer the problem does not ask (an
+assignment's ``parts``), so asking fewer parts never changes the numbers of those asked.
 
 Parameters print by :func:`grader.model.quantities.printed_text`.
 """

@@ -8,7 +8,8 @@ relative tolerance breaks; a derived ``e`` at 0 or 1), or whose tolerance, widen
 rounding along a solution route (:mod:`grader.assign.fair`), would pass ``grading.max_tolerance``,
 is redrawn from the same generator, at most ``MAX_DRAWS`` times. Whether a draw is degenerate or
 too loose never depends on the rest of the class, nor on an answer the problem does not ask (an
-assignment's ``parts``), so asking fewer parts never changes the numbers of those asked.
+assignment's ``parts``): a part added to the template changes no numbers of an assignment that lists its
+parts.
 
 Parameters print by :func:`grader.model.quantities.printed_text`.
 """

@@ -143,12 +143,14 @@ def test_missing_bank_folder_is_a_clear_error(tmp_path: Path) -> None:
 
 
 def test_shipped_bank_has_the_five_seed_templates_with_their_names() -> None:
-    """Ids, parameters and answers exactly as the foundation issue names them."""
+    """Ids, parameters and answers exactly as the foundation issue names them (issue 27 adds pile-driver's
+    energy lost and impulse after them)."""
     bank = load_bank()
     expected = {
         "drop-rebound": (["h_drop", "h_rebound"], ["e", "loss_pct"]),
         "car-collision": (["p", "e"], ["vA", "vB", "vA_ratio", "vB_ratio"]),
-        "pile-driver": (["m_ram", "m_pile", "h_drop", "h_rebound"], ["v_pile", "e", "loss_pct"]),
+        "pile-driver": (["m_ram", "m_pile", "h_drop", "h_rebound"], ["v_pile", "e", "loss_pct", "energy_lost",
+                                                                    "impulse"]),
         "ball-plate": (["v", "theta", "e"], ["v_out", "theta_out"]),
         "oblique-spheres": (["v1", "theta", "e", "m1", "m2"], ["v1_out", "v2_out", "theta1_out", "loss_pct"]),
     }

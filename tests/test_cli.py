@@ -28,7 +28,7 @@ def test_solve_json_has_the_documented_shape(capsys: pytest.CaptureFixture[str])
     assert code == 0
     assert record["template"] == "pile-driver"
     assert record["params"] == {"m_ram": 800.0, "m_pile": 2400.0, "h_drop": 2.0, "h_rebound": 0.1}
-    assert set(record["answers"]) == {"v_pile", "e", "loss_pct"}
+    assert set(record["answers"]) == {"v_pile", "e", "loss_pct", "energy_lost", "impulse"}
     assert record["answers"]["v_pile"]["unit"] == "m/s"
     assert record["answers"]["e"]["value"] == pytest.approx(0.6315, abs=1e-4)
 

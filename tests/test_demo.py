@@ -59,7 +59,7 @@ def test_the_demo_exits_0_and_says_how_the_class_graded_and_how_to_grade_again(d
     lines = demo_run.stdout.splitlines()
     assert lines[0].startswith("30 students x 5 problems -> grader-demo (76 files, ")
     assert lines[1] == ("submissions.csv (simulated answers) graded: 30 students (29 submitted), 450 parts graded "
-                        "(344 correct, 9 ecf, 28 mistake, 35 incorrect, 1 invalid, 33 missing); 1 row set aside "
+                        "(331 correct, 17 ecf, 24 mistake, 44 incorrect, 1 invalid, 33 missing); 1 row set aside "
                         "(superseded or not a student), 0 rows not graded (see problems.csv) -> grader-demo/grades")
     assert lines[2] == "Each student's graded sheet, with their worked solutions: grader-demo/grades/feedback"
     assert lines[-2:] == ["Grade the submissions again, or your own file, with", f"  {REGRADE}"]
@@ -244,8 +244,8 @@ def test_the_documented_excerpts_are_rows_of_the_demo_output(demo_run: DemoRun, 
     assert len(excerpt) > 1 and set(excerpt[1:]) <= set(stream.getvalue().splitlines())
 
 
-@pytest.mark.parametrize("typed", ["2.75 m/s", "7.60°", "283 cm/s", "17.0 mph", "7.18 km/h", "2,95", "5.72×10^1",
-                                   "2.06 m", "about 48", "v(1-0.07p)/(p+1)"])
+@pytest.mark.parametrize("typed", ["2.06 m/s", "7.77°", "778 cm/s", "25.6 mph", "9.18 km/h", "63,5", "5.57×10^-1",
+                                   "2.22 m", "about 48", "v(1-0.07p)/(p+1)"])
 def test_the_documented_examples_of_forms_are_in_the_demo_file(answers: list[SampleAnswer], typed: str) -> None:
     assert f"`{typed}`" in DOCS or f'`"{typed}"`' in DOCS
     assert typed in {a.text for a in answers}

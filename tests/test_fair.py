@@ -162,8 +162,8 @@ def test_textbook_printed_answers_grade_correct_on_the_textbook_variant(template
                                                        "fixed": dict(case["params"])}], students=1)
     variant = generate(load_assignment(assignment), load_roster(roster), bank).students[0].problems[0]
     for part in variant.answers:
-        printed = case["answers"][part.name]
-        if isinstance(printed, str):
+        printed = case["answers"].get(part.name)  # None: the book does not print it (pile-driver's impulse)
+        if printed is None or isinstance(printed, str):
             continue
         assert isinstance(part.value, float)
         assert is_correct(printed, part.value, part.tolerance, angle_unit="deg" if part.unit == "deg" else None), \

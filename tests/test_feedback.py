@@ -96,19 +96,19 @@ def test_no_file_holds_anything_of_another_student_nor_the_instructors_notes(fee
 
 
 def test_a_sheet_shows_what_was_typed_read_the_verdicts_sentences_and_the_worked_solutions(feedback: Path) -> None:
-    """Ben O'Brien (2026137) of the demo: 18 of 28; 3c right for his wrong 3b (error carried forward); 4b the
-    angle in radians; then his worked solutions, as the answer key has them. Another student's 5d (oblique-spheres'
+    """Yara Mansour (2026988) of the demo: 15 of 28; 3c right for her wrong 3a (error carried forward); 4b the
+    angle in radians; then her worked solutions, as the answer key has them. Another student's 5d (oblique-spheres'
     loss) has its tolerance widened, with why."""
-    text = pdf_text(feedback / "2026137.pdf")
-    for shown in ("Total: 18 of 28 points", "Name Ben O'Brien", "ID 2026137 Section L02",
-                  "You typed 5.72×10^1 read as 57.2 %",
-                  "3b coefficient of restitution between ram and pile incorrect · 0 of 2 points",
+    text = pdf_text(feedback / "2026988.pdf")
+    for shown in ("Total: 15 of 28 points", "Name Yara Mansour", "ID 2026988 Section L01",
+                  "You typed 16.3 km/h read as 4.52778 m/s",
+                  "velocity of the pile just after the impact incorrect · 0 of 2 points",
                   "correct for your earlier answer (error carried forward) · 2 of 2 points",
-                  "right for your 3b = 0.727 (error carried forward); with 3b = 0.595688, 3c is 50.9821 %",
+                  "right for your 3a = 2.12 m/s (error carried forward); with 3a = 2.54838 m/s, 3c is 39.3093 %",
                   "a common mistake · 0 of 2 points",
                   "your answer matches the angle in radians where degrees were asked",
-                  "Expected 0.595688 accepted ±1 %",
-                  "Problem 3: Pile driver ram striking a pile", "Given:"):
+                  "Expected 23.171° accepted ±1 %",
+                  "Pile driver ram striking a pile", "Given:"):
         assert shown in text, shown
     widened = "accepted ±1.1 %: rounding T to 4 figures along the energy route (T − T′) moves loss_pct by up to 0.41 %"
     assert widened in pdf_text(feedback / "2026174.pdf")
@@ -150,13 +150,13 @@ def test_who_submitted_nothing_gets_the_sheet_the_expected_values_and_the_worked
 
 
 def test_the_late_resubmission_says_how_late(feedback: Path, demo_run: DemoRun) -> None:
-    """Zoë Keller (2027025) resubmitted 1a 309 minutes after the due time; the demo has no late policy."""
+    """Zoë Keller (2027025) resubmitted 1a 127 minutes after the due time; the demo has no late policy."""
     late = {row["student_id"]: row["late"] for row in roster(demo_run.out / "grades" / "grades.csv")
             if row["late"] not in ("", "0")}
-    assert late == {"2027025": "309"}
+    assert late == {"2027025": "127"}
     said = [row["id"] for row in index_rows(feedback) if "Your answers came" in pdf_text(feedback / row["file"])]
     assert said == ["2027025"]
-    assert "Your answers came 5 h 9 min late." in pdf_text(feedback / "2027025.pdf")
+    assert "Your answers came 2 h 7 min late." in pdf_text(feedback / "2027025.pdf")
 
 
 @pytest.fixture(scope="module")

@@ -36,9 +36,11 @@ GOLDEN: dict[str, list[tuple[str | None, str]]] = {
         (None, 'v_"ram" = sqrt(2 g h_"drop")'),
         (None, 'T = 1/2 m_"ram" v_"ram"^2'),
         ('-v\'_"ram" = sqrt(2 g h_"rebound")', 'v\'_"ram" = -sqrt(2 g h_"rebound")'),
-        # Sample Problem 3/28 (a): conservation of momentum gives the pile's velocity, no impulse on the page
+        # Sample Problem 3/28 (a): conservation of momentum gives the pile's velocity; the impulse asked is the
+        # pile's change of momentum
         ('m_"ram" v_"ram" = m_"ram" v\'_"ram" + m_"pile" v_"pile"',
          'v_"pile" = (m_"ram" (v_"ram" - v\'_"ram"))/m_"pile"'),
+        (None, 'J = m_"pile" v_"pile"'),
         (None, 'e = (v_"pile" - v\'_"ram")/v_"ram"'),
         (None, 'E_"lost" = (m_"ram" m_"pile" v_"ram"^2 (1 - e^2))/(2 (m_"ram" + m_"pile"))'),
         (None, 'f_"loss" = E_"lost"/T'),

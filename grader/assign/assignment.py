@@ -19,6 +19,7 @@ from datetime import datetime
 from pathlib import Path
 from typing import Any
 
+from grader.assign.asked import question_start
 from grader.assign.deadlines import (
     DEFAULT_ZONE,
     LatePolicy,
@@ -44,7 +45,8 @@ _NUMBER_WORDS = ("zero", "one", "two", "three", "four", "five", "six", "seven", 
 @dataclass(frozen=True)
 class ProblemSpec:
     """One problem of an assignment: a template, its key (``1``), points per answer part, and
-    parameters fixed or narrowed for everyone, tolerance overrides per answer."""
+    parameters fixed or narrowed for everyone, tolerance overrides per answer; ``parts``, the answers asked
+    (by name; None: every answer of the template)."""
 
     key: str
     template: str
@@ -52,6 +54,18 @@ class ProblemSpec:
     fixed: Mapping[str, float]
     narrowed: Mapping[str, tuple[float, float]]
     tolerances: Mapping[str, Mapping[str, Any]]  # answer name -> the override as written
+    parts: tuple[str, ...] | None = None
+
+    def asked(self, template: Template) -> list[str]:
+        """The answers of ``template`` this problem asks, in the template's order (a later part may use an
+        earlier one, and error carried forward follows that order).
+
+        >>> from grader.bank.template import load_bank
+        >>> pile = load_bank()["pile-driver"]
+        >>> ProblemSpec("3", "pile-driver", {}, {}, {}, {}, ("e", "v_pile")).asked(pile)
+        ['v_pile', 'e']
+        """
+        return [name for name in template.answers if self.parts is None or name in self.parts]
 
 
 @dataclass(frozen=True)
@@ -218,7 +232,7 @@ def _text(raw: Mapping[str, Any], key: str, where: str, required: bool = True) -
 
 def _problem(raw: Any, index: int, where: str) -> ProblemSpec:
     key = f"problems[{index}]"
-    allowed = {"key", "template", "points", "fixed", "narrow", "tolerance"}
+    allowed = {"key", "template", "points", "fixed", "narrow", "tolerance", "parts"}
     if not isinstance(raw, Mapping) or "template" not in raw or set(raw) - allowed:
         raise TemplateError(where, key, f"a mapping with template and only {', '.join(sorted(allowed))}", shown(raw))
     problem_key = str(raw.get("key", index + 1))
@@ -246,7 +260,21 @@ def _problem(raw: Any, index: int, where: str) -> ProblemSpec:
     return ProblemSpec(problem_key, str(raw["template"]), {str(k): float(v) for k, v in points.items()},
                        {str(k): float(v) for k, v in fixed.items()},
                        {str(k): (float(v[0]), float(v[1])) for k, v in narrowed.items()},
-                       tolerance_specs)
+                       tolerance_specs, _parts(raw, where, f"{key}.parts"))
+
+
+def _parts(raw: Mapping[str, Any], where: str, key: str) -> tuple[str, ...] | None:
+    """The answers a problem asks, as listed (checked against the template with the bank)."""
+    if "parts" not in raw:
+        return None
+    parts = raw["parts"]
+    if not isinstance(parts, list) or not parts or not all(isinstance(p, str) and p.strip() for p in parts):
+        raise TemplateError(where, key, "a non-empty list of the template's answer names, such as [v_pile, e] "
+                            "(leave parts out to ask every answer)", shown(parts))
+    twice = sorted({p for p in parts if parts.count(p) > 1})
+    if twice:
+        raise TemplateError(where, key, "each answer name once", f"{', '.join(twice)} twice")
+    return tuple(p.strip() for p in parts)
 
 
 def _tolerance(raw: Any, where: str, key: str) -> Mapping[str, Any]:
@@ -284,10 +312,22 @@ def check_against_bank(assignment: Assignment, bank: Mapping[str, Template]) -> 
         for name, (low, high) in problem.narrowed.items():
             for value in (low, high):
                 _admitted(template.parameters[name], value, assignment.where, f"{key}.narrow.{name}")
-        unknown = (set(problem.points) - {"*"} | set(problem.tolerances)) - set(template.answers)
-        if unknown:
-            raise TemplateError(assignment.where, key, f"answer names of {template.id} ({', '.join(template.answers)})",
-                                ", ".join(sorted(unknown)))
+        available = f"answer names of {template.id} ({', '.join(template.answers)})"
+        unasked = sorted(set(problem.parts or ()) - set(template.answers))
+        if unasked:
+            raise TemplateError(assignment.where, f"{key}.parts (problem {problem.key})", available, ", ".join(unasked))
+        if problem.parts is not None and question_start(template.statement) is None:
+            raise TemplateError(assignment.where, f"{key}.parts (problem {problem.key})", f"no parts: every answer "
+                                f"of {template.id}, since its statement's question is not a sentence beginning Find "
+                                "or Determine that can be restated for some of them (or a copy of the template "
+                                "that asks only those)", ", ".join(problem.parts))
+        unnamed = sorted((set(problem.points) - {"*"} | set(problem.tolerances)) - set(template.answers))
+        if unnamed:
+            raise TemplateError(assignment.where, key, available, ", ".join(unnamed))
+        unasked = sorted((set(problem.points) - {"*"} | set(problem.tolerances)) - set(problem.asked(template)))
+        if unasked:
+            raise TemplateError(assignment.where, key, f"points and tolerances only for the parts asked "
+                                f"({', '.join(problem.asked(template))})", f"{', '.join(unasked)}, not in parts")
 
 
 def check_extensions(assignment: Assignment, roster: Sequence[Student], path: Path) -> None:

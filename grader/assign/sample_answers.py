@@ -1,19 +1,21 @@
 """Simulated submissions: what a class might type for its variants, for ``grader demo`` to grade.
 
-Each student's answers are drawn from a generator keyed on ``(assignment seed, "sample answers", student
-id)`` (:func:`grader.assign.variants.variant_generator`; no problem key has a space), so a generation
-always gives the same file. Most answers are right and rounded to three significant figures, as the
-sheet asks; the others come in the forms real submissions hold: the unit written, another unit of the
-same kind (``283 cm/s``), a decimal comma, ``×10^`` notation, unrounded, wrong (off by 6 to 30 %, a
-percentage typed as a fraction, an angle in radians, a speed with no ``/s``), or blank. Symbolic answers
-are typed with implicit products (``v(1-0.07p)/(p+1)``), as in the key, or with a sign wrong. One student
-submits nothing, one writes ``about 48``, and one resubmits a corrected answer after the deadline.
+Each student's answers to each problem are drawn from a generator keyed on ``(assignment seed, "sample
+answers <problem key>", student id)`` (:func:`grader.assign.variants.variant_generator`; no problem key has
+a space), so a generation always gives the same file, and a part added to one template changes no other
+problem's answers (the time of the student's submission comes from ``"sample answers"`` alone). Most
+answers are right and rounded to three significant figures, as the sheet asks; the others come in the
+forms real submissions hold: the unit written, another unit of the same kind (``283 cm/s``), a decimal
+comma, ``×10^`` notation, unrounded, wrong (off by 6 to 30 %, a percentage typed as a fraction, an angle in
+radians, a speed with no ``/s``), or blank. Symbolic answers are typed with implicit products
+(``v(1-0.07p)/(p+1)``), as in the key, or with a sign wrong. One student submits nothing, one writes
+``about 48``, and one resubmits a corrected answer after the deadline.
 
-A second generator per student (``"sample physics"``) turns a few right answers into what the grader's
-physics recognises (:mod:`grader.solve.alternatives`): a diagnosed mistake (``e²`` for ``e``, the masses
-swapped, ...), or, after an earlier wrong answer of the problem, the answer that follows from it (error
-carried forward). An answer off by 6 to 30 % is moved off any value the grader would diagnose, so each
-answer deserves exactly one verdict.
+A second generator per student and problem (``"sample physics <problem key>"``) turns a few right answers
+into what the grader's physics recognises (:mod:`grader.solve.alternatives`): a diagnosed mistake (``e²``
+for ``e``, the masses swapped, ...), or, after an earlier wrong answer of the problem, the answer that
+follows from it (error carried forward). An answer off by 6 to 30 % is moved off any value the grader would
+diagnose, so each answer deserves exactly one verdict.
 
 >>> student_style("v*(1 - 0.07*p)/(p + 1)"), sign_error("1.07*v/(p + 1)")
 ('v(1-0.07p)/(p+1)', '1.07v/(p-1)')
@@ -90,11 +92,14 @@ def sample_answers(assignment: Assignment, generation: Generation,
         if index == absent:
             continue
         rng = variant_generator(assignment.seed, _KEY, entry.student.id)[0]
-        physics_rng = variant_generator(assignment.seed, _PHYSICS_KEY, entry.student.id)[0]
         when = (deadline - timedelta(seconds=int(rng.integers(600, 3 * 86400)))).strftime(_WHEN)
         parts = [part for problem in entry.problems for part in problem.answers]
         numeric = [part for part in parts if isinstance(part.value, float)]
         for problem in entry.problems:
+            # Streams of the student's own per problem: a part added to one template moves no other
+            # problem's answers.
+            rng = variant_generator(assignment.seed, f"{_KEY} {problem.key}", entry.student.id)[0]
+            physics_rng = variant_generator(assignment.seed, f"{_PHYSICS_KEY} {problem.key}", entry.student.id)[0]
             physics = _Physics(bank[problem.template], problem.params)
             earlier: list[tuple[AnswerPart, float | None]] = []
             for part in problem.answers:

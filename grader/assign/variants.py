@@ -7,7 +7,9 @@ solver refuses, or whose answer sits near a degenerate point (an answer near zer
 relative tolerance breaks; a derived ``e`` at 0 or 1), or whose tolerance, widened for honest
 rounding along a solution route (:mod:`grader.assign.fair`), would pass ``grading.max_tolerance``,
 is redrawn from the same generator, at most ``MAX_DRAWS`` times. Whether a draw is degenerate or
-too loose never depends on the rest of the class.
+too loose never depends on the rest of the class, nor on an answer the problem does not ask (an
+assignment's ``parts``): a part added to the template changes no numbers of an assignment that lists its
+parts.
 
 Parameters print by :func:`grader.model.quantities.printed_text`.
 """
@@ -139,8 +141,9 @@ class ProblemDraws:
         self.where = f"{assignment.where}: problem {problem.key} ({template.id})"
         self.compiled: Compiled = compiled_for(template)
         self.restitution = _restitution_answers(template)
+        self.asked = problem.asked(template)
         self.typical = self._typical_sizes()
-        self.configured = {name: tolerance(problem, template, name) for name in template.answers}
+        self.configured = {name: tolerance(problem, template, name) for name in self.asked}
         self.tolerances: dict[str, dict[str, Tolerance]] = {}  # per student drawn: each answer's tolerance
 
     @cached_property
@@ -152,12 +155,17 @@ class ProblemDraws:
         """Each answer's tolerance per row of a result, widened for honest rounding, and the rows whose
         widened tolerance would pass the cap."""
         answered = {name: [refused is None and missing is None for refused, missing in
-                           zip(result.refusals, result.undefined[name], strict=True)] for name in result.values}
+                           zip(result.refusals, result.undefined[name], strict=True)] for name in self._numeric(result)}
         grading = self.assignment.grading
         return fair_tolerances(self.routes, self.configured,
                                {name: spec.unit.text for name, spec in self.template.answers.items()},
-                               result.params, result.values, answered, grading.intermediate_sig_figs,
+                               result.params, {name: result.values[name] for name in answered}, answered,
+                               grading.intermediate_sig_figs,
                                grading.max_tolerance)
+
+    def _numeric(self, result: Columns) -> list[str]:
+        """The answers asked that have a number per row (a symbolic answer has none)."""
+        return [name for name in self.asked if name in result.values]
 
     def _typical_sizes(self) -> dict[str, float]:
         rng, _ = variant_generator(self.assignment.seed, self.problem.key, "\x00pilot")
@@ -165,7 +173,8 @@ class ProblemDraws:
         result = solve_columns(self.template, self.compiled, self.table(rows))
         ok = np.array([reason is None for reason in result.refusals])
         typical = {}
-        for name, values in result.values.items():
+        for name in self._numeric(result):
+            values = result.values[name]
             defined = ok & np.array([reason is None for reason in result.undefined[name]])
             typical[name] = float(np.median(np.abs(values[defined]))) if defined.any() else 0.0
             if ok.any() and typical[name] == 0 and _relative(tolerance(self.problem, self.template, name)):
@@ -188,10 +197,11 @@ class ProblemDraws:
         return {name: np.array([float(row[name]) for row in rows]) for name in self.template.parameters}
 
     def degeneracies(self, result: Columns) -> list[str | None]:
-        """Per row of a result, why a draw the solver answered sits at a degenerate point (an answer too
-        close to zero to grade relatively, a derived ``e`` at 0 or 1), or None."""
+        """Per row of a result, why a draw the solver answered sits at a degenerate point (an answer asked that
+        is too close to zero to grade relatively, a derived ``e`` at 0 or 1), or None."""
         flaws: list[str | None] = [None] * len(result.refusals)
-        for name, values in result.values.items():
+        for name in self._numeric(result):
+            values = result.values[name]
             for row, value in enumerate(values):
                 answered = result.refusals[row] is None and result.undefined[name][row] is None
                 if flaws[row] is not None or not answered:
@@ -261,7 +271,7 @@ class ClassDraws:
     def _variants(self, index: int, maker: ProblemDraws, students: Sequence[Student]) -> list[ProblemVariant]:
         problem, template = maker.problem, maker.template
         rows, seeds = maker.draw(students)
-        answers = _Answers(_blank_parts(problem, template), template, maker.compiled,
+        answers = _Answers(_blank_parts(problem, template, maker.asked), template, maker.compiled,
                            solve_columns(template, maker.compiled, maker.table(rows)))
         variants = [ProblemVariant(problem.key, template.id, seed, {n: float(v) for n, v in row.items()}, row,
                                    answers.parts(row_index, row, maker.tolerances[student.id]))
@@ -296,10 +306,12 @@ def generate(assignment: Assignment, roster: Sequence[Student], bank: Mapping[st
     return Generation(students, draws.collisions())
 
 
-def _blank_parts(problem: ProblemSpec, template: Template) -> list[AnswerPart]:
-    """What every student's answer parts share: label, unit, points, tolerance (overrides applied)."""
+def _blank_parts(problem: ProblemSpec, template: Template, asked: Sequence[str]) -> list[AnswerPart]:
+    """What every student's answer parts share: label, unit, points, tolerance (overrides applied). The
+    parts asked are lettered a, b, c, ... as the sheet prints them, whichever of the template's they are."""
     parts = []
-    for index, (name, spec) in enumerate(template.answers.items()):
+    for index, name in enumerate(asked):
+        spec = template.answers[name]
         parts.append(AnswerPart(name, f"{problem.key}{chr(ord('a') + index)}", None, spec.unit.text,
                                 problem.points.get(name, problem.points.get("*", 1.0)),
                                 tolerance(problem, template, name), spec.description))

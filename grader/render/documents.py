@@ -30,6 +30,7 @@ from typing import Any
 
 import jinja2
 
+from grader.assign.asked import restated
 from grader.assign.assignment import Assignment, Student
 from grader.assign.fair import display_name
 from grader.assign.variants import AnswerPart, Generation, ProblemVariant, tolerance
@@ -391,8 +392,13 @@ _UNIT = re.compile(r"(?<![\w/.])((?:[-−]?\d+(?:\.\d+)? )?[A-Za-z]{1,3}/[A-Za-z
 
 def statement(template: Template, variant: ProblemVariant) -> Typ:
     """The template's statement (instructor-written Typst markup, text and math only) with the
-    variant's printed values; a unit in its text (``m/s``), and the number before it, kept on one line."""
-    parts = filled_statement(template, variant.printed).split("$")
+    variant's printed values; a unit in its text (``m/s``), and the number before it, kept on one line. When
+    the assignment asks only some of the template's answers, its question is restated for those
+    (:mod:`grader.assign.asked`)."""
+    filled = filled_statement(template, variant.printed)
+    if [part.name for part in variant.answers] != list(template.answers):
+        filled = restated(filled, [part.description for part in variant.answers]) or filled
+    parts = filled.split("$")
     return Typ("$".join(_UNIT.sub(r"#box[\1]", part) if index % 2 == 0 else part
                         for index, part in enumerate(parts)))
 

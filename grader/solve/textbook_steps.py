@@ -246,7 +246,8 @@ def _one_impact(template: Template, steps: list[Step], extra: list[Step], impuls
         bodies = next((b for b in labels if b), None)
         if bodies is None:
             first_body = _MOMENTUM_OF.fullmatch(found.relation)
-            return _momentum_only(template, steps, found, first_body.group(1) if first_body else "", impulse, answers)
+            return _momentum_only(template, steps, found, first_body.group(1) if first_body else "", impulse, answers,
+                                  extra)
     pair = _pair(template, bodies.group(1), bodies.group(2))
     if pair is None:
         return None
@@ -276,21 +277,30 @@ def _one_impact(template: Template, steps: list[Step], extra: list[Step], impuls
 
 
 def _momentum_only(template: Template, steps: list[Step], found: Step, body: str, impulse: str,
-                   answers: set[str]) -> list[Step] | None:
+                   answers: set[str], extra: list[Step]) -> list[Step] | None:
     """A velocity after from the other body's: the impulse found from one body's momentum change and given to
-    the other's is the momentum balance of the two, solved for one velocity."""
+    the other's is the momentum balance of the two, solved for one velocity; an impulse asked then follows as
+    the change of momentum of the body it acts on (Sample Problem 3/28: the pile's, m_p v_p′)."""
     users = [s for s in steps if s is not found and _uses(s, impulse)]
-    if len(users) != 1 or impulse in answers or not _MOMENTUM_OF.fullmatch(users[0].relation):
+    if len(users) != 1 or not _MOMENTUM_OF.fullmatch(users[0].relation):
         return None
     other = _MOMENTUM_OF.fullmatch(users[0].relation).group(1)  # type: ignore[union-attr]
     pair = _pair(template, body, other) or _pair(template, other, body)
     if pair is None or users[0].unknown not in pair.after_names:
         return None
     known = pair.after_names.index(users[0].unknown) ^ 1
-    step = Step(users[0].unknown, pair.relation(), pair.momentum(), pair.one_after(known))
+    shown = [Step(users[0].unknown, pair.relation(), pair.momentum(), pair.one_after(known))]
+    if impulse in answers:  # along n, from the first body to the second, as the impact's impulse is
+        on = known ^ 1
+        change = _mul(pair.masses[on], _sub(pair.after[on], pair.before[on] or _ZERO) if on else
+                      _sub(pair.before[on] or _ZERO, pair.after[on]))
+        name = pair.second if on else pair.first
+        shown.append(Step(impulse, f"impulse-momentum for {name} along n", (Sym(impulse), change), change))
+    chain = {s.unknown for s in steps}
+    extra += [s for s in shown if s.unknown not in chain]
     index = steps.index(found)
     rest = [s for s in steps if s is not found and s is not users[0]]
-    return [*rest[:index], step, *rest[index:]]
+    return [*rest[:index], *shown, *rest[index:]]
 
 
 def _first_before(steps: list[Step], found: Step, members: list[Step], pair: _Pair) -> list[Step] | None:

@@ -184,13 +184,14 @@ def _factors(node: Node) -> list[Node]:
     return [node]
 
 
-def _product(factors: list[Node]) -> Node:
+def product(factors: list[Node]) -> Node:
+    """The factors multiplied left to right (1 for none)."""
     if not factors:
         return _ONE
-    product = factors[0]
+    result = factors[0]
     for factor in factors[1:]:
-        product = Op("mul", (product, factor))
-    return product
+        result = Op("mul", (result, factor))
+    return result
 
 
 def _cancelled(top: list[Node], bottom: list[Node]) -> Node | None:
@@ -204,7 +205,7 @@ def _cancelled(top: list[Node], bottom: list[Node]) -> Node | None:
             shared = True
     if not shared:
         return None
-    return _product(top) if not bottom else Op("div", (_product(top), _product(bottom)))
+    return product(top) if not bottom else Op("div", (product(top), product(bottom)))
 
 
 def _one_fraction(node: Op) -> Node:

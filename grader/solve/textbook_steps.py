@@ -27,7 +27,15 @@ from grader.bank.template import Template
 from grader.model.expr import Node, Num, Op, Sym, names
 from grader.model.scene import Stage, Velocity
 from grader.solve.compiled import Compiled, Step
-from grader.solve.page_forms import bounce_heights, folded, inverse_trig, is_zero, magnitudes, one_fraction
+from grader.solve.page_forms import (
+    bounce_heights,
+    folded,
+    inverse_trig,
+    is_zero,
+    magnitudes,
+    one_fraction,
+    product,
+)
 
 _IMPULSE = re.compile(r"impulse along n in the impact of (\S+) and (\S+), with restitution .+")
 _MOMENTUM_OF = re.compile(r"impulse-momentum for (\S+) along n")
@@ -64,13 +72,7 @@ def _add(*terms: Node | None) -> Node:
 def _mul(*factors: Node) -> Node:
     if any(is_zero(f) for f in factors):
         return _ZERO
-    kept = [f for f in factors if f != _ONE]
-    if not kept:
-        return _ONE
-    product = kept[0]
-    for factor in kept[1:]:
-        product = Op("mul", (product, factor))
-    return product
+    return product([f for f in factors if f != _ONE])
 
 
 def _neg(node: Node) -> Node:

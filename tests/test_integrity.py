@@ -462,3 +462,35 @@ def test_a_copy_typed_as_its_source_typed_it_is_measured_from_what_the_source_ty
     p, q = UNRELATED * 0.25 * 0.001, UNRELATED * 0.25 * 0.060008
     assert pair.chance == pytest.approx(p**2 + 2 * p * q * (1 - p), rel=1e-6)
     assert (pair.closest, pair.closeness) == (2, 0.0)
+
+
+@pytest.mark.parametrize("kept", [1.0, 2.0])
+def test_the_pairs_worked_out_a_few_students_at_a_time_give_the_same_findings(
+        monkeypatch: pytest.MonkeyPatch, kept: float) -> None:
+    """The candidate pairs are worked out a block of students at a time (issue 29: memory bounded, whatever
+    the class): blocks of one student, of a few, and the whole class in one find the same pairs, chances and
+    listed matches, to the bit, in a class whose values lie close (every band overlaps dozens of others),
+    whose students have from none to all parts wrong, two of them copying (one with 8 wrong parts, one with 5:
+    a block of the second alone would sum its chances over fewer columns, which numpy adds in another order,
+    and this class's figures show it), and whose student with the most wrong parts matches nobody (the first
+    block searched finds no pair). ``kept`` 2: every pair is kept."""
+    from grader.grade import integrity
+
+    monkeypatch.setattr(integrity, "KEPT", kept)
+    rng = np.random.default_rng(13)
+    labels = tuple(f"1{letter}" for letter in "abcdefghij")  # up to 10 wrong parts: numpy sums 11 columns
+    values = rng.uniform(1.0, 1.3, size=(150, len(labels)))
+    key = make_key(values.tolist())
+    slips = rng.uniform(0.0, 0.8, size=150)  # each student's share of wrong parts
+    typed = {(f"s{i}", label): f"{values[i, j] * (rng.uniform(0.8, 1.2) if rng.random() < slips[i] else 1):.5g}"
+             for i in range(150) for j, label in enumerate(labels)}
+    typed |= {("s0", label): f"{values[1, j]:.5g}" for j, label in enumerate(labels[:8])}
+    typed |= {("s2", label): f"{values[3 if j < 5 else 2, j]:.{3 + j % 3}g}" for j, label in enumerate(labels)}
+    typed |= {("s4", label): f"{1000 * values[4, j]:.5g}" for j, label in enumerate(labels)}
+    result = graded(key, typed)
+    whole = check(result, block=10**9)
+    assert len(whole.pairs) >= (100 if kept > 1 else 1) and whole.flagged  # the class has pairs to find
+    for block in (1, 7, 500):
+        found = check(result, block=block)
+        assert found == whole
+        assert "".join(integrity_csv(result, found)) == "".join(integrity_csv(result, whole))

@@ -26,7 +26,8 @@ matches by accident (docs/grading.md, *Answers from another student's variant*):
 
 A pair whose corrected chance is at most the assignment's ``grading.integrity_threshold`` is flagged.
 
-The band search (which students' bands hold an answer) is :mod:`grader.grade.integrity_search`.
+The band search (which students' bands hold an answer) is :mod:`grader.grade.integrity_search`. The candidate
+pairs are worked out a block of students at a time (:data:`PAIRS`), so memory grows with the class, not its square.
 """
 
 from __future__ import annotations
@@ -44,10 +45,22 @@ from grader.grade.cells import typed_place
 from grader.grade.compare import errors
 from grader.grade.grading import Graded, Row
 from grader.grade.integrity_chance import UNRELATED, Spread
-from grader.grade.integrity_search import Bands, Floats, Ints, accepts, bands, expanded, holding, nearest, range_least
+from grader.grade.integrity_search import (
+    Bands,
+    Floats,
+    Ints,
+    accepts,
+    bands,
+    blocks,
+    candidates,
+    holding,
+    nearest,
+    range_least,
+)
 
 LISTED = 5  # students named per wrong answer in integrity.csv; the rest are counted
 KEPT = 1.0  # pairs with two or more matched parts are kept when their corrected chance is below this
+PAIRS = 1 << 19  # candidate pairs worked out at a time (a few hundred bytes each): memory bounded, whatever the class
 
 
 class Match(NamedTuple):
@@ -142,8 +155,9 @@ class _Answers(NamedTuple):
         return found
 
 
-def check(graded: Graded) -> Integrity:
-    """The integrity check of a grading run (the key's numeric parts; symbolic ones are left out)."""
+def check(graded: Graded, block: int = PAIRS) -> Integrity:
+    """The integrity check of a grading run (the key's numeric parts; symbolic ones are left out), its
+    candidate pairs worked out about ``block`` at a time (the findings are the same whatever the block)."""
     key = graded.key
     students = len(key.students)
     parts: list[Bands] = []
@@ -173,7 +187,7 @@ def check(graded: Graded) -> Integrity:
     examined = int(np.count_nonzero(per_student >= 2)) * max(students - 1, 0)
     found = [holding(part, wrong[part.label], graded.numbers[part.label]) for part in parts]
     answers = _Answers(wrong, graded.numbers, steps, right, graded.columns, per_student, {})
-    pairs = _pairs(parts, answers, spread, found, examined)
+    pairs = _pairs(parts, answers, spread, found, examined, block)
     matches = _listed(parts, wrong, graded.numbers, found, pairs)
     # Every listed match has its pair's figures.
     others = sorted({(match.student, match.partner) for match in matches} - pairs.keys())
@@ -215,13 +229,18 @@ def _number(value: object) -> float:
 
 
 def _pairs(parts: Sequence[Bands], answers: _Answers, spread: Spread,
-           found: Sequence[tuple[Ints, list[tuple[Ints, Ints]]]], examined: int) -> dict[tuple[int, int], Pair]:
+           found: Sequence[tuple[Ints, list[tuple[Ints, Ints]]]], examined: int,
+           block: int = PAIRS) -> dict[tuple[int, int], Pair]:
     """Every pair with two or more matched parts whose corrected chance is below :data:`KEPT`.
 
     A pair needs as many matched parts as the fewest whose chance could be that small (:func:`_needed`); a
     partner that matches ``n`` of a student's parts is in the band search of at least one part other than
-    the ``n - 1`` that matched the most students: those searches alone are expanded."""
-    wrong, students = answers.wrong, len(answers.per_student)
+    the ``n - 1`` that matched the most students: those searches alone are expanded. The candidates are taken
+    a block of students at a time (about ``block`` candidates a block, so memory does not grow with the
+    square of the class), the students with the most wrong parts first: the first block with a pair of two
+    matched parts sets how many wrong parts the chances are counted up to (:func:`_figures`'s ``most``), as
+    one block of the whole class would."""
+    wrong, students, per_student = answers.wrong, len(answers.per_student), answers.per_student
     counts = np.zeros((students, len(parts)), dtype=np.int64)  # per student and part, the students matched
     for index, (part, (found_counts, _)) in enumerate(zip(parts, found, strict=True)):
         counts[wrong[part.label], index] = found_counts
@@ -229,21 +248,32 @@ def _pairs(parts: Sequence[Bands], answers: _Answers, spread: Spread,
     needed = _needed(parts, answers, spread, found, examined)
     # Each part's rank among the student's, most students matched first: the needed - 1 first are not searched.
     rank = np.argsort(np.argsort(-counts, axis=1, kind="stable"), axis=1, kind="stable")
-    keys = []
+    chosen, sizes = [], np.zeros(students, dtype=np.int64)  # per part the answers searched; per student, candidates
     for index, (part, (found_counts, ranges)) in enumerate(zip(parts, found, strict=True)):
         members = wrong[part.label]
-        chosen = np.flatnonzero((found_counts > 0) & (matched[members] >= needed[members])
-                                & (rank[members, index] >= needed[members] - 1))
+        chosen.append(np.flatnonzero((found_counts > 0) & (matched[members] >= needed[members])
+                                     & (rank[members, index] >= needed[members] - 1)))
         for starts, ends in ranges:
-            for which, positions in expanded(starts[chosen], ends[chosen]):
-                owners, partners = members[chosen[which]], part.order[positions]
-                ok = accepts(part, owners, partners, answers.numbers[part.label])
-                keys.append(np.unique(owners[ok] * students + partners[ok]))
-    if not keys:
-        return {}
-    pairs = np.unique(np.concatenate(keys))
-    return {(pair.student, pair.partner): pair
-            for pair in _figures(parts, answers, spread, pairs // students, pairs % students, examined, 2, KEPT)}
+            sizes += np.bincount(members[chosen[-1]], minlength=students,
+                                 weights=np.maximum(ends - starts, 0)[chosen[-1]]).astype(np.int64)
+    searched = np.flatnonzero(sizes > 0)
+    searched = searched[np.argsort(-per_student[searched], kind="stable")]
+    pairs: dict[tuple[int, int], Pair] = {}
+    most: int | None = None
+    for group in blocks(sizes[searched], block):
+        inside = np.zeros(students, dtype=bool)
+        inside[searched[group]] = True
+        owners, partners = candidates(parts, wrong, answers.numbers, [ranges for _, ranges in found], chosen,
+                                      inside)
+        hits = _hits(parts, answers, owners, partners)
+        if most is None:
+            two = hits.sum(axis=1) >= 2
+            if not two.any():
+                continue
+            most = int(per_student[owners[two]].max())
+        pairs.update(((pair.student, pair.partner), pair) for pair in _figures(
+            parts, answers, spread, owners, partners, examined, 2, KEPT, hits, most))
+    return pairs
 
 
 def _needed(parts: Sequence[Bands], answers: _Answers, spread: Spread,
@@ -296,19 +326,27 @@ def _least(part: Bands, spread: Spread, owners: Ints, numbers: Floats, steps: Fl
     return np.where(np.isfinite(least_reach), found, np.inf)
 
 
+def _hits(parts: Sequence[Bands], answers: _Answers, owners: Ints, partners: Ints) -> npt.NDArray[np.bool_]:
+    """Per pair (a row) and part (a column), whether the owner's wrong answer is in the partner's band."""
+    hits = np.zeros((len(owners), len(parts)), dtype=bool)
+    for index, part in enumerate(parts):
+        rows = np.flatnonzero(answers.answered(part.label)[owners])
+        hits[rows, index] = accepts(part, owners[rows], partners[rows], answers.numbers[part.label])
+    return hits
+
+
 def _figures(parts: Sequence[Bands], answers: _Answers, spread: Spread, owners: Ints, partners: Ints,
-             examined: int, least: int = 0, below: float = math.inf) -> list[Pair]:
+             examined: int, least: int = 0, below: float = math.inf, hits: npt.NDArray[np.bool_] | None = None,
+             most: int | None = None) -> list[Pair]:
     """Each pair's matched parts and chances; only the pairs with ``least`` matched parts or more and a
     corrected chance under ``below``. For ``j`` from 2 to the matches (1 for a pair of one match): the chance
     that ``j`` or more of the owner's wrong parts land by accident as close to the partner's values as the
     pair's ``j`` closest matches, closeness counted in half-units of the owner's typed answers (the
-    least close of those ``j`` sets it for every part); the pair's chance is the least of these."""
+    least close of those ``j`` sets it for every part); the pair's chance is the least of these. ``hits``:
+    :func:`_hits` of the pairs, if worked out already; ``most``: the wrong parts the chances are counted up to
+    (:func:`_tails`), if not the most of the pairs kept."""
     per_student = answers.per_student
-    hits = np.zeros((len(owners), len(parts)), dtype=bool)
-    units = np.full((len(owners), len(parts)), np.inf)
-    for index, part in enumerate(parts):
-        rows = np.flatnonzero(answers.answered(part.label)[owners])
-        hits[rows, index] = accepts(part, owners[rows], partners[rows], answers.numbers[part.label])
+    hits = _hits(parts, answers, owners, partners) if hits is None else hits
     matched = hits.sum(axis=1)
     kept = matched >= least  # the chances are worked out only for the pairs that could be kept
     owners, partners, hits, matched = owners[kept], partners[kept], hits[kept], matched[kept]
@@ -333,7 +371,7 @@ def _figures(parts: Sequence[Bands], answers: _Answers, spread: Spread, owners: 
         closeness[rows[better]] = ordered[rows[better], closest - 1]
     # The closeness and the number of matches counted were read off the answers: paid for over every number
     # ``j`` a pair could be counted with, each at most the chance of ``j`` matches anywhere in the bands.
-    anywhere = _tails(parts, answers, spread, owners, partners, np.full(len(owners), np.inf))
+    anywhere = _tails(parts, answers, spread, owners, partners, np.full(len(owners), np.inf), most)
     first = np.where(matched >= 2, 2, 1)
     counts = np.arange(anywhere.shape[1])
     paid = np.where(counts >= first[:, None], np.minimum(chances[:, None], anywhere), 0.0).sum(axis=1)
@@ -353,12 +391,14 @@ def _figures(parts: Sequence[Bands], answers: _Answers, spread: Spread, owners: 
 
 
 def _tails(parts: Sequence[Bands], answers: _Answers, spread: Spread, owners: Ints, partners: Ints,
-           closeness: Floats) -> Floats:
-    """Per pair (a row), the chance that ``j`` (a column) or more of the owner's wrong parts land within
-    ``closeness`` half-units of the partner's (:func:`_chance`; inf: anywhere in the bands): the tails of the
-    Poisson binomial distribution of the count, built a part at a time."""
+           closeness: Floats, most: int | None = None) -> Floats:
+    """Per pair (a row), the chance that ``j`` (a column, up to ``most``: by default the most wrong parts of
+    the owners) or more of the owner's wrong parts land within ``closeness`` half-units of the partner's
+    (:func:`_chance`; inf: anywhere in the bands): the tails of the Poisson binomial distribution of the
+    count, built a part at a time."""
     count = len(owners)
-    most = int(answers.per_student[owners].max()) if count else 0
+    if most is None:
+        most = int(answers.per_student[owners].max()) if count else 0
     distribution = np.zeros((count, most + 1))
     distribution[:, 0] = 1.0
     for part in parts:

@@ -127,6 +127,39 @@ def expanded(starts: Ints, ends: Ints) -> Iterator[tuple[Ints, Ints]]:
         begin = end
 
 
+def blocks(sizes: Ints, size: int) -> Iterator[slice]:
+    """Consecutive runs of ``sizes`` whose sum is at most ``size`` (one entry if it alone is more).
+
+    >>> [(run.start, run.stop) for run in blocks(np.array([2, 3, 1, 9, 1]), 5)]
+    [(0, 2), (2, 3), (3, 4), (4, 5)]
+    """
+    total = np.cumsum(sizes)
+    begin = 0
+    while begin < len(sizes):
+        before = int(total[begin - 1]) if begin else 0
+        end = max(begin + 1, int(np.searchsorted(total, before + size, side="right")))
+        yield slice(begin, end)
+        begin = end
+
+
+def candidates(parts: Sequence[Bands], wrong: Mapping[str, Ints], numbers: Mapping[str, Floats],
+               ranges: Sequence[Sequence[tuple[Ints, Ints]]], chosen: Sequence[Ints],
+               inside: npt.NDArray[np.bool_]) -> tuple[Ints, Ints]:
+    """The pairs (owner, partner), in order, whose partner's band holds a wrong answer of the owner's: per
+    part, the answers ``chosen`` (rows of ``wrong``) of the owners ``inside``, searched over their ranges."""
+    students, keys = len(inside), [np.zeros(0, dtype=np.int64)]
+    for part, part_ranges, rows in zip(parts, ranges, chosen, strict=True):
+        members = wrong[part.label]
+        rows = rows[inside[members[rows]]]
+        for starts, ends in part_ranges:
+            for which, positions in expanded(starts[rows], ends[rows]):
+                owners, partners = members[rows[which]], part.order[positions]
+                ok = accepts(part, owners, partners, numbers[part.label])
+                keys.append(np.unique(owners[ok] * students + partners[ok]))
+    pairs = np.unique(np.concatenate(keys))
+    return pairs // students, pairs % students
+
+
 def matches(part: Bands, owners: Ints, numbers: Floats) -> tuple[Ints, Ints]:
     """Every (owner, partner) whose partner's band holds ``numbers`` (one per owner); for a test's eyes."""
     full = np.full(len(part.values), np.nan)

@@ -326,7 +326,8 @@ def test_the_energy_lost_is_t_before_less_t_after_with_the_velocities_after_on_t
         before, after = (side.name for side in lost.solved.args)  # type: ignore[union-attr]
         assert lost.solved.op == "sub", (template_id, to_text(lost.solved))  # type: ignore[union-attr]
         found = steps[order.index(after)]
-        assert found.relation == "kinetic energy just after the impact" and order.index(before) < order.index(lost.unknown)
+        assert found.relation == "kinetic energy just after the impact"
+        assert order.index(before) < order.index(lost.unknown)
         for velocity in names(found.solved) - set(BANK[template_id].parameters) - set(BANK[template_id].symbols):
             assert order.index(velocity) < order.index(after), (template_id, velocity)
 

@@ -7,7 +7,10 @@ kernel's (``tests/test_textbook_steps.py`` evaluates every form on the page agai
 two bodies that both move after an impact are worked with **conservation of momentum** and **the restitution
 equation** as two labelled equations, then their simultaneous solution (Sample Problems 3/28 and 3/30), whichever
 way round the scene lists them; a velocity after found from the other's is conservation of momentum alone (the
-pile driver's ``v_p'``). The other forms (``e = √(h′/h)``, inverse trigonometric functions, speeds by name, one
+pile driver's ``v_p'``). The energy lost in an impact is ``T − T′``, with ``T′ = ½ m_A v′_A² + ½ m_B v′_B²`` from
+the velocities after on the page (``½ (m_A + m_B) v′²`` for bodies that move on together; components squared and
+added when oblique), where the kernel keeps its stable form ``m_A m_B (v_A − v_B)² (1 − e²)/(2 (m_A + m_B))``. The other
+forms (``e = √(h′/h)``, inverse trigonometric functions, speeds by name, one
 fraction for a reciprocal sum) are :mod:`grader.solve.page_forms`'.
 
 The impacts are found by their relations' wording (:mod:`grader.physics.effects.impact`): "impulse along n in
@@ -21,6 +24,7 @@ import re
 from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 from fractions import Fraction
+from functools import partial
 from typing import Any
 
 from grader.bank.template import Template
@@ -416,6 +420,12 @@ def _kinetic(masses: list[Node], velocities: list[tuple[Node | None, ...]], zero
     return _add(*terms) if terms else None
 
 
+def _components(stage: Stage, when: str, body: str) -> tuple[Node | None, ...]:
+    """A body's velocity ``before`` or ``after`` an impact: ``(n, t)``, or ``(n,)`` as a number or a name alone."""
+    velocity = stage.fields.get(when, {}).get(body)
+    return (velocity.n, velocity.t) if isinstance(velocity, Velocity) else (velocity,)
+
+
 def _energy(template: Template, steps: list[Step], extra: list[Step]) -> list[Step]:
     """The energy lost in an impact as a textbook finds it once the velocities after are on the page (Sample
     Problems 3/28–3/30): ``T = ½ m_A v_A² + ½ m_B v_B²``, ``T′`` likewise with the velocities after, then ``ΔE = T −
@@ -423,7 +433,7 @@ def _energy(template: Template, steps: list[Step], extra: list[Step]) -> list[St
     A velocity the page has not found by then keeps the kernel's form."""
     bodies = template.scene.bodies
     impacts = [s for s in template.scene.stages if s.effect == "impact"]
-    for at, found in enumerate(list(steps)):
+    for found in list(steps):
         if found.relation != _LOST or found.numeric:
             continue
         stages = [s for s in impacts if s.fields.get("energy_lost", "E_lost") == found.unknown]
@@ -438,10 +448,7 @@ def _energy(template: Template, steps: list[Step], extra: list[Step]) -> list[St
         movable = [b for b in stage.fields["bodies"] if bodies[b].mass is not None]
         masses = [bodies[b].mass for b in movable]
 
-        def components(when: str, body: str) -> tuple[Node | None, ...]:
-            velocity = stage.fields.get(when, {}).get(body)
-            return (velocity.n, velocity.t) if isinstance(velocity, Velocity) else (velocity,)
-
+        components = partial(_components, stage)
         after = [components("after", b) for b in movable]
         if any(all(c is None for c in v) for v in after):
             continue  # a velocity after the scene does not name

@@ -115,7 +115,8 @@ def test_a_value_three_times_outside_the_stored_tolerance_is_not_correct(whole_b
 
 def test_widened_tolerances_say_why_and_stay_under_the_cap(whole_bank: Generation) -> None:
     """A tolerance wider than configured carries its reason (route and values rounded) and is at most
-    the default cap of 5 %; the energy route of oblique-spheres' loss is among those widened."""
+    the default cap of 5 %; oblique-spheres' loss, along the worked solution's energy route (T and T′ written down,
+    then T − T′), is among those widened."""
     widened = [(variant.template, part) for student in whole_bank.students for variant in student.problems
                for part in variant.answers if part.tolerance.reason]
     assert widened
@@ -124,7 +125,8 @@ def test_widened_tolerances_say_why_and_stay_under_the_cap(whole_bank: Generatio
         assert part.tolerance.reason.startswith("rounding ")
         assert f" to {FIGURES} figures along " in part.tolerance.reason
         assert f"moves {part.name} by up to " in part.tolerance.reason
-    assert any(t == "oblique-spheres" and "energy route" in p.tolerance.reason for t, p in widened)
+    assert any(t == "oblique-spheres" and "T′" in p.tolerance.reason and "the worked solution" in p.tolerance.reason
+               for t, p in widened)
 
 
 def test_first_order_bound_covers_the_route_evaluated_with_rounded_values(whole_bank: Generation,
@@ -173,7 +175,8 @@ def test_textbook_printed_answers_grade_correct_on_the_textbook_variant(template
 def test_a_widened_loss_names_the_energy_route_and_its_values(bank: dict[str, Template], tmp_path: Path) -> None:
     """Sample Problem 3/30's route for the loss, (T − T′)/T, on a variant that loses 3 %: the stored
     tolerance is twice the route's bound plus the answer's own rounding, rounded up to two figures,
-    and its reason names the route and the values whose rounding moves it most."""
+    and its reason names the route and the values whose rounding moves it most. The worked solution takes that
+    route (T, T′, then T − T′), so the reason names it."""
     fixed = {"v1": 3.0, "theta": 58, "e": 0.88, "m1": 2.0, "m2": 1.9}
     assignment, roster = _write_assignment(tmp_path, [{"key": "1", "template": "oblique-spheres", "fixed": fixed}],
                                            students=1)
@@ -187,8 +190,9 @@ def test_a_widened_loss_names_the_energy_route_and_its_values(bank: dict[str, Te
     assert needed > 0.01
     assert needed <= loss.tolerance.rtol < needed * 1.1
     rounded, _, rest = loss.tolerance.reason.removeprefix("rounding ").partition(f" to {FIGURES} figures along ")
-    assert rest.startswith("the energy route (T − T′) moves loss_pct by up to ")
-    energy = next(r for r in routes.for_answer("loss_pct") if r.id == "energy")
+    assert rest.startswith("the worked solution moves loss_pct by up to ")
+    energy = next(r for r in routes.for_answer("loss_pct") if r.id == "chain")
+    assert {"T", "T_after", "E_lost"} <= set(energy.names)
     assert set(rounded.replace(" and ", ", ").split(", ")) <= {display_name(n) for n in energy.names}
     assert loss.tolerance.explained("%").startswith(f"±{loss.tolerance.rtol * 100:g} %: rounding ")
 

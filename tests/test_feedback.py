@@ -110,7 +110,7 @@ def test_a_sheet_shows_what_was_typed_read_the_verdicts_sentences_and_the_worked
                   "Expected 23.171° accepted ±1 %",
                   "Pile driver ram striking a pile", "Given:"):
         assert shown in text, shown
-    widened = "accepted ±1.1 %: rounding T to 4 figures along the energy route (T − T′) moves loss_pct by up to 0.41 %"
+    widened = "accepted ±1.1 %: rounding T to 4 figures along the worked solution moves loss_pct by up to 0.41 %"
     assert widened in pdf_text(feedback / "2026174.pdf")
 
 

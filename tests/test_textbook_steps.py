@@ -23,7 +23,7 @@ from grader.assign.assignment import load_assignment, load_roster
 from grader.assign.variants import ProblemVariant, generate
 from grader.bank.template import Template, load_bank
 from grader.base.resources import sample_dir
-from grader.model.expr import Num, Sym, parse, substitute, to_text
+from grader.model.expr import Num, Sym, names, parse, substitute, to_text
 from grader.model.kernel import evaluate
 from grader.render.readable import readable
 from grader.render.typst_math import math as typst_math
@@ -75,7 +75,9 @@ def test_every_form_on_the_page_gives_the_kernels_value(template_id: str,
     for variant in variants[template_id]:
         for symbols in (1.0, 2.0):  # a mass that cancels must cancel on the page too
             kernel = _kernel_values(template, variant, symbols)
-            env = {**kernel, **{s.unknown: float(page_value(s.solved, kernel)) for s in route.extra}}
+            env = dict(kernel)
+            for extra in route.extra:  # in order, as the page finds them: T′ from a t-velocity only the page names
+                env[extra.unknown] = float(page_value(extra.solved, env))
             for step, shown in zip(route.steps, form.steps, strict=True):
                 if step.numeric:
                     continue
@@ -308,3 +310,35 @@ def test_the_route_gives_the_kernels_values_whichever_way_the_scene_is_written(t
             assert _close(float(page_value(step.solved, env)), kernel[step.unknown]), (template_id, step.unknown)
         lhs, rhs = (float(page_value(side, env)) for side in step.equation)
         assert _close(lhs, rhs), (template_id, step.relation)
+
+
+ENERGY = [t for t in ORDER if any(step.relation == "energy lost in the impact" for step in compiled_for(BANK[t]).steps)]
+"""Every shipped template that finds the energy lost in an impact."""
+
+
+@pytest.mark.parametrize("template_id", ENERGY)
+def test_the_energy_lost_is_t_before_less_t_after_with_the_velocities_after_on_the_page(template_id: str) -> None:
+    """Sample Problems 3/28–3/30: T = ½ m_A v_A² + ½ m_B v_B², T′ from the velocities after already found, then
+    ΔE = T − T′ (the kernel's stable form stays the kernel's)."""
+    steps = textbook_route(BANK[template_id], compiled_for(BANK[template_id])).steps
+    order = [step.unknown for step in steps]
+    for lost in [s for s in steps if s.relation == "energy lost in the impact"]:
+        before, after = (side.name for side in lost.solved.args)  # type: ignore[union-attr]
+        assert lost.solved.op == "sub", (template_id, to_text(lost.solved))  # type: ignore[union-attr]
+        found = steps[order.index(after)]
+        assert found.relation == "kinetic energy just after the impact"
+        assert order.index(before) < order.index(lost.unknown)
+        for velocity in names(found.solved) - set(BANK[template_id].parameters) - set(BANK[template_id].symbols):
+            assert order.index(velocity) < order.index(after), (template_id, velocity)
+
+
+def test_a_plastic_impacts_t_after_is_half_the_masses_together_times_the_common_speed_squared() -> None:
+    steps = {s.unknown: s for s in textbook_route(BANK["coupling"], compiled_for(BANK["coupling"])).steps}
+    assert to_text(steps["T_after"].solved) == "(m_A + m_B)*v_common**2/2"
+    assert to_text(steps["E_lost"].solved) == "T - T_after"
+
+
+def test_an_oblique_impacts_t_after_adds_the_components_squared() -> None:
+    steps = {s.unknown: s for s in textbook_route(BANK["oblique-spheres"], compiled_for(BANK["oblique-spheres"])).steps}
+    # sphere 2 leaves along n (its t-velocity is 0, never written 0²)
+    assert to_text(steps["T_after"].solved) == "m1*(v1_n_after**2 + v1_t_after**2)/2 + m2*v2_n_after**2/2"

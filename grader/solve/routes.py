@@ -6,7 +6,8 @@ prints it (each value the page computes, in its order, from the form it prints:
 :func:`~grader.solve.textbook_steps.textbook_route`; the solver's chain where the page solves a value it
 needs numerically); the textbook's other routes that the effects declare (an impact's energies: ``T`` and
 ``T′`` written down, then ``(T − T′)/T``), the page's values but those the route finds its own way, and
-only for an answer that needs one of them; and,
+only for an answer that needs one of them (a route that writes down what the page does is the page's: the
+worked solution finds an impact's energy lost as ``T − T′`` wherever the velocities after are on it); and,
 for an answer whose square is a ratio of the parameters, that ratio written down first (``e`` from
 ``√(h_rebound/h_drop)``). A percentage comes from the fraction the route writes down. Printed
 parameters are used as printed, never rounded again; a value that is only copied (``v_t′ = v_t``)
@@ -27,13 +28,12 @@ ways, and the larger figure is kept.
 >>> routes = routes_for(load_bank()["oblique-spheres"])
 >>> for route in routes.for_answer("loss_pct"):
 ...     print(route.id, " ".join(route.names))
-chain v1_n T E_lost f_loss
-energy v1_n v1_t v1_n_after v2_n_after T T_after E_lost f_loss
+chain v1_n v1_t v1_n_after v2_n_after T T_after E_lost f_loss
 >>> params = {"v1": np.array([6.0]), "theta": np.array([30.0]), "e": np.array([0.6]), "m1": np.array([1.0]),
 ...           "m2": np.array([1.0])}
 >>> moves = rounding_bounds(routes, params, 4)["loss_pct"]
 >>> routes.items[moves.route[0]].id, round(float(moves.bound[0]), 3)
-('energy', 0.089)
+('chain', 0.089)
 """
 
 from __future__ import annotations

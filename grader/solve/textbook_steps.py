@@ -7,7 +7,10 @@ kernel's (``tests/test_textbook_steps.py`` evaluates every form on the page agai
 two bodies that both move after an impact are worked with **conservation of momentum** and **the restitution
 equation** as two labelled equations, then their simultaneous solution (Sample Problems 3/28 and 3/30), whichever
 way round the scene lists them; a velocity after found from the other's is conservation of momentum alone (the
-pile driver's ``v_p'``). The other forms (``e = √(h′/h)``, inverse trigonometric functions, speeds by name, one
+pile driver's ``v_p'``). The energy lost in an impact is ``T − T′``, with ``T′ = ½ m_A v′_A² + ½ m_B v′_B²`` from
+the velocities after on the page (``½ (m_A + m_B) v′²`` for bodies that move on together; components squared and
+added when oblique), where the kernel keeps its stable form ``m_A m_B (v_A − v_B)² (1 − e²)/(2 (m_A + m_B))``. The other
+forms (``e = √(h′/h)``, inverse trigonometric functions, speeds by name, one
 fraction for a reciprocal sum) are :mod:`grader.solve.page_forms`'.
 
 The impacts are found by their relations' wording (:mod:`grader.physics.effects.impact`): "impulse along n in
@@ -21,6 +24,7 @@ import re
 from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 from fractions import Fraction
+from functools import partial
 from typing import Any
 
 from grader.bank.template import Template
@@ -373,8 +377,109 @@ def textbook_route(template: Template, compiled: Compiled) -> Route:
     extra: list[Step] = []
     positive: dict[str, Node] = {}
     steps = _numeric_blocks(_plastic(template, _impacts(template, compiled, list(compiled.steps), extra)))
+    steps = _energy(template, steps, extra)
     steps = bounce_heights(steps)
     steps = magnitudes(steps)
     steps = inverse_trig(steps, positive)
     steps = [one_fraction(s) for s in steps]
     return Route(tuple(folded(s) for s in steps), tuple(folded(s) for s in extra), positive)
+
+
+_LOST = "energy lost in the impact"
+_BEFORE = "kinetic energy just before the impact"
+_AFTER = "kinetic energy just after the impact"
+_TWO = Num(Fraction(2))
+
+
+def _speed(node: Node | None) -> Node | None:
+    """A velocity component as a speed is squared: ``v`` for ``−v``; None for none or zero."""
+    if is_zero(node):
+        return None
+    return node.args[0] if isinstance(node, Op) and node.op == "neg" else node
+
+
+def _kinetic(masses: list[Node], velocities: list[tuple[Node | None, ...]], zero: set[str]) -> Node | None:
+    """``½ m_A v_A² + ½ m_B v_B²`` over the bodies that move (a velocity's components squared and added, ``v′² =
+    v′_n² + v′_t²``), bodies with one velocity together as one, ``½ (m_A + m_B) v′²``; None where none moves."""
+    grouped: list[tuple[list[Node], tuple[Node, ...]]] = []
+    for mass, velocity in zip(masses, velocities, strict=True):
+        parts = tuple(p for p in (_speed(c) for c in velocity)
+                      if p is not None and not (isinstance(p, Sym) and p.name in zero))
+        if not parts:
+            continue
+        same = next((group for group in grouped if group[1] == parts), None)
+        if same is None:
+            grouped.append(([mass], parts))
+        else:
+            same[0].append(mass)
+    terms = []
+    for group_masses, parts in grouped:
+        mass = _add(*group_masses)
+        squares = _add(*(Op("pow", (p, _TWO)) for p in parts))
+        terms.append(_div(_mul(mass, squares), _TWO))
+    return _add(*terms) if terms else None
+
+
+def _components(stage: Stage, when: str, body: str) -> tuple[Node | None, ...]:
+    """A body's velocity ``before`` or ``after`` an impact: ``(n, t)``, or ``(n,)`` as a number or a name alone."""
+    velocity = stage.fields.get(when, {}).get(body)
+    return (velocity.n, velocity.t) if isinstance(velocity, Velocity) else (velocity,)
+
+
+def _energy(template: Template, steps: list[Step], extra: list[Step]) -> list[Step]:
+    """The energy lost in an impact as a textbook finds it once the velocities after are on the page (Sample
+    Problems 3/28–3/30): ``T = ½ m_A v_A² + ½ m_B v_B²``, ``T′`` likewise with the velocities after, then ``ΔE = T −
+    T′``, where the kernel's stable form (``m_A m_B (v_A − v_B)² (1 − e²)/(2 (m_A + m_B))``) stays the kernel's.
+    A velocity the page has not found by then keeps the kernel's form."""
+    bodies = template.scene.bodies
+    impacts = [s for s in template.scene.stages if s.effect == "impact"]
+    for found in list(steps):
+        if found.relation != _LOST or found.numeric:
+            continue
+        stages = [s for s in impacts if s.fields.get("energy_lost", "E_lost") == found.unknown]
+        if len(stages) != 1:
+            continue
+        stage = stages[0]
+        index = steps.index(found)
+        taken = (set(template.parameters) | set(template.symbols) | set(template.scene.names())
+                 | {s.unknown for s in steps} | {s.unknown for s in extra})
+        known = set(template.parameters) | set(template.symbols) | {"g"} | {s.unknown for s in steps[:index]}
+        zero = {s.unknown for s in steps if is_zero(s.solved)}
+        movable = [b for b in stage.fields["bodies"] if bodies[b].mass is not None]
+        masses = [bodies[b].mass for b in movable]
+
+        components = partial(_components, stage)
+        after = [components("after", b) for b in movable]
+        if any(all(c is None for c in v) for v in after):
+            continue  # a velocity after the scene does not name
+        new: list[Step] = []
+        for body, (_, tangent) in zip(movable, after, strict=True):
+            # a t-velocity after the chain never needed: unchanged, as the page says for the other body's
+            unchanged = _speed(components("before", body)[-1]) if len(components("before", body)) == 2 else None
+            if isinstance(tangent, Sym) and tangent.name not in known and unchanged is not None \
+                    and names(unchanged) <= known \
+                    and tangent.name not in {s.unknown for s in (*steps, *extra)}:
+                copy = components("before", body)[-1]
+                new.append(Step(tangent.name, f"smooth surfaces: no impulse along t, so {body}'s t-velocity is "
+                                "unchanged", (tangent, copy), copy))  # type: ignore[arg-type]
+                known.add(tangent.name)
+        before_form = _kinetic(masses, [components("before", b) for b in movable], zero)  # type: ignore[arg-type]
+        after_form = _kinetic(masses, after, zero)  # type: ignore[arg-type]
+        if before_form is None or after_form is None:
+            continue
+        # E_lost_2 = T_2 − T_after_2 (T₂ − T′₂ on the page), the second impact's
+        suffix = found.unknown[len("E_lost"):] if found.unknown.startswith("E_lost") else f"_{stage.index}"
+        before = stage.fields.get("energy_before", "T" + suffix)
+        if before not in {s.unknown for s in steps[:index]}:
+            if before in taken:
+                continue
+            new.append(Step(before, _BEFORE, (Sym(before), before_form), before_form))
+        after_name = stage.fields.get("energy_after", "T_after" + suffix)
+        if after_name in taken or not names(after_form) <= known | {before}:
+            continue
+        new.append(Step(after_name, _AFTER, (Sym(after_name), after_form), after_form))
+        difference = _sub(Sym(before), Sym(after_name))
+        extra += new
+        steps = [*steps[:index], *new, replace(found, equation=(Sym(found.unknown), difference), solved=difference),
+                 *steps[index + 1:]]
+    return steps

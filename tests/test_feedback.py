@@ -108,7 +108,8 @@ def test_a_sheet_shows_what_was_typed_read_the_verdicts_sentences_and_the_worked
                   "a common mistake · 0 of 2 points",
                   "your answer matches the angle in radians where degrees were asked",
                   "Expected 23.171° accepted ±1 %",
-                  "Pile driver ram striking a pile", "Given:"):
+                  "Pile driver ram striking a pile", "Given:",
+                  "not answered · 0 of 2 points You typed nothing the answer was blank"):  # her blank 3b
         assert shown in text, shown
     widened = "accepted ±1.1 %: rounding T to 4 figures along the worked solution moves loss_pct by up to 0.41 %"
     assert widened in pdf_text(feedback / "2026174.pdf")

@@ -137,11 +137,12 @@ class Feedback:
 
     @staticmethod
     def _mark(part: MarkedPart, description: str) -> MarkView:
-        typed = Typ("#text(fill: luma(90))[nothing]") if part.typed is None else \
-            Typ(f'#text(font: "DejaVu Sans Mono", size: 8.5pt, {string(part.typed)})')
+        shown = part.typed if part.typed is not None and part.typed.strip() else None  # a blank cell: nothing
+        typed = Typ("#text(fill: luma(90))[nothing]") if shown is None else \
+            Typ(f'#text(font: "DejaVu Sans Mono", size: 8.5pt, {string(shown)})')
         late = f"late: the late policy took {_points(part.deduction)} of its points" if part.deduction else ""
         return MarkView(part.verdict, part.label, description, VERDICT_WORDS.get(part.verdict, part.verdict),
-                        _credit(part), typed, part.typed, part.read_as if part.typed is not None else "", part.feedback,
+                        _credit(part), typed, shown, part.read_as if shown is not None else "", part.feedback,
                         part.expected, part.tolerance, late)
 
     def submit(self, back: Returned, fmt: Format,

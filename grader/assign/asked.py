@@ -21,14 +21,19 @@ from collections.abc import Sequence
 
 # The question: "Find" or "Determine" opening a sentence (at the start, or after a sentence's end), to the
 # end of the statement; the last such sentence, so that a scene mentioning "Find" earlier is kept.
-_OPENS = r"(?:Find|Determine)\b"
-_QUESTION = re.compile(rf"(?:^|(?<=[.!?:]\s)|(?<=\n)){_OPENS}(?![\s\S]*(?:^|[.!?:]\s|\n){_OPENS})", re.MULTILINE)
+_QUESTION = re.compile(r"(?:^|(?<=[.!?:]\s)|(?<=\n))(?:Find|Determine)\b", re.MULTILINE)
 
 
 def question_start(statement: str) -> int | None:
-    """Where the statement's question begins, or None when no sentence begins ``Find`` or ``Determine``."""
-    found = _QUESTION.search(statement)
-    return None if found is None else found.start()
+    """Where the statement's question begins, or None when no sentence begins ``Find`` or ``Determine``.
+
+    >>> question_start("Find the mass. Then it falls. Determine e.")
+    30
+    """
+    start = None
+    for found in _QUESTION.finditer(statement):  # the last one; one pass, whatever the statement's length
+        start = found.start()
+    return start
 
 
 def restated(statement: str, descriptions: Sequence[str]) -> str | None:

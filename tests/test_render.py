@@ -154,6 +154,7 @@ def footers(reader: PdfReader) -> list[tuple[str, int, int]]:
     return found
 
 
+@pytest.mark.slow  # two threads typesetting parts of 2 students: about 5 s
 def test_a_key_typeset_in_many_parts_numbers_its_pages_and_contents_rightly(
         tmp_path: Path, monkeypatch: pytest.MonkeyPatch, assignment: Assignment, bank: dict[str, Template],
         few: Generation) -> None:

@@ -141,9 +141,9 @@ def write_key_files(folder: Path, assignment: Assignment, chunks: Iterable[Seque
         with _blamed_on(folder / "key.json"):
             students.seek(0)  # writes what is buffered
         with atomic_file(folder / "key.json") as key:
-            key.write(f'{head[:-2]},\n "students": [\n  '.encode())
+            key.write(_opening(head).encode())
             shutil.copyfileobj(students, key, COPY_BLOCK)
-            key.write(b"\n ]\n}\n")
+            key.write(_CLOSING.encode())
 
 
 COPY_BLOCK = 1 << 20  # bytes of the students' lines copied at a time into key.json
@@ -235,7 +235,16 @@ def key_json(document: Mapping[str, Any]) -> str:
     head = json.dumps({k: v for k, v in document.items() if k != "students"}, ensure_ascii=False, indent=1,
                       allow_nan=False)
     students = ",\n  ".join(json.dumps(s, ensure_ascii=False, allow_nan=False) for s in document["students"])
-    return f'{head[:-2]},\n "students": [\n  {students}\n ]\n}}\n'
+    return f"{_opening(head)}{students}{_CLOSING}"
+
+
+def _opening(head: str) -> str:
+    """key.json up to its first student: the indented head (``head``, a dump without the students) reopened
+    for the students' list."""
+    return f'{head[:-2]},\n "students": [\n  '
+
+
+_CLOSING = "\n ]\n}\n"  # key.json after its last student
 
 
 KEY_CSV_HEADER = ("student_id", "name", "section", "problem", "template", "label", "answer", "value", "unit",

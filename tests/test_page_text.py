@@ -74,6 +74,7 @@ FORBIDDEN = {
     "a subscript of internal words": re.compile(r"\d,\s*between"),
     "a fraction's number before a name (1/4 p for p/4)": re.compile(
         r"(?<![\d.,])1 (?:[3-9]|[1-9]\d+) ?[\U0001D44E-\U0001D467\U0001D6FC-\U0001D71B]"),
+    "dt for the contact time Δt": re.compile(r"(?<![A-Za-z])dt(?![A-Za-z])"),
 }
 
 

@@ -40,10 +40,15 @@ def name(quantity: str) -> str:
     ``after`` becomes a prime, as in the textbook; a trailing digit or capital of the first part is
     a subscript (``vA`` -> ``v_A``, ``theta1`` -> ``theta_1``).
 
-    >>> name("theta"), name("vA_after"), name("E_lost")
-    ('theta', "v'_A", 'E_"lost"')
+    A time interval ``dt`` (the catalogue's name for a contact time) is ``Δt``, as the page's sentences say.
+
+    >>> name("theta"), name("vA_after"), name("E_lost"), name("dt")
+    ('theta', "v'_A", 'E_"lost"', 'Delta t')
     """
     parts = quantity.split("_")
+    if parts[0] == "dt":
+        parts[0] = "t"
+        return "Delta " + name("_".join(parts))
     primes = parts.count("after")
     rest = [p for p in parts[1:] if p and p != "after"]
     base = parts[0]

@@ -112,6 +112,7 @@ def test_another_version_of_the_template_under_its_name_is_compiled_again(cache:
     assert _answers(shipped) == right
 
 
+@pytest.mark.slow  # compiles two templates' chains again: about 3 s each
 @pytest.mark.parametrize("kind", ["-alternatives", "-routes"])
 def test_another_templates_alternatives_or_routes_are_compiled_again(cache: Path, kind: str) -> None:
     bank = load_bank()

@@ -505,6 +505,7 @@ def test_a_read_only_parent_folder_is_one_line(tmp_path: Path, capsys: pytest.Ca
     assert list(locked.iterdir()) == []
 
 
+@pytest.mark.slow  # about 3.5 s; the full disk while the students' lines wait stays in the default run
 @pytest.mark.skipif(not Path("/dev/full").exists(), reason="needs /dev/full")
 def test_a_full_disk_while_writing_the_key_is_one_line_and_leaves_nothing(
         tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]) -> None:

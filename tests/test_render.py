@@ -518,6 +518,7 @@ def test_cjk_and_hangul_names_print_with_the_system_noto_font(tmp_path: Path, ca
     assert not uncovered([name], font_paths(()))
 
 
+@pytest.mark.slow  # about 3 s of rendering to PNG
 def test_other_templates_pages_render_to_pngs(others: tuple[Assignment, Generation],
                                               bank: dict[str, Template]) -> None:
     """Each template's page, and a page of the answer key, written to tests/artifacts/ to look at."""

@@ -199,6 +199,7 @@ def _check(indexes: list[int], folder: Path) -> None:
     assert not found, found
 
 
+@pytest.mark.slow  # about 5 s of mutated templates loaded; each kind of mistake has its own test above
 def test_a_sample_of_mutated_templates_is_told_what_to_change(tmp_path: Path) -> None:
     """100 mutations, a seeded sample of all of them."""
     _check(SAMPLED, tmp_path)

@@ -17,12 +17,12 @@ import math
 from collections.abc import Iterable, Iterator, Sequence
 from pathlib import Path
 
-from grader.base.errors import visible
 from grader.base.files import write_atomic
-from grader.base.spreadsheet import csv_pieces, number_cell, safe_cell
+from grader.base.spreadsheet import csv_pieces, number_cell
 from grader.grade.canvas_file import CanvasFile
 from grader.grade.class_report import REPORT, class_report
 from grader.grade.compare import number_text
+from grader.grade.details_file import details_csv, report_cell
 from grader.grade.grading import Graded, final_scores, lateness, totals
 from grader.grade.integrity import Integrity, check
 
@@ -54,40 +54,6 @@ def grades_csv(graded: Graded) -> str:
         rows.append([student.id, student.name, student.section, *per_problem, minutes,
                      graded.deductions.get(student.id, 0.0), final[student.id], student.possible])
     return _csv(rows)
-
-
-DETAILS_HEADER = ("student_id", "label", "submitted", "verdict", "credit", "points", "score", "expected", "parsed",
-                  "unit", "abs_error", "rel_error", "tolerance", "feedback", "diagnosis", "source", "late", "deduction")
-
-
-def details_csv(graded: Graded, students_per_piece: int = 2000) -> Iterator[str]:
-    """One row per (student, part): what was submitted, the verdict and why, and how many minutes late the
-    row it came from was (empty: not known) with the points the late policy took. The text comes in pieces
-    of ``students_per_piece`` students, to be written as it comes (a class of 100,000 has a million rows).
-
-    Each cell is what :func:`_cell` makes of the verdict's field (the loop knows the field's type).
-    """
-    unknown = [None] * len(graded.key.students)  # no due time: no lateness, no deduction
-    late = graded.late
-    columns = [(safe_cell(label), graded.columns[label], late.minutes[label] if late else unknown,
-                late.shares[label] if late else unknown) for label in graded.key.labels]
-    numbers = _Cells()  # credits, points and scores: a few values
-    words = _Cells()  # verdicts, units, tolerances: a few texts
-
-    def rows() -> Iterator[Sequence[object]]:
-        yield DETAILS_HEADER
-        for index, student in enumerate(graded.key.students):
-            who = safe_cell(student.id)
-            for label, verdicts, minutes, shares in columns:
-                (submitted, verdict, credit, points, expected, parsed, unit, abs_error, rel_error, tolerance, feedback,
-                 diagnosis, source) = verdicts[index]
-                yield (who, label, "" if submitted is None else safe_cell(visible(submitted)), words[verdict],
-                       numbers[credit], numbers[points], numbers[credit * points], safe_cell(expected),
-                       safe_cell(visible(parsed)), words[unit], _error(abs_error), _error(rel_error), words[tolerance],
-                       safe_cell(visible(feedback)), words[diagnosis], safe_cell(visible(source)),
-                       numbers[minutes[index]], numbers[shares[index] or 0.0])
-
-    return csv_pieces(rows(), students_per_piece * max(1, len(columns)))
 
 
 INTEGRITY_HEADER = ("student_id", "label", "submitted", "parsed", "matches_id", "matches_value", "students_matched",
@@ -160,34 +126,5 @@ def _csv(rows: Iterable[Sequence[object]]) -> str:
 
 
 def _csv_pieces(rows: Iterable[Sequence[object]]) -> Iterator[str]:
-    """The CSV text of ``rows``, each value a report's cell (:func:`_cell`), in pieces written as they come."""
-    return csv_pieces([_cell(value) for value in row] for row in rows)
-
-
-def _cell(value: object) -> str:
-    """Text guarded against formulas; a number as its shortest exact text; None as empty."""
-    if value is None:
-        return ""
-    if isinstance(value, float):
-        return number_cell(value)
-    if isinstance(value, int):
-        return str(value)
-    return safe_cell(visible(str(value)))
-
-
-def _error(value: float | None) -> str:
-    """details.csv's ``abs_error`` or ``rel_error``, for people: 6 significant figures, as ``expected`` and
-    ``parsed`` (the verdict was decided on the numbers unrounded)."""
-    if value is None:
-        return ""
-    if not math.isfinite(value):
-        raise ValueError("a report cell is not a finite number")  # a bug: verdicts never hold one
-    return number_text(value)
-
-
-class _Cells(dict[object, str]):
-    """:func:`_cell` of each value, worked out once: for the columns that hold a few distinct values."""
-
-    def __missing__(self, value: object) -> str:
-        self[value] = _cell(value)
-        return self[value]
+    """The CSV text of ``rows``, each value a report's cell (:func:`report_cell`), in pieces written as they come."""
+    return csv_pieces([report_cell(value) for value in row] for row in rows)

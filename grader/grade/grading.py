@@ -11,10 +11,11 @@ pass; the verdicts are kept as rows of plain values (a class of 100,000 has a mi
 
 from __future__ import annotations
 
+import functools
+import itertools
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from datetime import datetime
-from functools import lru_cache
 from typing import Any, NamedTuple
 
 import numpy as np
@@ -344,30 +345,40 @@ class _Column:
 
 
 def _grade_column(cells: Sequence[tuple[KeyPart, Answer | None]], key: Key) -> _Column:
-    """A row for each (part, answer): outcomes decided cell by cell, numbers compared by group."""
+    """A row for each (part, answer): outcomes decided once per distinct text, numbers compared by group."""
     rows: list[Row | None] = [None] * len(cells)
     # The key's tolerance mappings, by value (a few distinct ones): the rule and its words. Rules equal but for
     # their reasons (widened alike for different reasons) are equal Tolerances: compared in one group.
     tolerances: dict[tuple[tuple[str, Any], ...], tuple[Tolerance, str]] = {}
     groups: dict[tuple[Tolerance, str], _Group] = {}
+    # What each distinct text typed for a number reads as (a class types a few thousand), by the part's unit and
+    # answer name, then by the text and the file's delimiter: nothing else decides it.
+    read: dict[tuple[str, str], dict[tuple[str, str], Outcome | CellNumber]] = {}
     mapping: Mapping[str, Any] | None = None
+    unit = name = None
     for index, (part, answer) in enumerate(cells):
-        if part.tolerance is not mapping:  # the key shares one mapping between equal rules: a column has a few
-            mapping = part.tolerance
+        if part.tolerance is not mapping or part.unit != unit or part.name != name:  # a column has a few of each
+            mapping, unit, name = part.tolerance, part.unit, part.name
             written = tuple(mapping.items())
             known = tolerances.get(written)
             if known is None:
                 tolerance = Tolerance.from_json(mapping)
                 known = tolerances[written] = (tolerance, tolerance.explained())
             rule, words = known
-        outcome = _outcome(part, answer, key)
+            group = None  # found at the first number: groups come in the order of their first numbers
+            readings = read.setdefault((unit, name), {})
+        value = part.value
+        if answer is None or value is None or isinstance(value, str):
+            outcome = _outcome(part, answer, key)
+        else:
+            typed = (answer.text, answer.delimiter)
+            outcome = readings.get(typed) or readings.setdefault(typed, _outcome(part, answer, key))
         if isinstance(outcome, CellNumber):
-            group = groups.get((rule, part.unit))
             if group is None:
-                group = groups[rule, part.unit] = _Group([], [], [], [], [])
+                group = groups.get((rule, unit)) or groups.setdefault((rule, unit), _Group([], [], [], [], []))
             group.members.append(index)
             group.submitted.append(outcome.value)
-            group.expected.append(float(part.value))  # type: ignore[arg-type]  # a number: not symbolic, not None
+            group.expected.append(float(value))  # type: ignore[arg-type]  # a number: not symbolic, not None
             group.typed.append(_converted(outcome, part, answer))
             group.words.append(words)
         else:
@@ -399,17 +410,26 @@ def _compare(cells: Sequence[tuple[KeyPart, Answer | None]], group: _Group, tole
     absolute, relative = errors(submitted, expected, angle_unit=angle)
     said = feedbacks(submitted, expected, unit, tolerance, right, angle_unit=angle, typed=typed)
     shown: dict[float, str] = {}  # the numbers a class typed: a few thousand
-    wrong = []
-    for index, value, key_value, ok, sentence, error, ratio, rule in zip(
-            members, submitted, expected, right.tolist(), said, absolute.tolist(), relative.tolist(), words,
-            strict=True):
-        part, answer = cells[index]
-        parsed = shown.get(value) or shown.setdefault(value, number_text(value))
-        rows[index] = _row(part, answer, number_text(key_value), rule, "correct" if ok else "incorrect",
-                           1.0 if ok else 0.0, sentence, parsed, error, ratio)
-        if not ok:
-            wrong.append(index)
-    return wrong
+    answers = [answer for _, answer in map(cells.__getitem__, members) if answer is not None]  # each one given
+    parts = [part for part, _ in map(cells.__getitem__, members)]
+    verdicts = right.tolist()
+    # The rows' fields a column at a time, zipped in Row's order (tuple.__new__: no Python call per row).
+    fields = zip([_shown_answer(answer.text) for answer in answers],
+                 ["correct" if ok else "incorrect" for ok in verdicts], [1.0 if ok else 0.0 for ok in verdicts],
+                 [part.points for part in parts], list(map(number_text, expected)),
+                 [shown.get(value) or shown.setdefault(value, number_text(value)) for value in submitted],
+                 [part.unit for part in parts], absolute.tolist(), relative.tolist(), words, said,
+                 itertools.repeat("", len(members)),
+                 [f"{answer.file}:{answer.line}" for answer in answers],
+                 strict=False)  # all of the group's length (repeat's too)
+    for index, row in zip(members, map(functools.partial(tuple.__new__, Row), fields), strict=True):
+        rows[index] = row
+    return [index for index, ok in zip(members, verdicts, strict=True) if not ok]
+
+
+def _shown_answer(text: str) -> str:
+    """An answer as a verdict shows it: a longer one than CELL_CHARS is invalid, its first characters say which."""
+    return cut(text, CELL_CHARS)
 
 
 def _outcome(part: KeyPart, answer: Answer | None, key: Key) -> Outcome | CellNumber:
@@ -436,8 +456,7 @@ def _outcome(part: KeyPart, answer: Answer | None, key: Key) -> Outcome | CellNu
 def _row(part: KeyPart, answer: Answer | None, expected: str, words: str, kind: str, credit: float, said: str,
          parsed: str = "", absolute: float | None = None, relative: float | None = None) -> Row:
     """The verdict's fields; ``expected``: what the key holds, in words; ``words``: the tolerance that decided it."""
-    # A longer answer than CELL_CHARS is invalid: its first characters say which.
-    shown_text = None if answer is None else cut(answer.text, CELL_CHARS)
+    shown_text = None if answer is None else _shown_answer(answer.text)
     source = "" if answer is None else f"{answer.file}:{answer.line}"
     # tuple.__new__: a million rows a class, and the named tuple's own __new__ is a Python call (~0.4 µs each).
     return tuple.__new__(Row, (shown_text, kind, credit, part.points, expected, parsed, part.unit, absolute, relative,
@@ -449,7 +468,7 @@ def _symbolic(part: KeyPart, text: str, delimiter: str, key: Key) -> Outcome:
     return symbolic_outcome(text, delimiter, domains, str(part.value), f"{key.title}/{part.label}")
 
 
-@lru_cache(maxsize=65536)
+@functools.lru_cache(maxsize=65536)
 def symbolic_outcome(text: str, delimiter: str, domains: tuple[tuple[str, tuple[float, float]], ...],
                      expected_text: str, seed: str) -> Outcome:
     """A symbolic answer's verdict, credit, sentence and what it was read as; ``domains``: where each name is
@@ -472,7 +491,7 @@ def symbolic_outcome(text: str, delimiter: str, domains: tuple[tuple[str, tuple[
     return "correct" if same else "incorrect", 1.0 if same else 0.0, said, cell.text
 
 
-@lru_cache(maxsize=65536)
+@functools.lru_cache(maxsize=65536)
 def _number(text: str, unit: str, delimiter: str, numeric_expressions: bool,
             names: tuple[str, ...]) -> CellBlank | CellInvalid | CellWrongUnit | CellNumber:
     return read_number(text, unit, delimiter=delimiter, numeric_expressions=numeric_expressions, names=names)

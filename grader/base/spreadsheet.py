@@ -16,16 +16,19 @@ begins).
 
 from __future__ import annotations
 
+import bisect
 import csv
 import io
 import itertools
 import math
+import operator
 import re
 from collections.abc import Iterable, Iterator, Sequence
 
 # A formula's first characters, their full-width forms (an East Asian keyboard's ＝, which a spreadsheet may
 # read as =) and small forms, and the guard's own.
 _GUARDED_START = frozenset("=+-@\t\r\n'" "\uff1d\uff0b\uff0d\uff20" "\ufe66\ufe62\ufe63\ufe6b")
+_FIRST = operator.itemgetter(slice(0, 1))  # a text's first character, or "" for ""
 # A negative number as a spreadsheet reads one, and nothing else: ASCII digits, a point, an exponent.
 _NEGATIVE_NUMBER = re.compile(r"-(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][-+]?[0-9]+)?")
 
@@ -44,6 +47,18 @@ def safe_cell(text: str) -> str:
     if text[:1] not in _GUARDED_START or _NEGATIVE_NUMBER.fullmatch(text):
         return text
     return "'" + text
+
+
+def safe_cells(texts: Sequence[str]) -> list[str]:
+    """:func:`safe_cell` of each text, called only for those that start with a character it guards.
+
+    >>> safe_cells(["Ana", "=1+1", "-0.369", ""])
+    ['Ana', "'=1+1", '-0.369', '']
+    """
+    firsts = list(map(_FIRST, texts))
+    if _GUARDED_START.isdisjoint(firsts):
+        return list(texts)
+    return [safe_cell(text) if first in _GUARDED_START else text for text, first in zip(texts, firsts, strict=True)]
 
 
 def original_cell(cell: str) -> str:
@@ -107,11 +122,19 @@ def csv_columns_text(columns: Sequence[Sequence[str]]) -> str:
 
 
 def _quoted(column: Sequence[str]) -> Sequence[str]:
-    """The cells of a column as the CSV writer writes them."""
-    if not _QUOTED.search("".join(column)):
+    """The cells of a column as the CSV writer writes them (``excel``'s dialect: a cell with a delimiter, quote or
+    line break is quoted, its quotes doubled); the cells to quote are found in one search of the column's
+    joined text (each place found is in the cell whose end comes next)."""
+    joined = "".join(column)
+    if not any(special in joined for special in _SPECIAL):  # most columns: a few fast scans
         return column
-    search = _QUOTED.search
-    return [csv_text([(cell, "")])[:-2] if search(cell) else cell for cell in column]
+    ends = list(itertools.accumulate(map(len, column)))
+    written = list(column)
+    for index in {bisect.bisect_right(ends, place.start()) for place in _QUOTED.finditer(joined)}:
+        written[index] = '"' + written[index].replace('"', '""') + '"'
+    return written
 
 
-_QUOTED = re.compile('[,"\n\r]')  # what a cell may hold that the writer quotes (\r: from Python 3.12)
+# What a cell may hold that the writer quotes, asked of the writer (a carriage return: from Python 3.12).
+_SPECIAL = tuple(special for special in (",", '"', "\n", "\r") if csv_text([(special, "")]).startswith('"'))
+_QUOTED = re.compile("[" + re.escape("".join(_SPECIAL)) + "]")

@@ -14,10 +14,10 @@ from __future__ import annotations
 import itertools
 import math
 import operator
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Callable, Iterable, Iterator, Sequence
 
 from grader.base.errors import visible
-from grader.base.spreadsheet import csv_columns_text, csv_text, number_cell, safe_cell
+from grader.base.spreadsheet import csv_columns_text, csv_text, number_cell, safe_cell, safe_cells
 from grader.grade.grading import Graded, Row
 
 DETAILS_HEADER = ("student_id", "label", "submitted", "verdict", "credit", "points", "score", "expected", "parsed",
@@ -56,7 +56,7 @@ def _label_cells(rows: Sequence[Row], numbers: _Cells, words: _Cells) -> list[li
     return [[], [], _texts(["" if text is None else text for text in submitted]), _mapped(verdict, words),
             _mapped(credit, numbers), _mapped(points, numbers),
             _mapped(list(map(operator.mul, credit, points)), numbers),
-            list(map(safe_cell, expected)), _texts(parsed), _mapped(unit, words), _errors(abs_error),
+            safe_cells(expected), _texts(parsed), _mapped(unit, words), _errors(abs_error),
             _errors(rel_error), _mapped(tolerance, words), _texts(feedback), _mapped(diagnosis, words),
             _texts(source), [], []]
 
@@ -70,8 +70,21 @@ def _texts(texts: Sequence[str]) -> list[str]:
     """Each text guarded and its control characters shown (``safe_cell(visible(text))``); the texts are checked
     for control characters in one call (most columns have none)."""
     if "".join(texts).isprintable():  # every text printable: visible() returns each as it is
-        return list(map(safe_cell, texts))
+        return safe_cells(texts)
     return [safe_cell(visible(text)) for text in texts]
+
+
+def report_pieces(rows: Iterable[Sequence[object]], rows_per_piece: int = 2000) -> Iterator[str]:
+    """The CSV text of ``rows``, each value a report's cell (:func:`report_cell`), in pieces of
+    ``rows_per_piece`` rows written as they come; a piece's cells a column at a time, where its rows are
+    equally long (a column of text checked for control characters in one call)."""
+    rows = iter(rows)
+    while piece := list(itertools.islice(rows, max(1, rows_per_piece))):
+        if len(set(map(len, piece))) > 1 or not piece[0]:  # rows of one length, and not empty, as columns
+            yield csv_text([list(map(report_cell, row)) for row in piece])
+        else:
+            yield csv_columns_text([_texts(column) if set(map(type, column)) == {str} else
+                                    list(map(report_cell, column)) for column in zip(*piece, strict=True)])
 
 
 def _mapped(values: Sequence[object], cells: _Cells) -> list[str]:

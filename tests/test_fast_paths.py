@@ -1,0 +1,195 @@
+"""The column-at-a-time paths of grading and its reports give the bytes the cell-at-a-time rules give.
+
+Each fast path is held against the rule it stands for, written here a cell at a time with the public pieces
+(``safe_cell``, ``visible``, ``number_cell``, ``number_text``, the CSV writer, ``read_number``, ``is_correct``,
+``errors``, :meth:`_Words.sentence`), on crafted inputs: every verdict kind, units, blanks, late work, and
+hostile text (formula starters, their full-width forms, control characters, bidi marks, quotes, commas, line
+breaks).
+"""
+
+from __future__ import annotations
+
+import math
+import random
+from collections.abc import Sequence
+
+import numpy as np
+import pytest
+
+from grader.base.errors import visible
+from grader.base.spreadsheet import csv_columns_text, csv_text, number_cell, safe_cell, safe_cells
+from grader.grade.cells import CellNumber, read_number
+from grader.grade.compare import _difference, _period, _Words, errors, feedback, is_correct, number_text
+from grader.grade.details_file import DETAILS_HEADER, details_csv, report_pieces
+from grader.grade.grading import Graded, LateWork, Row, _grade_column
+from grader.grade.key import Key, KeyPart, KeyProblem, KeyStudent
+from grader.grade.latest import Answer
+from grader.model.tolerance import Tolerance
+
+HOSTILE = ["=1+1", "+1", "-1+1", "@SUM(A1)", "\uff1dHYPERLINK(1)", "\ufe62x", "'quoted", "\tx", "\rx", "\nx",
+           "a\x1b[31mred", "v\u202e2", "\u2066iso", 'say "hi"', "6,26", "two\nlines", "cr\rhere", "-0.369",
+           "-1.5e-07", "", " ", "é ü", "\x00nul", "a,\"b\",\nc", "\xa0nbsp", "-", "=", "'"]
+
+
+def cell_rule(value: object) -> str:
+    """A report's cell, a cell at a time: text guarded with control characters shown, numbers shortest."""
+    if value is None:
+        return ""
+    if isinstance(value, float):
+        return number_cell(value)
+    if isinstance(value, int):
+        return str(value)
+    return safe_cell(visible(str(value)))
+
+
+def error_rule(value: float | None) -> str:
+    return "" if value is None else number_text(value)
+
+
+def details_rule(graded: Graded) -> str:
+    """details.csv a row at a time, each cell by its rule, through the CSV writer."""
+    late = graded.late
+    rows: list[Sequence[object]] = [DETAILS_HEADER]
+    for index, student in enumerate(graded.key.students):
+        for label in graded.key.labels:
+            row = graded.columns[label][index]
+            minutes = late.minutes[label][index] if late else None
+            share = late.shares[label][index] if late else None
+            rows.append((safe_cell(student.id), safe_cell(label),
+                         "" if row.submitted is None else safe_cell(visible(row.submitted)), cell_rule(row.verdict),
+                         cell_rule(row.credit), cell_rule(row.points), cell_rule(row.credit * row.points),
+                         safe_cell(row.expected), safe_cell(visible(row.parsed)), cell_rule(row.unit),
+                         error_rule(row.abs_error), error_rule(row.rel_error), cell_rule(row.tolerance),
+                         safe_cell(visible(row.feedback)), cell_rule(row.diagnosis), safe_cell(visible(row.source)),
+                         cell_rule(minutes), cell_rule(share or 0.0)))
+    return csv_text(rows)
+
+
+KINDS = [("correct", 1.0), ("ecf", 0.5), ("mistake", 0.25), ("incorrect", 0.0), ("invalid", 0.0), ("missing", 0.0)]
+
+
+def crafted_class(students: int, late: bool, seed: int = 7) -> Graded:
+    """A class whose rows take every verdict kind and hostile text in every text field."""
+    rng = random.Random(seed)
+    labels = ("1a", "=1b", "1,c")
+    tolerance = {"mode": "rtol", "rtol": 0.01, "atol": 0.0}
+    people = [KeyStudent(rng.choice([f"s{index}", f"=s{index}", f"-{index}", f"s\n{index}"]), "", "", "1",
+                         {label: KeyPart("1", f"x{label}", label, 1.5, "m/s", 2.0, tolerance, None, {})
+                          for label in labels}) for index in range(students)]
+    key = Key("key.json", 2, "HW", True, (KeyProblem("1", "Drop", labels),), tuple(people))
+
+    def row() -> Row:
+        kind, credit = rng.choice(KINDS)
+        number = rng.choice([None, 0.0, -0.0, 1.5, -2.25e-7, 123456789.0, 1e300, 3.0000000000000004])
+        return Row(None if kind == "missing" else rng.choice([*HOSTILE, "1.5", "-1.5 m/s"]), kind, credit,
+                   rng.choice([1.0, 2.0, 0.5]), rng.choice(["1.5", "-1.5", "=x", "undefined (no value)"]),
+                   rng.choice(["", "1.5", "-1.5", *HOSTILE]), rng.choice(["m/s", "", "=u", "°"]), number,
+                   None if number is None else abs(number) / 3, rng.choice(["±1 %", "±1 %, widened", "=t"]),
+                   rng.choice([*HOSTILE, "1.5 m/s is 0.1 % below 1.5015 m/s; within ±1 % is accepted"]),
+                   rng.choice(["", "ecf:1a", "impact.e_squared", "=d"]), rng.choice(["a.csv:2", "=a.csv:3", "b\x1b:4"]))
+
+    columns = {label: [row() for _ in people] for label in labels}
+    work = None
+    if late:
+        work = LateWork({label: [rng.choice([None, 0, 5, 1440]) for _ in people] for label in labels},
+                        {label: [rng.choice([0.0, 0.25, 1.0 / 3]) for _ in people] for label in labels}, {})
+    return Graded(key, columns, (), (), (), late=work)
+
+
+@pytest.mark.parametrize(("students", "late", "piece"),
+                         [(40, False, 2000), (40, True, 7), (13, True, 1), (0, False, 3)])
+def test_details_csv_is_the_cell_at_a_time_rule(students: int, late: bool, piece: int) -> None:
+    graded = crafted_class(students, late)
+    assert "".join(details_csv(graded, piece)) == details_rule(graded)
+
+
+def test_report_pieces_are_the_cell_at_a_time_rule() -> None:
+    """Mixed columns (text, numbers, None) and rows of another length, in pieces of a few rows."""
+    rng = random.Random(3)
+    values: list[object] = [*HOSTILE, None, 0, 7, 2.0, -0.0, 0.1 + 0.2, 1e20, "yes"]
+    rows: list[Sequence[object]] = [[rng.choice(values) for _ in range(5)] for _ in range(60)]
+    rows += [["only", "three", None], [1, 2.5, "x", "y", "z"], ["a", "b", "c", "d", "e"]]
+    rows.append([rng.choice(HOSTILE) for _ in range(5)])
+    expected = csv_text([[cell_rule(value) for value in row] for row in rows])
+    for piece in (1, 4, 1000):
+        assert "".join(report_pieces(rows, piece)) == expected
+
+
+def test_columns_are_written_as_the_csv_writer_writes_rows() -> None:
+    rng = random.Random(11)
+    alphabet = ["a", ",", '"', "\n", "\r", "=", " ", "é", "\x00", "'", "\u202e"]
+    for _ in range(500):
+        width, height = rng.randint(2, 4), rng.randint(0, 4)
+        columns = [["".join(rng.choice(alphabet) for _ in range(rng.randint(0, 4))) for _ in range(height)]
+                   for _ in range(width)]
+        assert csv_columns_text(columns) == csv_text(list(zip(*columns, strict=True)))
+    assert csv_columns_text([["", "x"]]) == csv_text([[""], ["x"]])  # one column: a row of one empty cell is ""
+
+
+def test_safe_cells_is_safe_cell_of_each() -> None:
+    texts = [*HOSTILE, "Ana", "1.5", "-0.5 m/s is 3 % above"]
+    assert safe_cells(texts) == [safe_cell(text) for text in texts]
+    assert safe_cells(["Ana", "Bo"]) == ["Ana", "Bo"]
+
+
+SENTENCE_CASES = [Tolerance(), Tolerance(rtol=0.05), Tolerance(atol=0.5), Tolerance(rtol=0, atol=0.5),
+                  Tolerance("sigfigs", digits=3), Tolerance("decimals", digits=2)]
+
+
+@pytest.mark.parametrize("tolerance", SENTENCE_CASES)
+@pytest.mark.parametrize("angle", [None, "deg"])
+def test_feedback_sentences_are_each_sentence(tolerance: Tolerance, angle: str | None) -> None:
+    """The percentage sentences written for a column are :meth:`_Words.sentence`'s, word for word."""
+    rng = np.random.default_rng(5)
+    key = np.concatenate([rng.normal(0, 10, 60), [0.0, -0.0, 1e-300, 1e300, 6.26, 6.26, 350.0, math.inf, math.nan]])
+    submitted = np.concatenate([key[:60] * rng.choice([1.0, 1.004, 0.98, -1.0, 1 + 1e-16], 60),
+                                [0.0, 1.0, 5e-301, 1.7e308, 6.3226, 6.26, -10.0, 1.0, 2.0]])
+    right = is_correct(submitted, key, tolerance, angle_unit=angle)
+    typed: list[str | None] = [None] * len(key)
+    typed[3] = "17.0 mph"
+    unit = "m/s" if angle is None else angle
+    words = _Words(tolerance, unit, _period(angle))
+    with np.errstate(all="ignore"):
+        distances = _difference(submitted, key, words.period)
+    expected = [words.sentence(s, t, d, ok, text) for s, t, d, ok, text in
+                zip(submitted.tolist(), key.tolist(), distances.tolist(), right.tolist(), typed, strict=True)]
+    fresh = _Words(tolerance, unit, _period(angle))  # its own cache of the numbers said
+    assert fresh.sentences(submitted, key, distances, right, typed) == expected
+
+
+NUMBER_TEXTS = ["1.5", "1.49", "1,5", "-1.5", "150 cm/s", "1.5 m/s", "5.4 km/h", "1.5 kg", "abc", "", "=1+1",
+                "1.5e0", "3/2", "1.5\x1b", "1.5 or 1.6", "  1.5  ", "0", "1e400", "-0"]
+
+
+def test_a_column_grades_each_cell_as_its_rule_says() -> None:
+    """_grade_column (texts read once per distinct text, rows built a field at a time) against each cell
+    graded on its own by the public rules: the number read, the verdict, errors and sentence, the source."""
+    tolerance = {"mode": "rtol", "rtol": 0.01, "atol": 0.0}
+    wide = {"mode": "rtol", "rtol": 0.05, "atol": 0.0}
+    parts = [KeyPart("1", "v", "1a", value, "m/s", 2.0, rule, None, {})
+             for value in (1.5, -1.5, 1.52) for rule in (tolerance, wide)]
+    cells = [(parts[index % len(parts)], None if text is None else
+              Answer("a.csv", index + 2, f"s{index}", "1a", text, ";" if index % 3 else ",", None))
+             for index, text in enumerate([*NUMBER_TEXTS, *NUMBER_TEXTS[::-1], None])]
+    key = Key("key.json", 2, "HW", True, (KeyProblem("1", "Drop", ("1a",)),), ())
+    column = _grade_column(cells, key)
+    for (part, answer), row in zip(cells, column.rows, strict=True):
+        assert row.points == part.points and row.unit == "m/s" and row.diagnosis == ""
+        if answer is None:
+            assert (row.submitted, row.verdict, row.source) == (None, "missing", "")
+            continue
+        assert row.source == f"a.csv:{answer.line}" and row.submitted == answer.text
+        read = read_number(answer.text, "m/s", delimiter=answer.delimiter, names=("v", "1a"))
+        if not isinstance(read, CellNumber):
+            assert row.verdict in ("missing", "invalid", "incorrect") and row.abs_error is None
+            continue
+        rule, value = Tolerance.from_json(part.tolerance), float(part.value)  # type: ignore[arg-type]  # numbers
+        right = bool(is_correct(read.value, value, rule))
+        absolute, relative = errors(read.value, value)
+        typed = None if read.unit_given in (None, "m/s") else " ".join(answer.text.split())
+        said = _Words(rule, "m/s", None).sentence(read.value, value, read.value - value, right, typed)
+        if typed is None:
+            assert said == feedback(read.value, value, "m/s", rule, right)
+        assert row == Row(answer.text, "correct" if right else "incorrect", 1.0 if right else 0.0, 2.0,
+                          number_text(value), number_text(read.value), "m/s", float(absolute), float(relative),
+                          rule.explained(), said, "", row.source)

@@ -414,17 +414,19 @@ def _compare(cells: Sequence[tuple[KeyPart, Answer | None]], group: _Group, tole
     parts = [part for part, _ in map(cells.__getitem__, members)]
     verdicts = right.tolist()
     # The rows' fields a column at a time, zipped in Row's order (tuple.__new__: no Python call per row).
-    fields = zip([_shown_answer(answer.text) for answer in answers],
-                 ["correct" if ok else "incorrect" for ok in verdicts], [1.0 if ok else 0.0 for ok in verdicts],
-                 [part.points for part in parts], list(map(number_text, expected)),
+    fields = zip([answer.text if len(answer.text) <= CELL_CHARS else _shown_answer(answer.text) for answer in answers],
+                 map(_KINDS.__getitem__, verdicts), map(_CREDITS.__getitem__, verdicts),
+                 [part.points for part in parts], [f"{value + 0.0:.6g}" for value in expected],  # number_text's
                  [shown.get(value) or shown.setdefault(value, number_text(value)) for value in submitted],
                  [part.unit for part in parts], absolute.tolist(), relative.tolist(), words, said,
-                 itertools.repeat("", len(members)),
-                 [f"{answer.file}:{answer.line}" for answer in answers],
+                 itertools.repeat("", len(members)), [f"{answer.file}:{answer.line}" for answer in answers],
                  strict=False)  # all of the group's length (repeat's too)
     for index, row in zip(members, map(functools.partial(tuple.__new__, Row), fields), strict=True):
         rows[index] = row
     return [index for index, ok in zip(members, verdicts, strict=True) if not ok]
+
+
+_KINDS, _CREDITS = {True: "correct", False: "incorrect"}, {True: 1.0, False: 0.0}  # a number's verdict
 
 
 def _shown_answer(text: str) -> str:

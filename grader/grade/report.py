@@ -24,7 +24,7 @@ from grader.grade.class_report import REPORT, class_report
 from grader.grade.compare import number_text
 from grader.grade.details_file import details_csv, report_pieces
 from grader.grade.grading import Graded, final_scores, lateness, totals
-from grader.grade.integrity import Integrity, Pair, check
+from grader.grade.integrity import Integrity, check
 
 GRADES, DETAILS, PROBLEMS, CANVAS = "grades.csv", "details.csv", "problems.csv", "canvas.csv"
 INTEGRITY = "integrity.csv"
@@ -74,28 +74,20 @@ def integrity_csv(graded: Graded, integrity: Integrity) -> Iterator[str]:
     no grade."""
     students = graded.key.students
     flagged = set(integrity.flagged)
-    by_pair: dict[tuple[int, int], list[object]] = {}  # a pair's figures, on each of its rows: worked out once
 
     def rows() -> Iterator[Sequence[object]]:
         yield INTEGRITY_HEADER
         for match in integrity.matches:
             row = graded.columns[match.label][match.student]
-            figures = by_pair.get((match.student, match.partner))
-            if figures is None:
-                figures = by_pair[match.student, match.partner] = _pair_figures(
-                    integrity.pair(match.student, match.partner), flagged)
+            pair = integrity.pair(match.student, match.partner)
+            figures: list[object] = [None] * 8 if pair is None else [
+                len(pair.labels), " ".join(pair.labels), pair.wrong, pair.closest,
+                number_cell(pair.closeness, 3) if math.isfinite(pair.closeness) else None, _chance(pair.chance),
+                _chance(pair.corrected), "yes" if pair in flagged else "no"]
             yield [students[match.student].id, match.label, row.submitted, row.parsed, students[match.partner].id,
                    number_text(match.value), match.matches, *figures]
 
     return _csv_pieces(rows())
-
-
-def _pair_figures(pair: Pair | None, flagged: set[Pair]) -> list[object]:
-    """integrity.csv's figures of a pair (empty: not listed)."""
-    return [None] * 8 if pair is None else [
-        len(pair.labels), " ".join(pair.labels), pair.wrong, pair.closest,
-        number_cell(pair.closeness, 3) if math.isfinite(pair.closeness) else None, _chance(pair.chance),
-        _chance(pair.corrected), "yes" if pair in flagged else "no"]
 
 
 def _chance(value: float) -> str:

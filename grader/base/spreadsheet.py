@@ -123,18 +123,26 @@ def csv_columns_text(columns: Sequence[Sequence[str]]) -> str:
 
 def _quoted(column: Sequence[str]) -> Sequence[str]:
     """The cells of a column as the CSV writer writes them (``excel``'s dialect: a cell with a delimiter, quote or
-    line break is quoted, its quotes doubled); the cells to quote are found in one search of the column's
-    joined text (each place found is in the cell whose end comes next)."""
+    line break is quoted, its quotes doubled); the cells to quote are found by searching the column's joined
+    text (each place found is in the cell whose end comes next)."""
     joined = "".join(column)
-    if not any(special in joined for special in _SPECIAL):  # most columns: a few fast scans
+    places = [place for special in _SPECIAL for place in _places(joined, special)]
+    if not places:  # most columns
         return column
     ends = list(itertools.accumulate(map(len, column)))
     written = list(column)
-    for index in {bisect.bisect_right(ends, place.start()) for place in _QUOTED.finditer(joined)}:
+    for index in {bisect.bisect_right(ends, place) for place in places}:
         written[index] = '"' + written[index].replace('"', '""') + '"'
     return written
 
 
+def _places(text: str, special: str) -> Iterator[int]:
+    """Where ``special`` is in ``text`` (str.find: faster than a regular expression over a long text)."""
+    place = text.find(special)
+    while place >= 0:
+        yield place
+        place = text.find(special, place + 1)
+
+
 # What a cell may hold that the writer quotes, asked of the writer (a carriage return: from Python 3.12).
 _SPECIAL = tuple(special for special in (",", '"', "\n", "\r") if csv_text([(special, "")]).startswith('"'))
-_QUOTED = re.compile("[" + re.escape("".join(_SPECIAL)) + "]")

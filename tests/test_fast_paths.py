@@ -18,7 +18,7 @@ import pytest
 
 from grader.base.errors import visible
 from grader.base.spreadsheet import csv_columns_text, csv_text, number_cell, safe_cell, safe_cells
-from grader.grade.cells import CellNumber, read_number
+from grader.grade.cells import _DECIMAL, CellNumber, _read_number, read_number
 from grader.grade.compare import _difference, _period, _Words, errors, feedback, is_correct, number_text
 from grader.grade.details_file import DETAILS_HEADER, details_csv, report_pieces
 from grader.grade.grading import Graded, LateWork, Row, _grade_column
@@ -193,3 +193,21 @@ def test_a_column_grades_each_cell_as_its_rule_says() -> None:
         assert row == Row(answer.text, "correct" if right else "incorrect", 1.0 if right else 0.0, 2.0,
                           number_text(value), number_text(read.value), "m/s", float(absolute), float(relative),
                           rule.explained(), said, "", row.source)
+
+
+def test_a_plain_decimal_is_read_as_every_step_reads_it() -> None:
+    """read_number's shortcut for ``6.26`` and ``-0.369`` gives what the full reading gives, whatever the
+    file's delimiter, the unit and the names (a label ``1`` before ``1.5`` is no prefix)."""
+    rng = random.Random(17)
+    texts = ["0", "-0", "0.0", "007", "1.5", "-1.5", "1" * 15, "9" * 15 + "." + "9" * 15, "0.000000000000001",
+             "1.000", "-0.369", "123456789012345.5"]
+    texts += [("-" if rng.random() < 0.3 else "") + str(rng.randint(0, 10 ** rng.randint(1, 15)))
+              + ("." + str(rng.randint(0, 10 ** rng.randint(1, 15))) if rng.random() < 0.8 else "") for _ in range(300)]
+    for text in texts:
+        assert _DECIMAL.fullmatch(text), text
+        for delimiter, unit, names in ((",", "m/s", ("v", "1a")), (";", "", ("1", "1")),
+                                       ("\t", "deg", ("theta", "2b"))):
+            assert read_number(text, unit, delimiter=delimiter, names=names) == _read_number(
+                text, unit, delimiter, True, names), text
+    for text in ("1,5", "1.5e3", " 1.5", "+1.5", "1.", ".5", "1.5 m", "1" * 16):
+        assert not _DECIMAL.fullmatch(text)

@@ -75,6 +75,8 @@ _SUPERSCRIPT_RUN = re.compile("[⁰¹²³⁴⁵⁶⁷⁸⁹⁻⁺]+")
 _UNDEFINED = frozenset({"", "undefined", "none", "n/a", "-", "no direction"})
 
 _NUM = r"(?>\d+(?:\.\d*)?|\.\d+)"  # atomic: no backtracking on long runs of digits
+# A plain decimal as most answers are typed: no spaces, unit, exponent or comma, digits few enough to be finite.
+_DECIMAL = re.compile(r"-?[0-9]{1,15}(?:\.[0-9]{1,15})?")
 _PLAIN = re.compile(rf"(?P<sign>[-+]?)\s*(?P<digits>{_NUM}(?>[eE][-+]?\d+)?)")
 _SCIENTIFIC = re.compile(rf"(?P<sign>[-+]?)\s*(?P<mantissa>{_NUM})\s*[×xX*·]\s*10\s*(?:\^|\*\*)\s*"
                          r"(?P<open>\(?)\s*(?P<exponent>[-+]?\d+)\s*(?P<close>\)?)")
@@ -104,6 +106,14 @@ def read_number(text: str, unit: str, *, delimiter: str = ",", numeric_expressio
     >>> read_number("6.2 or 6.3", "m")
     CellInvalid(reason='two numbers (6.2 or 6.3); give one answer')
     """
+    if _DECIMAL.fullmatch(text):  # the usual answer (6.26, -0.369): what the steps below read it as, at once
+        return CellNumber(float(text) + 0.0, None)
+    return _read_number(text, unit, delimiter, numeric_expressions, names)
+
+
+def _read_number(text: str, unit: str, delimiter: str, numeric_expressions: bool,
+                 names: Sequence[str]) -> CellBlank | CellInvalid | CellWrongUnit | CellNumber:
+    """:func:`read_number`, every step."""
     cleaned = _clean(text)
     if not isinstance(cleaned, str):
         return cleaned

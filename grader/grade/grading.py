@@ -155,6 +155,7 @@ def grade(key: Key, submissions: Submissions, physics: Physics | None = None) ->
     numbers: dict[str, np.ndarray] = {}
     stamps: dict[str, list[datetime | None]] = {}
     everyone = np.arange(len(key.students))
+    timed = _timed(key)  # else no answer's lateness is measured: its timestamp is not kept
     for problem in key.problems:
         earlier: list[Earlier] = []
         for label in problem.labels:
@@ -162,7 +163,8 @@ def grade(key: Key, submissions: Submissions, physics: Physics | None = None) ->
             cells = [(student.parts[label], answers.get(student.id)) for student in key.students]
             columns[label], numbers[label] = _grade_label(cells, key, everyone, physics.problems.get(problem.key),
                                                           earlier)
-            stamps[label] = [None if answer is None else answer.timestamp for _, answer in cells]
+            if timed:
+                stamps[label] = [None if answer is None else answer.timestamp for _, answer in cells]
     late, notes = _late_work(key, columns, stamps)
     return Graded(key, columns, (*submissions.problems, *problems), submissions.ignored_columns,
                   (*submissions.notes, *physics.notes, *notes), mistake_words(key, physics), late, numbers)
@@ -222,11 +224,16 @@ def _best(key: Key, label: str, answers: Mapping[str, list[Answer]], physics: Pr
     return chosen
 
 
+def _timed(key: Key) -> bool:
+    """Whether the key has due times (the assignment's, or a student's own)."""
+    return key.deadline is not None or any(student.due for student in key.students)
+
+
 def _late_work(key: Key, columns: Mapping[str, Sequence[Row]],
                stamps: Mapping[str, Sequence[datetime | None]]) -> tuple[LateWork | None, list[str]]:
     """How late each answer was and what the key's late policy takes for it (:mod:`grader.grade.lateness`),
     and notes (answers whose lateness is not known); None for a key without due times."""
-    if key.deadline is None and not any(student.due for student in key.students):
+    if not _timed(key):
         return None, []
     policy, everyone = key.late, range(len(key.students))
     dues = [_due(key, index) for index in everyone]

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import functools
 import itertools
+from collections import Counter
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from datetime import datetime
@@ -545,6 +546,14 @@ def counts(graded: Graded) -> dict[str, int]:
     """How many verdicts of each kind."""
     found = dict.fromkeys(VERDICTS, 0)
     for rows in graded.columns.values():
-        for row in rows:
-            found[row.verdict] += 1
+        for verdict, count in Counter(row.verdict for row in rows).items():
+            found[verdict] += count
+    return found
+
+
+def answered(graded: Graded) -> list[bool]:
+    """Per student of the key, in its order, whether they answered any part (submitted anything)."""
+    found = [False] * len(graded.key.students)
+    for rows in graded.columns.values():
+        found = [known or row.submitted is not None for known, row in zip(found, rows, strict=True)]
     return found

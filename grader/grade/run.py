@@ -21,7 +21,7 @@ from grader.base.heap import collector_paused
 from grader.grade.canvas import CanvasExport, read_export
 from grader.grade.canvas_file import CanvasFile, canvas_file
 from grader.grade.diagnosis import physics_for
-from grader.grade.grading import Graded, counts, final_scores, grade
+from grader.grade.grading import Graded, answered, counts, final_scores, grade
 from grader.grade.key import Key, load_key
 from grader.grade.report import write_reports
 from grader.grade.submissions import StudentRef, read_submissions
@@ -110,16 +110,13 @@ def _graded(key: Key, paths: Sequence[Path], fmt: Literal["auto", "long", "wide"
 
 def _canvas(graded: Graded, export: CanvasExport | None, missing: str | None) -> CanvasFile:
     """``canvas.csv`` of a run: who submitted anything is who has an answer to any part."""
-    columns = graded.columns.values()
-    submitted = {student.id for index, student in enumerate(graded.key.students)
-                 if any(rows[index].submitted is not None for rows in columns)}
+    submitted = {student.id for student, gave in zip(graded.key.students, answered(graded), strict=True) if gave}
     return canvas_file(graded.key, final_scores(graded), submitted, export, missing)
 
 
 def _summary(graded: Graded, out: Path, started: float, canvas: CanvasFile) -> GradeSummary:
-    students, columns = range(len(graded.key.students)), graded.columns.values()
-    answered = sum(any(rows[index].submitted is not None for rows in columns) for index in students)
-    return GradeSummary(out, len(students), answered, len(students) * len(graded.columns),
+    students = len(graded.key.students)
+    return GradeSummary(out, students, sum(answered(graded)), students * len(graded.columns),
                         sum(problem.rows for problem in graded.problems if problem.not_graded),
                         sum(problem.rows for problem in graded.problems if problem.routine), counts(graded),
                         graded.ignored_columns, (*graded.notes, *canvas.notes),

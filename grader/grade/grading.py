@@ -387,7 +387,7 @@ def _grade_column(cells: Sequence[tuple[KeyPart, Answer | None]], key: Key) -> _
             group.members.append(index)
             group.submitted.append(outcome.value)
             group.expected.append(float(value))  # type: ignore[arg-type]  # a number: not symbolic, not None
-            group.typed.append(_converted(outcome, part, answer))
+            group.typed.append(None if outcome.unit_given in (None, unit) else _converted(outcome, part, answer))
             group.words.append(words)
         else:
             rows[index] = _row(part, answer, _expected(part), EQUAL_EXPRESSIONS if part.symbolic else words,

@@ -41,10 +41,12 @@ def _read(path: Path, attempts: str = "latest") -> Submissions:
     return read_submissions([path], STUDENTS, LABELS, attempts=attempts)
 
 
+@pytest.mark.parametrize("piece", [65536, 1])  # rows read a piece at a time: a student's label twice across pieces
 @pytest.mark.parametrize("attempts", ["latest", "first", "best"])
 @pytest.mark.parametrize("name", [*PLAIN, *ROW_BY_ROW])
 def test_the_plain_reading_reads_what_the_row_by_row_reading_reads(tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
-                                                                   name: str, attempts: str) -> None:
+                                                                   name: str, attempts: str, piece: int) -> None:
+    monkeypatch.setattr(submissions, "_PLAIN_PIECE", piece)
     path = tmp_path / "answers.csv"
     path.write_bytes((PLAIN | ROW_BY_ROW)[name].encode("utf-8"))
     used = []

@@ -151,21 +151,28 @@ def _plain_answers(table: CsvStream, layout: Layout, ids: Container[str], labels
     header, known = table.header, set(labels)
     width, student, label, answer = (len(header), header.index(layout.student), header.index(layout.label),
                                      header.index(layout.answer))
-    records = list(table.records())
-    if not records:
-        return []
-    lines, rows = zip(*records, strict=True)
-    if set(map(len, rows)) != {width} or max(map(len, itertools.chain.from_iterable(rows))) > CELL_CHARS:
-        return None
-    # A column at a time (a file of a million rows): each cell of the three columns stripped, as _Reader does.
-    who, part = list(map(str.strip, map(itemgetter(student), rows))), list(map(str.strip, map(itemgetter(label), rows)))
-    if not (all(map(ids.__contains__, who)) and known.issuperset(part) and len(set(zip(who, part, strict=True)))
-            == len(rows)):
-        return None
-    texts = map(str.strip, map(itemgetter(answer), rows))
-    # tuple.__new__: the named tuple's own __new__ is a Python call per answer.
-    return list(map(functools.partial(tuple.__new__, Answer), zip(
-        itertools.repeat(name), lines, who, part, texts, itertools.repeat(table.delimiter), itertools.repeat(None))))
+    answers: list[Answer] = []
+    seen: set[tuple[str, str]] = set()
+    records = table.records()
+    # A piece of rows at a time (a file of a million rows is not held as cells beside its answers), each check
+    # and each cell of the three columns (stripped, as _Reader strips them) a column at a time.
+    while piece := list(itertools.islice(records, _PLAIN_PIECE)):
+        lines, rows = zip(*piece, strict=True)
+        if set(map(len, rows)) != {width} or max(map(len, itertools.chain.from_iterable(rows))) > CELL_CHARS:
+            return None
+        who = list(map(str.strip, map(itemgetter(student), rows)))
+        part = list(map(str.strip, map(itemgetter(label), rows)))
+        seen.update(zip(who, part, strict=True))
+        if not (all(map(ids.__contains__, who)) and known.issuperset(part) and len(seen) == len(answers) + len(rows)):
+            return None
+        texts = map(str.strip, map(itemgetter(answer), rows))
+        # tuple.__new__: the named tuple's own __new__ is a Python call per answer.
+        answers += map(functools.partial(tuple.__new__, Answer), zip(
+            itertools.repeat(name), lines, who, part, texts, itertools.repeat(table.delimiter), itertools.repeat(None)))
+    return answers
+
+
+_PLAIN_PIECE = 65536  # rows
 
 
 def _refuse_repeated(paths: Sequence[Path]) -> None:

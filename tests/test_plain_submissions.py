@@ -41,8 +41,8 @@ def _read(path: Path, attempts: str = "latest") -> Submissions:
     return read_submissions([path], STUDENTS, LABELS, attempts=attempts)
 
 
-@pytest.mark.parametrize("piece", [65536, 1])  # rows read a piece at a time: a student's label twice across pieces
-@pytest.mark.parametrize("attempts", ["latest", "first", "best"])
+# Rows read a piece at a time: a piece of one row, where a student's label twice is in two pieces.
+@pytest.mark.parametrize(("attempts", "piece"), [("latest", 65536), ("first", 65536), ("best", 65536), ("latest", 1)])
 @pytest.mark.parametrize("name", [*PLAIN, *ROW_BY_ROW])
 def test_the_plain_reading_reads_what_the_row_by_row_reading_reads(tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
                                                                    name: str, attempts: str, piece: int) -> None:

@@ -19,21 +19,21 @@ safeguard), and every partner of an angle's part (its chance has no related kind
 the student's own value is not read (zero, none), are searched over the whole range, as before.
 
 >>> window(np.array([0.0, 0.5, 1.0]), np.array([0.0, 1.0, 2.0]), np.array([1.0]), np.array([0.3]))
-(array([0.5]), array([inf]))
+(array([0.85]), array([inf]))
 """
 
 from __future__ import annotations
 
 import math
 from collections.abc import Iterator, Mapping, Sequence
-from typing import NamedTuple
+from typing import Literal, NamedTuple
 
 import numpy as np
 import numpy.typing as npt
 
 from grader.grade.compare import errors
 from grader.grade.integrity_chance import UNRELATED, Spread
-from grader.grade.integrity_search import Bands, Floats, Ints, accepts, blocks, expanded
+from grader.grade.integrity_search import Bands, Floats, Ints, accepts, blocks, expanded, range_least
 
 MARGIN = 2.0  # the bound is loosened by this factor against floating-point rounding in the chances
 WIDEN = 1e-9  # each window's ends are moved out by this share of their size, against rounding in log and exp
@@ -42,13 +42,35 @@ WIDEN = 1e-9  # each window's ends are moved out by this share of their size, ag
 def window(grid: Floats, table: Floats, at: Floats, mass: Floats) -> tuple[Floats, Floats]:
     """Per point ``at`` (on the grid's scale), the widest interval around it outside which a cumulative
     distribution ``table`` (on ``grid``, linear between) has at least ``mass`` between the point and any point:
-    ``-inf`` / ``inf`` where the distribution has not so much on that side."""
+    ``-inf`` / ``inf`` where the distribution has not so much on that side.
+
+    >>> window(np.array([0.0, 0.5, 1.0]), np.array([0.0, 1.0, 2.0]), np.array([1.0, 0.5]), np.array([0.3, 1.5]))
+    (array([0.85, -inf]), array([inf, inf]))
+    """
     level = np.interp(at, grid, table)
-    below = np.searchsorted(table, level - mass, side="right") - 1
-    above = np.searchsorted(table, level + mass, side="left")
-    low = np.where(below >= 0, grid[np.clip(below, 0, len(grid) - 1)], -np.inf)
-    high = np.where(above < len(table), grid[np.clip(above, 0, len(grid) - 1)], np.inf)
-    return np.minimum(low, at), np.maximum(high, at)
+    return (np.minimum(_inverse(grid, table, level - mass, "right"), at),
+            np.maximum(_inverse(grid, table, level + mass, "left"), at))
+
+
+def _inverse(grid: Floats, table: Floats, level: Floats, side: Literal["left", "right"]) -> Floats:
+    """Where the piecewise linear ``table`` reaches ``level``: for ``right``, the highest point at or below
+    which it is at most ``level`` (-inf: none); for ``left``, the lowest at or above which it is at least
+    ``level`` (inf: none)."""
+    found = np.searchsorted(table, level, side=side)
+    if side == "right":  # table[k] <= level < table[k + 1]
+        below = found - 1
+        inside = (below >= 0) & (below < len(table) - 1)
+        k = np.clip(below, 0, len(table) - 2)
+        edge = np.where(below >= 0, np.inf, -np.inf)  # past the last point: the table is flat at its end
+    else:  # table[k - 1] < level <= table[k]
+        k = np.clip(found - 1, 0, len(table) - 2)
+        inside = (found >= 1) & (found < len(table))
+        edge = np.where(found < len(table), -np.inf, np.inf)
+    rise = table[k + 1] - table[k]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        share = np.clip(np.where(rise > 0, (level - table[k]) / rise, 0.0 if side == "right" else 1.0), 0.0, 1.0)
+    point = grid[k] + share * (grid[k + 1] - grid[k])
+    return np.where(inside, point, edge)
 
 
 def centres_window(part: Bands, spread: Spread, owners: Ints, numbers: Floats, least: Floats) -> tuple[Floats, Floats]:
@@ -84,13 +106,16 @@ def centres_window(part: Bands, spread: Spread, owners: Ints, numbers: Floats, l
 
 
 class Typed:
-    """A part's right answers as typed, sorted (the other centre a closeness is read from), and the students
-    whose typed right answer lies outside their own band (searched whole)."""
+    """A part's right answers as typed, sorted (the other centre a closeness is read from; those typed as the
+    value is are found by it), and the students whose typed right answer lies outside their own band (searched
+    whole)."""
 
     def __init__(self, part: Bands, right: Floats) -> None:
-        have = np.flatnonzero(np.isfinite(right) & np.isfinite(part.values) & np.isfinite(part.reach))
-        self.order = have[np.argsort(right[have], kind="stable")]
-        self.sorted = right[self.order]
+        have = np.flatnonzero(np.isfinite(right) & np.isfinite(part.values) & np.isfinite(part.reach)
+                              & (right != part.values))
+        placed = right[have] if part.period is None else np.mod(right[have], part.period)  # as the values
+        self.order = have[np.argsort(placed, kind="stable")]
+        self.sorted = np.sort(placed, kind="stable")
         unit = part.unit if part.period is not None else None
         distance = errors(right[have], part.values[have], angle_unit=unit)[0]
         self.outside = have[~(distance <= part.reach[have])]
@@ -154,18 +179,63 @@ def _close_sources(part: Bands, spread: Spread, owners: Ints, numbers: Floats, r
     """The close search's sources for a part's answers ``rows`` (of ``owners``): the values in each answer's
     window within its range, the typed right answers in it, and the students whose typed right answer is
     outside their band; the whole range where no window is read."""
-    typed_numbers = numbers[owners]
+    typed_numbers, typed = numbers[owners], Typed(part, right)
+    if part.period is not None:
+        return _angle_sources(part, owners, typed_numbers, typed, part_ranges, rows, least[owners])
     low, high = centres_window(part, spread, owners, typed_numbers, least[owners])
     windowed = np.isfinite(low) | np.isfinite(high)
     sources = []
     for starts, ends in part_ranges:
+        sources.append(_within(rows, starts[rows], ends[rows], part.sorted_values, low, high, windowed, part.order))
+        # A typed centre is in its band, which holds the answer: within twice the widest reach of the range.
+        widest = 2 * (1 + WIDEN) * -range_least(-part.reach[part.order], starts[rows], ends[rows])
+        low, high = np.maximum(low, typed_numbers - widest), np.minimum(high, typed_numbers + widest)
+    sources += _typed_sources(typed, rows, low, high, windowed)
+    return sources
+
+
+def _angle_sources(part: Bands, owners: Ints, numbers: Floats, typed: Typed,
+                   part_ranges: Sequence[tuple[Ints, Ints]], rows: Ints, least: Floats) -> list[_Source]:
+    """An angle's close search. Its chance is the partner's ``p`` times the narrowed share of their band, at
+    least ``p |a - c| / 2r`` (the band narrowed holds all between the answer and the centre): a centre can
+    make it under ``least`` only within ``2 least r / p`` of the answer, the widest of that over the range,
+    a turn at a time as the range is."""
+    period = float(part.period or 0.0)
+    order = part.order
+    with np.errstate(divide="ignore", invalid="ignore"):
+        spread_out = np.where(part.chance[order] > 0, part.reach[order] / part.chance[order], np.inf)
+    spread_out = np.nan_to_num(spread_out, nan=np.inf)
+    placed = np.mod(numbers, period)
+    sources = []
+    for shift, (starts, ends) in zip((0.0, -period, period), part_ranges, strict=True):
         starts, ends = starts[rows], ends[rows]
-        lowest = np.searchsorted(part.sorted_values, low, side="left")
-        highest = np.searchsorted(part.sorted_values, high, side="right")
-        sources.append(_Source(rows, np.where(windowed, np.maximum(starts, lowest), starts),
-                               np.where(windowed, np.minimum(ends, highest), ends), part.order))
+        widest = -range_least(-spread_out, starts, ends)
+        with np.errstate(invalid="ignore"):
+            reach = np.maximum(2 * least * widest * (1 + WIDEN), 0.0) + WIDEN * period
+        windowed = np.isfinite(reach)
+        target = placed + shift
+        widest = 2 * (1 + WIDEN) * -range_least(-part.reach[order], starts, ends)
+        low, high = target - np.minimum(reach, widest), target + np.minimum(reach, widest)
+        sources.append(_within(rows, starts, ends, part.sorted_values, low, high, windowed, order))
+        sources += _typed_sources(typed, rows, low, high, windowed)
+    return sources
+
+
+def _within(rows: Ints, starts: Ints, ends: Ints, sorted_values: Floats, low: Floats, high: Floats,
+            windowed: npt.NDArray[np.bool_], order: Ints) -> _Source:
+    """The range of each answer, narrowed to the values between ``low`` and ``high`` where ``windowed``."""
+    lowest = np.searchsorted(sorted_values, low, side="left")
+    highest = np.searchsorted(sorted_values, high, side="right")
+    return _Source(rows, np.where(windowed, np.maximum(starts, lowest), starts),
+                   np.where(windowed, np.minimum(ends, highest), ends), order)
+
+
+def _typed_sources(typed: Typed, rows: Ints, low: Floats, high: Floats,
+                   windowed: npt.NDArray[np.bool_]) -> list[_Source]:
+    """The students whose typed right answer is between ``low`` and ``high``, and those whose typed right
+    answer is outside their band, for the answers ``windowed``."""
     picked = np.flatnonzero(windowed)
-    typed = Typed(part, right)
+    sources = []
     if len(picked) and len(typed.order):
         sources.append(_Source(rows[picked], np.searchsorted(typed.sorted, low[picked], side="left"),
                                np.searchsorted(typed.sorted, high[picked], side="right"), typed.order))

@@ -35,6 +35,7 @@ from grader.grade.compare import errors
 from grader.grade.integrity_chance import UNRELATED, Spread
 from grader.grade.integrity_search import Bands, Floats, Ints, accepts, blocks, expanded, range_least
 
+CLOSE = True  # False: the band search alone, as before the close search (for the tests' comparison)
 MARGIN = 2.0  # the bound is loosened by this factor against floating-point rounding in the chances
 WIDEN = 1e-9  # each window's ends are moved out by this share of their size, against rounding in log and exp
 
@@ -154,7 +155,7 @@ def close_pairs(parts: Sequence[Bands], spread: Spread, wrong: Mapping[str, Ints
             for source in sources:
                 cost[which] += np.bincount(members[source.rows], minlength=students,
                                            weights=np.maximum(source.ends - source.starts, 0))
-    by_close = cost[0] < cost[1]
+    by_close = (cost[0] < cost[1]) & CLOSE
     owners = np.flatnonzero(cost.min(axis=0) > 0)
     for group in blocks(cost.min(axis=0)[owners].astype(np.int64), chunk):
         inside = np.zeros(students, dtype=bool)

@@ -11,13 +11,13 @@ import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
+from test_integrity import graded, make_key
 
 from grader.grade import integrity, integrity_close
 from grader.grade.integrity import Integrity, Pair, check
 from grader.grade.integrity_close import bound, window
 from grader.grade.key import Key
 from grader.grade.report import integrity_csv
-from test_integrity import graded, make_key
 
 SETTINGS = settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
 
@@ -59,7 +59,8 @@ def _key(values: list[list[float]], unit: str) -> Key:
     return dataclasses.replace(key, students=students)
 
 
-def _every_pair(result_graded: object, kept: float, monkeypatch: pytest.MonkeyPatch) -> set[tuple[int, int, tuple[str, ...]]]:
+def _every_pair(result_graded: object, kept: float,
+                monkeypatch: pytest.MonkeyPatch) -> set[tuple[int, int, tuple[str, ...]]]:
     """The pairs kept when every ordered pair of the class is tested, none left out by any search."""
     captured = {}
     original = integrity._pairs
@@ -129,7 +130,8 @@ def test_a_copy_in_full_is_found_among_many_alike(monkeypatch: pytest.MonkeyPatc
     """Forty students share one value in each part (a crowd every wrong answer near it falls in); student 0 types
     student 41's values in full: the pair is found by the close search as by the band search."""
     values = [[2.0, 3.0]] * 40 + [[2.5, 3.5], [2.7, 3.9], [2.9, 4.4]]
-    typed = {(f"s{i}", label): f"{v * 1.3:.3g}" for i, row in enumerate(values) for label, v in zip(("1a", "1b"), row)}
+    typed = {(f"s{i}", label): f"{v * 1.3:.3g}"
+             for i, row in enumerate(values) for label, v in zip(("1a", "1b"), row, strict=True)}
     typed |= {("s0", "1a"): repr(2.7), ("s0", "1b"): repr(3.9)}
     result_graded = graded(make_key(values), typed)
     close = check(result_graded)

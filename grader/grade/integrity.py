@@ -285,7 +285,7 @@ def _most(parts: Sequence[Bands], answers: _Answers, found: Sequence[tuple[Ints,
     wrong, per_student = answers.wrong, answers.per_student
     students = len(per_student)
     chosen, sizes = [], np.zeros(students, dtype=np.int64)
-    for index, (part, (found_counts, ranges)) in enumerate(zip(parts, found, strict=True)):
+    for index, (part, (_, ranges)) in enumerate(zip(parts, found, strict=True)):
         members = wrong[part.label]
         chosen.append(np.flatnonzero(candidate[members, index] & (per_student[members] > least)))
         for starts, ends in ranges:

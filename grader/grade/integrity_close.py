@@ -91,7 +91,7 @@ def centres_window(part: Bands, spread: Spread, owners: Ints, numbers: Floats, l
         ratio = numbers / own
         at = np.log(np.abs(ratio))
     usable = np.isfinite(at) & (ratio != 0) & (left > 0) & np.isfinite(mass)
-    grid = spread.start + spread.step * np.arange(len(spread.same))
+    grid: Floats = spread.start + spread.step * np.arange(len(spread.same), dtype=np.float64)
     for same, table in ((True, spread.same), (False, spread.other)):
         rows = np.flatnonzero(usable & ((ratio > 0) == same))
         if not len(rows):
@@ -151,15 +151,15 @@ def close_pairs(parts: Sequence[Bands], spread: Spread, wrong: Mapping[str, Ints
                                     part_ranges, rows, least))
         banded.append([_Source(rows_chosen, starts[rows_chosen], ends[rows_chosen], part.order)
                        for starts, ends in part_ranges])
-        for which, sources in enumerate((close[-1], banded[-1])):
+        for search, sources in enumerate((close[-1], banded[-1])):
             for source in sources:
-                cost[which] += np.bincount(members[source.rows], minlength=students,
+                cost[search] += np.bincount(members[source.rows], minlength=students,
                                            weights=np.maximum(source.ends - source.starts, 0))
     by_close = (cost[0] < cost[1]) & CLOSE
-    owners = np.flatnonzero(cost.min(axis=0) > 0)
-    for group in blocks(cost.min(axis=0)[owners].astype(np.int64), chunk):
+    searching = np.flatnonzero(cost.min(axis=0) > 0)
+    for group in blocks(cost.min(axis=0)[searching].astype(np.int64), chunk):
         inside = np.zeros(students, dtype=bool)
-        inside[owners[group]] = True
+        inside[searching[group]] = True
         keys = [np.zeros(0, dtype=np.int64)]
         for part, close_sources, band_sources in zip(parts, close, banded, strict=True):
             members = wrong[part.label]

@@ -26,8 +26,9 @@ matches by accident (docs/grading.md, *Answers from another student's variant*):
 
 A pair whose corrected chance is at most the assignment's ``grading.integrity_threshold`` is flagged.
 
-The band search (which students' bands hold an answer) is :mod:`grader.grade.integrity_search`. The candidate
-pairs are worked out a block of students at a time (:data:`PAIRS`), so memory grows with the class, not its square.
+The band search (which students' bands hold an answer) is :mod:`grader.grade.integrity_search`; of the candidate
+pairs, only those that could be kept are formed (:mod:`grader.grade.integrity_close`), about :data:`PAIRS` at a
+time, so time and memory grow with the class, not its square.
 """
 
 from __future__ import annotations

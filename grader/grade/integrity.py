@@ -256,7 +256,7 @@ def _pairs(parts: Sequence[Bands], answers: _Answers, spread: Spread,
     searched = [np.flatnonzero((found_counts > 0) & owners_in[wrong[part.label]])
                 for part, (found_counts, _) in zip(parts, found, strict=True)]
     chosen = [np.flatnonzero(candidate[wrong[part.label], index]) for index, part in enumerate(parts)]
-    least = bound(examined, KEPT, matched)
+    least = bound(examined, KEPT, per_student)  # a pair matches in at most the wrong parts
     kept: list[tuple[Ints, Ints, npt.NDArray[np.bool_]]] = []
     for owners, partners in close_pairs(parts, spread, wrong, answers.numbers, answers.right, ranges, searched,
                                         chosen, least, block):

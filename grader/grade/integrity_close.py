@@ -6,7 +6,7 @@ under ``1 / M`` (``M`` the pairs examined). Its chance is at least the product, 
 part's chance taken as narrowly as that part's own match allows (the ``j`` closest matches narrow every band to
 at least their own distance; a Poisson binomial tail of ``j`` or more is at least the chance that ``j`` given coins
 all land); so the matched part whose chance is least has a chance under ``M ** (-1 / k)``, ``k`` the matched parts,
-at most the student's parts that match anyone. A part's chance is at least its related kind's share times the
+at most the student's wrong parts. A part's chance is at least its related kind's share times the
 class's wrong answers' mass between the answer ``a`` and the centre ``c`` its closeness is measured from (the
 partner's typed answer or value, both in the partner's band, so the narrowed band holds all between them), less
 what the student's own answers may add to it (at most their count over the answers). That mass grows as ``c``
@@ -246,16 +246,16 @@ def _typed_sources(typed: Typed, rows: Ints, low: Floats, high: Floats,
     return sources
 
 
-def bound(examined: int, kept: float, matchable: Ints) -> Floats:
+def bound(examined: int, kept: float, wrong: Ints) -> Floats:
     """Per owner, the chance the least likely matched part of a pair kept (its corrected chance under ``kept``)
-    must be under: ``(kept / M) ** (1 / k)`` with ``k`` the owner's parts that match anyone, loosened by
-    :data:`MARGIN` (inf: any, when ``kept`` is over 1 or no part matches).
+    must be under: ``(kept / M) ** (1 / k)`` with ``k`` the owner's wrong parts, loosened by
+    :data:`MARGIN` (inf: any, when ``kept`` is over 1 or no part is wrong).
 
     >>> bound(10_000, 1.0, np.array([2, 4, 0])).tolist()
     [0.02, 0.2, inf]
     """
     if kept > 1:
-        return np.full(len(matchable), math.inf)
-    exponent = 1.0 / np.maximum(matchable, 1)
+        return np.full(len(wrong), math.inf)
+    exponent = 1.0 / np.maximum(wrong, 1)
     found = MARGIN * np.power(kept / float(max(examined, 1)), exponent)
-    return np.where(matchable > 0, found, math.inf)
+    return np.where(wrong > 0, found, math.inf)

@@ -19,7 +19,7 @@ from grader.grade.integrity_close import bound, window
 from grader.grade.key import Key
 from grader.grade.report import integrity_csv
 
-SETTINGS = settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+SETTINGS = settings(max_examples=15, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
 
 
 def _class(draw: st.DrawFn) -> tuple[list[list[float]], dict[tuple[str, str], str]]:

@@ -26,8 +26,9 @@ matches by accident (docs/grading.md, *Answers from another student's variant*):
 
 A pair whose corrected chance is at most the assignment's ``grading.integrity_threshold`` is flagged.
 
-The band search (which students' bands hold an answer) is :mod:`grader.grade.integrity_search`. The candidate
-pairs are worked out a block of students at a time (:data:`PAIRS`), so memory grows with the class, not its square.
+The band search (which students' bands hold an answer) is :mod:`grader.grade.integrity_search`; of the candidate
+pairs, only those that could be kept are formed (:mod:`grader.grade.integrity_close`), about :data:`PAIRS` at a
+time, so time and memory grow with the class, not its square.
 """
 
 from __future__ import annotations
@@ -45,6 +46,7 @@ from grader.grade.cells import typed_place
 from grader.grade.compare import errors
 from grader.grade.grading import Graded, Row
 from grader.grade.integrity_chance import UNRELATED, Spread
+from grader.grade.integrity_close import bound, close_pairs
 from grader.grade.integrity_search import (
     Bands,
     Floats,
@@ -235,11 +237,11 @@ def _pairs(parts: Sequence[Bands], answers: _Answers, spread: Spread,
 
     A pair needs as many matched parts as the fewest whose chance could be that small (:func:`_needed`); a
     partner that matches ``n`` of a student's parts is in the band search of at least one part other than
-    the ``n - 1`` that matched the most students: those searches alone are expanded. The candidates are taken
-    a block of students at a time (about ``block`` candidates a block, so memory does not grow with the
-    square of the class), the students with the most wrong parts first: the first block with a pair of two
-    matched parts sets how many wrong parts the chances are counted up to (:func:`_figures`'s ``most``), as
-    one block of the whole class would."""
+    the ``n - 1`` that matched the most students: the pairs of those searches are the candidates. Of them, only
+    those the close search finds are formed (:mod:`grader.grade.integrity_close`: a pair whose every matched
+    part is far from its centre cannot be kept), about ``block`` at a time, so the pairs formed grow with the
+    class, not its square. The chances are counted up to as many wrong parts as the most of any candidate's
+    student with two matched parts (:func:`_figures`'s ``most``), as one block of all candidates would."""
     wrong, students, per_student = answers.wrong, len(answers.per_student), answers.per_student
     counts = np.zeros((students, len(parts)), dtype=np.int64)  # per student and part, the students matched
     for index, (part, (found_counts, _)) in enumerate(zip(parts, found, strict=True)):
@@ -248,32 +250,59 @@ def _pairs(parts: Sequence[Bands], answers: _Answers, spread: Spread,
     needed = _needed(parts, answers, spread, found, examined)
     # Each part's rank among the student's, most students matched first: the needed - 1 first are not searched.
     rank = np.argsort(np.argsort(-counts, axis=1, kind="stable"), axis=1, kind="stable")
-    chosen, sizes = [], np.zeros(students, dtype=np.int64)  # per part the answers searched; per student, candidates
-    for index, (part, (found_counts, ranges)) in enumerate(zip(parts, found, strict=True)):
+    candidate = (counts > 0) & (matched >= needed)[:, None] & (rank >= (needed - 1)[:, None])
+    ranges = [part_ranges for _, part_ranges in found]
+    owners_in = candidate.any(axis=1)
+    searched = [np.flatnonzero((found_counts > 0) & owners_in[wrong[part.label]])
+                for part, (found_counts, _) in zip(parts, found, strict=True)]
+    chosen = [np.flatnonzero(candidate[wrong[part.label], index]) for index, part in enumerate(parts)]
+    least = bound(examined, KEPT, per_student)  # a pair matches in at most the wrong parts
+    kept: list[tuple[Ints, Ints, npt.NDArray[np.bool_]]] = []
+    for owners, partners in close_pairs(parts, spread, wrong, answers.numbers, answers.right, ranges, searched,
+                                        chosen, least, block):
+        hits = _hits(parts, answers, owners, partners)
+        two = (hits & candidate[owners]).any(axis=1) & (hits.sum(axis=1) >= 2)
+        if two.any():
+            kept.append((owners[two], partners[two], hits[two]))
+    if not kept:
+        return {}
+    owners = np.concatenate([owners for owners, _, _ in kept])
+    partners = np.concatenate([partners for _, partners, _ in kept])
+    hits = np.concatenate([hits for _, _, hits in kept])
+    most = _most(parts, answers, found, candidate, int(per_student[owners].max()), block)
+    pairs: dict[tuple[int, int], Pair] = {}
+    for start in range(0, len(owners), max(block, 1)):
+        rows = slice(start, start + max(block, 1))
+        pairs.update(((pair.student, pair.partner), pair) for pair in _figures(
+            parts, answers, spread, owners[rows], partners[rows], examined, 2, KEPT, hits[rows], most))
+    return pairs
+
+
+def _most(parts: Sequence[Bands], answers: _Answers, found: Sequence[tuple[Ints, list[tuple[Ints, Ints]]]],
+          candidate: npt.NDArray[np.bool_], least: int, block: int) -> int:
+    """The most wrong parts of any student with a candidate pair of two or more matched parts, at least
+    ``least`` (such a student's): the students with more are searched whole, most wrong parts first, until one
+    has such a pair (usually none has more, or the first does)."""
+    wrong, per_student = answers.wrong, answers.per_student
+    students = len(per_student)
+    chosen, sizes = [], np.zeros(students, dtype=np.int64)
+    for index, (part, (_, ranges)) in enumerate(zip(parts, found, strict=True)):
         members = wrong[part.label]
-        chosen.append(np.flatnonzero((found_counts > 0) & (matched[members] >= needed[members])
-                                     & (rank[members, index] >= needed[members] - 1)))
+        chosen.append(np.flatnonzero(candidate[members, index] & (per_student[members] > least)))
         for starts, ends in ranges:
             sizes += np.bincount(members[chosen[-1]], minlength=students,
                                  weights=np.maximum(ends - starts, 0)[chosen[-1]]).astype(np.int64)
     searched = np.flatnonzero(sizes > 0)
     searched = searched[np.argsort(-per_student[searched], kind="stable")]
-    pairs: dict[tuple[int, int], Pair] = {}
-    most: int | None = None
     for group in blocks(sizes[searched], block):
         inside = np.zeros(students, dtype=bool)
         inside[searched[group]] = True
         owners, partners = candidates(parts, wrong, answers.numbers, [ranges for _, ranges in found], chosen,
                                       inside)
-        hits = _hits(parts, answers, owners, partners)
-        if most is None:
-            two = hits.sum(axis=1) >= 2
-            if not two.any():
-                continue
-            most = int(per_student[owners[two]].max())
-        pairs.update(((pair.student, pair.partner), pair) for pair in _figures(
-            parts, answers, spread, owners, partners, examined, 2, KEPT, hits, most))
-    return pairs
+        two = _hits(parts, answers, owners, partners).sum(axis=1) >= 2
+        if two.any():
+            return max(least, int(per_student[owners[two]].max()))
+    return least
 
 
 def _needed(parts: Sequence[Bands], answers: _Answers, spread: Spread,

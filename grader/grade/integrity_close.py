@@ -1,0 +1,261 @@
+"""The close search of the integrity check (:mod:`grader.grade.integrity`): the partners that could make a pair
+of matched answers unlikely enough to keep, found without forming the pairs that could not.
+
+A pair is kept when its corrected chance is under 1 (:data:`~grader.grade.integrity.KEPT`), so when its chance is
+under ``1 / M`` (``M`` the pairs examined). Its chance is at least the product, over its matched parts, of each
+part's chance taken as narrowly as that part's own match allows (the ``j`` closest matches narrow every band to
+at least their own distance; a Poisson binomial tail of ``j`` or more is at least the chance that ``j`` given coins
+all land); so the matched part whose chance is least has a chance under ``M ** (-1 / k)``, ``k`` the matched parts,
+at most the student's wrong parts. A part's chance is at least its related kind's share times the
+class's wrong answers' mass between the answer ``a`` and the centre ``c`` its closeness is measured from (the
+partner's typed answer or value, both in the partner's band, so the narrowed band holds all between them), less
+what the student's own answers may add to it (at most their count over the answers). That mass grows as ``c``
+moves away from ``a``: inverting the class's cumulative distribution gives, per answer, a window of centres
+outside which no partner can be kept, and only partners whose value or typed answer lies inside it are formed.
+In a big class the window narrows as ``M`` grows, so the pairs formed grow with the class, not its square.
+
+A partner whose typed right answer lies outside their own band (it cannot, when their tolerance accepted it; a
+safeguard), and every partner of an angle's part (its chance has no related kind), or of an answer whose ratio to
+the student's own value is not read (zero, none), are searched over the whole range, as before.
+
+>>> window(np.array([0.0, 0.5, 1.0]), np.array([0.0, 1.0, 2.0]), np.array([1.0]), np.array([0.3]))
+(array([0.85]), array([inf]))
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterator, Mapping, Sequence
+from typing import Literal, NamedTuple
+
+import numpy as np
+import numpy.typing as npt
+
+from grader.grade.compare import errors
+from grader.grade.integrity_chance import UNRELATED, Spread
+from grader.grade.integrity_search import Bands, Floats, Ints, accepts, blocks, expanded, range_least
+
+CLOSE = True  # False: the band search alone, as before the close search (for the tests' comparison)
+MARGIN = 2.0  # the bound is loosened by this factor against floating-point rounding in the chances
+WIDEN = 1e-9  # each window's ends are moved out by this share of their size, against rounding in log and exp
+
+
+def window(grid: Floats, table: Floats, at: Floats, mass: Floats) -> tuple[Floats, Floats]:
+    """Per point ``at`` (on the grid's scale), the widest interval around it outside which a cumulative
+    distribution ``table`` (on ``grid``, linear between) has at least ``mass`` between the point and any point:
+    ``-inf`` / ``inf`` where the distribution has not so much on that side.
+
+    >>> window(np.array([0.0, 0.5, 1.0]), np.array([0.0, 1.0, 2.0]), np.array([1.0, 0.5]), np.array([0.3, 1.5]))
+    (array([0.85, -inf]), array([inf, inf]))
+    """
+    level = np.interp(at, grid, table)
+    return (np.minimum(_inverse(grid, table, level - mass, "right"), at),
+            np.maximum(_inverse(grid, table, level + mass, "left"), at))
+
+
+def _inverse(grid: Floats, table: Floats, level: Floats, side: Literal["left", "right"]) -> Floats:
+    """Where the piecewise linear ``table`` reaches ``level``: for ``right``, the highest point at or below
+    which it is at most ``level`` (-inf: none); for ``left``, the lowest at or above which it is at least
+    ``level`` (inf: none)."""
+    found = np.searchsorted(table, level, side=side)
+    if side == "right":  # table[k] <= level < table[k + 1]
+        below = found - 1
+        inside = (below >= 0) & (below < len(table) - 1)
+        k = np.clip(below, 0, len(table) - 2)
+        edge = np.where(below >= 0, np.inf, -np.inf)  # past the last point: the table is flat at its end
+    else:  # table[k - 1] < level <= table[k]
+        k = np.clip(found - 1, 0, len(table) - 2)
+        inside = (found >= 1) & (found < len(table))
+        edge = np.where(found < len(table), -np.inf, np.inf)
+    rise = table[k + 1] - table[k]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        share = np.clip(np.where(rise > 0, (level - table[k]) / rise, 0.0 if side == "right" else 1.0), 0.0, 1.0)
+    point = grid[k] + share * (grid[k + 1] - grid[k])
+    return np.where(inside, point, edge)
+
+
+def centres_window(part: Bands, spread: Spread, owners: Ints, numbers: Floats, least: Floats) -> tuple[Floats, Floats]:
+    """Per answer (``numbers``, of ``owners``), the values of a centre outside which the part's chance is at
+    least ``least``: ``(-inf, inf)`` where no such window is read (an angle, a zero, no other answers)."""
+    count = len(owners)
+    low, high = np.full(count, -np.inf), np.full(count, np.inf)
+    if part.period is not None or spread.answers == 0 or not count:
+        return low, high
+    own = part.values[owners]
+    theirs = np.isfinite(spread.cells[owners]).sum(axis=1)
+    left = spread.answers - theirs
+    total = float(spread.kernel[-1] - spread.kernel[0])
+    # The related kind's mass wanted: the chance over its share, plus what the owner's own answers may take off.
+    mass = least / (1 - UNRELATED) + theirs * total * (1 + 1e-9) / spread.answers
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ratio = numbers / own
+        at = np.log(np.abs(ratio))
+    usable = np.isfinite(at) & (ratio != 0) & (left > 0) & np.isfinite(mass)
+    grid: Floats = spread.start + spread.step * np.arange(len(spread.same), dtype=np.float64)
+    for same, table in ((True, spread.same), (False, spread.other)):
+        rows = np.flatnonzero(usable & ((ratio > 0) == same))
+        if not len(rows):
+            continue
+        lowest, highest = window(grid, table, at[rows], mass[rows])
+        sign = own[rows] * (1.0 if same else -1.0)
+        with np.errstate(over="ignore", invalid="ignore"):
+            ends = np.stack([sign * np.exp(lowest), sign * np.exp(highest)])
+        first, second = np.nanmin(ends, axis=0), np.nanmax(ends, axis=0)
+        spare = WIDEN * (np.abs(first) + np.abs(second))
+        low[rows], high[rows] = first - spare, second + spare
+    return low, high
+
+
+class Typed:
+    """A part's right answers as typed, sorted (the other centre a closeness is read from; those typed as the
+    value is are found by it), and the students whose typed right answer lies outside their own band (searched
+    whole)."""
+
+    def __init__(self, part: Bands, right: Floats) -> None:
+        have = np.flatnonzero(np.isfinite(right) & np.isfinite(part.values) & np.isfinite(part.reach)
+                              & (right != part.values))
+        placed = right[have] if part.period is None else np.mod(right[have], part.period)  # as the values
+        self.order = have[np.argsort(placed, kind="stable")]
+        self.sorted = np.sort(placed, kind="stable")
+        unit = part.unit if part.period is not None else None
+        distance = errors(right[have], part.values[have], angle_unit=unit)[0]
+        self.outside = have[~(distance <= part.reach[have])]
+
+
+class _Source(NamedTuple):
+    """Where a part's search looks for each answer (a row of the part's wrong answers): from ``starts`` to
+    ``ends`` in the students listed in ``at``."""
+
+    rows: Ints
+    starts: Ints
+    ends: Ints
+    at: Ints
+
+
+def close_pairs(parts: Sequence[Bands], spread: Spread, wrong: Mapping[str, Ints], numbers: Mapping[str, Floats],
+                right: Mapping[str, Floats], ranges: Sequence[Sequence[tuple[Ints, Ints]]],
+                searched: Sequence[Ints], chosen: Sequence[Ints], least: Floats, chunk: int
+                ) -> Iterator[tuple[Ints, Ints]]:
+    """The pairs (owner, partner) whose partner's band holds a wrong answer of the owner's, per owner by the
+    cheaper of two searches that both find every pair that could be kept: the close search, over the answers
+    ``searched`` (rows of ``wrong``, per part: every part that matches anyone), of the partners whose centre is
+    in the answer's window (:func:`centres_window`, for the chance ``least`` per owner); or the band search
+    over the answers ``chosen`` (per part), of every partner in their ranges. In pieces of about ``chunk``
+    pairs (a block of owners at a time), each sorted and without repeats."""
+    students = len(least)
+    close, banded = [], []
+    cost = np.zeros((2, students))  # per owner, the partners the close and the band search would look at
+    for part, part_ranges, rows, rows_chosen in zip(parts, ranges, searched, chosen, strict=True):
+        members = wrong[part.label]
+        close.append(_close_sources(part, spread, members[rows], numbers[part.label], right[part.label],
+                                    part_ranges, rows, least))
+        banded.append([_Source(rows_chosen, starts[rows_chosen], ends[rows_chosen], part.order)
+                       for starts, ends in part_ranges])
+        for search, sources in enumerate((close[-1], banded[-1])):
+            for source in sources:
+                cost[search] += np.bincount(members[source.rows], minlength=students,
+                                           weights=np.maximum(source.ends - source.starts, 0))
+    by_close = (cost[0] < cost[1]) & CLOSE
+    searching = np.flatnonzero(cost.min(axis=0) > 0)
+    for group in blocks(cost.min(axis=0)[searching].astype(np.int64), chunk):
+        inside = np.zeros(students, dtype=bool)
+        inside[searching[group]] = True
+        keys = [np.zeros(0, dtype=np.int64)]
+        for part, close_sources, band_sources in zip(parts, close, banded, strict=True):
+            members = wrong[part.label]
+            for source, is_close in [*((source, True) for source in close_sources),
+                                     *((source, False) for source in band_sources)]:
+                who = members[source.rows]
+                use = (by_close[who] == is_close) & inside[who]
+                for which, positions in expanded(source.starts[use], source.ends[use]):
+                    owner, partners = who[use][which], source.at[positions]
+                    ok = accepts(part, owner, partners, numbers[part.label])
+                    keys.append(np.unique(owner[ok] * students + partners[ok]))
+        pairs = np.unique(np.concatenate(keys))
+        yield pairs // students, pairs % students
+
+
+def _close_sources(part: Bands, spread: Spread, owners: Ints, numbers: Floats, right: Floats,
+                   part_ranges: Sequence[tuple[Ints, Ints]], rows: Ints, least: Floats) -> list[_Source]:
+    """The close search's sources for a part's answers ``rows`` (of ``owners``): the values in each answer's
+    window within its range, the typed right answers in it, and the students whose typed right answer is
+    outside their band; the whole range where no window is read."""
+    typed_numbers, typed = numbers[owners], Typed(part, right)
+    if part.period is not None:
+        return _angle_sources(part, owners, typed_numbers, typed, part_ranges, rows, least[owners])
+    low, high = centres_window(part, spread, owners, typed_numbers, least[owners])
+    windowed = np.isfinite(low) | np.isfinite(high)
+    sources = []
+    for starts, ends in part_ranges:
+        sources.append(_within(rows, starts[rows], ends[rows], part.sorted_values, low, high, windowed, part.order))
+        # A typed centre is in its band, which holds the answer: within twice the widest reach of the range.
+        widest = 2 * (1 + WIDEN) * -range_least(-part.reach[part.order], starts[rows], ends[rows])
+        low, high = np.maximum(low, typed_numbers - widest), np.minimum(high, typed_numbers + widest)
+    sources += _typed_sources(typed, rows, low, high, windowed)
+    return sources
+
+
+def _angle_sources(part: Bands, owners: Ints, numbers: Floats, typed: Typed,
+                   part_ranges: Sequence[tuple[Ints, Ints]], rows: Ints, least: Floats) -> list[_Source]:
+    """An angle's close search. Its chance is the partner's ``p`` times the narrowed share of their band, at
+    least ``p |a - c| / 2r`` (the band narrowed holds all between the answer and the centre): a centre can
+    make it under ``least`` only within ``2 least r / p`` of the answer, the widest of that over the range,
+    a turn at a time as the range is."""
+    period = float(part.period or 0.0)
+    order = part.order
+    with np.errstate(divide="ignore", invalid="ignore"):
+        spread_out = np.where(part.chance[order] > 0, part.reach[order] / part.chance[order], np.inf)
+    spread_out = np.nan_to_num(spread_out, nan=np.inf)
+    placed = np.mod(numbers, period)
+    sources = []
+    for shift, (starts, ends) in zip((0.0, -period, period), part_ranges, strict=True):
+        starts, ends = starts[rows], ends[rows]
+        widest = -range_least(-spread_out, starts, ends)
+        with np.errstate(invalid="ignore"):
+            reach = np.maximum(2 * least * widest * (1 + WIDEN), 0.0) + WIDEN * period
+        windowed = np.isfinite(reach)
+        target = placed + shift
+        widest = 2 * (1 + WIDEN) * -range_least(-part.reach[order], starts, ends)
+        low, high = target - np.minimum(reach, widest), target + np.minimum(reach, widest)
+        sources.append(_within(rows, starts, ends, part.sorted_values, low, high, windowed, order))
+        sources += _typed_sources(typed, rows, low, high, windowed)
+    return sources
+
+
+def _within(rows: Ints, starts: Ints, ends: Ints, sorted_values: Floats, low: Floats, high: Floats,
+            windowed: npt.NDArray[np.bool_], order: Ints) -> _Source:
+    """The range of each answer, narrowed to the values between ``low`` and ``high`` where ``windowed``."""
+    lowest = np.searchsorted(sorted_values, low, side="left")
+    highest = np.searchsorted(sorted_values, high, side="right")
+    return _Source(rows, np.where(windowed, np.maximum(starts, lowest), starts),
+                   np.where(windowed, np.minimum(ends, highest), ends), order)
+
+
+def _typed_sources(typed: Typed, rows: Ints, low: Floats, high: Floats,
+                   windowed: npt.NDArray[np.bool_]) -> list[_Source]:
+    """The students whose typed right answer is between ``low`` and ``high``, and those whose typed right
+    answer is outside their band, for the answers ``windowed``."""
+    picked = np.flatnonzero(windowed)
+    sources = []
+    if len(picked) and len(typed.order):
+        sources.append(_Source(rows[picked], np.searchsorted(typed.sorted, low[picked], side="left"),
+                               np.searchsorted(typed.sorted, high[picked], side="right"), typed.order))
+    if len(picked) and len(typed.outside):
+        sources.append(_Source(rows[picked], np.zeros(len(picked), np.int64),
+                               np.full(len(picked), len(typed.outside), np.int64), typed.outside))
+    return sources
+
+
+def bound(examined: int, kept: float, wrong: Ints) -> Floats:
+    """Per owner, the chance the least likely matched part of a pair kept (its corrected chance under ``kept``)
+    must be under: ``(kept / M) ** (1 / k)`` with ``k`` the owner's wrong parts, loosened by
+    :data:`MARGIN` (inf: any, when ``kept`` is over 1 or no part is wrong).
+
+    >>> bound(10_000, 1.0, np.array([2, 4, 0])).tolist()
+    [0.02, 0.2, inf]
+    """
+    if kept > 1:
+        return np.full(len(wrong), math.inf)
+    exponent = 1.0 / np.maximum(wrong, 1)
+    found = MARGIN * np.power(kept / float(max(examined, 1)), exponent)
+    return np.where(wrong > 0, found, math.inf)

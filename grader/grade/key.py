@@ -48,6 +48,7 @@ from grader.assign.key_columns import (
     UNIT,
     KeyColumns,
     read_key_columns,
+    sidecar,
 )
 from grader.base.errors import GraderError, TemplateError, shown
 from grader.base.inputs import CELL_CHARS, decode_text, read_bytes
@@ -57,7 +58,10 @@ from grader.model.quantities import parse_unit
 from grader.model.tolerance import SYMBOL_RANGE, Tolerance
 
 VERSIONS = (1, 2)  # the key schema versions grading reads
-KEY_BYTES = 1 << 30  # 1 GiB: a key holds every student's numbers; 2,000 students take about 2 MB
+# 1 GiB: the most of key.json read whole and decoded, which a key needs when it has no sidecar made from it
+# (key.columns.npz); 2,000 students take about 6 MB, 100,000 about 290 MB. A key with its sidecar has no
+# limit of size: it is hashed a piece at a time and graded from the sidecar.
+KEY_BYTES = 1 << 30
 
 _T = TypeVar("_T")
 
@@ -183,11 +187,12 @@ class Key:
 def load_key(path: Path) -> Key:
     """Read and check a key file; a file that is not a grader key is refused with the reason."""
     where = str(path)
-    data = read_bytes(path, KEY_BYTES)
-    columns = read_key_columns(path, data)  # the sidecar grader generate wrote, if it was made from these bytes
+    columns = read_key_columns(path)  # the sidecar grader generate wrote, if it was made from these bytes
     key = None if columns is None else _key_from_columns(columns, where)
     if key is not None:
         return key
+    del columns
+    data = read_bytes(_within_limit(path), KEY_BYTES)
     text = decode_text(data, path)
     del data
     try:
@@ -214,6 +219,21 @@ def load_key(path: Path) -> Key:
 
 
 _ESCAPED_SURROGATE = re.compile(r"\\u[dD][89a-fA-F]")
+
+
+def _within_limit(path: Path) -> Path:
+    """``path``, unless it is a regular file over :data:`KEY_BYTES`: that is refused with the way out."""
+    try:
+        size = path.stat().st_size if path.is_file() else 0
+    except OSError:
+        size = 0  # read_bytes says why it cannot be read
+    if size > KEY_BYTES:
+        beside = sidecar(path).name
+        raise GraderError(f"{path}: {size:,} bytes, more than the {KEY_BYTES:,} a key.json is read whole within; a "
+                          f"larger key is graded from the {beside} beside it, which is missing, unreadable or made "
+                          f"from another key.json: regenerate the key with grader generate, which writes {beside} "
+                          "beside it")
+    return path
 
 
 def _refuse_lone_surrogates(raw: Any, where: str) -> None:

@@ -42,7 +42,7 @@ import functools
 import itertools
 import os
 from collections import defaultdict
-from collections.abc import Callable, Container, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from datetime import UTC, datetime, tzinfo
 from functools import lru_cache
@@ -139,7 +139,7 @@ def read_submissions(paths: Sequence[Path], students: Sequence[StudentRef], labe
                        tuple(ignored), (*notes, *reader.notes()))
 
 
-def _plain_answers(table: CsvStream, layout: Layout, ids: Container[str], labels: Sequence[str],
+def _plain_answers(table: CsvStream, layout: Layout, ids: Mapping[str, str], labels: Sequence[str],
                    name: str) -> list[Answer] | None:
     """The answers of a long file without timestamps each of whose rows has a cell per column, none too
     long, and names a student of the key by their id and a label as they are written, each student's label
@@ -148,7 +148,7 @@ def _plain_answers(table: CsvStream, layout: Layout, ids: Container[str], labels
     if layout.wide or layout.by_email or layout.timestamp is not None or layout.label is None \
             or layout.answer is None:
         return None
-    header, known = table.header, set(labels)
+    header, known = table.header, {label: label for label in labels}
     width, student, label, answer = (len(header), header.index(layout.student), header.index(layout.label),
                                      header.index(layout.answer))
     answers: list[Answer] = []
@@ -162,8 +162,12 @@ def _plain_answers(table: CsvStream, layout: Layout, ids: Container[str], labels
             return None
         who = list(map(str.strip, map(itemgetter(student), rows)))
         part = list(map(str.strip, map(itemgetter(label), rows)))
+        if not (all(map(ids.__contains__, who)) and all(map(known.__contains__, part))):
+            return None
+        # The key's own id and label texts, not the file's: one object a student and a part, not three a row.
+        who, part = list(map(ids.__getitem__, who)), list(map(known.__getitem__, part))
         seen.update(zip(who, part, strict=True))
-        if not (all(map(ids.__contains__, who)) and known.issuperset(part) and len(seen) == len(answers) + len(rows)):
+        if len(seen) != len(answers) + len(rows):  # a student's label twice
             return None
         texts = map(str.strip, map(itemgetter(answer), rows))
         # tuple.__new__: the named tuple's own __new__ is a Python call per answer.
@@ -192,7 +196,7 @@ class Roster:
     that student, with a caveat."""
 
     def __init__(self, students: Sequence[StudentRef]) -> None:
-        self.ids = {s.id for s in students}
+        self.ids = {s.id: s.id for s in students}  # each id to the key's own text (answers share it)
         self.stripped: dict[str, list[str]] = defaultdict(list)
         for s in students:
             self.stripped[s.id.lstrip("0")].append(s.id)

@@ -270,3 +270,26 @@ def test_a_key_over_the_limit_without_a_sidecar_made_from_it_is_refused_with_the
     assert f"{key}: {key.stat().st_size:,} bytes, more than the 1,000 a key.json is read whole within" in err
     assert "regenerate the key with grader generate, which writes key.columns.npz beside it" in err
     assert not (tmp_path / "out").exists()
+
+
+def test_a_submissions_file_over_the_limit_is_refused_and_graded_split_in_two_files(
+        graded_class: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
+        capsys: pytest.CaptureFixture[str]) -> None:
+    """The submissions' limit (its text is held whole while read) names the way out: the rows split over files
+    under it, read in turn, give the same grades. The limit is made small, not the file large."""
+    import grader.grade.submissions as submissions
+
+    key, answers = graded_class / "hw" / "key.json", graded_class / "answers.csv"
+    expected = _grade_all(tmp_path, key, answers, "whole")
+    monkeypatch.setattr(submissions, "SUBMISSIONS_BYTES", answers.stat().st_size - 1)
+    assert main(["grade", "--key", str(key), str(answers), "--out", str(tmp_path / "refused")]) == 2
+    err = capsys.readouterr().err
+    assert f"{answers}: {answers.stat().st_size:,} bytes, more than the {answers.stat().st_size - 1:,} a " \
+           "submissions file is read within; split its rows into files under that size" in err
+    assert not (tmp_path / "refused").exists()
+    header, *rows = answers.read_text(encoding="utf-8").splitlines(keepends=True)
+    halves = [tmp_path / "first.csv", tmp_path / "second.csv"]
+    halves[0].write_text(header + "".join(rows[:len(rows) // 2]), encoding="utf-8")
+    halves[1].write_text(header + "".join(rows[len(rows) // 2:]), encoding="utf-8")
+    run(key, halves, tmp_path / "split")
+    assert (tmp_path / "split" / "grades.csv").read_bytes() == expected["grades.csv"]

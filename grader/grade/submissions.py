@@ -52,7 +52,7 @@ from typing import Literal
 
 from grader.base.errors import GraderError, shown
 from grader.base.files import shown_path
-from grader.base.inputs import CELL_CHARS, CsvRow, CsvStream, open_csv
+from grader.base.inputs import CELL_CHARS, CSV_BYTES, CsvRow, CsvStream, open_csv
 from grader.grade import timestamps
 from grader.grade.columns import Layout, find_layout
 from grader.grade.latest import Answer, Contests, SubmittedRow
@@ -117,7 +117,7 @@ def read_submissions(paths: Sequence[Path], students: Sequence[StudentRef], labe
     shown_as = [shown_path(name) for name in names or paths]
     plain: list[Answer] | None = None
     for index, (path, name) in enumerate(zip(paths, shown_as, strict=True)):
-        table = open_csv(path, exports=True)
+        table = open_csv(_within_limit(path), exports=True)
         layout = find_layout(table, labels, fmt, reader.roster.known)
         ignored.update(dict.fromkeys(layout.ignored))
         if table.encoding == "Windows-1252":
@@ -177,6 +177,26 @@ def _plain_answers(table: CsvStream, layout: Layout, ids: Mapping[str, str], lab
 
 
 _PLAIN_PIECE = 65536  # rows
+
+
+# The most of one submissions file: its text is held whole while its rows are read (1 byte a character of
+# ASCII, up to 4 of other scripts, and its bytes beside it while they are decoded), and each answer kept takes
+# about 200 bytes beside the file's 18 to 30 a row (measured: docs/benchmarks.md): 64 MiB of short rows keep
+# about 1 GiB. A larger class splits its rows over several files, each read in turn.
+SUBMISSIONS_BYTES = CSV_BYTES
+
+
+def _within_limit(path: Path) -> Path:
+    """``path``, unless it is a regular file over :data:`SUBMISSIONS_BYTES`: that is refused with the way out."""
+    try:
+        size = path.stat().st_size if path.is_file() else 0
+    except OSError:
+        size = 0  # open_csv says why it cannot be read
+    if size > SUBMISSIONS_BYTES:
+        raise GraderError(f"{path}: {size:,} bytes, more than the {SUBMISSIONS_BYTES:,} a submissions file is read "
+                          "within; split its rows into files under that size and give them all to grader grade "
+                          "(they are read in turn, a student's rows in any of them)")
+    return path
 
 
 def _refuse_repeated(paths: Sequence[Path]) -> None:

@@ -153,6 +153,7 @@ def _plain_answers(table: CsvStream, layout: Layout, ids: Mapping[str, str], lab
                                      header.index(layout.answer))
     answers: list[Answer] = []
     seen: set[tuple[str, str]] = set()
+    typed: dict[str, str] = {}
     records = table.records()
     # A piece of rows at a time (a file of a million rows is not held as cells beside its answers), each check
     # and each cell of the three columns (stripped, as _Reader strips them) a column at a time.
@@ -169,7 +170,9 @@ def _plain_answers(table: CsvStream, layout: Layout, ids: Mapping[str, str], lab
         seen.update(zip(who, part, strict=True))
         if len(seen) != len(answers) + len(rows):  # a student's label twice
             return None
-        texts = map(str.strip, map(itemgetter(answer), rows))
+        # One text object for equal answers (a class types a few thousand distinct ones): a verdict keeps it.
+        stripped = list(map(str.strip, map(itemgetter(answer), rows)))
+        texts = map(typed.setdefault, stripped, stripped)
         # tuple.__new__: the named tuple's own __new__ is a Python call per answer.
         answers += map(functools.partial(tuple.__new__, Answer), zip(
             itertools.repeat(name), lines, who, part, texts, itertools.repeat(table.delimiter), itertools.repeat(None)))

@@ -184,8 +184,8 @@ _PLAIN_PIECE = 65536  # rows
 
 # The most of one submissions file: its text is held whole while its rows are read (1 byte a character of
 # ASCII, up to 4 of other scripts, and its bytes beside it while they are decoded), and each answer kept takes
-# about 200 bytes beside the file's 18 to 30 a row (docs/grading.md): 64 MiB of short rows, each kept, keep
-# about 0.7 GiB. A larger class splits its rows over several files, each read in turn.
+# about 150 bytes beside the file's 18 to 30 a row (docs/grading.md): 64 MiB of short rows, each kept, keep
+# about 0.5 GiB. A larger class splits its rows over several files, each read in turn.
 SUBMISSIONS_BYTES = CSV_BYTES
 
 

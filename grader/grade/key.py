@@ -51,7 +51,7 @@ from grader.assign.key_columns import (
     sidecar,
 )
 from grader.base.errors import GraderError, TemplateError, shown
-from grader.base.inputs import CELL_CHARS, decode_text, read_bytes
+from grader.base.inputs import CELL_CHARS, decode_text, read_bytes, regular_size
 from grader.grade.notation import ReadError, check_powers
 from grader.model.expr import names, parse
 from grader.model.quantities import parse_unit
@@ -223,10 +223,7 @@ _ESCAPED_SURROGATE = re.compile(r"\\u[dD][89a-fA-F]")
 
 def _within_limit(path: Path) -> Path:
     """``path``, unless it is a regular file over :data:`KEY_BYTES`: that is refused with the way out."""
-    try:
-        size = path.stat().st_size if path.is_file() else 0
-    except OSError:
-        size = 0  # read_bytes says why it cannot be read
+    size = regular_size(path)
     if size > KEY_BYTES:
         beside = sidecar(path).name
         raise GraderError(f"{path}: {size:,} bytes, more than the {KEY_BYTES:,} a key.json is read whole within; a "

@@ -52,7 +52,7 @@ from typing import Literal
 
 from grader.base.errors import GraderError, shown
 from grader.base.files import shown_path
-from grader.base.inputs import CELL_CHARS, CSV_BYTES, CsvRow, CsvStream, open_csv
+from grader.base.inputs import CELL_CHARS, CSV_BYTES, CsvRow, CsvStream, open_csv, regular_size
 from grader.grade import timestamps
 from grader.grade.columns import Layout, find_layout
 from grader.grade.latest import Answer, Contests, SubmittedRow
@@ -191,10 +191,7 @@ SUBMISSIONS_BYTES = CSV_BYTES
 
 def _within_limit(path: Path) -> Path:
     """``path``, unless it is a regular file over :data:`SUBMISSIONS_BYTES`: that is refused with the way out."""
-    try:
-        size = path.stat().st_size if path.is_file() else 0
-    except OSError:
-        size = 0  # open_csv says why it cannot be read
+    size = regular_size(path)
     if size > SUBMISSIONS_BYTES:
         raise GraderError(f"{path}: {size:,} bytes, more than the {SUBMISSIONS_BYTES:,} a submissions file is read "
                           "within; split its rows into files under that size and give them all to grader grade "

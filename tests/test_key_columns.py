@@ -293,3 +293,29 @@ def test_a_submissions_file_over_the_limit_is_refused_and_graded_split_in_two_fi
     halves[1].write_text(header + "".join(rows[len(rows) // 2:]), encoding="utf-8")
     run(key, halves, tmp_path / "split")
     assert (tmp_path / "split" / "grades.csv").read_bytes() == expected["grades.csv"]
+
+
+def test_points_of_minus_zero_and_zero_read_from_the_sidecar_as_from_key_json(tmp_path: Path) -> None:
+    """The sidecar's parts are grouped by their entries' bits (-0.0 apart from 0.0), then shaped as key.json's
+    reader shapes them, where equal points are one: the first found."""
+    def student(number: int, points: float) -> dict[str, object]:
+        return {"id": f"s{number}", "problems": [{"key": "1", "answers": {"e": {
+            "value": 0.7, "unit": "", "label": "1a", "points": points, "tolerance": {"mode": "rtol", "rtol": 0.01,
+                                                                                       "atol": 0}}}}]}
+
+    for order in ((-0.0, 0.0, -0.0), (0.0, -0.0, 0.0)):
+        folder = tmp_path / str(order[0])
+        folder.mkdir()
+        key = folder / "key.json"
+        key.write_text(json.dumps({"schema": "grader-key", "version": 2, "assignment": {"title": "HW"},
+                                   "problems": [{"key": "1", "answers": [{"name": "e", "label": "1a", "unit": "",
+                                                                           "points": 2}]}],
+                                   "students": [student(n, p) for n, p in enumerate(order)]}), encoding="utf-8")
+        assert write_key_columns(key)
+        alone = folder / "alone" / "key.json"
+        alone.parent.mkdir()
+        shutil.copyfile(key, alone)
+        from_json, from_columns = load_key(alone), load_key(key)
+        assert from_columns == replace(from_json, where=str(key))
+        signs = [str(s.parts["1a"].points) for s in from_columns.students]
+        assert signs == [str(order[0])] * 3  # the first found, for all three

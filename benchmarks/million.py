@@ -76,11 +76,13 @@ def _number(text: str) -> bool:
 
 def refusal(key: Path, answers: Path) -> str | None:
     """Why ``grade`` would refuse these files for their size, or None."""
+    from grader.assign.key_columns import sidecar
     from grader.base.inputs import CSV_BYTES
     from grader.grade.key import KEY_BYTES
 
-    if key.stat().st_size > KEY_BYTES:
-        return f"refused: key.json is {key.stat().st_size / 2**30:.2f} GiB, over KEY_BYTES ({KEY_BYTES >> 20} MiB)"
+    if key.stat().st_size > KEY_BYTES and not sidecar(key).is_file():  # with its sidecar, a key has no limit
+        return f"refused: key.json is {key.stat().st_size / 2**30:.2f} GiB, over KEY_BYTES ({KEY_BYTES >> 20} MiB), " \
+               "and has no key.columns.npz"
     if answers.stat().st_size > CSV_BYTES:
         return f"refused: the submissions are {answers.stat().st_size / 2**20:.0f} MiB, over CSV_BYTES " \
                f"({CSV_BYTES >> 20} MiB)"

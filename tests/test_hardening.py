@@ -257,7 +257,9 @@ def test_a_sparse_2_gb_key_is_refused_by_its_size_before_reading_it(tmp_path: Pa
         assert tracemalloc.get_traced_memory()[1] < 50 << 20
     finally:
         tracemalloc.stop()
-    assert "key.json: larger than 1024 MiB" in err
+    # Without a sidecar (key.columns.npz) the key would be read whole: refused, saying how to get one.
+    assert f"key.json: {2 << 30:,} bytes, more than the {1 << 30:,} a key.json is read whole within" in err
+    assert "regenerate the key with grader generate, which writes key.columns.npz beside it" in err
 
 
 @pytest.mark.parametrize(("row", "message"), [

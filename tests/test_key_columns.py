@@ -100,10 +100,10 @@ def test_a_missing_stale_or_damaged_sidecar_is_passed_over(graded_class: Path, t
     answer["value"] = answer["value"] * 3
     edited = tmp_path / "edited.json"
     edited.write_text(json.dumps(raw), encoding="utf-8")
-    assert read_key_columns(edited, edited.read_bytes()) is None
+    assert read_key_columns(edited) is None
     shutil.copyfile(key, tmp_path / "stale.json")
     sidecar(tmp_path / "edited.json").write_bytes(good)  # the old key's sidecar beside the edited key
-    assert read_key_columns(edited, edited.read_bytes()) is None
+    assert read_key_columns(edited) is None
     sidecar(tmp_path / "edited.json").unlink()
     reference = _grade_all(tmp_path, edited, answers, "edited-alone")
     sidecar(tmp_path / "edited.json").write_bytes(good)
@@ -117,7 +117,7 @@ def test_a_missing_stale_or_damaged_sidecar_is_passed_over(graded_class: Path, t
             sidecar(key).unlink()
         else:
             sidecar(key).write_bytes(damaged)
-        assert read_key_columns(key, key.read_bytes()) is None
+        assert read_key_columns(key) is None
         assert _grade_all(tmp_path, key, answers, f"damaged-{number}") == expected
 
 
@@ -193,13 +193,13 @@ def test_a_sidecar_compressed_or_larger_than_its_key_is_passed_over_unread(tmp_p
     assert write_key_columns(key)
     with zipfile.ZipFile(sidecar(key)) as archive:
         members = {name: archive.read(name) for name in archive.namelist()}
-    assert read_key_columns(key, key.read_bytes()) is not None
+    assert read_key_columns(key) is not None
     with zipfile.ZipFile(sidecar(key), "w", zipfile.ZIP_DEFLATED) as archive:
         for name, content in members.items():
             archive.writestr(name, content)
-    assert read_key_columns(key, key.read_bytes()) is None
+    assert read_key_columns(key) is None
     sidecar(key).write_bytes(b"\0" * (len(key.read_bytes()) + (1 << 16) + 1))
-    assert read_key_columns(key, key.read_bytes()) is None
+    assert read_key_columns(key) is None
 
 
 def test_a_key_laid_out_a_student_a_line_is_read_a_line_at_a_time_to_the_same_sidecar(
@@ -214,11 +214,11 @@ def test_a_key_laid_out_a_student_a_line_is_read_a_line_at_a_time_to_the_same_si
     decode_text = key_columns.decode_text
     monkeypatch.setattr(key_columns, "decode_text", lambda *given: whole.append(1) or decode_text(*given))
     assert write_key_columns(key) and not whole
-    by_line = read_key_columns(key, key.read_bytes())
+    by_line = read_key_columns(key)
     compact = tmp_path / "compact.json"
     compact.write_text(json.dumps(json.loads(key.read_text(encoding="utf-8")), ensure_ascii=False), encoding="utf-8")
     assert write_key_columns(compact) and whole
-    decoded = read_key_columns(compact, compact.read_bytes())
+    decoded = read_key_columns(compact)
     assert by_line is not None and decoded is not None
     for name in ("header", "ids", "names", "emails", "sections", "dues", "shapes", "texts", "tolerances"):
         assert getattr(by_line, name) == getattr(decoded, name), name
@@ -238,3 +238,84 @@ def test_the_sidecar_is_an_output_like_any_other_for_the_manifest(tmp_path: Path
     capsys.readouterr()
     assert main([*arguments, "--force"]) == 2
     assert "key.columns.npz (changed since grader wrote it)" in capsys.readouterr().err
+
+
+def test_a_key_over_the_limit_with_its_sidecar_is_graded_the_same(graded_class: Path, tmp_path: Path,
+                                                                   monkeypatch: pytest.MonkeyPatch) -> None:
+    """KEY_BYTES bounds only key.json read whole (issue 29): with its sidecar a larger key is hashed a piece at a
+    time and graded, to the bytes a key within the limit gives. The limit is made small, not the file large."""
+    import grader.grade.key as key_module
+
+    key, answers = graded_class / "hw" / "key.json", graded_class / "answers.csv"
+    expected = _grade_all(tmp_path, key, answers, "within")
+    monkeypatch.setattr(key_module, "KEY_BYTES", key.stat().st_size - 1)
+    assert _grade_all(tmp_path, key, answers, "over") == expected
+
+
+@pytest.mark.parametrize("sidecar_is", ["missing", "stale"])
+def test_a_key_over_the_limit_without_a_sidecar_made_from_it_is_refused_with_the_way_out(
+        graded_class: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str],
+        sidecar_is: str) -> None:
+    import grader.grade.key as key_module
+
+    key = tmp_path / "key.json"
+    shutil.copyfile(graded_class / "hw" / "key.json", key)
+    if sidecar_is == "stale":  # made from the key before a byte was added to it
+        shutil.copyfile(sidecar(graded_class / "hw" / "key.json"), sidecar(key))
+        with open(key, "a", encoding="utf-8") as stream:
+            stream.write("\n")
+    monkeypatch.setattr(key_module, "KEY_BYTES", 1000)
+    assert main(["grade", "--key", str(key), str(graded_class / "answers.csv"), "--out", str(tmp_path / "out")]) == 2
+    err = capsys.readouterr().err
+    assert f"{key}: {key.stat().st_size:,} bytes, more than the 1,000 a key.json is read whole within" in err
+    assert "regenerate the key with grader generate, which writes key.columns.npz beside it" in err
+    assert not (tmp_path / "out").exists()
+
+
+def test_a_submissions_file_over_the_limit_is_refused_and_graded_split_in_two_files(
+        graded_class: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
+        capsys: pytest.CaptureFixture[str]) -> None:
+    """The submissions' limit (its text is held whole while read) names the way out: the rows split over files
+    under it, read in turn, give the same grades. The limit is made small, not the file large."""
+    import grader.grade.submissions as submissions
+
+    key, answers = graded_class / "hw" / "key.json", graded_class / "answers.csv"
+    expected = _grade_all(tmp_path, key, answers, "whole")
+    monkeypatch.setattr(submissions, "SUBMISSIONS_BYTES", answers.stat().st_size - 1)
+    assert main(["grade", "--key", str(key), str(answers), "--out", str(tmp_path / "refused")]) == 2
+    err = capsys.readouterr().err
+    assert f"{answers}: {answers.stat().st_size:,} bytes, more than the {answers.stat().st_size - 1:,} a " \
+           "submissions file is read within; split its rows into files under that size" in err
+    assert not (tmp_path / "refused").exists()
+    header, *rows = answers.read_text(encoding="utf-8").splitlines(keepends=True)
+    halves = [tmp_path / "first.csv", tmp_path / "second.csv"]
+    halves[0].write_text(header + "".join(rows[:len(rows) // 2]), encoding="utf-8")
+    halves[1].write_text(header + "".join(rows[len(rows) // 2:]), encoding="utf-8")
+    run(key, halves, tmp_path / "split")
+    assert (tmp_path / "split" / "grades.csv").read_bytes() == expected["grades.csv"]
+
+
+def test_points_of_minus_zero_and_zero_read_from_the_sidecar_as_from_key_json(tmp_path: Path) -> None:
+    """The sidecar's parts are grouped by their entries' bits (-0.0 apart from 0.0), then shaped as key.json's
+    reader shapes them, where equal points are one: the first found."""
+    def student(number: int, points: float) -> dict[str, object]:
+        return {"id": f"s{number}", "problems": [{"key": "1", "answers": {"e": {
+            "value": 0.7, "unit": "", "label": "1a", "points": points, "tolerance": {"mode": "rtol", "rtol": 0.01,
+                                                                                       "atol": 0}}}}]}
+
+    for order in ((-0.0, 0.0, -0.0), (0.0, -0.0, 0.0)):
+        folder = tmp_path / str(order[0])
+        folder.mkdir()
+        key = folder / "key.json"
+        key.write_text(json.dumps({"schema": "grader-key", "version": 2, "assignment": {"title": "HW"},
+                                   "problems": [{"key": "1", "answers": [{"name": "e", "label": "1a", "unit": "",
+                                                                           "points": 2}]}],
+                                   "students": [student(n, p) for n, p in enumerate(order)]}), encoding="utf-8")
+        assert write_key_columns(key)
+        alone = folder / "alone" / "key.json"
+        alone.parent.mkdir()
+        shutil.copyfile(key, alone)
+        from_json, from_columns = load_key(alone), load_key(key)
+        assert from_columns == replace(from_json, where=str(key))
+        signs = [str(s.parts["1a"].points) for s in from_columns.students]
+        assert signs == [str(order[0])] * 3  # the first found, for all three

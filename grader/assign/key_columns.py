@@ -23,10 +23,11 @@ a parameter that is no number, an unusual key) makes no sidecar: grading then re
 ...                                             "tolerance": {"mode": "rtol", "rtol": 0.01, "atol": 0}}}}]}]}))
 >>> write_key_columns(folder / "key.json")
 True
->>> columns = read_key_columns(folder / "key.json", (folder / "key.json").read_bytes())
+>>> columns = read_key_columns(folder / "key.json")
 >>> columns.ids, columns.value.tolist(), columns.texts[columns.code[0][LABEL]], columns.params.tolist()
 (['007'], [0.7], '1a', [2.5])
->>> read_key_columns(folder / "key.json", b"another key") is None  # made from another key.json: not used
+>>> _ = (folder / "key.json").write_text("another key")
+>>> read_key_columns(folder / "key.json") is None  # made from another key.json: not used
 True
 """
 
@@ -36,7 +37,9 @@ import hashlib
 import io
 import itertools
 import json
+import os
 import re
+import stat
 import sys
 import zipfile
 from array import array
@@ -185,42 +188,65 @@ def _loaded(text: str) -> Any:
         raise _LayoutError from None
 
 
-def read_key_columns(key: Path, data: bytes) -> KeyColumns | None:
-    """The sidecar of ``key``, whose bytes are ``data``, if there is one made from these bytes and it reads
-    whole; else None (grading reads ``key.json``)."""
+def read_key_columns(key: Path) -> KeyColumns | None:
+    """The sidecar of ``key`` if there is one made from the bytes ``key`` holds now and it reads whole; else
+    None (grading reads ``key.json``). Neither file is held whole: the sidecar's arrays are read from the file,
+    and ``key.json`` is hashed a piece at a time, only once the sidecar has been found sound (a key of a
+    million students is 3.4 GB)."""
     try:
         with open(sidecar(key), "rb") as stream:
+            status = os.fstat(stream.fileno())
+            size = _size(key)
             # The columns are smaller than the JSON they come from: a bigger file is no sidecar of it.
-            stored = stream.read(_most(data) + 1)
-    except OSError:
-        return None
-    if len(stored) > _most(data) or not _stored_whole(stored):
-        return None
-    try:
-        with np.load(io.BytesIO(stored), allow_pickle=False) as archive:
-            if sorted(archive.files) != sorted(_ARRAYS):
+            if size is None or not stat.S_ISREG(status.st_mode) or status.st_size > _most(size) \
+                    or not _stored_whole(stream, status.st_size):
                 return None
-            meta = json.loads(archive["meta"].tobytes().decode("utf-8"))
-            if not (isinstance(meta, dict) and meta.get("format") == FORMAT and meta.get("version") == VERSION
-                    and meta.get("key_sha256") == hashlib.sha256(data).hexdigest()):
-                return None
-            arrays = {name: archive[name] for name in _ARRAYS[1:]}
+            stream.seek(0)
+            with np.load(stream, allow_pickle=False) as archive:
+                if sorted(archive.files) != sorted(_ARRAYS):
+                    return None
+                meta = json.loads(archive["meta"].tobytes().decode("utf-8"))
+                if not (isinstance(meta, dict) and meta.get("format") == FORMAT and meta.get("version") == VERSION
+                        and meta.get("key_sha256") == _sha256(key, size)):
+                    return None
+                arrays = {name: archive[name] for name in _ARRAYS[1:]}
         return _checked(meta, arrays)
     except (OSError, ValueError, KeyError, TypeError, EOFError, MemoryError, zipfile.BadZipFile):
         return None  # a sidecar cut short, altered, or of another layout: key.json is read instead
 
 
-def _most(data: bytes) -> int:
-    """The largest sidecar of a key of these bytes (the zip's own entries aside, its columns take at most the
+def _size(key: Path) -> int | None:
+    """The size of ``key``, a regular file (None: another kind of file, which has no sidecar: a pipe read to
+    hash it would be read no more)."""
+    status = key.stat()
+    return status.st_size if stat.S_ISREG(status.st_mode) else None
+
+
+def _sha256(key: Path, size: int) -> str | None:
+    """The SHA-256 of ``key``'s bytes, read a MiB at a time; None if it holds more than ``size`` (written to
+    while it was read: its sidecar is not used)."""
+    digest, read = hashlib.sha256(), 0
+    with open(key, "rb") as stream:
+        while piece := stream.read(1 << 20):
+            read += len(piece)
+            if read > size:
+                return None
+            digest.update(piece)
+    return digest.hexdigest()
+
+
+def _most(size: int) -> int:
+    """The largest sidecar of a key of ``size`` bytes (the zip's own entries aside, its columns take at most the
     JSON's length)."""
-    return len(data) + (1 << 16)
+    return size + (1 << 16)
 
 
-def _stored_whole(stored: bytes) -> bool:
-    """Whether the zip holds its arrays as they are (no compression: no member unpacks to more than the file)."""
+def _stored_whole(stream: BinaryIO, size: int) -> bool:
+    """Whether the zip of ``size`` bytes holds its arrays as they are (no compression: no member unpacks to more
+    than the file)."""
     try:
-        with zipfile.ZipFile(io.BytesIO(stored)) as archive:
-            return all(entry.compress_type == zipfile.ZIP_STORED and entry.file_size <= len(stored)
+        with zipfile.ZipFile(stream) as archive:
+            return all(entry.compress_type == zipfile.ZIP_STORED and entry.file_size <= size
                        for entry in archive.infolist())
     except (zipfile.BadZipFile, ValueError, EOFError, OSError):
         return False

@@ -46,6 +46,19 @@ CSV_BYTES = 64 << 20  # 64 MiB: 100,000 rows of 50 cells
 CELL_CHARS = 1000  # no answer, id or parameter value is longer
 
 
+def regular_size(path: Path) -> int:
+    """The size of ``path`` if it is a regular file; 0 for another kind of file or one that cannot be read (its
+    reader then says why), whose size is not known before it is read.
+
+    >>> regular_size(Path("/dev/null")), regular_size(Path("no such file"))
+    (0, 0)
+    """
+    try:
+        return path.stat().st_size if path.is_file() else 0
+    except OSError:
+        return 0
+
+
 def read_bytes(path: Path, limit: int) -> bytes:
     """A file's bytes, refused beyond ``limit`` (read no further: ``/dev/zero`` is a file too; a
     regular file's size is known, so a 2 GB file is refused before any of it is read). Memory is taken for

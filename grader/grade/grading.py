@@ -151,6 +151,9 @@ def grade(key: Key, submissions: Submissions, physics: Physics | None = None) ->
     by_label: dict[str, dict[str, list[Answer]]] = {label: {} for label in key.labels}
     for answer in submissions.answers:
         by_label[answer.label].setdefault(answer.student_id, []).append(answer)
+    # The answers are let go a part at a time, as it is graded (where the caller keeps no reference to them).
+    problems_read, ignored, notes_read = submissions.problems, submissions.ignored_columns, submissions.notes
+    del submissions
     problems: list[RowProblem] = []
     columns: dict[str, list[Row]] = {}
     numbers: dict[str, np.ndarray] = {}
@@ -167,8 +170,8 @@ def grade(key: Key, submissions: Submissions, physics: Physics | None = None) ->
             if timed:
                 stamps[label] = [None if answer is None else answer.timestamp for _, answer in cells]
     late, notes = _late_work(key, columns, stamps)
-    return Graded(key, columns, (*submissions.problems, *problems), submissions.ignored_columns,
-                  (*submissions.notes, *physics.notes, *notes), mistake_words(key, physics), late, numbers)
+    return Graded(key, columns, (*problems_read, *problems), ignored, (*notes_read, *physics.notes, *notes),
+                  mistake_words(key, physics), late, numbers)
 
 
 def mistake_words(key: Key, physics: Physics) -> dict[tuple[str, str], str]:

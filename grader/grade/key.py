@@ -48,16 +48,20 @@ from grader.assign.key_columns import (
     UNIT,
     KeyColumns,
     read_key_columns,
+    sidecar,
 )
 from grader.base.errors import GraderError, TemplateError, shown
-from grader.base.inputs import CELL_CHARS, decode_text, read_bytes
+from grader.base.inputs import CELL_CHARS, decode_text, read_bytes, regular_size
 from grader.grade.notation import ReadError, check_powers
 from grader.model.expr import names, parse
 from grader.model.quantities import parse_unit
 from grader.model.tolerance import SYMBOL_RANGE, Tolerance
 
 VERSIONS = (1, 2)  # the key schema versions grading reads
-KEY_BYTES = 1 << 30  # 1 GiB: a key holds every student's numbers; 2,000 students take about 2 MB
+# 1 GiB: the most of key.json read whole and decoded, which a key needs when it has no sidecar made from it
+# (key.columns.npz); 2,000 students take about 6 MB, 100,000 about 290 MB. A key with its sidecar has no
+# limit of size: it is hashed a piece at a time and graded from the sidecar.
+KEY_BYTES = 1 << 30
 
 _T = TypeVar("_T")
 
@@ -183,11 +187,12 @@ class Key:
 def load_key(path: Path) -> Key:
     """Read and check a key file; a file that is not a grader key is refused with the reason."""
     where = str(path)
-    data = read_bytes(path, KEY_BYTES)
-    columns = read_key_columns(path, data)  # the sidecar grader generate wrote, if it was made from these bytes
+    columns = read_key_columns(path)  # the sidecar grader generate wrote, if it was made from these bytes
     key = None if columns is None else _key_from_columns(columns, where)
     if key is not None:
         return key
+    del columns
+    data = read_bytes(_within_limit(path), KEY_BYTES)
     text = decode_text(data, path)
     del data
     try:
@@ -214,6 +219,18 @@ def load_key(path: Path) -> Key:
 
 
 _ESCAPED_SURROGATE = re.compile(r"\\u[dD][89a-fA-F]")
+
+
+def _within_limit(path: Path) -> Path:
+    """``path``, unless it is a regular file over :data:`KEY_BYTES`: that is refused with the way out."""
+    size = regular_size(path)
+    if size > KEY_BYTES:
+        beside = sidecar(path).name
+        raise GraderError(f"{path}: {size:,} bytes, more than the {KEY_BYTES:,} a key.json is read whole within; a "
+                          f"larger key is graded from the {beside} beside it, which is missing, unreadable or made "
+                          f"from another key.json: regenerate the key with grader generate, which writes {beside} "
+                          "beside it")
+    return path
 
 
 def _refuse_lone_surrogates(raw: Any, where: str) -> None:
@@ -701,7 +718,11 @@ def _columns_students(columns: KeyColumns, symbols: Mapping[str, Mapping[str, tu
         raise _EntryError("a value that is not finite")
     shapes: dict[tuple[Any, ...], _PartShape] = {}
     layouts = [_layout(shape, shared) for shape in columns.shapes]
-    value_list, points, codes = values.tolist(), columns.points.tolist(), columns.code.tolist()
+    value_list, kinds = values.tolist(), columns.code[:, TEXT].tolist()
+    first, inverse = _combinations(columns)
+    rests, points, which = columns.code[first, UNIT:].tolist(), columns.points[first].tolist(), inverse.tolist()
+    del inverse
+    found: dict[tuple[str, str, int], _PartShape] = {}
     params, every_printed = columns.params.tolist(), bool((np.abs(columns.params) < 1.7e308).all())
     dues: dict[str, datetime] = {}
     students, answer, parameter = [], 0, 0
@@ -713,16 +734,19 @@ def _columns_students(columns: KeyColumns, symbols: Mapping[str, Mapping[str, tu
         parts: dict[str, KeyPart] = {}
         for problem, answers in layouts[shape][0]:
             for answer_name in answers:
-                code, value = codes[answer], value_list[answer]
-                key = (problem, answer_name, *code[UNIT:], points[answer])
-                part = shapes.get(key)
+                kind, value, combination = kinds[answer], value_list[answer], which[answer]
+                part = found.get((problem, answer_name, combination))
                 if part is None:
-                    part = shapes[key] = _part_shape(key, texts, columns.tolerances, symbols, shared)
-                if code[TEXT] == NUMBER:
+                    key = (problem, answer_name, *rests[combination], points[combination])
+                    part = shapes.get(key)  # -0.0 points are 0.0's: one shape, the first found, as before
+                    if part is None:
+                        part = shapes[key] = _part_shape(key, texts, columns.tolerances, symbols, shared)
+                    found[problem, answer_name, combination] = part
+                if kind == NUMBER:
                     parts[part.label] = KeyPart(part.problem, part.name, part.label, value, part.unit, part.points,
                                                 part.tolerance, part.undefined, part.symbols)
                 else:
-                    parts[part.label] = _part_valued(part, None if code[TEXT] == NONE else texts[code[TEXT]], shared)
+                    parts[part.label] = _part_valued(part, None if kind == NONE else texts[kind], shared)
                 answer += 1
         if len(parts) != layouts[shape][2]:
             raise _EntryError(f"student {student_id}: a label appears twice")
@@ -737,6 +761,28 @@ def _columns_students(columns: KeyColumns, symbols: Mapping[str, Mapping[str, tu
         students.append(KeyStudent(student_id, _text(name, "name"), _text(email, "email"), _text(section, "section"),
                                    parts, names, tuple(printed), when))
     return students
+
+
+def _combinations(columns: KeyColumns) -> tuple[np.ndarray, np.ndarray]:
+    """Each answer's entries but its value (unit, label, tolerance, reason, points) as one index into the
+    combinations the class has (a few thousand), and where each is first found: a list of five numbers an
+    answer took, for a moment, half again what the key then holds (points compared by their bits: -0.0 is not
+    0.0 here, and :func:`_columns_students` makes them one shape, as equal points).
+
+    >>> import types
+    >>> code = np.array([[-1, 0, 1, 0, -2], [-1, 0, 2, 0, -2], [-1, 0, 1, 0, -2]], dtype=np.int32)
+    >>> first, which = _combinations(types.SimpleNamespace(code=code, points=np.array([2.0, 2.0, 2.0])))
+    >>> first.tolist(), which.tolist()
+    ([0, 1], [0, 1, 0])
+    """
+    combined = np.zeros(len(columns.points), np.int64)
+    for column in (*columns.code[:, UNIT:].T, columns.points.view(np.int64)):
+        distinct, index = np.unique(column, return_inverse=True)
+        if combined.size and int(combined.max()) >= (1 << 62) // len(distinct):
+            combined = np.unique(combined, return_inverse=True)[1].ravel()  # numbered afresh from 0: fits again
+        combined = combined * len(distinct) + index.ravel()
+    _, first, inverse = np.unique(combined, return_index=True, return_inverse=True)
+    return first, inverse.ravel()
 
 
 def _layout(shape: list[tuple[str, list[str], list[str]]], shared: dict[Any, Any]

@@ -103,9 +103,9 @@ def grade_into(folder: Path, key_path: Path, paths: Sequence[Path], out: Path, n
 
 def _graded(key: Key, paths: Sequence[Path], fmt: Literal["auto", "long", "wide"], names: Sequence[str],
             bank: Path | Mapping[str, Template] | None, now: datetime | None = None) -> Graded:
-    submissions = read_submissions(paths, [StudentRef(s.id, s.email) for s in key.students], key.labels, fmt,
-                                   names, now=now, zone=key.zone, attempts=key.attempts)
-    return grade(key, submissions, physics_for(key, bank))
+    # Handed over, not kept: grading lets a part's answers go once it is graded.
+    return grade(key, read_submissions(paths, [StudentRef(s.id, s.email) for s in key.students], key.labels, fmt,
+                                       names, now=now, zone=key.zone, attempts=key.attempts), physics_for(key, bank))
 
 
 def _canvas(graded: Graded, export: CanvasExport | None, missing: str | None) -> CanvasFile:

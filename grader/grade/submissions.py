@@ -42,7 +42,7 @@ import functools
 import itertools
 import os
 from collections import defaultdict
-from collections.abc import Callable, Container, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from datetime import UTC, datetime, tzinfo
 from functools import lru_cache
@@ -52,7 +52,7 @@ from typing import Literal
 
 from grader.base.errors import GraderError, shown
 from grader.base.files import shown_path
-from grader.base.inputs import CELL_CHARS, CsvRow, CsvStream, open_csv
+from grader.base.inputs import CELL_CHARS, CSV_BYTES, CsvRow, CsvStream, open_csv, regular_size
 from grader.grade import timestamps
 from grader.grade.columns import Layout, find_layout
 from grader.grade.latest import Answer, Contests, SubmittedRow
@@ -117,7 +117,7 @@ def read_submissions(paths: Sequence[Path], students: Sequence[StudentRef], labe
     shown_as = [shown_path(name) for name in names or paths]
     plain: list[Answer] | None = None
     for index, (path, name) in enumerate(zip(paths, shown_as, strict=True)):
-        table = open_csv(path, exports=True)
+        table = open_csv(_within_limit(path), exports=True)
         layout = find_layout(table, labels, fmt, reader.roster.known)
         ignored.update(dict.fromkeys(layout.ignored))
         if table.encoding == "Windows-1252":
@@ -139,7 +139,7 @@ def read_submissions(paths: Sequence[Path], students: Sequence[StudentRef], labe
                        tuple(ignored), (*notes, *reader.notes()))
 
 
-def _plain_answers(table: CsvStream, layout: Layout, ids: Container[str], labels: Sequence[str],
+def _plain_answers(table: CsvStream, layout: Layout, ids: Mapping[str, str], labels: Sequence[str],
                    name: str) -> list[Answer] | None:
     """The answers of a long file without timestamps each of whose rows has a cell per column, none too
     long, and names a student of the key by their id and a label as they are written, each student's label
@@ -148,11 +148,12 @@ def _plain_answers(table: CsvStream, layout: Layout, ids: Container[str], labels
     if layout.wide or layout.by_email or layout.timestamp is not None or layout.label is None \
             or layout.answer is None:
         return None
-    header, known = table.header, set(labels)
+    header, known = table.header, {label: label for label in labels}
     width, student, label, answer = (len(header), header.index(layout.student), header.index(layout.label),
                                      header.index(layout.answer))
     answers: list[Answer] = []
     seen: set[tuple[str, str]] = set()
+    typed: dict[str, str] = {}
     records = table.records()
     # A piece of rows at a time (a file of a million rows is not held as cells beside its answers), each check
     # and each cell of the three columns (stripped, as _Reader strips them) a column at a time.
@@ -162,10 +163,16 @@ def _plain_answers(table: CsvStream, layout: Layout, ids: Container[str], labels
             return None
         who = list(map(str.strip, map(itemgetter(student), rows)))
         part = list(map(str.strip, map(itemgetter(label), rows)))
-        seen.update(zip(who, part, strict=True))
-        if not (all(map(ids.__contains__, who)) and known.issuperset(part) and len(seen) == len(answers) + len(rows)):
+        if not (all(map(ids.__contains__, who)) and all(map(known.__contains__, part))):
             return None
-        texts = map(str.strip, map(itemgetter(answer), rows))
+        # The key's own id and label texts, not the file's: one object a student and a part, not three a row.
+        who, part = list(map(ids.__getitem__, who)), list(map(known.__getitem__, part))
+        seen.update(zip(who, part, strict=True))
+        if len(seen) != len(answers) + len(rows):  # a student's label twice
+            return None
+        # One text object for equal answers (a class types a few thousand distinct ones): a verdict keeps it.
+        stripped = list(map(str.strip, map(itemgetter(answer), rows)))
+        texts = map(typed.setdefault, stripped, stripped)
         # tuple.__new__: the named tuple's own __new__ is a Python call per answer.
         answers += map(functools.partial(tuple.__new__, Answer), zip(
             itertools.repeat(name), lines, who, part, texts, itertools.repeat(table.delimiter), itertools.repeat(None)))
@@ -173,6 +180,23 @@ def _plain_answers(table: CsvStream, layout: Layout, ids: Container[str], labels
 
 
 _PLAIN_PIECE = 65536  # rows
+
+
+# The most of one submissions file: its text is held whole while its rows are read (1 byte a character of
+# ASCII, up to 4 of other scripts, and its bytes beside it while they are decoded), and each answer kept takes
+# about 150 bytes beside the file's 18 to 30 a row (docs/grading.md): 64 MiB of short rows, each kept, keep
+# about 0.5 GiB. A larger class splits its rows over several files, each read in turn.
+SUBMISSIONS_BYTES = CSV_BYTES
+
+
+def _within_limit(path: Path) -> Path:
+    """``path``, unless it is a regular file over :data:`SUBMISSIONS_BYTES`: that is refused with the way out."""
+    size = regular_size(path)
+    if size > SUBMISSIONS_BYTES:
+        raise GraderError(f"{path}: {size:,} bytes, more than the {SUBMISSIONS_BYTES:,} a submissions file is read "
+                          "within; split its rows into files under that size and give them all to grader grade "
+                          "(they are read in turn, a student's rows in any of them)")
+    return path
 
 
 def _refuse_repeated(paths: Sequence[Path]) -> None:
@@ -192,7 +216,7 @@ class Roster:
     that student, with a caveat."""
 
     def __init__(self, students: Sequence[StudentRef]) -> None:
-        self.ids = {s.id for s in students}
+        self.ids = {s.id: s.id for s in students}  # each id to the key's own text (answers share it)
         self.stripped: dict[str, list[str]] = defaultdict(list)
         for s in students:
             self.stripped[s.id.lstrip("0")].append(s.id)

@@ -17,10 +17,10 @@ import numpy as np
 import pytest
 
 from grader.base.errors import visible
-from grader.base.spreadsheet import csv_columns_text, csv_text, number_cell, safe_cell, safe_cells
+from grader.base.spreadsheet import csv_columns_text, csv_text, safe_cell, safe_cells
 from grader.grade.cells import _DECIMAL, CellNumber, _read_number, read_number
 from grader.grade.compare import _difference, _period, _Words, errors, feedback, is_correct, number_text
-from grader.grade.details_file import DETAILS_HEADER, details_csv, report_pieces
+from grader.grade.details_file import DETAILS_HEADER, details_csv, report_cell, report_pieces
 from grader.grade.grading import Graded, LateWork, Row, _grade_column
 from grader.grade.key import Key, KeyPart, KeyProblem, KeyStudent
 from grader.grade.latest import Answer
@@ -29,17 +29,6 @@ from grader.model.tolerance import Tolerance
 HOSTILE = ["=1+1", "+1", "-1+1", "@SUM(A1)", "\uff1dHYPERLINK(1)", "\ufe62x", "'quoted", "\tx", "\rx", "\nx",
            "a\x1b[31mred", "v\u202e2", "\u2066iso", 'say "hi"', "6,26", "two\nlines", "cr\rhere", "-0.369",
            "-1.5e-07", "", " ", "é ü", "\x00nul", "a,\"b\",\nc", "\xa0nbsp", "-", "=", "'"]
-
-
-def cell_rule(value: object) -> str:
-    """A report's cell, a cell at a time: text guarded with control characters shown, numbers shortest."""
-    if value is None:
-        return ""
-    if isinstance(value, float):
-        return number_cell(value)
-    if isinstance(value, int):
-        return str(value)
-    return safe_cell(visible(str(value)))
 
 
 def error_rule(value: float | None) -> str:
@@ -56,12 +45,12 @@ def details_rule(graded: Graded) -> str:
             minutes = late.minutes[label][index] if late else None
             share = late.shares[label][index] if late else None
             rows.append((safe_cell(student.id), safe_cell(label),
-                         "" if row.submitted is None else safe_cell(visible(row.submitted)), cell_rule(row.verdict),
-                         cell_rule(row.credit), cell_rule(row.points), cell_rule(row.credit * row.points),
-                         safe_cell(row.expected), safe_cell(visible(row.parsed)), cell_rule(row.unit),
-                         error_rule(row.abs_error), error_rule(row.rel_error), cell_rule(row.tolerance),
-                         safe_cell(visible(row.feedback)), cell_rule(row.diagnosis), safe_cell(visible(row.source)),
-                         cell_rule(minutes), cell_rule(share or 0.0)))
+                         "" if row.submitted is None else safe_cell(visible(row.submitted)), report_cell(row.verdict),
+                         report_cell(row.credit), report_cell(row.points), report_cell(row.credit * row.points),
+                         safe_cell(row.expected), safe_cell(visible(row.parsed)), report_cell(row.unit),
+                         error_rule(row.abs_error), error_rule(row.rel_error), report_cell(row.tolerance),
+                         safe_cell(visible(row.feedback)), report_cell(row.diagnosis), safe_cell(visible(row.source)),
+                         report_cell(minutes), report_cell(share or 0.0)))
     return csv_text(rows)
 
 
@@ -110,7 +99,7 @@ def test_report_pieces_are_the_cell_at_a_time_rule() -> None:
     rows: list[Sequence[object]] = [[rng.choice(values) for _ in range(5)] for _ in range(60)]
     rows += [["only", "three", None], [1, 2.5, "x", "y", "z"], ["a", "b", "c", "d", "e"]]
     rows.append([rng.choice(HOSTILE) for _ in range(5)])
-    expected = csv_text([[cell_rule(value) for value in row] for row in rows])
+    expected = csv_text([[report_cell(value) for value in row] for row in rows])
     for piece in (1, 4, 1000):
         assert "".join(report_pieces(rows, piece)) == expected
 

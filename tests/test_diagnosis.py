@@ -256,6 +256,31 @@ def test_an_earlier_answer_that_leaves_no_real_value_carries_nothing(bank: dict[
     assert verdict.verdict == "incorrect" and "nan" not in verdict.feedback.lower()
 
 
+def test_a_class_of_several_tolerances_is_reconsidered_as_each_student_alone(bank: dict[str, Template]) -> None:
+    """A part's wrong numbers fall into a group per tolerance, reconsidered together: each student's verdicts are
+    the ones the student gets graded alone (an error carried forward, radians for degrees, a plain slip)."""
+    template = bank["ball-plate"]
+    carried = math.degrees(math.atan2(SQRT(47.0**2 - V_T**2), V_T))
+    typed = [{"1a": "47.0", "1b": f"{carried:.3g}"}, {"1a": "45.1", "1b": "0.281"}, {"1a": "60", "1b": "20"},
+             {"1a": "47.0", "1b": "0.281"}]
+    tolerances = [{"mode": "rtol", "rtol": rtol, "atol": 0.0} for rtol in (0.01, 0.02, 0.03)]
+    alone = [graded(student_key(template, PLATE, tolerance=tolerances[index % 3]), answers, template)
+             for index, answers in enumerate(typed * 3)]
+    keys = [student_key(template, PLATE, tolerance=tolerances[index % 3]) for index in range(len(alone))]
+    students = tuple(replace(key.students[0], id=f"s{index}") for index, key in enumerate(keys))
+    answers = tuple(Answer("s.csv", 2 + 2 * index + line, f"s{index}", label, text, ",", None)
+                    for index, typed_here in enumerate(typed * 3) for line, (label, text) in enumerate(typed_here.items()))
+    key = replace(keys[0], students=students)
+    together = grade(key, Submissions(answers, (), (), ()), physics_for(key, {template.id: template}))
+    by_student = {(verdict.student_id, verdict.label): verdict for verdict in together.verdicts}
+    assert {verdict.verdict for verdicts in alone for verdict in verdicts.values()} >= {"ecf", "mistake", "incorrect"}
+    for index, verdicts in enumerate(alone):
+        for label, verdict in verdicts.items():
+            mine = by_student[(f"s{index}", label)]
+            assert (mine.verdict, mine.credit, mine.feedback, mine.diagnosis) == \
+                (verdict.verdict, verdict.credit, verdict.feedback, verdict.diagnosis)
+
+
 # --- where the template is not available ----------------------------------------------------------
 
 def test_without_the_template_the_key_was_made_from_grading_goes_on_with_a_note(bank: dict[str, Template]) -> None:

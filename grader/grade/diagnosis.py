@@ -169,22 +169,38 @@ def _said(template_id: str, where: str, why: str) -> str:
     return f"template {template_id} could not be read from {where} ({why})"
 
 
-def reconsider(problem: ProblemPhysics, key: Key, name: str, label: str, unit: str, tolerance: Tolerance,
-               students: np.ndarray, submitted: np.ndarray, right: np.ndarray, said: Sequence[str],
-               earlier: Sequence[Earlier]) -> dict[int, Finding]:
+def reconsider(problem: ProblemPhysics, key: Key, name: str, label: str, unit: str,
+               groups: Sequence[tuple[Tolerance, np.ndarray]], students: np.ndarray, submitted: np.ndarray,
+               right: np.ndarray, said: Sequence[str], earlier: Sequence[Earlier]) -> dict[int, Finding]:
     """The wrong numbers ``submitted`` to part ``label`` (answer ``name``) by ``students`` (their indices in
     the key; ``right``: the key's values, ``said``: the sentences comparing them) that earn ``ecf`` or are
-    a ``mistake``, by position in ``students``."""
+    a ``mistake``, by position in ``students``; ``groups``: the positions each tolerance decides.
+
+    A part's wrong numbers fall into a few tolerance groups: each alternative is evaluated once for all
+    of them (its value for a student does not depend on the others'), then told apart by each group's rule.
+    """
     alternatives = problem.alternatives.for_answer(name)
     angle = unit if unit in ("deg", "rad") else None
     found: dict[int, Finding] = {}
     open_ = np.ones(len(students), dtype=bool)
+    group_of = np.zeros(len(students), dtype=np.intp)
+    for number, (_, positions) in enumerate(groups):
+        group_of[positions] = number
+
+    def correct(given: np.ndarray, expected: np.ndarray, rows: np.ndarray) -> np.ndarray:
+        verdicts = np.zeros(rows.size, dtype=bool)
+        among = group_of[rows]
+        for number, (tolerance, _) in enumerate(groups):
+            mine = among == number
+            if mine.any():
+                verdicts[mine] = is_correct(given[mine], expected[mine], tolerance, angle_unit=angle)
+        return verdicts
 
     def matches(alternative: Alternative, rows: np.ndarray,
                 given: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
         params = {parameter: column[students[rows]] for parameter, column in problem.params.items()}
         value = values(problem.alternatives, alternative, params, given)
-        return value, is_correct(submitted[rows], value, tolerance, angle_unit=angle)
+        return value, correct(submitted[rows], value, rows)
 
     for source in reversed(earlier) if key.ecf_credit > 0 else ():
         chains = [a for a in alternatives if a.kind == "ecf" and a.id == source.name]
@@ -204,7 +220,7 @@ def reconsider(problem: ProblemPhysics, key: Key, name: str, label: str, unit: s
         if not rows.size:
             break
         value, hit = matches(mistake, rows)
-        hit &= ~is_correct(value, right[rows], tolerance, angle_unit=angle)  # not to be told from the right answer
+        hit &= ~correct(value, right[rows], rows)  # not to be told from the right answer
         for row in rows[hit]:
             found[int(row)] = Finding("mistake", key.mistake_credit, f"your answer matches {mistake.says}: {said[row]}",
                                       mistake.id)

@@ -314,11 +314,13 @@ def _grade_label(cells: Sequence[tuple[KeyPart, Answer | None]], key: Key, stude
     if physics is None or not cells:
         return rows, column.numbers
     part = cells[0][0]
-    for tolerance, wrong in column.wrong:
-        if not wrong:
-            continue
-        members = np.array(wrong)
-        found = reconsider(physics, key, part.name, part.label, part.unit, tolerance, students[members],
+    wrong = [index for _, indices in column.wrong for index in indices]
+    if wrong:
+        members, groups, start = np.array(wrong), [], 0
+        for tolerance, indices in column.wrong:
+            groups.append((tolerance, np.arange(start, start + len(indices))))
+            start += len(indices)
+        found = reconsider(physics, key, part.name, part.label, part.unit, groups, students[members],
                            column.numbers[members], column.right[members], [rows[index].feedback for index in wrong],
                            earlier)
         for position, finding in found.items():

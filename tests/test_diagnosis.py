@@ -269,7 +269,7 @@ def test_a_class_of_several_tolerances_is_reconsidered_as_each_student_alone(ban
     keys = [student_key(template, PLATE, tolerance=tolerances[index % 3]) for index in range(len(alone))]
     students = tuple(replace(key.students[0], id=f"s{index}") for index, key in enumerate(keys))
     answers = tuple(Answer("s.csv", 2 + 2 * index + line, f"s{index}", label, text, ",", None)
-                    for index, typed_here in enumerate(typed * 3) for line, (label, text) in enumerate(typed_here.items()))
+                    for index, mine in enumerate(typed * 3) for line, (label, text) in enumerate(mine.items()))
     key = replace(keys[0], students=students)
     together = grade(key, Submissions(answers, (), (), ()), physics_for(key, {template.id: template}))
     by_student = {(verdict.student_id, verdict.label): verdict for verdict in together.verdicts}

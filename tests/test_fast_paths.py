@@ -104,6 +104,20 @@ def test_report_pieces_are_the_cell_at_a_time_rule() -> None:
         assert "".join(report_pieces(rows, piece)) == expected
 
 
+@pytest.mark.parametrize("cells", [
+    [0.0, -0.0, 1.0, 1.0, 0.1 + 0.2, 0.3, None, 1e16, 2.0**60, -0.0, 3.4149999999999996, None],  # floats
+    [0, 1, 2**60, None, 1, 0, 7],  # ints
+    [1, True, 1.0, 0, False, -0.0, 2**60, 2.0**60],  # bools and ints and floats equal to one another
+    [None, None, None]])
+def test_a_column_of_repeated_numbers_is_the_cell_at_a_time_rule(cells: list[object]) -> None:
+    """A column of numbers of one type is formatted once per value: equal values (0.0 and -0.0) give one text,
+    and values equal across types (True, 1, 1.0; 2**60 and 2.0**60) keep each its own."""
+    rows = [[cell, "x"] for cell in cells * 3]
+    expected = csv_text([[report_cell(value) for value in row] for row in rows])
+    for piece in (2, 1000):
+        assert "".join(report_pieces(rows, piece)) == expected
+
+
 def test_columns_are_written_as_the_csv_writer_writes_rows() -> None:
     rng = random.Random(11)
     alphabet = ["a", ",", '"', "\n", "\r", "=", " ", "é", "\x00", "'", "\u202e"]

@@ -83,8 +83,21 @@ def report_pieces(rows: Iterable[Sequence[object]], rows_per_piece: int = 2000) 
         if len(set(map(len, piece))) > 1 or not piece[0]:  # rows of one length, and not empty, as columns
             yield csv_text([list(map(report_cell, row)) for row in piece])
         else:
-            yield csv_columns_text([_texts(column) if set(map(type, column)) == {str} else
-                                    list(map(report_cell, column)) for column in zip(*piece, strict=True)])
+            yield csv_columns_text([_column_cells(column) for column in zip(*piece, strict=True)])
+
+
+def _column_cells(column: Sequence[object]) -> list[str]:
+    """A column's report cells: text checked for control characters in one call; numbers of one type (scores,
+    totals: a few hundred distinct values in a class) formatted once per value."""
+    kinds = set(map(type, column))
+    if kinds == {str}:
+        return _texts(column)  # type: ignore[arg-type]  # every cell a str
+    if kinds <= _FLOATS or kinds <= _INTS:  # equal values of one type have one text (0.0 and -0.0 both "0")
+        return _mapped(column, _Cells(report_cell))
+    return list(map(report_cell, column))
+
+
+_FLOATS, _INTS = {float, type(None)}, {int, type(None)}  # exactly: a bool is an int equal to 1 or 0, not its text
 
 
 def _mapped(values: Sequence[object], cells: _Cells) -> list[str]:

@@ -518,10 +518,11 @@ def _expected(part: KeyPart) -> str:
     return part.value if isinstance(part.value, str) else number_text(part.value)
 
 
-def final_scores(graded: Graded) -> dict[str, float]:
-    """Per student, the total after the late policy's deduction (what grades.csv and canvas.csv carry)."""
+def final_scores(graded: Graded, scores: Mapping[str, Mapping[str, float]] | None = None) -> dict[str, float]:
+    """Per student, the total after the late policy's deduction (what grades.csv and canvas.csv carry);
+    ``scores``: the :func:`totals`, when the caller has them."""
     return {student_id: sum(by_problem.values()) - graded.deductions.get(student_id, 0.0)
-            for student_id, by_problem in totals(graded).items()}
+            for student_id, by_problem in (totals(graded) if scores is None else scores).items()}
 
 
 def lateness(graded: Graded) -> list[int | None]:

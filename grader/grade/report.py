@@ -46,7 +46,8 @@ def grades_csv(graded: Graded) -> str:
     counts (empty: not known, or nothing submitted), the points the late policy took, the total after it,
     and what was possible."""
     key = graded.key
-    scores, final, late = totals(graded), final_scores(graded), lateness(graded)
+    scores = totals(graded)
+    final, late = final_scores(graded, scores), lateness(graded)
     rows: list[list[object]] = [["student_id", "name", "section", *(f"problem {p.key}" for p in key.problems),
                                  "late", "deduction", "total", "possible"]]
     for student, minutes in zip(key.students, late, strict=True):

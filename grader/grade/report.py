@@ -75,6 +75,12 @@ def integrity_csv(graded: Graded, integrity: Integrity) -> Iterator[str]:
     no grade."""
     students = graded.key.students
     flagged = set(integrity.flagged)
+    # A row per matching answer, most of them a pair's own; their chances and closeness repeat (a third distinct).
+    figures: dict[float, str] = {}
+
+    def cell(value: float) -> str:
+        """A chance or closeness to 3 significant figures (a column for people), once per value."""
+        return figures.get(value) or figures.setdefault(value, number_cell(value, 3))
 
     def rows() -> Iterator[Sequence[object]]:
         yield INTEGRITY_HEADER
@@ -83,17 +89,12 @@ def integrity_csv(graded: Graded, integrity: Integrity) -> Iterator[str]:
             pair = integrity.pair(match.student, match.partner)
             figures: list[object] = [None] * 8 if pair is None else [
                 len(pair.labels), " ".join(pair.labels), pair.wrong, pair.closest,
-                number_cell(pair.closeness, 3) if math.isfinite(pair.closeness) else None, _chance(pair.chance),
-                _chance(pair.corrected), "yes" if pair in flagged else "no"]
+                cell(pair.closeness) if math.isfinite(pair.closeness) else None, cell(pair.chance),
+                cell(pair.corrected), "yes" if pair in flagged else "no"]
             yield [students[match.student].id, match.label, row.submitted, row.parsed, students[match.partner].id,
                    number_text(match.value), match.matches, *figures]
 
     return _csv_pieces(rows())
-
-
-def _chance(value: float) -> str:
-    """A chance to 3 significant figures (a column for people)."""
-    return number_cell(value, 3)
 
 
 def problems_csv(graded: Graded, canvas: CanvasFile | None = None) -> Iterator[str]:

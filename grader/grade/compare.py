@@ -298,7 +298,7 @@ def _shown(value: float, *, full: bool = False, digits: int = 6) -> str:
 
 def _key_text(value: float) -> str:
     """``_shown(value)`` of a finite value, the usual case (no exponent) without its calls."""
-    text = f"{value + 0.0:.6g}"
+    text = number_text(value)
     return text if "e" not in text else _shown(value)  # %g never ends in ".0": nothing else to take off
 
 

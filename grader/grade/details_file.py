@@ -6,7 +6,7 @@ an error to 6 significant figures), and the rule is applied a column at a time, 
 column of a few distinct values (verdicts, credits, units, tolerances) is worked out once per value, and a
 column of text is checked for control characters in one call before each cell is guarded. The rows are the
 columns zipped, written by the one CSV writer (:func:`grader.base.spreadsheet.csv_pieces`), so the bytes are
-those a row at a time gives (``tests/test_details_file.py`` holds the two to the same bytes on hostile text).
+those a row at a time gives (``tests/test_fast_paths.py`` holds the two to the same bytes on hostile text).
 """
 
 from __future__ import annotations
@@ -18,6 +18,7 @@ from collections.abc import Callable, Iterable, Iterator, Sequence
 
 from grader.base.errors import visible
 from grader.base.spreadsheet import csv_columns_text, csv_text, number_cell, safe_cell, safe_cells
+from grader.grade.compare import number_text
 from grader.grade.grading import Graded, Row
 
 DETAILS_HEADER = ("student_id", "label", "submitted", "verdict", "credit", "points", "score", "expected", "parsed",
@@ -122,10 +123,10 @@ def report_cell(value: object) -> str:
 
 def _errors(values: Sequence[float | None]) -> list[str]:
     """``abs_error`` or ``rel_error``, for people: 6 significant figures, as ``expected`` and ``parsed`` (the
-    verdict was decided on the numbers unrounded), as :func:`grader.grade.compare.number_text` writes them."""
+    verdict was decided on the numbers unrounded)."""
     if not all(map(math.isfinite, filter(None, values))):  # 0.0 and None left out: both finite
         raise ValueError("a report cell is not a finite number")  # a bug: verdicts never hold one
-    return ["" if value is None else f"{value + 0.0:.6g}" for value in values]
+    return ["" if value is None else number_text(value) for value in values]
 
 
 class _Cells(dict[object, str]):

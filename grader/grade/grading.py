@@ -429,7 +429,7 @@ def _compare(cells: Sequence[tuple[KeyPart, Answer | None]], group: _Group, tole
     # The rows' fields a column at a time, zipped in Row's order (tuple.__new__: no Python call per row).
     fields = zip([answer.text if len(answer.text) <= CELL_CHARS else _shown_answer(answer.text) for answer in answers],
                  map(_KINDS.__getitem__, verdicts), map(_CREDITS.__getitem__, verdicts),
-                 [part.points for part in parts], [f"{value + 0.0:.6g}" for value in expected],  # number_text's
+                 [part.points for part in parts], list(map(number_text, expected)),
                  [shown.get(value) or shown.setdefault(value, number_text(value)) for value in submitted],
                  [part.unit for part in parts], absolute.tolist(), relative.tolist(), words, said,
                  itertools.repeat("", len(members)), [f"{answer.file}:{answer.line}" for answer in answers],

@@ -76,11 +76,11 @@ def integrity_csv(graded: Graded, integrity: Integrity) -> Iterator[str]:
     students = graded.key.students
     flagged = set(integrity.flagged)
     # A row per matching answer, most of them a pair's own; their chances and closeness repeat (a third distinct).
-    figures: dict[float, str] = {}
+    shown: dict[float, str] = {}
 
     def cell(value: float) -> str:
         """A chance or closeness to 3 significant figures (a column for people), once per value."""
-        return figures.get(value) or figures.setdefault(value, number_cell(value, 3))
+        return shown.get(value) or shown.setdefault(value, number_cell(value, 3))
 
     def rows() -> Iterator[Sequence[object]]:
         yield INTEGRITY_HEADER

@@ -605,3 +605,11 @@ def test_every_pdf_is_clean_for_pdfinfo_and_qpdf(rendered: tuple[Path, list[Path
             run = subprocess.run([*command, str(path)], capture_output=True, text=True, check=False)
             assert run.returncode == 0 and not run.stderr.strip(), (command, path.name, run.stderr)
             assert "warning" not in run.stdout.lower(), (command, path.name, run.stdout)
+
+
+def test_a_contact_time_under_a_slash_or_a_power_is_one_group() -> None:
+    """``Delta t`` is two atoms to Typst: ``|J|/Delta t`` would divide by Delta and multiply by t (seen on
+    wall-impulse's key, F = |J_n|/Δ · t); grouped, Typst drops the parentheses of a fraction's denominator."""
+    assert math(parse("abs(J)/dt")) == "abs(J)/(Delta t)"
+    assert math(parse("dt^2")) == "(Delta t)^2"
+    assert math(parse("F*dt")) == "F Delta t"  # a product needs no group

@@ -102,8 +102,9 @@ class _Math:
             return (f"({shown})", 9, True) if shown.startswith("-") or "/" in shown else (shown, 9, True)
         if isinstance(node, Sym):
             value = (self.degrees.get(node.name) if trig else None) or self.values.get(node.name)
-            if value is None:
-                return name(node.name), 9, False
+            if value is None:  # a name of two atoms (Delta t) is grouped under a slash or a power, as a product is
+                shown = name(node.name)
+                return shown, 8 if " " in re.sub(r"\([^()]*\)", "", shown) else 9, False  # a space outside v_(1, n)
             bare = re.fullmatch(r"[0-9.]+|[0-9.]+ degree", value)
             return (value if bare else f"({value})"), 9, True
         if node.op in FUNCTIONS or node.op in _CALLS:

@@ -4,6 +4,7 @@ worked solutions in the key, figures that fit; PNGs of each template's page in t
 from __future__ import annotations
 
 import dataclasses
+import io
 import re
 import struct
 from pathlib import Path
@@ -423,6 +424,22 @@ def test_scenes_of_other_shapes_get_a_figure_and_a_worked_solution(source: str, 
     png = render_page_png(one, generated, {template.id: template}, 0)
     ARTIFACTS.mkdir(exist_ok=True)
     (ARTIFACTS / f"extra-{template.id}.png").write_bytes(png)
+
+
+def test_a_semicolon_or_a_dot_after_a_unit_stays_in_the_statement(assignment: Assignment) -> None:
+    """A unit kept on one line is a box in code: a semicolon after it would end that code and be lost
+    (wall-impulse's "at 23.8 m/s; the coefficient ..." printed without it)."""
+    raw = yaml.safe_load(WALL)
+    raw["statement"] = "A puck at {{ v }} m/s; it strikes a wall at {{ v }} m/s. Then $e = {{ e }}$."
+    template = parse_template(raw, "test:wall", "hash-wall")
+    spec = ProblemSpec("1", template.id, {"*": 1.0}, {}, {}, {})
+    variant = generate(dataclasses.replace(assignment, problems=(spec,)), (Student("s1", "Sam", "", ""),),
+                       {template.id: template}).students[0].problems[0]
+    pdf = compile_typst(f"#set page(width: 20cm, height: auto)\n{statement(template, variant)}")
+    assert isinstance(pdf, bytes)
+    shown = " ".join(PdfReader(io.BytesIO(pdf)).pages[0].extract_text().split())
+    v = variant.printed["v"]
+    assert f"A puck at {v} m/s; it strikes a wall at {v} m/s. Then" in shown
 
 
 # --- hardening: statements, the Typst root, fonts -------------------------------------------------

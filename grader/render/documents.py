@@ -392,14 +392,14 @@ _UNIT = re.compile(r"(?<![\w/.])((?:[-−]?\d+(?:\.\d+)? )?[A-Za-z]{1,3}/[A-Za-z
 
 def statement(template: Template, variant: ProblemVariant) -> Typ:
     """The template's statement (instructor-written Typst markup, text and math only) with the
-    variant's printed values; a unit in its text (``m/s``), and the number before it, kept on one line. When
-    the assignment asks only some of the template's answers, its question is restated for those
-    (:mod:`grader.assign.asked`)."""
+    variant's printed values; a unit in its text (``m/s``), and the number before it, kept on one line (a
+    box ended by ``;``: a semicolon after the unit would end the box's code and be lost). When the assignment
+    asks only some of the template's answers, its question is restated for those (:mod:`grader.assign.asked`)."""
     filled = filled_statement(template, variant.printed)
     if [part.name for part in variant.answers] != list(template.answers):
         filled = restated(filled, [part.description for part in variant.answers]) or filled
     parts = filled.split("$")
-    return Typ("$".join(_UNIT.sub(r"#box[\1]", part) if index % 2 == 0 else part
+    return Typ("$".join(_UNIT.sub(r"#box[\1];", part) if index % 2 == 0 else part
                         for index, part in enumerate(parts)))
 
 

@@ -7,8 +7,9 @@ peak memory of its process tree (``wait4``'s ``ru_maxrss``), the machine's load 
   1,000,000 at most 1.2x that at 100,000 (linear).
 - **grade**: each size given with ``--grade`` (it must also be a ``--generate`` size, whose key it grades), the
   submissions made from that run's key.csv a row at a time (nine numbers in ten right, one in ten 7 % off, every
-  student one row per part). A key or a submissions file over what ``grade`` reads (``KEY_BYTES``, ``CSV_BYTES``)
-  is not run: the row says it is refused, and why.
+  student one row per part), split into files of at most ``CSV_BYTES`` as ``grade``'s refusal of a larger file
+  tells a user to. A key over what ``grade`` reads without its sidecar (``KEY_BYTES``) is not run: the row says
+  it is refused, and why.
 
 Run: ``python benchmarks/million.py [--generate 10000,100000,1000000] [--grade 10000,100000] [--folder DIR]``; it writes
 ``benchmarks/results/million.md``. The folder (default: a temporary one, removed at the end) needs about 5 GB a
@@ -66,6 +67,35 @@ def submissions(key_csv: Path, path: Path, rng: random.Random) -> int:
     return cells
 
 
+def pieces(path: Path, limit: int) -> list[Path]:
+    """The submissions file split as a user would split it when ``grade`` refuses it for its size (the refusal
+    says so): files of at most ``limit`` bytes, each with the header, a student's rows kept together (key.csv is
+    in the key's order, so a student's rows are next to each other); ``path`` itself when it is small enough."""
+    if path.stat().st_size <= limit:
+        return [path]
+    written: list[Path] = []
+    with open(path, encoding="utf-8", newline="") as source:
+        header = source.readline()
+        lines, size, student = [header], len(header.encode()), ""
+        for line in source:
+            owner = line.split(",", 1)[0]
+            if size + len(line.encode()) > limit and owner != student and len(lines) > 1:
+                written.append(_piece(path, len(written), lines))
+                lines, size = [header], len(header.encode())
+            lines.append(line)
+            size += len(line.encode())
+            student = owner
+        written.append(_piece(path, len(written), lines))
+    path.unlink()
+    return written
+
+
+def _piece(path: Path, number: int, lines: list[str]) -> Path:
+    piece = path.with_name(f"{path.stem}-{number + 1:02d}{path.suffix}")
+    piece.write_text("".join(lines), encoding="utf-8", newline="")
+    return piece
+
+
 def _number(text: str) -> bool:
     try:
         float(text)
@@ -74,18 +104,15 @@ def _number(text: str) -> bool:
     return True
 
 
-def refusal(key: Path, answers: Path) -> str | None:
-    """Why ``grade`` would refuse these files for their size, or None."""
+def refusal(key: Path) -> str | None:
+    """Why ``grade`` would refuse this key for its size, or None (submissions are split into files it reads,
+    :func:`pieces`)."""
     from grader.assign.key_columns import sidecar
-    from grader.base.inputs import CSV_BYTES
     from grader.grade.key import KEY_BYTES
 
     if key.stat().st_size > KEY_BYTES and not sidecar(key).is_file():  # with its sidecar, a key has no limit
         return f"refused: key.json is {key.stat().st_size / 2**30:.2f} GiB, over KEY_BYTES ({KEY_BYTES >> 20} MiB), " \
                "and has no key.columns.npz"
-    if answers.stat().st_size > CSV_BYTES:
-        return f"refused: the submissions are {answers.stat().st_size / 2**20:.0f} MiB, over CSV_BYTES " \
-               f"({CSV_BYTES >> 20} MiB)"
     return None
 
 
@@ -104,19 +131,22 @@ def measure(sizes: Sequence[int], graded: Sequence[int], folder: Path,
                      "load": load(), "bytes": (out / "key.json").stat().st_size})
         done(rows)
         if size in graded:
-            answers = folder / f"answers-{size}.csv"
-            cells = submissions(out / "key.csv", answers, random.Random(7))
-            why = refusal(out / "key.json", answers)
+            from grader.base.inputs import CSV_BYTES
+
+            cells = submissions(out / "key.csv", folder / f"answers-{size}.csv", random.Random(7))
+            answers = pieces(folder / f"answers-{size}.csv", CSV_BYTES)
+            why = refusal(out / "key.json")
             if why is None:
-                seconds, peak, cpu = timed([*GRADER, "grade", "--key", str(out / "key.json"), str(answers), "--out",
-                                            str(folder / f"graded-{size}")])
+                seconds, peak, cpu = timed([*GRADER, "grade", "--key", str(out / "key.json"), *map(str, answers),
+                                            "--out", str(folder / f"graded-{size}")])
                 rows.append({"what": f"`grade` ({cells:,} cells)", "size": size, "seconds": seconds, "cpu": cpu,
                              "peak": peak, "load": load()})
             else:
                 rows.append({"what": f"`grade` ({cells:,} cells)", "size": size, "refused": why, "load": load()})
             done(rows)
             shutil.rmtree(folder / f"graded-{size}", ignore_errors=True)
-            answers.unlink()
+            for piece in answers:
+                piece.unlink()
         shutil.rmtree(out)
     return rows
 

@@ -31,7 +31,7 @@ from grader.grade.cells import (
     read_number,
     undefined_word,
 )
-from grader.grade.compare import errors, feedbacks, is_correct, number_text
+from grader.grade.compare import errors, feedbacks, is_correct, number_text, number_texts
 from grader.grade.diagnosis import Earlier, Physics, ProblemPhysics, physics_for, reconsider
 from grader.grade.equivalence import equivalent, refused
 from grader.grade.key import Key, KeyPart
@@ -336,10 +336,12 @@ Outcome = tuple[str, float, str, str]
 
 
 class _Group(NamedTuple):
-    """Cells compared together (one rule and unit): their indices, the numbers read, the key's, what was typed
-    in another unit, and the words of each one's tolerance (one rule; reasons may differ)."""
+    """Cells compared together (one rule and unit): their indices, answers and points, the numbers read, the
+    key's, what was typed in another unit, and the words of each one's tolerance (one rule; reasons may differ)."""
 
     members: list[int]
+    answers: list[Answer]
+    points: list[float]
     submitted: list[float]
     expected: list[float]
     typed: list[str | None]
@@ -358,7 +360,9 @@ class _Column:
 
 
 def _grade_column(cells: Sequence[tuple[KeyPart, Answer | None]], key: Key) -> _Column:
-    """A row for each (part, answer): outcomes decided once per distinct text, numbers compared by group."""
+    """A row for each (part, answer): outcomes decided once per distinct text, numbers compared by group.
+    The cells are taken a run at a time (one tolerance, unit and answer name: a column has a few runs), each
+    step of a run a column at a time."""
     rows: list[Row | None] = [None] * len(cells)
     # The key's tolerance mappings, by value (a few distinct ones): the rule and its words. Rules equal but for
     # their reasons (widened alike for different reasons) are equal Tolerances: compared in one group.
@@ -367,42 +371,57 @@ def _grade_column(cells: Sequence[tuple[KeyPart, Answer | None]], key: Key) -> _
     # What each distinct text typed for a number reads as (a class types a few thousand), by the part's unit and
     # answer name, then by the text and the file's delimiter: nothing else decides it.
     read: dict[tuple[str, str], dict[tuple[str, str], Outcome | CellNumber]] = {}
-    mapping: Mapping[str, Any] | None = None
-    unit = name = None
-    for index, (part, answer) in enumerate(cells):
-        if part.tolerance is not mapping or part.unit != unit or part.name != name:  # a column has a few of each
-            mapping, unit, name = part.tolerance, part.unit, part.name
-            written = tuple(mapping.items())
-            known = tolerances.get(written)
-            if known is None:
-                tolerance = Tolerance.from_json(mapping)
-                known = tolerances[written] = (tolerance, tolerance.explained())
-            rule, words = known
-            group = None  # found at the first number: groups come in the order of their first numbers
-            readings = read.setdefault((unit, name), {})
-        value = part.value
-        if answer is None or value is None or isinstance(value, str):
-            outcome = _outcome(part, answer, key)
-        else:
-            typed = (answer.text, answer.delimiter)
-            outcome = readings.get(typed) or readings.setdefault(typed, _outcome(part, answer, key))
-        if isinstance(outcome, CellNumber):
-            if group is None:
-                group = groups.get((rule, unit)) or groups.setdefault((rule, unit), _Group([], [], [], [], []))
-            group.members.append(index)
-            group.submitted.append(outcome.value)
-            group.expected.append(float(value))  # type: ignore[arg-type]  # a number: not symbolic, not None
-            group.typed.append(None if outcome.unit_given in (None, unit) else _converted(outcome, part, answer))
-            group.words.append(words)
-        else:
-            rows[index] = _row(part, answer, _expected(part), EQUAL_EXPRESSIONS if part.symbolic else words,
-                               *outcome)
+    for start, stop in _runs(cells):
+        run = cells[start:stop]
+        first = run[0][0]
+        unit, mapping = first.unit, first.tolerance
+        written = tuple(mapping.items())
+        rule, words = tolerances.get(written) or tolerances.setdefault(written, _rule(mapping))
+        readings = read.setdefault((unit, first.name), {})
+        outcomes = [readings.get(typed := (answer.text, answer.delimiter))
+                    or readings.setdefault(typed, _outcome(part, answer, key))
+                    if answer is not None and type(part.value) is float else _outcome(part, answer, key)
+                    for part, answer in run]
+        numbered = [offset for offset, outcome in enumerate(outcomes) if isinstance(outcome, CellNumber)]
+        if numbered:  # groups come in the order of their first numbers
+            group = groups.get((rule, unit)) or groups.setdefault((rule, unit), _Group([], [], [], [], [], [], []))
+            found: list[CellNumber] = [outcomes[offset] for offset in numbered]  # type: ignore[misc]  # numbers
+            given = [run[offset] for offset in numbered]
+            group.members.extend([start + offset for offset in numbered])
+            group.answers.extend([answer for _, answer in given])  # type: ignore[misc]  # a number was given
+            group.points.extend([part.points for part, _ in given])
+            group.submitted.extend([cell.value for cell in found])
+            group.expected.extend([float(part.value) for part, _ in given])  # type: ignore[arg-type]  # numbers
+            group.typed.extend([None if cell.unit_given is None or cell.unit_given == unit else
+                                _converted(cell, part, answer)
+                                for cell, (part, answer) in zip(found, given, strict=True)])
+            group.words.extend([words] * len(numbered))
+        if len(numbered) < len(run):
+            for offset, outcome in enumerate(outcomes):
+                if not isinstance(outcome, CellNumber):
+                    part, answer = run[offset]
+                    rows[start + offset] = _row(part, answer, _expected(part),
+                                                EQUAL_EXPRESSIONS if part.symbolic else words, *outcome)
     numbers, right = np.full(len(cells), np.nan), np.full(len(cells), np.nan)
     wrong = []
     for (rule, unit), group in groups.items():
         numbers[group.members], right[group.members] = group.submitted, group.expected
-        wrong.append((rule, _compare(cells, group, rule, unit, rows)))
+        wrong.append((rule, _compare(group, rule, unit, rows)))
     return _Column(rows, numbers, right, wrong)  # type: ignore[arg-type]  # every row is filled, here or by _compare
+
+
+def _runs(cells: Sequence[tuple[KeyPart, Answer | None]]) -> list[tuple[int, int]]:
+    """Where a column's cells are alike (one tolerance mapping, unit and answer name), as (start, stop)."""
+    parts = [part for part, _ in cells]
+    bounds = [0, *(index for index, (before, part) in enumerate(itertools.pairwise(parts), start=1)
+                   if part.tolerance is not before.tolerance or part.unit != before.unit or part.name != before.name)]
+    return list(itertools.pairwise([*bounds, len(cells)])) if cells else []
+
+
+def _rule(mapping: Mapping[str, Any]) -> tuple[Tolerance, str]:
+    """A key's tolerance mapping as a rule, and its words."""
+    tolerance = Tolerance.from_json(mapping)
+    return tolerance, tolerance.explained()
 
 
 def _converted(cell: CellNumber, part: KeyPart, answer: Answer | None) -> str | None:
@@ -412,28 +431,25 @@ def _converted(cell: CellNumber, part: KeyPart, answer: Answer | None) -> str | 
     return cut(" ".join(answer.text.split()), 40)
 
 
-def _compare(cells: Sequence[tuple[KeyPart, Answer | None]], group: _Group, tolerance: Tolerance, unit: str,
-             rows: list[Row | None]) -> list[int]:
-    """The rows of a group of cells (their indices, the numbers read, the key's, what was typed in another
-    unit, the words of each one's tolerance) of one tolerance and unit: verdicts, errors and sentences, each
-    in one pass over the group; returns the cells found wrong."""
-    members, submitted, expected, typed, words = group
+def _compare(group: _Group, tolerance: Tolerance, unit: str, rows: list[Row | None]) -> list[int]:
+    """The rows of a group of cells of one tolerance and unit: verdicts, errors and sentences, each in one pass
+    over the group; returns the cells found wrong."""
+    members, answers, points, submitted, expected, typed, words = group
     angle = unit if unit in ("deg", "rad") else None
-    right = is_correct(submitted, expected, tolerance, angle_unit=angle)
-    absolute, relative = errors(submitted, expected, angle_unit=angle)
-    said = feedbacks(submitted, expected, unit, tolerance, right, angle_unit=angle, typed=typed)
+    given, key = np.array(submitted), np.array(expected)
+    right = is_correct(given, key, tolerance, angle_unit=angle)
+    absolute, relative = errors(given, key, angle_unit=angle)
+    expected_texts = number_texts(expected)
+    said = feedbacks(given, key, unit, tolerance, right, angle_unit=angle, typed=typed, expected_texts=expected_texts)
     shown: dict[float, str] = {}  # the numbers a class typed: a few thousand
-    answers = [answer for _, answer in map(cells.__getitem__, members) if answer is not None]  # each one given
-    parts = [part for part, _ in map(cells.__getitem__, members)]
     verdicts = right.tolist()
-    # The rows' fields a column at a time, zipped in Row's order (tuple.__new__: no Python call per row).
-    fields = zip([answer.text if len(answer.text) <= CELL_CHARS else _shown_answer(answer.text) for answer in answers],
-                 map(_KINDS.__getitem__, verdicts), map(_CREDITS.__getitem__, verdicts),
-                 [part.points for part in parts], list(map(number_text, expected)),
+    # The rows' fields a column at a time, zipped in Row's order (tuple.__new__: no Python call per row). A
+    # number's text is never longer than CELL_CHARS (such a text does not read); a group's rows share its unit.
+    fields = zip([answer.text for answer in answers], map(_KINDS.__getitem__, verdicts),
+                 map(_CREDITS.__getitem__, verdicts), points, expected_texts,
                  [shown.get(value) or shown.setdefault(value, number_text(value)) for value in submitted],
-                 [part.unit for part in parts], absolute.tolist(), relative.tolist(), words, said,
-                 itertools.repeat("", len(members)), [f"{answer.file}:{answer.line}" for answer in answers],
-                 strict=False)  # all of the group's length (repeat's too)
+                 itertools.repeat(unit), absolute.tolist(), relative.tolist(), words, said, itertools.repeat(""),
+                 [f"{answer.file}:{answer.line}" for answer in answers], strict=False)  # repeat: endless
     for index, row in zip(members, map(functools.partial(tuple.__new__, Row), fields), strict=True):
         rows[index] = row
     return [index for index, ok in zip(members, verdicts, strict=True) if not ok]

@@ -148,9 +148,13 @@ def grade(key: Key, submissions: Submissions, physics: Physics | None = None) ->
     student gave several answers to a part (the key's ``attempts`` is ``best``), the best counts; then
     the key's late policy is applied (:func:`_late_work`)."""
     physics = physics_for(key) if physics is None else physics
-    by_label: dict[str, dict[str, list[Answer]]] = {label: {} for label in key.labels}
+    # Per label, each student's first answer; and, for a part a student answered more than once, all of them.
+    by_label: dict[str, dict[str, Answer]] = {label: {} for label in key.labels}
+    again: dict[str, dict[str, list[Answer]]] = {label: {} for label in key.labels}
     for answer in submissions.answers:
-        by_label[answer.label].setdefault(answer.student_id, []).append(answer)
+        first = by_label[answer.label].setdefault(answer.student_id, answer)
+        if first is not answer:
+            again[answer.label].setdefault(answer.student_id, [first]).append(answer)
     # The answers are let go a part at a time, as it is graded (where the caller keeps no reference to them).
     problems_read, ignored, notes_read = submissions.problems, submissions.ignored_columns, submissions.notes
     del submissions
@@ -159,12 +163,15 @@ def grade(key: Key, submissions: Submissions, physics: Physics | None = None) ->
     numbers: dict[str, np.ndarray] = {}
     stamps: dict[str, list[datetime | None]] = {}
     everyone = np.arange(len(key.students))
+    people = [(student.parts, student.id) for student in key.students]
     timed = _timed(key)  # else no answer's lateness is measured: its timestamp is not kept
     for problem in key.problems:
         earlier: list[Earlier] = []
         for label in problem.labels:
-            answers = _best(key, label, by_label.pop(label), physics.problems.get(problem.key), problems)
-            cells = [(student.parts[label], answers.get(student.id)) for student in key.students]
+            answers = _best(key, label, by_label.pop(label), again.pop(label), physics.problems.get(problem.key),
+                            problems)
+            given = answers.get
+            cells = [(parts[label], given(student_id)) for parts, student_id in people]
             columns[label], numbers[label] = _grade_label(cells, key, everyone, physics.problems.get(problem.key),
                                                           earlier)
             if timed:
@@ -194,21 +201,21 @@ def _due(key: Key, index: int) -> datetime | None:
     return key.students[index].due or key.deadline
 
 
-def _best(key: Key, label: str, answers: Mapping[str, list[Answer]], physics: ProblemPhysics | None,
-          problems: list[RowProblem]) -> dict[str, Answer]:
-    """Per student, the answer to ``label`` that counts: the only one, or, of several (``attempts: best``),
-    the one that scores most after its own late deduction (ties: the earliest). Every attempt is graded on
-    its own (an error is not carried forward while choosing: the earlier parts are not chosen yet); each
-    one not counted is a problem (routine) naming the one that is."""
-    chosen = {student_id: found[0] for student_id, found in answers.items() if len(found) == 1}
-    if len(chosen) == len(answers):
+def _best(key: Key, label: str, chosen: dict[str, Answer], several: Mapping[str, list[Answer]],
+          physics: ProblemPhysics | None, problems: list[RowProblem]) -> dict[str, Answer]:
+    """Per student, the answer to ``label`` that counts (``chosen``: each one's first, which this updates):
+    the only one, or, of ``several`` (``attempts: best``), the one that scores most after its own late
+    deduction (ties: the earliest). Every attempt is graded on its own (an error is not carried forward
+    while choosing: the earlier parts are not chosen yet); each one not counted is a problem (routine)
+    naming the one that is."""
+    if not several:
         return chosen
     positions = key.positions
     cells, students = [], []
-    for student_id, found in answers.items():
-        if len(found) > 1:
-            cells += [(key.students[positions[student_id]].parts[label], answer) for answer in found]
-            students += [positions[student_id]] * len(found)
+    for student_id in [student_id for student_id in chosen if student_id in several]:  # in the order first given
+        found = several[student_id]
+        cells += [(key.students[positions[student_id]].parts[label], answer) for answer in found]
+        students += [positions[student_id]] * len(found)
     rows, _ = _grade_label(cells, key, np.array(students), physics, [])
     scored: dict[str, list[tuple[float, Answer]]] = {}
     for (part, answer), index, row in zip(cells, students, rows, strict=True):

@@ -186,7 +186,7 @@ def test_a_column_grades_each_cell_as_its_rule_says() -> None:
               Answer("a.csv", index + 2, f"s{index}", "1a", text, ";" if index % 3 else ",", None))
              for index, text in enumerate([*NUMBER_TEXTS, *NUMBER_TEXTS[::-1], None])]
     key = Key("key.json", 2, "HW", True, (KeyProblem("1", "Drop", ("1a",)),), ())
-    column = _grade_column(cells, key)
+    column = _grade_column([part for part, _ in cells], [answer for _, answer in cells], key)
     for (part, answer), row in zip(cells, column.rows, strict=True):
         assert row.points == part.points and row.unit == "m/s" and row.diagnosis == ""
         if answer is None:

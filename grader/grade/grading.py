@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import functools
 import itertools
+import operator
 from collections import Counter
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
@@ -163,19 +164,18 @@ def grade(key: Key, submissions: Submissions, physics: Physics | None = None) ->
     numbers: dict[str, np.ndarray] = {}
     stamps: dict[str, list[datetime | None]] = {}
     everyone = np.arange(len(key.students))
-    people = [(student.parts, student.id) for student in key.students]
+    parts_of, ids = [student.parts for student in key.students], [student.id for student in key.students]
     timed = _timed(key)  # else no answer's lateness is measured: its timestamp is not kept
     for problem in key.problems:
         earlier: list[Earlier] = []
         for label in problem.labels:
             answers = _best(key, label, by_label.pop(label), again.pop(label), physics.problems.get(problem.key),
                             problems)
-            given = answers.get
-            cells = [(parts[label], given(student_id)) for parts, student_id in people]
-            columns[label], numbers[label] = _grade_label(cells, key, everyone, physics.problems.get(problem.key),
-                                                          earlier)
+            parts, given = [found[label] for found in parts_of], list(map(answers.get, ids))
+            columns[label], numbers[label] = _grade_label(parts, given, key, everyone,
+                                                          physics.problems.get(problem.key), earlier)
             if timed:
-                stamps[label] = [None if answer is None else answer.timestamp for _, answer in cells]
+                stamps[label] = [None if answer is None else answer.timestamp for answer in given]
     late, notes = _late_work(key, columns, stamps)
     return Graded(key, columns, (*problems_read, *problems), ignored, (*notes_read, *physics.notes, *notes),
                   mistake_words(key, physics), late, numbers)
@@ -211,21 +211,23 @@ def _best(key: Key, label: str, chosen: dict[str, Answer], several: Mapping[str,
     if not several:
         return chosen
     positions = key.positions
-    cells, students = [], []
+    parts: list[KeyPart] = []
+    attempts: list[Answer] = []
+    students: list[int] = []
     for student_id in [student_id for student_id in chosen if student_id in several]:  # in the order first given
         found = several[student_id]
-        cells += [(key.students[positions[student_id]].parts[label], answer) for answer in found]
+        parts += [key.students[positions[student_id]].parts[label]] * len(found)
+        attempts += found
         students += [positions[student_id]] * len(found)
-    rows, _ = _grade_label(cells, key, np.array(students), physics, [])
+    rows, _ = _grade_label(parts, attempts, key, np.array(students), physics, [])
     scored: dict[str, list[tuple[float, Answer]]] = {}
-    for (part, answer), index, row in zip(cells, students, rows, strict=True):
-        assert answer is not None  # every cell holds an attempt
+    for part, answer, index, row in zip(parts, attempts, students, rows, strict=True):
         lost = 0.0 if key.late is None else float(part_deduction(
             key.late, row.score, part.points, intervals(key.late, late_by(answer.timestamp, _due(key, index)))))
         scored.setdefault(answer.student_id, []).append((row.score - lost, answer))
-    for student_id, attempts in scored.items():
-        attempts.sort(key=lambda pair: (-pair[0], instant(pair[1].timestamp), pair[1].line))
-        (best, winner), *others = attempts
+    for student_id, tried in scored.items():
+        tried.sort(key=lambda pair: (-pair[0], instant(pair[1].timestamp), pair[1].line))
+        (best, winner), *others = tried
         chosen[student_id] = winner
         problems.extend(RowProblem(answer.file, answer.line, student_id, label, f"not counted: {winner.file} line "
                                    f"{winner.line} scored more ({best:g} points, this one {score:g}; the best "
@@ -305,22 +307,22 @@ def grade_parts(requests: Sequence[Request], key: Key, physics: Physics | None =
         first = requests[members[0]].part
         found = physics.problems.get(first.problem) if physics is not None and known else None
         students = np.array([positions.get(requests[index].student_id, 0) for index in members])
-        cells = [(requests[index].part, requests[index].answer) for index in members]
-        for index, row in zip(members, _grade_label(cells, key, students, found, [])[0], strict=True):
+        parts, answers = [requests[index].part for index in members], [requests[index].answer for index in members]
+        for index, row in zip(members, _grade_label(parts, answers, key, students, found, [])[0], strict=True):
             verdicts[index] = Verdict(requests[index].student_id, requests[index].part.label, *row)
     return verdicts  # type: ignore[return-value]  # every request is in one group
 
 
-def _grade_label(cells: Sequence[tuple[KeyPart, Answer | None]], key: Key, students: np.ndarray,
+def _grade_label(parts: Sequence[KeyPart], answers: Sequence[Answer | None], key: Key, students: np.ndarray,
                  physics: ProblemPhysics | None, earlier: list[Earlier]) -> tuple[list[Row], np.ndarray]:
-    """The rows of one part (``students``: each cell's student, by index in the key), the wrong numbers
-    reconsidered by the problem's ``physics``, which then adds the part to ``earlier``; and the number each
-    cell was read as (NaN: none)."""
-    column = _grade_column(cells, key)
+    """The rows of one part, a cell for each of ``parts`` (the key's) and ``answers`` (None: nothing given)
+    (``students``: each cell's student, by index in the key), the wrong numbers reconsidered by the problem's
+    ``physics``, which then adds the part to ``earlier``; and the number each cell was read as (NaN: none)."""
+    column = _grade_column(parts, answers, key)
     rows = column.rows
-    if physics is None or not cells:
+    if physics is None or not parts:
         return rows, column.numbers
-    part = cells[0][0]
+    part = parts[0]
     wrong = [index for _, indices in column.wrong for index in indices]
     if wrong:
         members, groups, start = np.array(wrong), [], 0
@@ -366,11 +368,11 @@ class _Column:
     wrong: list[tuple[Tolerance, list[int]]]
 
 
-def _grade_column(cells: Sequence[tuple[KeyPart, Answer | None]], key: Key) -> _Column:
-    """A row for each (part, answer): outcomes decided once per distinct text, numbers compared by group.
+def _grade_column(parts: Sequence[KeyPart], answers: Sequence[Answer | None], key: Key) -> _Column:
+    """A row for each part and answer: outcomes decided once per distinct text, numbers compared by group.
     The cells are taken a run at a time (one tolerance, unit and answer name: a column has a few runs), each
     step of a run a column at a time."""
-    rows: list[Row | None] = [None] * len(cells)
+    rows: list[Row | None] = [None] * len(parts)
     # The key's tolerance mappings, by value (a few distinct ones): the rule and its words. Rules equal but for
     # their reasons (widened alike for different reasons) are equal Tolerances: compared in one group.
     tolerances: dict[tuple[tuple[str, Any], ...], tuple[Tolerance, str]] = {}
@@ -378,8 +380,8 @@ def _grade_column(cells: Sequence[tuple[KeyPart, Answer | None]], key: Key) -> _
     # What each distinct text typed for a number reads as (a class types a few thousand), by the part's unit and
     # answer name, then by the text and the file's delimiter: nothing else decides it.
     read: dict[tuple[str, str], dict[tuple[str, str], Outcome | CellNumber]] = {}
-    for start, stop in _runs(cells):
-        run = cells[start:stop]
+    for start, stop in _runs(parts):
+        run = list(zip(parts[start:stop], answers[start:stop], strict=True))
         first = run[0][0]
         unit, mapping = first.unit, first.tolerance
         written = tuple(mapping.items())
@@ -409,7 +411,7 @@ def _grade_column(cells: Sequence[tuple[KeyPart, Answer | None]], key: Key) -> _
                     part, answer = run[offset]
                     rows[start + offset] = _row(part, answer, _expected(part),
                                                 EQUAL_EXPRESSIONS if part.symbolic else words, *outcome)
-    numbers, right = np.full(len(cells), np.nan), np.full(len(cells), np.nan)
+    numbers, right = np.full(len(parts), np.nan), np.full(len(parts), np.nan)
     wrong = []
     for (rule, unit), group in groups.items():
         numbers[group.members], right[group.members] = group.submitted, group.expected
@@ -417,12 +419,20 @@ def _grade_column(cells: Sequence[tuple[KeyPart, Answer | None]], key: Key) -> _
     return _Column(rows, numbers, right, wrong)  # type: ignore[arg-type]  # every row is filled, here or by _compare
 
 
-def _runs(cells: Sequence[tuple[KeyPart, Answer | None]]) -> list[tuple[int, int]]:
-    """Where a column's cells are alike (one tolerance mapping, unit and answer name), as (start, stop)."""
-    parts = [part for part, _ in cells]
+def _runs(parts: Sequence[KeyPart]) -> list[tuple[int, int]]:
+    """Where a column's parts are alike (one tolerance mapping, unit and answer name), as (start, stop). Most
+    columns are one run, found so without a Python step per part."""
+    if not parts:
+        return []
+    tolerances, names = list(map(_TOLERANCE, parts)), list(map(_UNIT_AND_NAME, parts))
+    if all(map(operator.is_, tolerances, itertools.repeat(tolerances[0]))) and names.count(names[0]) == len(names):
+        return [(0, len(parts))]
     bounds = [0, *(index for index, (before, part) in enumerate(itertools.pairwise(parts), start=1)
                    if part.tolerance is not before.tolerance or part.unit != before.unit or part.name != before.name)]
-    return list(itertools.pairwise([*bounds, len(cells)])) if cells else []
+    return list(itertools.pairwise([*bounds, len(parts)]))
+
+
+_TOLERANCE, _UNIT_AND_NAME = operator.attrgetter("tolerance"), operator.attrgetter("unit", "name")
 
 
 def _rule(mapping: Mapping[str, Any]) -> tuple[Tolerance, str]:

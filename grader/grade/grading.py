@@ -381,8 +381,8 @@ def _grade_column(parts: Sequence[KeyPart], answers: Sequence[Answer | None], ke
     # answer name, then by the text and the file's delimiter: nothing else decides it.
     read: dict[tuple[str, str], dict[tuple[str, str], Outcome | CellNumber]] = {}
     for start, stop in _runs(parts):
-        run = list(zip(parts[start:stop], answers[start:stop], strict=True))
-        first = run[0][0]
+        kept, given = parts[start:stop], answers[start:stop]
+        first = kept[0]
         unit, mapping = first.unit, first.tolerance
         written = tuple(mapping.items())
         rule, words = tolerances.get(written) or tolerances.setdefault(written, _rule(mapping))
@@ -390,25 +390,26 @@ def _grade_column(parts: Sequence[KeyPart], answers: Sequence[Answer | None], ke
         outcomes = [readings.get(typed := (answer.text, answer.delimiter))
                     or readings.setdefault(typed, _outcome(part, answer, key))
                     if answer is not None and type(part.value) is float else _outcome(part, answer, key)
-                    for part, answer in run]
+                    for part, answer in zip(kept, given, strict=True)]
         numbered = [offset for offset, outcome in enumerate(outcomes) if isinstance(outcome, CellNumber)]
         if numbered:  # groups come in the order of their first numbers
             group = groups.get((rule, unit)) or groups.setdefault((rule, unit), _Group([], [], [], [], [], [], []))
             found: list[CellNumber] = [outcomes[offset] for offset in numbered]  # type: ignore[misc]  # numbers
-            given = [run[offset] for offset in numbered]
-            group.members.extend([start + offset for offset in numbered])
-            group.answers.extend([answer for _, answer in given])  # type: ignore[misc]  # a number was given
-            group.points.extend([part.points for part, _ in given])
-            group.submitted.extend([cell.value for cell in found])
-            group.expected.extend([float(part.value) for part, _ in given])  # type: ignore[arg-type]  # numbers
+            their_parts = [kept[offset] for offset in numbered]
+            their_answers: list[Answer] = [given[offset] for offset in numbered]  # type: ignore[misc]  # given
+            group.members.extend([start + offset for offset in numbered] if start else numbered)
+            group.answers.extend(their_answers)
+            group.points.extend(map(_POINTS, their_parts))
+            group.submitted.extend(map(_VALUE, found))
+            group.expected.extend([float(part.value) for part in their_parts])  # type: ignore[arg-type]  # numbers
             group.typed.extend([None if cell.unit_given is None or cell.unit_given == unit else
                                 _converted(cell, part, answer)
-                                for cell, (part, answer) in zip(found, given, strict=True)])
+                                for cell, part, answer in zip(found, their_parts, their_answers, strict=True)])
             group.words.extend([words] * len(numbered))
-        if len(numbered) < len(run):
+        if len(numbered) < len(outcomes):
             for offset, outcome in enumerate(outcomes):
                 if not isinstance(outcome, CellNumber):
-                    part, answer = run[offset]
+                    part, answer = kept[offset], given[offset]
                     rows[start + offset] = _row(part, answer, _expected(part),
                                                 EQUAL_EXPRESSIONS if part.symbolic else words, *outcome)
     numbers, right = np.full(len(parts), np.nan), np.full(len(parts), np.nan)
@@ -433,6 +434,7 @@ def _runs(parts: Sequence[KeyPart]) -> list[tuple[int, int]]:
 
 
 _TOLERANCE, _UNIT_AND_NAME = operator.attrgetter("tolerance"), operator.attrgetter("unit", "name")
+_POINTS, _VALUE = operator.attrgetter("points"), operator.attrgetter("value")
 
 
 def _rule(mapping: Mapping[str, Any]) -> tuple[Tolerance, str]:

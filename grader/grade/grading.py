@@ -422,18 +422,18 @@ def _grade_column(parts: Sequence[KeyPart], answers: Sequence[Answer | None], ke
 
 def _runs(parts: Sequence[KeyPart]) -> list[tuple[int, int]]:
     """Where a column's parts are alike (one tolerance mapping, unit and answer name), as (start, stop). Most
-    columns are one run, found so without a Python step per part."""
+    columns are one run, their parts sharing these objects: found so without a Python step per part."""
     if not parts:
         return []
-    tolerances, names = list(map(_TOLERANCE, parts)), list(map(_UNIT_AND_NAME, parts))
-    if all(map(operator.is_, tolerances, itertools.repeat(tolerances[0]))) and names.count(names[0]) == len(names):
+    first = parts[0]
+    if all(all(map(operator.is_, map(field, parts), itertools.repeat(field(first)))) for field in _SHAPE):
         return [(0, len(parts))]
     bounds = [0, *(index for index, (before, part) in enumerate(itertools.pairwise(parts), start=1)
                    if part.tolerance is not before.tolerance or part.unit != before.unit or part.name != before.name)]
     return list(itertools.pairwise([*bounds, len(parts)]))
 
 
-_TOLERANCE, _UNIT_AND_NAME = operator.attrgetter("tolerance"), operator.attrgetter("unit", "name")
+_SHAPE = tuple(map(operator.attrgetter, ("tolerance", "unit", "name")))  # what decides how a part's cells are read
 _POINTS, _VALUE = operator.attrgetter("points"), operator.attrgetter("value")
 
 

@@ -233,10 +233,11 @@ class _Words:
         said = [subjects.get(value) or subjects.setdefault(value, _shown(value, full=True) + suffix)
                 for value in values]
         clauses = [f"{suffix}{self.clauses[ok]}" for ok in (False, True)]
-        return [f"{subject} is {percent} % {'above' if gap > 0 else 'below'} {key}{clauses[ok]}" if fast
-                else self.sentence(value, number, gap, ok, text)
-                for subject, percent, gap, key, ok, fast, value, number, text in zip(
-                    said, percents, gaps, key_texts, verdicts, usual.tolist(), values, keys, typed, strict=True)]
+        sentences = [f"{subject} is {percent} % {'above' if gap > 0 else 'below'} {key}{clauses[ok]}"
+                     for subject, percent, gap, key, ok in zip(said, percents, gaps, key_texts, verdicts, strict=True)]
+        for index in np.flatnonzero(~usual).tolist():  # the others (a few): their sentences said in full
+            sentences[index] = self.sentence(values[index], keys[index], gaps[index], verdicts[index], typed[index])
+        return sentences
 
     def sentence(self, submitted: float, expected: float, distance: float, correct: bool,
                  typed: str | None = None) -> str:

@@ -25,7 +25,7 @@ True
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Iterable, Iterator, Sequence
 from fractions import Fraction
 
 import numpy as np
@@ -334,10 +334,11 @@ def _percent(ratio: float) -> str:
     return _percent_of(ratio * 100)
 
 
-def _percent_texts(percents: Sequence[float]) -> list[str]:
-    """:func:`_percent_of` of each percentage, the usual ones (finite, no exponent) without a call."""
-    return [f"{percent:.0f}" if 10 <= percent < 1e6 else text if percent < 10 and "e" not in (text := f"{percent:.2g}")
-            else _percent_of(percent) for percent in percents]
+def _percent_texts(percents: Iterable[float]) -> Iterator[str]:
+    """:func:`_percent_of` of each percentage, the usual ones (finite, no exponent) without a call; one at a time
+    (each is let go once its sentence is written: a column of them would leave holes among the rows kept)."""
+    return (f"{percent:.0f}" if 10 <= percent < 1e6 else text if percent < 10 and "e" not in (text := f"{percent:.2g}")
+            else _percent_of(percent) for percent in percents)
 
 
 def _percent_of(percent: float) -> str:

@@ -190,7 +190,7 @@ def test_rules_widened_alike_for_different_reasons_are_compared_together() -> No
     cells = [(part(why), Answer("a.csv", line, "s", "1a", typed, ",", None))
              for line, (why, typed) in enumerate([("by T", "30.5"), ("by v", "29.5"), ("by T", "35")], start=2)]
     key = Key("key.json", 2, "HW", True, (), ())
-    column = _grade_column(cells, key)
+    column = _grade_column([part for part, _ in cells], [answer for _, answer in cells], key)
     assert [indices for _, indices in column.wrong] == [[2]]  # one group: one comparison, one reconsideration
     assert [row.tolerance for row in column.rows] == ["±2.7 %: by T", "±2.7 %: by v", "±2.7 %: by T"]
     assert [row.verdict for row in column.rows] == ["correct", "correct", "incorrect"]

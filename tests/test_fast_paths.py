@@ -18,7 +18,18 @@ import pytest
 
 from grader.base.errors import visible
 from grader.base.spreadsheet import csv_columns_text, csv_text, safe_cell, safe_cells
-from grader.grade.cells import _DECIMAL, CellNumber, _read_number, read_number
+from grader.grade.cells import (
+    _DECIMAL,
+    _DEGREES_MINUTES,
+    CellNumber,
+    _clean,
+    _read_number,
+    _refuse_formula,
+    _split_unit,
+    _usual_split,
+    _without_prefix,
+    read_number,
+)
 from grader.grade.compare import _difference, _period, _Words, errors, feedback, is_correct, number_text
 from grader.grade.details_file import DETAILS_HEADER, details_csv, report_cell, report_pieces
 from grader.grade.grading import Graded, LateWork, Row, _grade_column
@@ -175,7 +186,7 @@ def test_a_column_grades_each_cell_as_its_rule_says() -> None:
               Answer("a.csv", index + 2, f"s{index}", "1a", text, ";" if index % 3 else ",", None))
              for index, text in enumerate([*NUMBER_TEXTS, *NUMBER_TEXTS[::-1], None])]
     key = Key("key.json", 2, "HW", True, (KeyProblem("1", "Drop", ("1a",)),), ())
-    column = _grade_column(cells, key)
+    column = _grade_column([part for part, _ in cells], [answer for _, answer in cells], key)
     for (part, answer), row in zip(cells, column.rows, strict=True):
         assert row.points == part.points and row.unit == "m/s" and row.diagnosis == ""
         if answer is None:
@@ -214,3 +225,32 @@ def test_a_plain_decimal_is_read_as_every_step_reads_it() -> None:
                 text, unit, delimiter, True, names), text
     for text in ("1,5", "1.5e3", " 1.5", "+1.5", "1.", ".5", "1.5 m", "1" * 16):
         assert not _DECIMAL.fullmatch(text)
+
+
+UNIT_WORDS = ["m/s", "cm/s", "ft/s", "km/h", "N·s", "kJ", "%", "°", "deg", "rad", "e", "E", "x", "per", "pi", "m/",
+              "/s", "·m", "%%", "°C", "xyz", "lb", "mph", "s", "m" * 30, "kg·m/s", "a", "EM", "em"]
+
+
+def test_a_number_and_unit_is_split_as_every_step_splits_it() -> None:
+    """read_number's shortcut for ``9.9 cm/s`` (a plain decimal, a space or none, a unit of letters, ``/``, ``·``,
+    ``%`` and ``°``) splits it where every step (cleaned, a name taken off, no formula, no minutes, the unit
+    looked for) splits it, whatever the names; and it is taken for the usual answers."""
+    rng = random.Random(29)
+    numbers = ["0", "-0", "9.9", "-12.5", "007", "1" * 15, "9" * 15 + "." + "9" * 15, "1.", ".5", "1e3", "+2", "1,5"]
+    texts = [number + space + word for number in numbers for space in ("", " ", "  ") for word in UNIT_WORDS]
+    texts += [f"{rng.uniform(-1e3, 1e3):.{rng.randint(0, 6)}f}{rng.choice(['', ' '])}{rng.choice(UNIT_WORDS)}"
+              for _ in range(300)]
+    split = 0
+    for text in texts:
+        found = _usual_split(text)
+        if found is None:
+            continue
+        split += 1
+        for names in (("v", "1a"), ("1", "1"), ("e", "9"), ("m", "-")):
+            cleaned = _without_prefix(_clean(text), names)  # type: ignore[arg-type]  # a str: nothing to refuse
+            _refuse_formula(cleaned, names)
+            assert cleaned == text and not _DEGREES_MINUTES.fullmatch(cleaned), text
+            assert _split_unit(cleaned) == found, text
+    assert split > 300
+    for usual in ("9.9 cm/s", "-12.5 %", "45.2 deg", "3.1 N·s", "7 kJ", "25.0 ft/s", "12°", "5.5m/s"):
+        assert _usual_split(usual) is not None, usual

@@ -33,7 +33,7 @@ def test_a_text_is_read_with_its_own_files_delimiter() -> None:
                  + [(name, delimiter, text) for text in texts for name, delimiter in (("b.csv", ";"), ("a.csv", ","))],
                  start=2)]
     key = Key("key.json", 2, "HW", True, (KeyProblem("1", "Drop", ("1a",)),), ())
-    rows = _grade_column(cells, key).rows
+    rows = _grade_column([part for part, _ in cells], [answer for _, answer in cells], key).rows
     for (_, answer), row in zip(cells, rows, strict=True):
         read = read_number(answer.text, "m/s", delimiter=answer.delimiter, names=("v", "1a"))
         if isinstance(read, CellInvalid):

@@ -21,6 +21,7 @@ CellInvalid(reason='unknown name m; use p and v')
 
 from __future__ import annotations
 
+import functools
 import math
 import re
 from collections.abc import Sequence
@@ -89,6 +90,8 @@ _DEGREES_MINUTES = re.compile(rf"(?P<sign>[-+]?)\s*(?P<degrees>{_NUM})\s*°\s*(?
                               rf"(?:\s*(?P<seconds>{_NUM})\s*(?:\"|″|''|′′|”))?")
 _POWERED_WORD = re.compile(r"(?<=[\d.)\s])(?P<word>[A-Za-zµμ]+)\s*(?:\^|\*\*)\s*(?P<power>[-+]?\d+)$")
 _ASSIGNMENT = re.compile(r"(?P<word>[A-Za-z_][\w']*)\s*=")
+_NUMBER_UNIT = re.compile(r"-?[0-9]{1,15}(?:\.[0-9]{1,15})? ?(?P<unit>[A-Za-z%°][A-Za-z%°/·]*)")
+_WHOLE = 41  # a text this long or shorter is looked at whole for where its unit starts
 
 
 def read_number(text: str, unit: str, *, delimiter: str = ",", numeric_expressions: bool = True,
@@ -113,16 +116,12 @@ def read_number(text: str, unit: str, *, delimiter: str = ",", numeric_expressio
 
 def _read_number(text: str, unit: str, delimiter: str, numeric_expressions: bool,
                  names: Sequence[str]) -> CellBlank | CellInvalid | CellWrongUnit | CellNumber:
-    """:func:`read_number`, every step."""
-    cleaned = _clean(text)
-    if not isinstance(cleaned, str):
-        return cleaned
-    cleaned = _without_prefix(cleaned, names)
+    """:func:`read_number`, every step (the usual number and unit, ``9.9 cm/s``, told apart at once)."""
     try:
-        _refuse_formula(cleaned, names)
-        if angle := _DEGREES_MINUTES.fullmatch(cleaned):
-            return CellNumber(_degrees(angle) * unit_factor("deg", unit) + 0.0, "°")
-        number_text, unit_text = _split_unit(cleaned)
+        found = _usual_split(text) or _split(text, unit, names)
+        if not isinstance(found, tuple):
+            return found
+        number_text, unit_text = found
         value = _readvalue_of(number_text, delimiter, numeric_expressions)
         if unit_text:
             value *= unit_factor(unit_text, unit)
@@ -133,6 +132,42 @@ def _read_number(text: str, unit: str, delimiter: str, numeric_expressions: bool
     except UnitMismatchError as problem:
         return CellWrongUnit(str(problem))
     return CellNumber(value + 0.0, unit_text or None)
+
+
+def _split(text: str, unit: str, names: Sequence[str]) -> tuple[str, str] | CellBlank | CellInvalid | CellNumber:
+    """The number and the unit typed (:func:`_split_unit`) after the text is cleaned and any ``NAME =`` taken
+    off; or what the cell is without them (blank, unreadable, degrees and minutes). Raises ReadError,
+    UnknownUnitError or UnitMismatchError where the text says why it is not a number."""
+    cleaned = _clean(text)
+    if not isinstance(cleaned, str):
+        return cleaned
+    cleaned = _without_prefix(cleaned, names)
+    _refuse_formula(cleaned, names)
+    if angle := _DEGREES_MINUTES.fullmatch(cleaned):
+        return CellNumber(_degrees(angle) * unit_factor("deg", unit) + 0.0, "°")
+    return _split_unit(cleaned)
+
+
+def _usual_split(text: str) -> tuple[str, str] | None:
+    """:func:`_split` of the usual number and unit (``9.9 cm/s``, ``-12.5 %``), without its steps; None for any
+    other text. Such a text is a plain decimal, one space or none, and a unit of letters, ``/``, ``·``, ``%`` and
+    ``°`` (no digit, space, power or quote): cleaning leaves it as it is, it has no ``=`` for a name before it
+    and no minutes, and :func:`_split_unit`, which looks at the whole of a text this short, splits it where
+    the unit starts when the rest is a unit (else it looks on: that text takes every step).
+
+    >>> _usual_split("9.9 cm/s"), _usual_split("-12.5%"), _usual_split("2 e"), _usual_split("1.5e3 m")
+    (('9.9', 'cm/s'), ('-12.5', '%'), None, None)
+    """
+    match = _NUMBER_UNIT.fullmatch(text) if len(text) <= _WHOLE else None
+    if match is None or not _is_unit(match["unit"]):
+        return None
+    return text[:match.start("unit")].rstrip(), match["unit"]
+
+
+@functools.lru_cache(maxsize=1024)
+def _is_unit(text: str) -> bool:
+    """Whether ``text`` reads as a unit (a class types a few)."""
+    return unit_factors(text) is not None
 
 
 def read_expression(text: str, symbols: Sequence[str], *,
@@ -217,7 +252,7 @@ def _refuse_formula(text: str, names: Sequence[str]) -> None:
 def _split_unit(text: str) -> tuple[str, str]:
     """The number and the unit after it: the first word from which the rest is a unit, after a number."""
     _powered_unit(text[-60:])
-    for start in range(max(1, len(text) - 40), len(text)):
+    for start in range(max(1, len(text) + 1 - _WHOLE), len(text)):
         char, before = text[start], text[start - 1]
         if not (char.isalpha() or char in "°%") or before.isalpha() or before == "_":
             continue

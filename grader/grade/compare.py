@@ -25,7 +25,7 @@ True
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Iterable, Iterator, Sequence
 from fractions import Fraction
 
 import numpy as np
@@ -182,10 +182,12 @@ def feedback(submitted: float, expected: float, unit: str, tolerance: Tolerance,
 
 
 def feedbacks(submitted: ArrayLike, expected: ArrayLike, unit: str, tolerance: Tolerance, correct: ArrayLike, *,
-              angle_unit: str | None = None, typed: Sequence[str | None] | None = None) -> list[str]:
+              angle_unit: str | None = None, typed: Sequence[str | None] | None = None,
+              expected_texts: Sequence[str] | None = None) -> list[str]:
     """:func:`feedback` for each element of equally long sequences (a class's answers to one part):
     the distances in one numpy pass, the words that do not depend on the numbers once. ``typed``: for an
-    answer given in another unit, what the student wrote, said before its value in ``unit``.
+    answer given in another unit, what the student wrote, said before its value in ``unit``;
+    ``expected_texts``: the :func:`number_texts` of ``expected``, where the caller has them.
 
     >>> feedbacks([6.32, 6.5], [6.26, 6.26], "m/s", Tolerance(), [True, False])[1]
     '6.5 m/s is 3.8 % above 6.26 m/s; only ±1 % is accepted'
@@ -199,7 +201,7 @@ def feedbacks(submitted: ArrayLike, expected: ArrayLike, unit: str, tolerance: T
     words = _Words(tolerance, unit or {"deg": "°", "rad": "rad"}.get(angle_unit or "", ""), _period(angle_unit))
     with np.errstate(all="ignore"):
         distances = _difference(s, t, words.period)
-    return words.sentences(s, t, distances, right, typed if typed is not None else [None] * s.size)
+    return words.sentences(s, t, distances, right, typed if typed is not None else [None] * s.size, expected_texts)
 
 
 class _Words:
@@ -213,24 +215,29 @@ class _Words:
         self.to_digits = f" to {tolerance.describe()}"
 
     def sentences(self, s: np.ndarray, t: np.ndarray, distances: np.ndarray, right: np.ndarray,
-                  typed: Sequence[str | None]) -> list[str]:
+                  typed: Sequence[str | None], expected_texts: Sequence[str] | None = None) -> list[str]:
         """:meth:`sentence` for each answer. Most of a class's say ``6.32 m/s is 0.96 % above 6.26 m/s; within
         ±1 % is accepted``: where the tolerance is a percentage alone, such a sentence is written here, its
         percentage worked out for the column in one numpy pass (as :meth:`_comparison` works it out, in
-        float64); any other answer is :meth:`sentence`'s."""
+        float64) and each of its words a column at a time; any other answer is :meth:`sentence`'s.
+        ``expected_texts``: the :func:`number_texts` of ``t``, where the caller has them."""
         tolerance, suffix, subjects = self.tolerance, self.suffix, self.subjects
+        values, keys, gaps, verdicts = s.tolist(), t.tolist(), distances.tolist(), right.tolist()
         if self.period is not None or tolerance.mode != "rtol" or not tolerance.rtol or tolerance.atol:
-            return list(map(self.sentence, s.tolist(), t.tolist(), distances.tolist(), right.tolist(), typed))
+            return list(map(self.sentence, values, keys, gaps, verdicts, typed))
         with np.errstate(all="ignore"):
             usual = np.isfinite(s) & np.isfinite(t) & (t != 0) & (distances != 0)
-            percents = (np.abs(distances) / np.abs(t) * 100).tolist()
+            percents = _percent_texts((np.abs(distances) / np.abs(t) * 100).tolist())
         usual &= np.array([text is None for text in typed], dtype=bool)
-        return [f"{subjects.get(value) or subjects.setdefault(value, _shown(value, full=True) + suffix)} is "
-                f"{_percent_of(percent)} % {'above' if distance > 0 else 'below'} {_key_text(key)}{suffix}"
-                f"{self.clauses[ok]}" if fast else self.sentence(value, key, distance, ok, text)
-                for value, key, distance, ok, text, percent, fast in zip(
-                    s.tolist(), t.tolist(), distances.tolist(), right.tolist(), typed, percents, usual.tolist(),
-                    strict=True)]
+        key_texts = _key_texts(keys, number_texts(keys) if expected_texts is None else expected_texts)
+        said = [subjects.get(value) or subjects.setdefault(value, _shown(value, full=True) + suffix)
+                for value in values]
+        clauses = [f"{suffix}{self.clauses[ok]}" for ok in (False, True)]
+        sentences = [f"{subject} is {percent} % {'above' if gap > 0 else 'below'} {key}{clauses[ok]}"
+                     for subject, percent, gap, key, ok in zip(said, percents, gaps, key_texts, verdicts, strict=True)]
+        for index in np.flatnonzero(~usual).tolist():  # the others (a few): their sentences said in full
+            sentences[index] = self.sentence(values[index], keys[index], gaps[index], verdicts[index], typed[index])
+        return sentences
 
     def sentence(self, submitted: float, expected: float, distance: float, correct: bool,
                  typed: str | None = None) -> str:
@@ -296,10 +303,10 @@ def _shown(value: float, *, full: bool = False, digits: int = 6) -> str:
     return f"{mantissa}e{int(power)}" if power else mantissa
 
 
-def _key_text(value: float) -> str:
-    """``_shown(value)`` of a finite value, the usual case (no exponent) without its calls."""
-    text = number_text(value)
-    return text if "e" not in text else _shown(value)  # %g never ends in ".0": nothing else to take off
+def _key_texts(values: Sequence[float], texts: Sequence[str]) -> list[str]:
+    """``_shown(value)`` of each value from its :func:`number_text`: the usual one (no exponent) is that text."""
+    return [text if "e" not in text else _shown(value)  # %g never ends in ".0": nothing else to take off
+            for value, text in zip(values, texts, strict=True)]
 
 
 def number_text(value: float) -> str:
@@ -308,11 +315,30 @@ def number_text(value: float) -> str:
     >>> number_text(2.83138271), number_text(-0.0), number_text(1.5e-7)
     ('2.83138', '0', '1.5e-07')
     """
-    return f"{float(value) + 0.0:.6g}"
+    return f"{float(value) + 0.0:{_FIGURES}}"
+
+
+def number_texts(values: Sequence[float]) -> list[str]:
+    """:func:`number_text` of each of a column of floats (without a call for each).
+
+    >>> number_texts([2.83138271, -0.0, 1.5e-7])
+    ['2.83138', '0', '1.5e-07']
+    """
+    return [f"{value + 0.0:{_FIGURES}}" for value in values]
+
+
+_FIGURES = ".6g"  # how many significant figures a report shows
 
 
 def _percent(ratio: float) -> str:
     return _percent_of(ratio * 100)
+
+
+def _percent_texts(percents: Iterable[float]) -> Iterator[str]:
+    """:func:`_percent_of` of each percentage, the usual ones (finite, no exponent) without a call; one at a time
+    (each is let go once its sentence is written: a column of them would leave holes among the rows kept)."""
+    return (f"{percent:.0f}" if 10 <= percent < 1e6 else text if percent < 10 and "e" not in (text := f"{percent:.2g}")
+            else _percent_of(percent) for percent in percents)
 
 
 def _percent_of(percent: float) -> str:

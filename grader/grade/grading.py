@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import functools
 import itertools
+import operator
 from collections import Counter
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
@@ -31,7 +32,7 @@ from grader.grade.cells import (
     read_number,
     undefined_word,
 )
-from grader.grade.compare import errors, feedbacks, is_correct, number_text
+from grader.grade.compare import errors, feedbacks, is_correct, number_text, number_texts
 from grader.grade.diagnosis import Earlier, Physics, ProblemPhysics, physics_for, reconsider
 from grader.grade.equivalence import equivalent, refused
 from grader.grade.key import Key, KeyPart
@@ -148,9 +149,13 @@ def grade(key: Key, submissions: Submissions, physics: Physics | None = None) ->
     student gave several answers to a part (the key's ``attempts`` is ``best``), the best counts; then
     the key's late policy is applied (:func:`_late_work`)."""
     physics = physics_for(key) if physics is None else physics
-    by_label: dict[str, dict[str, list[Answer]]] = {label: {} for label in key.labels}
+    # Per label, each student's first answer; and, for a part a student answered more than once, all of them.
+    by_label: dict[str, dict[str, Answer]] = {label: {} for label in key.labels}
+    again: dict[str, dict[str, list[Answer]]] = {label: {} for label in key.labels}
     for answer in submissions.answers:
-        by_label[answer.label].setdefault(answer.student_id, []).append(answer)
+        first = by_label[answer.label].setdefault(answer.student_id, answer)
+        if first is not answer:
+            again[answer.label].setdefault(answer.student_id, [first]).append(answer)
     # The answers are let go a part at a time, as it is graded (where the caller keeps no reference to them).
     problems_read, ignored, notes_read = submissions.problems, submissions.ignored_columns, submissions.notes
     del submissions
@@ -159,16 +164,18 @@ def grade(key: Key, submissions: Submissions, physics: Physics | None = None) ->
     numbers: dict[str, np.ndarray] = {}
     stamps: dict[str, list[datetime | None]] = {}
     everyone = np.arange(len(key.students))
+    parts_of, ids = [student.parts for student in key.students], [student.id for student in key.students]
     timed = _timed(key)  # else no answer's lateness is measured: its timestamp is not kept
     for problem in key.problems:
         earlier: list[Earlier] = []
         for label in problem.labels:
-            answers = _best(key, label, by_label.pop(label), physics.problems.get(problem.key), problems)
-            cells = [(student.parts[label], answers.get(student.id)) for student in key.students]
-            columns[label], numbers[label] = _grade_label(cells, key, everyone, physics.problems.get(problem.key),
-                                                          earlier)
+            answers = _best(key, label, by_label.pop(label), again.pop(label), physics.problems.get(problem.key),
+                            problems)
+            parts, given = [found[label] for found in parts_of], list(map(answers.get, ids))
+            columns[label], numbers[label] = _grade_label(parts, given, key, everyone,
+                                                          physics.problems.get(problem.key), earlier)
             if timed:
-                stamps[label] = [None if answer is None else answer.timestamp for _, answer in cells]
+                stamps[label] = [None if answer is None else answer.timestamp for answer in given]
     late, notes = _late_work(key, columns, stamps)
     return Graded(key, columns, (*problems_read, *problems), ignored, (*notes_read, *physics.notes, *notes),
                   mistake_words(key, physics), late, numbers)
@@ -194,31 +201,33 @@ def _due(key: Key, index: int) -> datetime | None:
     return key.students[index].due or key.deadline
 
 
-def _best(key: Key, label: str, answers: Mapping[str, list[Answer]], physics: ProblemPhysics | None,
-          problems: list[RowProblem]) -> dict[str, Answer]:
-    """Per student, the answer to ``label`` that counts: the only one, or, of several (``attempts: best``),
-    the one that scores most after its own late deduction (ties: the earliest). Every attempt is graded on
-    its own (an error is not carried forward while choosing: the earlier parts are not chosen yet); each
-    one not counted is a problem (routine) naming the one that is."""
-    chosen = {student_id: found[0] for student_id, found in answers.items() if len(found) == 1}
-    if len(chosen) == len(answers):
+def _best(key: Key, label: str, chosen: dict[str, Answer], several: Mapping[str, list[Answer]],
+          physics: ProblemPhysics | None, problems: list[RowProblem]) -> dict[str, Answer]:
+    """Per student, the answer to ``label`` that counts (``chosen``: each one's first, which this updates):
+    the only one, or, of ``several`` (``attempts: best``), the one that scores most after its own late
+    deduction (ties: the earliest). Every attempt is graded on its own (an error is not carried forward
+    while choosing: the earlier parts are not chosen yet); each one not counted is a problem (routine)
+    naming the one that is."""
+    if not several:
         return chosen
     positions = key.positions
-    cells, students = [], []
-    for student_id, found in answers.items():
-        if len(found) > 1:
-            cells += [(key.students[positions[student_id]].parts[label], answer) for answer in found]
-            students += [positions[student_id]] * len(found)
-    rows, _ = _grade_label(cells, key, np.array(students), physics, [])
+    parts: list[KeyPart] = []
+    attempts: list[Answer] = []
+    students: list[int] = []
+    for student_id in [student_id for student_id in chosen if student_id in several]:  # in the order first given
+        found = several[student_id]
+        parts += [key.students[positions[student_id]].parts[label]] * len(found)
+        attempts += found
+        students += [positions[student_id]] * len(found)
+    rows, _ = _grade_label(parts, attempts, key, np.array(students), physics, [])
     scored: dict[str, list[tuple[float, Answer]]] = {}
-    for (part, answer), index, row in zip(cells, students, rows, strict=True):
-        assert answer is not None  # every cell holds an attempt
+    for part, answer, index, row in zip(parts, attempts, students, rows, strict=True):
         lost = 0.0 if key.late is None else float(part_deduction(
             key.late, row.score, part.points, intervals(key.late, late_by(answer.timestamp, _due(key, index)))))
         scored.setdefault(answer.student_id, []).append((row.score - lost, answer))
-    for student_id, attempts in scored.items():
-        attempts.sort(key=lambda pair: (-pair[0], instant(pair[1].timestamp), pair[1].line))
-        (best, winner), *others = attempts
+    for student_id, tried in scored.items():
+        tried.sort(key=lambda pair: (-pair[0], instant(pair[1].timestamp), pair[1].line))
+        (best, winner), *others = tried
         chosen[student_id] = winner
         problems.extend(RowProblem(answer.file, answer.line, student_id, label, f"not counted: {winner.file} line "
                                    f"{winner.line} scored more ({best:g} points, this one {score:g}; the best "
@@ -298,22 +307,22 @@ def grade_parts(requests: Sequence[Request], key: Key, physics: Physics | None =
         first = requests[members[0]].part
         found = physics.problems.get(first.problem) if physics is not None and known else None
         students = np.array([positions.get(requests[index].student_id, 0) for index in members])
-        cells = [(requests[index].part, requests[index].answer) for index in members]
-        for index, row in zip(members, _grade_label(cells, key, students, found, [])[0], strict=True):
+        parts, answers = [requests[index].part for index in members], [requests[index].answer for index in members]
+        for index, row in zip(members, _grade_label(parts, answers, key, students, found, [])[0], strict=True):
             verdicts[index] = Verdict(requests[index].student_id, requests[index].part.label, *row)
     return verdicts  # type: ignore[return-value]  # every request is in one group
 
 
-def _grade_label(cells: Sequence[tuple[KeyPart, Answer | None]], key: Key, students: np.ndarray,
+def _grade_label(parts: Sequence[KeyPart], answers: Sequence[Answer | None], key: Key, students: np.ndarray,
                  physics: ProblemPhysics | None, earlier: list[Earlier]) -> tuple[list[Row], np.ndarray]:
-    """The rows of one part (``students``: each cell's student, by index in the key), the wrong numbers
-    reconsidered by the problem's ``physics``, which then adds the part to ``earlier``; and the number each
-    cell was read as (NaN: none)."""
-    column = _grade_column(cells, key)
+    """The rows of one part, a cell for each of ``parts`` (the key's) and ``answers`` (None: nothing given)
+    (``students``: each cell's student, by index in the key), the wrong numbers reconsidered by the problem's
+    ``physics``, which then adds the part to ``earlier``; and the number each cell was read as (NaN: none)."""
+    column = _grade_column(parts, answers, key)
     rows = column.rows
-    if physics is None or not cells:
+    if physics is None or not parts:
         return rows, column.numbers
-    part = cells[0][0]
+    part = parts[0]
     wrong = [index for _, indices in column.wrong for index in indices]
     if wrong:
         members, groups, start = np.array(wrong), [], 0
@@ -336,10 +345,12 @@ Outcome = tuple[str, float, str, str]
 
 
 class _Group(NamedTuple):
-    """Cells compared together (one rule and unit): their indices, the numbers read, the key's, what was typed
-    in another unit, and the words of each one's tolerance (one rule; reasons may differ)."""
+    """Cells compared together (one rule and unit): their indices, answers and points, the numbers read, the
+    key's, what was typed in another unit, and the words of each one's tolerance (one rule; reasons may differ)."""
 
     members: list[int]
+    answers: list[Answer]
+    points: list[float]
     submitted: list[float]
     expected: list[float]
     typed: list[str | None]
@@ -357,9 +368,11 @@ class _Column:
     wrong: list[tuple[Tolerance, list[int]]]
 
 
-def _grade_column(cells: Sequence[tuple[KeyPart, Answer | None]], key: Key) -> _Column:
-    """A row for each (part, answer): outcomes decided once per distinct text, numbers compared by group."""
-    rows: list[Row | None] = [None] * len(cells)
+def _grade_column(parts: Sequence[KeyPart], answers: Sequence[Answer | None], key: Key) -> _Column:
+    """A row for each part and answer: outcomes decided once per distinct text, numbers compared by group.
+    The cells are taken a run at a time (one tolerance, unit and answer name: a column has a few runs), each
+    step of a run a column at a time."""
+    rows: list[Row | None] = [None] * len(parts)
     # The key's tolerance mappings, by value (a few distinct ones): the rule and its words. Rules equal but for
     # their reasons (widened alike for different reasons) are equal Tolerances: compared in one group.
     tolerances: dict[tuple[tuple[str, Any], ...], tuple[Tolerance, str]] = {}
@@ -367,42 +380,67 @@ def _grade_column(cells: Sequence[tuple[KeyPart, Answer | None]], key: Key) -> _
     # What each distinct text typed for a number reads as (a class types a few thousand), by the part's unit and
     # answer name, then by the text and the file's delimiter: nothing else decides it.
     read: dict[tuple[str, str], dict[tuple[str, str], Outcome | CellNumber]] = {}
-    mapping: Mapping[str, Any] | None = None
-    unit = name = None
-    for index, (part, answer) in enumerate(cells):
-        if part.tolerance is not mapping or part.unit != unit or part.name != name:  # a column has a few of each
-            mapping, unit, name = part.tolerance, part.unit, part.name
-            written = tuple(mapping.items())
-            known = tolerances.get(written)
-            if known is None:
-                tolerance = Tolerance.from_json(mapping)
-                known = tolerances[written] = (tolerance, tolerance.explained())
-            rule, words = known
-            group = None  # found at the first number: groups come in the order of their first numbers
-            readings = read.setdefault((unit, name), {})
-        value = part.value
-        if answer is None or value is None or isinstance(value, str):
-            outcome = _outcome(part, answer, key)
-        else:
-            typed = (answer.text, answer.delimiter)
-            outcome = readings.get(typed) or readings.setdefault(typed, _outcome(part, answer, key))
-        if isinstance(outcome, CellNumber):
-            if group is None:
-                group = groups.get((rule, unit)) or groups.setdefault((rule, unit), _Group([], [], [], [], []))
-            group.members.append(index)
-            group.submitted.append(outcome.value)
-            group.expected.append(float(value))  # type: ignore[arg-type]  # a number: not symbolic, not None
-            group.typed.append(None if outcome.unit_given in (None, unit) else _converted(outcome, part, answer))
-            group.words.append(words)
-        else:
-            rows[index] = _row(part, answer, _expected(part), EQUAL_EXPRESSIONS if part.symbolic else words,
-                               *outcome)
-    numbers, right = np.full(len(cells), np.nan), np.full(len(cells), np.nan)
+    for start, stop in _runs(parts):
+        kept, given = parts[start:stop], answers[start:stop]
+        first = kept[0]
+        unit, mapping = first.unit, first.tolerance
+        written = tuple(mapping.items())
+        rule, words = tolerances.get(written) or tolerances.setdefault(written, _rule(mapping))
+        readings = read.setdefault((unit, first.name), {})
+        outcomes = [readings.get(typed := (answer.text, answer.delimiter))
+                    or readings.setdefault(typed, _outcome(part, answer, key))
+                    if answer is not None and type(part.value) is float else _outcome(part, answer, key)
+                    for part, answer in zip(kept, given, strict=True)]
+        numbered = [offset for offset, outcome in enumerate(outcomes) if isinstance(outcome, CellNumber)]
+        if numbered:  # groups come in the order of their first numbers
+            group = groups.get((rule, unit)) or groups.setdefault((rule, unit), _Group([], [], [], [], [], [], []))
+            found: list[CellNumber] = [outcomes[offset] for offset in numbered]  # type: ignore[misc]  # numbers
+            their_parts = [kept[offset] for offset in numbered]
+            their_answers: list[Answer] = [given[offset] for offset in numbered]  # type: ignore[misc]  # given
+            group.members.extend([start + offset for offset in numbered] if start else numbered)
+            group.answers.extend(their_answers)
+            group.points.extend(map(_POINTS, their_parts))
+            group.submitted.extend(map(_VALUE, found))
+            group.expected.extend([float(part.value) for part in their_parts])  # type: ignore[arg-type]  # numbers
+            group.typed.extend([None if cell.unit_given is None or cell.unit_given == unit else
+                                _converted(cell, part, answer)
+                                for cell, part, answer in zip(found, their_parts, their_answers, strict=True)])
+            group.words.extend([words] * len(numbered))
+        if len(numbered) < len(outcomes):
+            for offset, outcome in enumerate(outcomes):
+                if not isinstance(outcome, CellNumber):
+                    part, answer = kept[offset], given[offset]
+                    rows[start + offset] = _row(part, answer, _expected(part),
+                                                EQUAL_EXPRESSIONS if part.symbolic else words, *outcome)
+    numbers, right = np.full(len(parts), np.nan), np.full(len(parts), np.nan)
     wrong = []
     for (rule, unit), group in groups.items():
         numbers[group.members], right[group.members] = group.submitted, group.expected
-        wrong.append((rule, _compare(cells, group, rule, unit, rows)))
+        wrong.append((rule, _compare(group, rule, unit, rows)))
     return _Column(rows, numbers, right, wrong)  # type: ignore[arg-type]  # every row is filled, here or by _compare
+
+
+def _runs(parts: Sequence[KeyPart]) -> list[tuple[int, int]]:
+    """Where a column's parts are alike (one tolerance mapping, unit and answer name), as (start, stop). Most
+    columns are one run, their parts sharing these objects: found so without a Python step per part."""
+    if not parts:
+        return []
+    first = parts[0]
+    if all(all(map(operator.is_, map(field, parts), itertools.repeat(field(first)))) for field in _SHAPE):
+        return [(0, len(parts))]
+    bounds = [0, *(index for index, (before, part) in enumerate(itertools.pairwise(parts), start=1)
+                   if part.tolerance is not before.tolerance or part.unit != before.unit or part.name != before.name)]
+    return list(itertools.pairwise([*bounds, len(parts)]))
+
+
+_SHAPE = tuple(map(operator.attrgetter, ("tolerance", "unit", "name")))  # what decides how a part's cells are read
+_POINTS, _VALUE = operator.attrgetter("points"), operator.attrgetter("value")
+
+
+def _rule(mapping: Mapping[str, Any]) -> tuple[Tolerance, str]:
+    """A key's tolerance mapping as a rule, and its words."""
+    tolerance = Tolerance.from_json(mapping)
+    return tolerance, tolerance.explained()
 
 
 def _converted(cell: CellNumber, part: KeyPart, answer: Answer | None) -> str | None:
@@ -412,28 +450,25 @@ def _converted(cell: CellNumber, part: KeyPart, answer: Answer | None) -> str | 
     return cut(" ".join(answer.text.split()), 40)
 
 
-def _compare(cells: Sequence[tuple[KeyPart, Answer | None]], group: _Group, tolerance: Tolerance, unit: str,
-             rows: list[Row | None]) -> list[int]:
-    """The rows of a group of cells (their indices, the numbers read, the key's, what was typed in another
-    unit, the words of each one's tolerance) of one tolerance and unit: verdicts, errors and sentences, each
-    in one pass over the group; returns the cells found wrong."""
-    members, submitted, expected, typed, words = group
+def _compare(group: _Group, tolerance: Tolerance, unit: str, rows: list[Row | None]) -> list[int]:
+    """The rows of a group of cells of one tolerance and unit: verdicts, errors and sentences, each in one pass
+    over the group; returns the cells found wrong."""
+    members, answers, points, submitted, expected, typed, words = group
     angle = unit if unit in ("deg", "rad") else None
-    right = is_correct(submitted, expected, tolerance, angle_unit=angle)
-    absolute, relative = errors(submitted, expected, angle_unit=angle)
-    said = feedbacks(submitted, expected, unit, tolerance, right, angle_unit=angle, typed=typed)
+    given, key = np.array(submitted), np.array(expected)
+    right = is_correct(given, key, tolerance, angle_unit=angle)
+    absolute, relative = errors(given, key, angle_unit=angle)
+    expected_texts = number_texts(expected)
+    said = feedbacks(given, key, unit, tolerance, right, angle_unit=angle, typed=typed, expected_texts=expected_texts)
     shown: dict[float, str] = {}  # the numbers a class typed: a few thousand
-    answers = [answer for _, answer in map(cells.__getitem__, members) if answer is not None]  # each one given
-    parts = [part for part, _ in map(cells.__getitem__, members)]
     verdicts = right.tolist()
-    # The rows' fields a column at a time, zipped in Row's order (tuple.__new__: no Python call per row).
-    fields = zip([answer.text if len(answer.text) <= CELL_CHARS else _shown_answer(answer.text) for answer in answers],
-                 map(_KINDS.__getitem__, verdicts), map(_CREDITS.__getitem__, verdicts),
-                 [part.points for part in parts], list(map(number_text, expected)),
+    # The rows' fields a column at a time, zipped in Row's order (tuple.__new__: no Python call per row). A
+    # number's text is never longer than CELL_CHARS (such a text does not read); a group's rows share its unit.
+    fields = zip([answer.text for answer in answers], map(_KINDS.__getitem__, verdicts),
+                 map(_CREDITS.__getitem__, verdicts), points, expected_texts,
                  [shown.get(value) or shown.setdefault(value, number_text(value)) for value in submitted],
-                 [part.unit for part in parts], absolute.tolist(), relative.tolist(), words, said,
-                 itertools.repeat("", len(members)), [f"{answer.file}:{answer.line}" for answer in answers],
-                 strict=False)  # all of the group's length (repeat's too)
+                 itertools.repeat(unit), absolute.tolist(), relative.tolist(), words, said, itertools.repeat(""),
+                 [f"{answer.file}:{answer.line}" for answer in answers], strict=False)  # repeat: endless
     for index, row in zip(members, map(functools.partial(tuple.__new__, Row), fields), strict=True):
         rows[index] = row
     return [index for index, ok in zip(members, verdicts, strict=True) if not ok]

@@ -74,18 +74,30 @@ def pieces(path: Path, limit: int) -> list[Path]:
     if path.stat().st_size <= limit:
         return [path]
     written: list[Path] = []
+    header = ""
+    piece: list[str] = []  # the lines of the file being filled, then of the student being read
+    student: list[str] = []
+    size = 0
+
+    def student_ends() -> None:
+        nonlocal piece, size
+        more = sum(len(line.encode()) for line in student)
+        if size + more > limit and len(piece) > 1:
+            written.append(_piece(path, len(written), piece))
+            piece, size = [header], len(header.encode())
+        piece += student
+        size += more
+        student.clear()
+
     with open(path, encoding="utf-8", newline="") as source:
         header = source.readline()
-        lines, size, student = [header], len(header.encode()), ""
+        piece, size = [header], len(header.encode())
         for line in source:
-            owner = line.split(",", 1)[0]
-            if size + len(line.encode()) > limit and owner != student and len(lines) > 1:
-                written.append(_piece(path, len(written), lines))
-                lines, size = [header], len(header.encode())
-            lines.append(line)
-            size += len(line.encode())
-            student = owner
-        written.append(_piece(path, len(written), lines))
+            if student and line.split(",", 1)[0] != student[0].split(",", 1)[0]:
+                student_ends()
+            student.append(line)
+        student_ends()
+    written.append(_piece(path, len(written), piece))
     path.unlink()
     return written
 

@@ -17,13 +17,15 @@ import numpy as np
 import pytest
 
 from grader.base.errors import visible
-from grader.base.spreadsheet import csv_columns_text, csv_text, safe_cell, safe_cells
+from grader.base.spreadsheet import csv_columns_text, csv_text, number_cell, quoted_cell, safe_cell, safe_cells
 from grader.grade.cells import _DECIMAL, CellNumber, _read_number, read_number
 from grader.grade.compare import _difference, _period, _Words, errors, feedback, is_correct, number_text
 from grader.grade.details_file import DETAILS_HEADER, details_csv, report_cell, report_pieces
 from grader.grade.grading import Graded, LateWork, Row, _grade_column
+from grader.grade.integrity import Integrity, Match, Pair
 from grader.grade.key import Key, KeyPart, KeyProblem, KeyStudent
 from grader.grade.latest import Answer
+from grader.grade.report import INTEGRITY_HEADER, integrity_csv
 from grader.model.tolerance import Tolerance
 
 HOSTILE = ["=1+1", "+1", "-1+1", "@SUM(A1)", "\uff1dHYPERLINK(1)", "\ufe62x", "'quoted", "\tx", "\rx", "\nx",
@@ -90,6 +92,47 @@ def crafted_class(students: int, late: bool, seed: int = 7) -> Graded:
 def test_details_csv_is_the_cell_at_a_time_rule(students: int, late: bool, piece: int) -> None:
     graded = crafted_class(students, late)
     assert "".join(details_csv(graded, piece)) == details_rule(graded)
+
+
+def integrity_rule(graded: Graded, integrity: Integrity) -> str:
+    """integrity.csv a row at a time, each cell a report's cell, through the CSV writer."""
+    students, flagged = graded.key.students, set(integrity.flagged)
+    rows: list[Sequence[object]] = [INTEGRITY_HEADER]
+    for match in integrity.matches:
+        row, pair = graded.columns[match.label][match.student], integrity.pair(match.student, match.partner)
+        figures: list[object] = [None] * 8 if pair is None else [
+            len(pair.labels), " ".join(pair.labels), pair.wrong, pair.closest,
+            number_cell(pair.closeness, 3) if math.isfinite(pair.closeness) else None, number_cell(pair.chance, 3),
+            number_cell(pair.corrected, 3), "yes" if pair in flagged else "no"]
+        rows.append([students[match.student].id, match.label, row.submitted, row.parsed,
+                     students[match.partner].id, number_text(match.value), match.matches, *figures])
+    return csv_text([[report_cell(value) for value in row] for row in rows])
+
+
+@pytest.mark.parametrize(("students", "piece"), [(40, 10_000), (40, 7), (13, 1), (0, 3)])
+def test_integrity_csv_is_the_cell_at_a_time_rule(students: int, piece: int) -> None:
+    """Hostile ids, labels and answers; pairs flagged and not, unread closeness, and matches whose pair is not
+    listed; figures repeated and not."""
+    graded, rng = crafted_class(students, late=False), random.Random(5)
+    labels = graded.key.labels
+    pairs = {}
+    for _ in range(students * 2):
+        student, partner = rng.randrange(students), rng.randrange(students)
+        pairs[student, partner] = Pair(student, partner, tuple(rng.sample(labels, rng.randint(1, len(labels)))),
+                                       rng.randint(1, 3), rng.choice([1e-9, 0.0123456, 0.5, 1.0, -0.0]),
+                                       rng.choice([2.5e-7, 0.049999, 1.0, 0.0]), rng.randint(0, 3),
+                                       rng.choice([math.inf, 0.0, 1.5, 12345.678, 999.6]))
+    unlisted = [(rng.randrange(students), rng.randrange(students)) for _ in range(students // 4)]
+    matches = tuple(Match(student, rng.choice(labels), partner, rng.choice([1.5, -0.0, -2.25e-7, 1e300, 0.1 + 0.2]),
+                          rng.randint(1, 9)) for student, partner in [*pairs, *unlisted])
+    integrity = Integrity(matches, tuple(pairs.values()), 100, 0.05, 10, 5)
+    assert (integrity.flagged and len(integrity.flagged) < len(pairs)) or not students
+    assert "".join(integrity_csv(graded, integrity, piece)) == integrity_rule(graded, integrity)
+
+
+def test_quoted_cell_is_the_csv_writers_cell() -> None:
+    for cell in [*HOSTILE, "a", "±1 %, widened", '"', "a\r\nb"]:
+        assert f"{quoted_cell(cell)},x\n" == csv_text([[cell, "x"]])
 
 
 def test_report_pieces_are_the_cell_at_a_time_rule() -> None:

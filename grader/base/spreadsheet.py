@@ -117,14 +117,28 @@ def csv_columns_text(columns: Sequence[Sequence[str]]) -> str:
     """
     if len(columns) < 2:  # a row of one empty cell is written as "": the writer knows its rules
         return csv_text(zip(*columns, strict=True))
-    text = "\n".join(map(",".join, zip(*map(_quoted, columns), strict=True)))
+    text = "\n".join(map(",".join, zip(*map(quoted_cells, columns), strict=True)))
     return text + "\n" if text else ""  # a row of two cells or more is never empty: "" is no row
 
 
-def _quoted(column: Sequence[str]) -> Sequence[str]:
-    """The cells of a column as the CSV writer writes them (``excel``'s dialect: a cell with a delimiter, quote or
-    line break is quoted, its quotes doubled); the cells to quote are found by searching the column's joined
-    text (each place found is in the cell whose end comes next)."""
+def quoted_cell(cell: str) -> str:
+    """A cell as the CSV writer writes it in a row of two cells or more (``excel``'s dialect: a cell with a
+    delimiter, quote or line break is quoted, its quotes doubled): for a column of a few distinct cells, each
+    quoted once.
+
+    >>> quoted_cell("±1 %"), quoted_cell('say "hi", then')
+    ('±1 %', '"say ""hi"", then"')
+    """
+    return '"' + cell.replace('"', '""') + '"' if _QUOTED.search(cell) else cell
+
+
+def quoted_cells(column: Sequence[str]) -> Sequence[str]:
+    """The cells of a column as the CSV writer writes them (:func:`quoted_cell`); the cells to quote are found
+    by searching the column's joined text (each place found is in the cell whose end comes next).
+
+    >>> quoted_cells(["a", "b,c", "d"])
+    ['a', '"b,c"', 'd']
+    """
     joined = "".join(column)
     places = [place for special in _SPECIAL for place in _places(joined, special)]
     if not places:  # most columns
@@ -132,7 +146,7 @@ def _quoted(column: Sequence[str]) -> Sequence[str]:
     ends = list(itertools.accumulate(map(len, column)))
     written = list(column)
     for index in {bisect.bisect_right(ends, place) for place in places}:
-        written[index] = '"' + written[index].replace('"', '""') + '"'
+        written[index] = quoted_cell(written[index])
     return written
 
 
@@ -146,3 +160,4 @@ def _places(text: str, special: str) -> Iterator[int]:
 
 # What a cell may hold that the writer quotes, asked of the writer (a carriage return: from Python 3.12).
 _SPECIAL = tuple(special for special in (",", '"', "\n", "\r") if csv_text([(special, "")]).startswith('"'))
+_QUOTED = re.compile("[" + re.escape("".join(_SPECIAL)) + "]")

@@ -18,11 +18,11 @@ from collections.abc import Iterable, Iterator, Sequence
 from pathlib import Path
 
 from grader.base.files import write_atomic
-from grader.base.spreadsheet import csv_pieces, number_cell
+from grader.base.spreadsheet import csv_pieces, csv_text, number_cell, safe_cell
 from grader.grade.canvas_file import CanvasFile
 from grader.grade.class_report import REPORT, class_report
 from grader.grade.compare import number_text
-from grader.grade.details_file import details_csv, report_pieces
+from grader.grade.details_file import Cells, details_csv, report_cell, report_pieces, written_cell, written_texts
 from grader.grade.grading import Graded, final_scores, lateness, totals
 from grader.grade.integrity import Integrity, check
 
@@ -62,7 +62,7 @@ INTEGRITY_HEADER = ("student_id", "label", "submitted", "parsed", "matches_id", 
                     "corrected_chance", "flagged")
 
 
-def integrity_csv(graded: Graded, integrity: Integrity) -> Iterator[str]:
+def integrity_csv(graded: Graded, integrity: Integrity, rows_per_piece: int = 10_000) -> Iterator[str]:
     """A row per wrong answer and student whose key accepts it (up to
     :data:`~grader.grade.integrity.LISTED` per answer): what was typed and read, whose variant it matches
     and that variant's value (6 significant figures, as ``details.csv``'s ``expected``), how many students'
@@ -71,30 +71,39 @@ def integrity_csv(graded: Graded, integrity: Integrity) -> Iterator[str]:
     chance counts and how close the least close of them is (in half-units of the last digit the student typed;
     empty: not read), the chance of so many matches so close by accident and that chance corrected for the
     pairs examined, and whether the pair is flagged (``yes``: at
-    most the assignment's ``integrity_threshold``). In pieces, as :func:`_csv_pieces`. A report: it changes
-    no grade."""
-    students = graded.key.students
-    flagged = set(integrity.flagged)
-    # A row per matching answer, most of them a pair's own; their chances and closeness repeat (a third distinct).
-    shown: dict[float, str] = {}
-
-    def cell(value: float) -> str:
-        """A chance or closeness to 3 significant figures (a column for people), once per value."""
-        return shown.get(value) or shown.setdefault(value, number_cell(value, 3))
-
-    def rows() -> Iterator[Sequence[object]]:
-        yield INTEGRITY_HEADER
-        for match in integrity.matches:
-            row = graded.columns[match.label][match.student]
-            pair = integrity.pair(match.student, match.partner)
-            figures: list[object] = [None] * 8 if pair is None else [
-                len(pair.labels), " ".join(pair.labels), pair.wrong, pair.closest,
-                cell(pair.closeness) if math.isfinite(pair.closeness) else None, cell(pair.chance),
-                cell(pair.corrected), "yes" if pair in flagged else "no"]
-            yield [students[match.student].id, match.label, row.submitted, row.parsed, students[match.partner].id,
-                   number_text(match.value), match.matches, *figures]
-
-    return _csv_pieces(rows())
+    most the assignment's ``integrity_threshold``). In pieces of ``rows_per_piece`` rows, each cell a report's
+    cell (:func:`report_cell`) as the CSV writer writes it. A report: it changes no grade."""
+    yield csv_text([list(map(report_cell, INTEGRITY_HEADER))])
+    students, matches, flagged = graded.key.students, integrity.matches, set(integrity.flagged)
+    # Most rows are a pair's own and name students, parts, values and figures that other rows name too (a
+    # third of the chances are distinct): the cells of each are worked out once.
+    who: Cells[int] = Cells(lambda index: written_cell(students[index].id))
+    words: Cells[object] = Cells(written_cell)
+    counts: Cells[int | None] = Cells(written_cell)
+    values: Cells[float] = Cells(lambda value: written_cell(number_text(value)))
+    # A figure to 3 significant figures (a column for people): a number's text, which nothing quotes.
+    shown: Cells[float | None] = Cells(lambda value: "" if value is None else safe_cell(number_cell(value, 3)))
+    step = max(1, rows_per_piece)
+    for start in range(0, len(matches), step):
+        piece = matches[start:start + step]
+        rows = [graded.columns[match.label][match.student] for match in piece]
+        pairs = [integrity.pair(match.student, match.partner) for match in piece]  # None: not listed
+        lines = map(",".join, zip(
+            map(who.__getitem__, [match.student for match in piece]), map(words.__getitem__, [m.label for m in piece]),
+            written_texts(["" if row.submitted is None else row.submitted for row in rows]),
+            written_texts([row.parsed for row in rows]), map(who.__getitem__, [match.partner for match in piece]),
+            map(values.__getitem__, [match.value for match in piece]),
+            map(counts.__getitem__, [match.matches for match in piece]),
+            map(counts.__getitem__, [None if pair is None else len(pair.labels) for pair in pairs]),
+            written_texts(["" if pair is None else " ".join(pair.labels) for pair in pairs]),
+            map(counts.__getitem__, [None if pair is None else pair.wrong for pair in pairs]),
+            map(counts.__getitem__, [None if pair is None else pair.closest for pair in pairs]),
+            map(shown.__getitem__, [pair.closeness if pair is not None and math.isfinite(pair.closeness) else None
+                                    for pair in pairs]),
+            map(shown.__getitem__, [None if pair is None else pair.chance for pair in pairs]),
+            map(shown.__getitem__, [None if pair is None else pair.corrected for pair in pairs]),
+            ["" if pair is None else "yes" if pair in flagged else "no" for pair in pairs], strict=True))
+        yield "\n".join(lines) + "\n"
 
 
 def problems_csv(graded: Graded, canvas: CanvasFile | None = None) -> Iterator[str]:

@@ -17,10 +17,18 @@ import numpy as np
 import pytest
 
 from grader.base.errors import visible
-from grader.base.spreadsheet import csv_columns_text, csv_text, number_cell, quoted_cell, safe_cell, safe_cells
+from grader.base.spreadsheet import (
+    csv_columns_text,
+    csv_text,
+    number_cell,
+    number_cells,
+    quoted_cell,
+    safe_cell,
+    safe_cells,
+)
 from grader.grade.cells import _DECIMAL, CellNumber, _read_number, read_number
 from grader.grade.compare import _difference, _period, _Words, errors, feedback, is_correct, number_text
-from grader.grade.details_file import DETAILS_HEADER, details_csv, report_cell, report_pieces
+from grader.grade.details_file import DETAILS_HEADER, details_csv, number_texts, report_cell, report_pieces
 from grader.grade.grading import Graded, LateWork, Row, _grade_column
 from grader.grade.integrity import Integrity, Match, Pair
 from grader.grade.key import Key, KeyPart, KeyProblem, KeyStudent
@@ -128,6 +136,24 @@ def test_integrity_csv_is_the_cell_at_a_time_rule(students: int, piece: int) -> 
     integrity = Integrity(matches, tuple(pairs.values()), 100, 0.05, 10, 5)
     assert (integrity.flagged and len(integrity.flagged) < len(pairs)) or not students
     assert "".join(integrity_csv(graded, integrity, piece)) == integrity_rule(graded, integrity)
+
+
+@pytest.mark.parametrize("figures", [1, 3, 6, 12, 15, 17])
+def test_number_cells_are_number_cell_of_each(figures: int) -> None:
+    """Every magnitude float64 has, signs, zeros, subnormals, whole numbers, and values that round up to a
+    power of ten (999.5 to 3 figures is 1000)."""
+    rng = random.Random(figures)
+    values = [rng.uniform(-10, 10) * 10.0 ** rng.randint(-320, 300) for _ in range(3000)]
+    values += [0.0, -0.0, 5e-324, -5e-324, 2.2250738585072014e-308, 2.225073858507201e-308, 1e-299,
+               1.0, 2.0**53, 1e15, 1e16, 999.5, 9.9995, 0.099995, 1e-4, 9.9996e-5,
+               123456.0, 0.1 + 0.2, 1.7976931348623157e308, *(float(n) for n in range(-20, 1200, 7))]
+    assert number_cells(values, figures) == [number_cell(value, figures) for value in values]
+
+
+def test_number_texts_are_number_text_of_each() -> None:
+    rng = random.Random(2)
+    values = [rng.uniform(-10, 10) * 10.0 ** rng.randint(-320, 300) for _ in range(3000)] + [0.0, -0.0, 5e-324]
+    assert number_texts(values) == [number_text(value) for value in values]
 
 
 def test_quoted_cell_is_the_csv_writers_cell() -> None:

@@ -87,6 +87,30 @@ def number_cell(value: float, figures: int | None = None) -> str:
     return repr(value + 0.0).removesuffix(".0") if value.is_integer() and abs(value) < 1e15 else repr(value)
 
 
+def number_cells(values: Sequence[float], figures: int) -> list[str]:
+    """:func:`number_cell` of each value rounded to ``figures`` significant figures, formatted in one call:
+    ``%g`` to that many figures (at most 15, which any float64 near them holds) writes the text of the number
+    rounded so, the shortest that reads back as it, but for a number with more digits before the point than
+    ``figures``, which it writes with an exponent (``1.23e+05``, where :func:`number_cell` writes ``123000``),
+    and one too small for float64 to hold so many figures (``4.94e-324``, read back as ``5e-324``): those,
+    with an exponent of ``+`` or ``-3..``, are written one by one.
+
+    >>> number_cells([0.012345, -0.0, 2.0, 123456.0, 1.5e-07, 5e-324], 3)
+    ['0.0123', '0', '2', '123000', '1.5e-07', '5e-324']
+    """
+    if not all(map(math.isfinite, values)):
+        raise ValueError("a CSV cell is not a finite number")  # a bug: no report holds one
+    if figures > _EXACT_FIGURES:
+        return [number_cell(value, figures) for value in values]
+    texts = (f"%.{figures}g\n" * len(values) % tuple(value + 0.0 for value in values)).split("\n")  # + 0.0: no -0
+    texts.pop()  # after the last line end
+    return [number_cell(value, figures) if "e+" in text or "e-3" in text else text
+            for text, value in zip(texts, values, strict=True)]
+
+
+_EXACT_FIGURES = 15  # decimal digits that every float64 from 1e-299 up reads back as (DBL_DIG)
+
+
 def csv_text(rows: Iterable[Sequence[object]]) -> str:
     """The CSV text of ``rows`` (``\\n`` line ends; cells as given: guard text cells with :func:`safe_cell`)."""
     return "".join(csv_pieces(rows))

@@ -14,15 +14,22 @@ from __future__ import annotations
 
 import itertools
 import math
-from collections.abc import Iterable, Iterator, Sequence
+from collections.abc import Callable, Iterable, Iterator, Sequence
 from pathlib import Path
 
 from grader.base.files import write_atomic
-from grader.base.spreadsheet import csv_pieces, csv_text, number_cell, safe_cell
+from grader.base.spreadsheet import csv_pieces, csv_text, number_cell, number_cells
 from grader.grade.canvas_file import CanvasFile
 from grader.grade.class_report import REPORT, class_report
-from grader.grade.compare import number_text
-from grader.grade.details_file import Cells, details_csv, report_cell, report_pieces, written_cell, written_texts
+from grader.grade.details_file import (
+    Cells,
+    details_csv,
+    number_texts,
+    report_cell,
+    report_pieces,
+    written_cell,
+    written_texts,
+)
 from grader.grade.grading import Graded, final_scores, lateness, totals
 from grader.grade.integrity import Integrity, check
 
@@ -80,9 +87,10 @@ def integrity_csv(graded: Graded, integrity: Integrity, rows_per_piece: int = 10
     who: Cells[int] = Cells(lambda index: written_cell(students[index].id))
     words: Cells[object] = Cells(written_cell)
     counts: Cells[int | None] = Cells(written_cell)
-    values: Cells[float] = Cells(lambda value: written_cell(number_text(value)))
-    # A figure to 3 significant figures (a column for people): a number's text, which nothing quotes.
-    shown: Cells[float | None] = Cells(lambda value: "" if value is None else safe_cell(number_cell(value, 3)))
+    # A value to 6 significant figures, a figure to 3 (columns for people): a number's text, which neither the
+    # formula guard nor the CSV writer changes; the values new to a piece are formatted in one call.
+    values: dict[float | None, str] = {}
+    shown: dict[float | None, str] = {None: ""}
     step = max(1, rows_per_piece)
     for start in range(0, len(matches), step):
         piece = matches[start:start + step]
@@ -92,18 +100,31 @@ def integrity_csv(graded: Graded, integrity: Integrity, rows_per_piece: int = 10
             map(who.__getitem__, [match.student for match in piece]), map(words.__getitem__, [m.label for m in piece]),
             written_texts(["" if row.submitted is None else row.submitted for row in rows]),
             written_texts([row.parsed for row in rows]), map(who.__getitem__, [match.partner for match in piece]),
-            map(values.__getitem__, [match.value for match in piece]),
+            _formatted([match.value for match in piece], values, number_texts),
             map(counts.__getitem__, [match.matches for match in piece]),
             map(counts.__getitem__, [None if pair is None else len(pair.labels) for pair in pairs]),
             written_texts(["" if pair is None else " ".join(pair.labels) for pair in pairs]),
             map(counts.__getitem__, [None if pair is None else pair.wrong for pair in pairs]),
             map(counts.__getitem__, [None if pair is None else pair.closest for pair in pairs]),
-            map(shown.__getitem__, [pair.closeness if pair is not None and math.isfinite(pair.closeness) else None
-                                    for pair in pairs]),
-            map(shown.__getitem__, [None if pair is None else pair.chance for pair in pairs]),
-            map(shown.__getitem__, [None if pair is None else pair.corrected for pair in pairs]),
+            _formatted([pair.closeness if pair is not None and math.isfinite(pair.closeness) else None
+                        for pair in pairs], shown, _figures),
+            _formatted([None if pair is None else pair.chance for pair in pairs], shown, _figures),
+            _formatted([None if pair is None else pair.corrected for pair in pairs], shown, _figures),
             ["" if pair is None else "yes" if pair in flagged else "no" for pair in pairs], strict=True))
         yield "\n".join(lines) + "\n"
+
+
+def _formatted(column: Sequence[float | None], known: dict[float | None, str],
+               rule: Callable[[list[float]], list[str]]) -> list[str]:
+    """The cells of a column of numbers (None: empty): those ``known`` has, and the new ones (distinct) by
+    ``rule`` in one call, kept in ``known``."""
+    new = [value for value in dict.fromkeys(column) if value is not None and value not in known]
+    known.update(zip(new, rule(new), strict=True))
+    return list(map(known.__getitem__, column))
+
+
+def _figures(values: list[float]) -> list[str]:
+    return number_cells(values, 3)
 
 
 def problems_csv(graded: Graded, canvas: CanvasFile | None = None) -> Iterator[str]:

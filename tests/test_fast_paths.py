@@ -28,7 +28,14 @@ from grader.base.spreadsheet import (
 )
 from grader.grade.cells import _DECIMAL, CellNumber, _read_number, read_number
 from grader.grade.compare import _difference, _period, _Words, errors, feedback, is_correct, number_text
-from grader.grade.details_file import DETAILS_HEADER, details_csv, number_texts, report_cell, report_pieces
+from grader.grade.details_file import (
+    DETAILS_HEADER,
+    details_csv,
+    number_texts,
+    report_cell,
+    report_columns,
+    report_pieces,
+)
 from grader.grade.grading import Graded, LateWork, Row, _grade_column
 from grader.grade.integrity import Integrity, Match, Pair
 from grader.grade.key import Key, KeyPart, KeyProblem, KeyStudent
@@ -171,6 +178,16 @@ def test_report_pieces_are_the_cell_at_a_time_rule() -> None:
     expected = csv_text([[report_cell(value) for value in row] for row in rows])
     for piece in (1, 4, 1000):
         assert "".join(report_pieces(rows, piece)) == expected
+
+
+def test_report_columns_are_the_cell_at_a_time_rule() -> None:
+    """grades.csv's columns: text, numbers of one type, and mixed, as the rows they make."""
+    rng = random.Random(4)
+    values: list[object] = [*HOSTILE, None, 0, 7, 2.0, -0.0, 0.1 + 0.2, 1e20, "yes"]
+    columns = [[rng.choice(HOSTILE) for _ in range(50)], [rng.choice([0.5, None, -0.0, 1e16]) for _ in range(50)],
+               [rng.choice([None, 5, 0]) for _ in range(50)], [rng.choice(values) for _ in range(50)]]
+    assert report_columns(columns) == csv_text([[report_cell(value) for value in row] for row in zip(*columns)])
+    assert report_columns([[], []]) == ""
 
 
 @pytest.mark.parametrize("cells", [

@@ -118,6 +118,16 @@ def report_pieces(rows: Iterable[Sequence[object]], rows_per_piece: int = 2000) 
             yield csv_columns_text([_column_cells(column) for column in zip(*piece, strict=True)])
 
 
+def report_columns(columns: Sequence[Sequence[object]]) -> str:
+    """The CSV text of the rows that ``columns`` make, each value a report's cell (:func:`report_cell`), worked
+    out a column at a time as :func:`report_pieces` does.
+
+    >>> report_columns([["=a", "b"], [1.0, None]])
+    "'=a,1\\nb,\\n"
+    """
+    return csv_columns_text([_column_cells(column) for column in columns])
+
+
 def _column_cells(column: Sequence[object]) -> list[str]:
     """A column's report cells: text checked for control characters in one call; numbers of one type (scores,
     totals: a few hundred distinct values in a class) formatted once per value."""

@@ -15,6 +15,7 @@ from __future__ import annotations
 import itertools
 import math
 from collections.abc import Callable, Iterable, Iterator, Sequence
+from operator import itemgetter
 from pathlib import Path
 
 from grader.base.files import write_atomic
@@ -26,6 +27,7 @@ from grader.grade.details_file import (
     details_csv,
     number_texts,
     report_cell,
+    report_columns,
     report_pieces,
     written_cell,
     written_texts,
@@ -52,16 +54,18 @@ def grades_csv(graded: Graded) -> str:
     """One row per student of the key: a column per problem, the minutes late of their latest answer that
     counts (empty: not known, or nothing submitted), the points the late policy took, the total after it,
     and what was possible."""
-    key = graded.key
+    key, students, deductions = graded.key, graded.key.students, graded.deductions
     scores = totals(graded)
-    final, late = final_scores(graded, scores), lateness(graded)
-    rows: list[list[object]] = [["student_id", "name", "section", *(f"problem {p.key}" for p in key.problems),
-                                 "late", "deduction", "total", "possible"]]
-    for student, minutes in zip(key.students, late, strict=True):
-        per_problem = [scores[student.id][p.key] for p in key.problems]
-        rows.append([student.id, student.name, student.section, *per_problem, minutes,
-                     graded.deductions.get(student.id, 0.0), final[student.id], student.possible])
-    return _csv(rows)
+    final, ids = final_scores(graded, scores), [student.id for student in students]
+    header = ["student_id", "name", "section", *(f"problem {p.key}" for p in key.problems), "late", "deduction",
+              "total", "possible"]
+    by_student = list(map(scores.__getitem__, ids))
+    columns: list[Sequence[object]] = [
+        ids, [student.name for student in students], [student.section for student in students],
+        *(list(map(itemgetter(problem.key), by_student)) for problem in key.problems), lateness(graded),
+        [deductions.get(student_id, 0.0) for student_id in ids], list(map(final.__getitem__, ids)),
+        [student.possible for student in students]]
+    return _csv([header]) + report_columns(columns)
 
 
 INTEGRITY_HEADER = ("student_id", "label", "submitted", "parsed", "matches_id", "matches_value", "students_matched",

@@ -186,7 +186,8 @@ def test_report_columns_are_the_cell_at_a_time_rule() -> None:
     values: list[object] = [*HOSTILE, None, 0, 7, 2.0, -0.0, 0.1 + 0.2, 1e20, "yes"]
     columns = [[rng.choice(HOSTILE) for _ in range(50)], [rng.choice([0.5, None, -0.0, 1e16]) for _ in range(50)],
                [rng.choice([None, 5, 0]) for _ in range(50)], [rng.choice(values) for _ in range(50)]]
-    assert report_columns(columns) == csv_text([[report_cell(value) for value in row] for row in zip(*columns)])
+    rows = zip(*columns, strict=True)
+    assert report_columns(columns) == csv_text([[report_cell(value) for value in row] for row in rows])
     assert report_columns([[], []]) == ""
 
 

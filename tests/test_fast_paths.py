@@ -26,6 +26,7 @@ from grader.base.spreadsheet import (
     safe_cell,
     safe_cells,
 )
+from grader.grade.canvas_file import CanvasFile
 from grader.grade.cells import _DECIMAL, CellNumber, _read_number, read_number
 from grader.grade.compare import _difference, _period, _Words, errors, feedback, is_correct, number_text
 from grader.grade.details_file import (
@@ -40,7 +41,7 @@ from grader.grade.grading import Graded, LateWork, Row, _grade_column
 from grader.grade.integrity import Integrity, Match, Pair
 from grader.grade.key import Key, KeyPart, KeyProblem, KeyStudent
 from grader.grade.latest import Answer
-from grader.grade.report import INTEGRITY_HEADER, integrity_csv
+from grader.grade.report import INTEGRITY_HEADER, canvas_csv, integrity_csv
 from grader.model.tolerance import Tolerance
 
 HOSTILE = ["=1+1", "+1", "-1+1", "@SUM(A1)", "\uff1dHYPERLINK(1)", "\ufe62x", "'quoted", "\tx", "\rx", "\nx",
@@ -161,6 +162,20 @@ def test_number_texts_are_number_text_of_each() -> None:
     rng = random.Random(2)
     values = [rng.uniform(-10, 10) * 10.0 ** rng.randint(-320, 300) for _ in range(3000)] + [0.0, -0.0, 5e-324]
     assert number_texts(values) == [number_text(value) for value in values]
+
+
+@pytest.mark.parametrize(("students", "piece", "width"), [(60, 10_000, 5), (60, 7, 5), (5, 1, 1), (0, 3, 5), (9, 4, 0)])
+def test_canvas_csv_is_the_cell_at_a_time_rule(students: int, piece: int, width: int) -> None:
+    """Hostile names and ids written exactly (no guard), scores of every type, an export's kept text."""
+    rng = random.Random(students + width)
+    identities = [tuple(rng.choice([*HOSTILE, "Ana", "2026001"]) for _ in range(width)) for _ in range(students)]
+    cells = [rng.choice([None, 0.0, -0.0, 17.5, 1e16, 0.1 + 0.2, "EX", "N/A", "=1", "a,b"]) for _ in range(students)]
+    made = CanvasFile(tuple(f"c{index}" for index in range(width)), "@Home, Lab", 12.0, identities, cells, (), ())
+    exact = [[*made.columns, made.title], ["Points Possible", *[""] * (width - 1), made.points],
+             *([*identity, cell] for identity, cell in zip(identities, cells, strict=True))]
+    expected = csv_text([["" if v is None else number_cell(v) if isinstance(v, float) else str(v) for v in row]
+                         for row in exact])
+    assert "".join(canvas_csv(made, piece)) == expected
 
 
 def test_quoted_cell_is_the_csv_writers_cell() -> None:

@@ -19,7 +19,7 @@ from operator import itemgetter
 from pathlib import Path
 
 from grader.base.files import write_atomic
-from grader.base.spreadsheet import csv_pieces, csv_text, number_cell, number_cells
+from grader.base.spreadsheet import csv_columns_text, csv_pieces, csv_text, number_cell, number_cells
 from grader.grade.canvas_file import CanvasFile
 from grader.grade.class_report import REPORT, class_report
 from grader.grade.details_file import (
@@ -140,14 +140,25 @@ def problems_csv(graded: Graded, canvas: CanvasFile | None = None) -> Iterator[s
     return _csv_pieces(itertools.chain(header, rows))
 
 
-def canvas_csv(canvas: CanvasFile) -> Iterator[str]:
+def canvas_csv(canvas: CanvasFile, rows_per_piece: int = 10_000) -> Iterator[str]:
     """A Canvas gradebook import: the student columns, one column of the assignment, and its ``Points
     Possible`` row, every cell exactly as :class:`CanvasFile` has it (no formula guard: Canvas matches on
-    the text), numbers as their shortest text. In pieces (an export may have 100,000 students)."""
+    the text), numbers as their shortest text. In pieces (an export may have 100,000 students), a piece's
+    cells a column at a time (the scores, a few hundred distinct, each formatted once)."""
     head: list[Sequence[object]] = [[*canvas.columns, canvas.title],
                                     ["Points Possible", *[""] * (len(canvas.columns) - 1), canvas.points]]
-    body = ([*identity, cell] for identity, cell in zip(canvas.identities, canvas.cells, strict=True))
-    return csv_pieces([_exact(value) for value in row] for row in itertools.chain(head, body))
+    yield csv_text([[_exact(value) for value in row] for row in head])
+    identities, cells, width = canvas.identities, canvas.cells, len(canvas.columns)
+    if not width or any(len(identity) != width for identity in identities):  # rows not all of two cells or more
+        body = ([*identity, cell] for identity, cell in zip(identities, cells, strict=True))
+        yield from csv_pieces([_exact(value) for value in row] for row in body)
+        return
+    scores: Cells[object] = Cells(_exact)
+    step = max(1, rows_per_piece)
+    for start in range(0, len(identities), step):
+        columns = [*zip(*identities[start:start + step], strict=True), cells[start:start + step]]
+        yield csv_columns_text([column if set(map(type, column)) == {str} else list(map(_exact, column))
+                                for column in columns[:-1]] + [list(map(scores.__getitem__, columns[-1]))])
 
 
 def _exact(value: object) -> str:

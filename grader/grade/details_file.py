@@ -5,8 +5,8 @@ against formulas with its control characters shown, :mod:`grader.grade.report`; 
 an error to 6 significant figures), and the rule is applied a column at a time, over a piece of students: the
 cells of a few distinct values (a verdict with its credit, points and score; units, tolerances, diagnoses;
 lateness) are worked out and quoted as the CSV writer quotes them once per value, the errors are formatted in
-one call per column, and a column of text is checked for control characters and for what the writer quotes in
-one search of its joined text. A part's rows are joined a row at a time, and the parts' rows interleaved
+one call per column, and a column of text is checked for control characters, and for what the writer quotes,
+each in one search of its joined text. A part's rows are joined a row at a time, and the parts' rows interleaved
 student by student, so the bytes are those the one CSV writer (:func:`grader.base.spreadsheet.csv_pieces`)
 gives a row at a time (``tests/test_fast_paths.py`` holds the two to the same bytes on hostile text).
 """

@@ -128,6 +128,7 @@ def _formatted(column: Sequence[float | None], known: dict[float | None, str],
 
 
 def _figures(values: list[float]) -> list[str]:
+    """Chances and closeness for people: 3 significant figures."""
     return number_cells(values, 3)
 
 

@@ -46,7 +46,8 @@ from grader.model.tolerance import Tolerance
 
 HOSTILE = ["=1+1", "+1", "-1+1", "@SUM(A1)", "\uff1dHYPERLINK(1)", "\ufe62x", "'quoted", "\tx", "\rx", "\nx",
            "a\x1b[31mred", "v\u202e2", "\u2066iso", 'say "hi"', "6,26", "two\nlines", "cr\rhere", "-0.369",
-           "-1.5e-07", "", " ", "é ü", "\x00nul", "a,\"b\",\nc", "\xa0nbsp", "-", "=", "'"]
+           "-1.5e-07", "", " ", "é ü", "\x00nul", "a,\"b\",\nc", "\xa0nbsp", "-", "=", "'", "=SUM(A1,B1)",
+           "-6,26", "'say \"hi\"", "@a,\"b\""]
 
 
 def error_rule(value: float | None) -> str:

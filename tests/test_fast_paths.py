@@ -17,7 +17,16 @@ import numpy as np
 import pytest
 
 from grader.base.errors import visible
-from grader.base.spreadsheet import csv_columns_text, csv_text, safe_cell, safe_cells
+from grader.base.spreadsheet import (
+    csv_columns_text,
+    csv_text,
+    number_cell,
+    number_cells,
+    quoted_cell,
+    safe_cell,
+    safe_cells,
+)
+from grader.grade.canvas_file import CanvasFile
 from grader.grade.cells import (
     _DECIMAL,
     _DEGREES_MINUTES,
@@ -31,15 +40,25 @@ from grader.grade.cells import (
     read_number,
 )
 from grader.grade.compare import _difference, _period, _Words, errors, feedback, is_correct, number_text
-from grader.grade.details_file import DETAILS_HEADER, details_csv, report_cell, report_pieces
+from grader.grade.details_file import (
+    DETAILS_HEADER,
+    details_csv,
+    number_texts,
+    report_cell,
+    report_columns,
+    report_pieces,
+)
 from grader.grade.grading import Graded, LateWork, Row, _grade_column
+from grader.grade.integrity import Integrity, Match, Pair
 from grader.grade.key import Key, KeyPart, KeyProblem, KeyStudent
 from grader.grade.latest import Answer
+from grader.grade.report import INTEGRITY_HEADER, canvas_csv, integrity_csv
 from grader.model.tolerance import Tolerance
 
 HOSTILE = ["=1+1", "+1", "-1+1", "@SUM(A1)", "\uff1dHYPERLINK(1)", "\ufe62x", "'quoted", "\tx", "\rx", "\nx",
            "a\x1b[31mred", "v\u202e2", "\u2066iso", 'say "hi"', "6,26", "two\nlines", "cr\rhere", "-0.369",
-           "-1.5e-07", "", " ", "é ü", "\x00nul", "a,\"b\",\nc", "\xa0nbsp", "-", "=", "'"]
+           "-1.5e-07", "", " ", "é ü", "\x00nul", "a,\"b\",\nc", "\xa0nbsp", "-", "=", "'", "=SUM(A1,B1)",
+           "-6,26", "'say \"hi\"", "@a,\"b\""]
 
 
 def error_rule(value: float | None) -> str:
@@ -103,6 +122,79 @@ def test_details_csv_is_the_cell_at_a_time_rule(students: int, late: bool, piece
     assert "".join(details_csv(graded, piece)) == details_rule(graded)
 
 
+def integrity_rule(graded: Graded, integrity: Integrity) -> str:
+    """integrity.csv a row at a time, each cell a report's cell, through the CSV writer."""
+    students, flagged = graded.key.students, set(integrity.flagged)
+    rows: list[Sequence[object]] = [INTEGRITY_HEADER]
+    for match in integrity.matches:
+        row, pair = graded.columns[match.label][match.student], integrity.pair(match.student, match.partner)
+        figures: list[object] = [None] * 8 if pair is None else [
+            len(pair.labels), " ".join(pair.labels), pair.wrong, pair.closest,
+            number_cell(pair.closeness, 3) if math.isfinite(pair.closeness) else None, number_cell(pair.chance, 3),
+            number_cell(pair.corrected, 3), "yes" if pair in flagged else "no"]
+        rows.append([students[match.student].id, match.label, row.submitted, row.parsed,
+                     students[match.partner].id, number_text(match.value), match.matches, *figures])
+    return csv_text([[report_cell(value) for value in row] for row in rows])
+
+
+@pytest.mark.parametrize(("students", "piece"), [(40, 10_000), (40, 7), (13, 1), (0, 3)])
+def test_integrity_csv_is_the_cell_at_a_time_rule(students: int, piece: int) -> None:
+    """Hostile ids, labels and answers; pairs flagged and not, unread closeness, and matches whose pair is not
+    listed; figures repeated and not."""
+    graded, rng = crafted_class(students, late=False), random.Random(5)
+    labels = graded.key.labels
+    pairs = {}
+    for _ in range(students * 2):
+        student, partner = rng.randrange(students), rng.randrange(students)
+        pairs[student, partner] = Pair(student, partner, tuple(rng.sample(labels, rng.randint(1, len(labels)))),
+                                       rng.randint(1, 3), rng.choice([1e-9, 0.0123456, 0.5, 1.0, -0.0]),
+                                       rng.choice([2.5e-7, 0.049999, 1.0, 0.0]), rng.randint(0, 3),
+                                       rng.choice([math.inf, 0.0, 1.5, 12345.678, 999.6]))
+    unlisted = [(rng.randrange(students), rng.randrange(students)) for _ in range(students // 4)]
+    matches = tuple(Match(student, rng.choice(labels), partner, rng.choice([1.5, -0.0, -2.25e-7, 1e300, 0.1 + 0.2]),
+                          rng.randint(1, 9)) for student, partner in [*pairs, *unlisted])
+    integrity = Integrity(matches, tuple(pairs.values()), 100, 0.05, 10, 5)
+    assert (integrity.flagged and len(integrity.flagged) < len(pairs)) or not students
+    assert "".join(integrity_csv(graded, integrity, piece)) == integrity_rule(graded, integrity)
+
+
+@pytest.mark.parametrize("figures", [1, 3, 6, 12, 15, 17])
+def test_number_cells_are_number_cell_of_each(figures: int) -> None:
+    """Every magnitude float64 has, signs, zeros, subnormals, whole numbers, and values that round up to a
+    power of ten (999.5 to 3 figures is 1000)."""
+    rng = random.Random(figures)
+    values = [rng.uniform(-10, 10) * 10.0 ** rng.randint(-320, 300) for _ in range(3000)]
+    values += [0.0, -0.0, 5e-324, -5e-324, 2.2250738585072014e-308, 2.225073858507201e-308, 1e-299,
+               1.0, 2.0**53, 1e15, 1e16, 999.5, 9.9995, 0.099995, 1e-4, 9.9996e-5,
+               123456.0, 0.1 + 0.2, 1.7976931348623157e308, *(float(n) for n in range(-20, 1200, 7))]
+    assert number_cells(values, figures) == [number_cell(value, figures) for value in values]
+
+
+def test_number_texts_are_number_text_of_each() -> None:
+    rng = random.Random(2)
+    values = [rng.uniform(-10, 10) * 10.0 ** rng.randint(-320, 300) for _ in range(3000)] + [0.0, -0.0, 5e-324]
+    assert number_texts(values) == [number_text(value) for value in values]
+
+
+@pytest.mark.parametrize(("students", "piece", "width"), [(60, 10_000, 5), (60, 7, 5), (5, 1, 1), (0, 3, 5), (9, 4, 0)])
+def test_canvas_csv_is_the_cell_at_a_time_rule(students: int, piece: int, width: int) -> None:
+    """Hostile names and ids written exactly (no guard), scores of every type, an export's kept text."""
+    rng = random.Random(students + width)
+    identities = [tuple(rng.choice([*HOSTILE, "Ana", "2026001"]) for _ in range(width)) for _ in range(students)]
+    cells = [rng.choice([None, 0.0, -0.0, 17.5, 1e16, 0.1 + 0.2, "EX", "N/A", "=1", "a,b"]) for _ in range(students)]
+    made = CanvasFile(tuple(f"c{index}" for index in range(width)), "@Home, Lab", 12.0, identities, cells, (), ())
+    exact = [[*made.columns, made.title], ["Points Possible", *[""] * (width - 1), made.points],
+             *([*identity, cell] for identity, cell in zip(identities, cells, strict=True))]
+    expected = csv_text([["" if v is None else number_cell(v) if isinstance(v, float) else str(v) for v in row]
+                         for row in exact])
+    assert "".join(canvas_csv(made, piece)) == expected
+
+
+def test_quoted_cell_is_the_csv_writers_cell() -> None:
+    for cell in [*HOSTILE, "a", "±1 %, widened", '"', "a\r\nb"]:
+        assert f"{quoted_cell(cell)},x\n" == csv_text([[cell, "x"]])
+
+
 def test_report_pieces_are_the_cell_at_a_time_rule() -> None:
     """Mixed columns (text, numbers, None) and rows of another length, in pieces of a few rows."""
     rng = random.Random(3)
@@ -113,6 +205,17 @@ def test_report_pieces_are_the_cell_at_a_time_rule() -> None:
     expected = csv_text([[report_cell(value) for value in row] for row in rows])
     for piece in (1, 4, 1000):
         assert "".join(report_pieces(rows, piece)) == expected
+
+
+def test_report_columns_are_the_cell_at_a_time_rule() -> None:
+    """grades.csv's columns: text, numbers of one type, and mixed, as the rows they make."""
+    rng = random.Random(4)
+    values: list[object] = [*HOSTILE, None, 0, 7, 2.0, -0.0, 0.1 + 0.2, 1e20, "yes"]
+    columns = [[rng.choice(HOSTILE) for _ in range(50)], [rng.choice([0.5, None, -0.0, 1e16]) for _ in range(50)],
+               [rng.choice([None, 5, 0]) for _ in range(50)], [rng.choice(values) for _ in range(50)]]
+    rows = zip(*columns, strict=True)
+    assert report_columns(columns) == csv_text([[report_cell(value) for value in row] for row in rows])
+    assert report_columns([[], []]) == ""
 
 
 @pytest.mark.parametrize("cells", [

@@ -87,6 +87,30 @@ def number_cell(value: float, figures: int | None = None) -> str:
     return repr(value + 0.0).removesuffix(".0") if value.is_integer() and abs(value) < 1e15 else repr(value)
 
 
+def number_cells(values: Sequence[float], figures: int) -> list[str]:
+    """:func:`number_cell` of each value rounded to ``figures`` significant figures, formatted in one call:
+    ``%g`` to that many figures (at most 15, which any float64 near them holds) writes the text of the number
+    rounded so, the shortest that reads back as it, but for a number with more digits before the point than
+    ``figures``, which it writes with an exponent (``1.23e+05``, where :func:`number_cell` writes ``123000``),
+    and one too small for float64 to hold so many figures (``4.94e-324``, read back as ``5e-324``): those,
+    with an exponent of ``+`` or ``-3..``, are written one by one.
+
+    >>> number_cells([0.012345, -0.0, 2.0, 123456.0, 1.5e-07, 5e-324], 3)
+    ['0.0123', '0', '2', '123000', '1.5e-07', '5e-324']
+    """
+    if not all(map(math.isfinite, values)):
+        raise ValueError("a CSV cell is not a finite number")  # a bug: no report holds one
+    if figures > _EXACT_FIGURES:
+        return [number_cell(value, figures) for value in values]
+    texts = (f"%.{figures}g\n" * len(values) % tuple(value + 0.0 for value in values)).split("\n")  # + 0.0: no -0
+    texts.pop()  # after the last line end
+    return [number_cell(value, figures) if "e+" in text or "e-3" in text else text
+            for text, value in zip(texts, values, strict=True)]
+
+
+_EXACT_FIGURES = 15  # decimal digits that every float64 from 1e-299 up reads back as (DBL_DIG)
+
+
 def csv_text(rows: Iterable[Sequence[object]]) -> str:
     """The CSV text of ``rows`` (``\\n`` line ends; cells as given: guard text cells with :func:`safe_cell`)."""
     return "".join(csv_pieces(rows))
@@ -117,14 +141,28 @@ def csv_columns_text(columns: Sequence[Sequence[str]]) -> str:
     """
     if len(columns) < 2:  # a row of one empty cell is written as "": the writer knows its rules
         return csv_text(zip(*columns, strict=True))
-    text = "\n".join(map(",".join, zip(*map(_quoted, columns), strict=True)))
+    text = "\n".join(map(",".join, zip(*map(quoted_cells, columns), strict=True)))
     return text + "\n" if text else ""  # a row of two cells or more is never empty: "" is no row
 
 
-def _quoted(column: Sequence[str]) -> Sequence[str]:
-    """The cells of a column as the CSV writer writes them (``excel``'s dialect: a cell with a delimiter, quote or
-    line break is quoted, its quotes doubled); the cells to quote are found by searching the column's joined
-    text (each place found is in the cell whose end comes next)."""
+def quoted_cell(cell: str) -> str:
+    """A cell as the CSV writer writes it in a row of two cells or more (``excel``'s dialect: a cell with a
+    delimiter, quote or line break is quoted, its quotes doubled): for a column of a few distinct cells, each
+    quoted once.
+
+    >>> quoted_cell("±1 %"), quoted_cell('say "hi", then')
+    ('±1 %', '"say ""hi"", then"')
+    """
+    return '"' + cell.replace('"', '""') + '"' if _QUOTED.search(cell) else cell
+
+
+def quoted_cells(column: Sequence[str]) -> Sequence[str]:
+    """The cells of a column as the CSV writer writes them (:func:`quoted_cell`); the cells to quote are found
+    by searching the column's joined text (each place found is in the cell whose end comes next).
+
+    >>> quoted_cells(["a", "b,c", "d"])
+    ['a', '"b,c"', 'd']
+    """
     joined = "".join(column)
     places = [place for special in _SPECIAL for place in _places(joined, special)]
     if not places:  # most columns
@@ -132,7 +170,7 @@ def _quoted(column: Sequence[str]) -> Sequence[str]:
     ends = list(itertools.accumulate(map(len, column)))
     written = list(column)
     for index in {bisect.bisect_right(ends, place) for place in places}:
-        written[index] = '"' + written[index].replace('"', '""') + '"'
+        written[index] = quoted_cell(written[index])
     return written
 
 
@@ -146,3 +184,4 @@ def _places(text: str, special: str) -> Iterator[int]:
 
 # What a cell may hold that the writer quotes, asked of the writer (a carriage return: from Python 3.12).
 _SPECIAL = tuple(special for special in (",", '"', "\n", "\r") if csv_text([(special, "")]).startswith('"'))
+_QUOTED = re.compile("[" + re.escape("".join(_SPECIAL)) + "]")

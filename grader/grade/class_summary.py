@@ -29,10 +29,10 @@ generically: every kind of :data:`~grader.grade.grading.VERDICTS` is counted, in
 from __future__ import annotations
 
 from collections import Counter
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from itertools import repeat
-from operator import attrgetter, eq, is_not, itemgetter
+from operator import attrgetter, eq, is_, is_not, itemgetter
 
 import numpy as np
 import numpy.typing as npt
@@ -192,6 +192,7 @@ def summarize(graded: Graded) -> ClassSummary:
     parts = []
     invalid: set[int] = set()  # students with an answer that could not be read
     answered = np.zeros(count, dtype=bool)
+    rules = _rules(key)
     for problem in key.problems:
         for label in problem.labels:
             rows = graded.columns[label]
@@ -201,7 +202,8 @@ def summarize(graded: Graded) -> ClassSummary:
             points[label] = worth
             missing[label] = _is(verdicts, "missing")
             answered |= np.fromiter(map(is_not, map(attrgetter("submitted"), rows), repeat(None)), bool, count)
-            parts.append(_part(graded, problem.key, label, rows, verdicts, scores[label], worth, kinds))
+            parts.append(_part(graded, problem.key, label, rows, verdicts, scores[label], worth, kinds,
+                               rules[label]))
             if parts[-1].counts.get("invalid"):
                 invalid.update(np.flatnonzero(_is(verdicts, "invalid")).tolist())
     possible = sum(points.values(), np.zeros(count))
@@ -228,7 +230,7 @@ def _kinds_found(graded: Graded) -> set[str]:
 
 
 def _part(graded: Graded, problem: str, label: str, rows: Sequence[Row], verdicts: list[str], scores: Floats,
-          worth: Floats, kinds: tuple[str, ...]) -> PartSummary:
+          worth: Floats, kinds: tuple[str, ...], rules: Sequence[Mapping[str, object]]) -> PartSummary:
     key = graded.key
     found = Counter(verdicts)
     mistakes = Counter(row.diagnosis for row in rows if row.verdict == "mistake")  # ecf rows name their part
@@ -238,16 +240,30 @@ def _part(graded: Graded, problem: str, label: str, rows: Sequence[Row], verdict
     says = {mistake: graded.mistakes[label, mistake] for mistake, _ in top if (label, mistake) in graded.mistakes}
     return PartSummary(label, problem, first.name if first else "", first.unit if first else "",
                        tuple(sorted(set(worth.tolist()))), {kind: found.get(kind, 0) for kind in kinds}, credit,
-                       *_tolerances(key, label, rows), top, sum(mistakes.values()), says)
+                       *_tolerances(rules, rows), top, sum(mistakes.values()), says)
 
 
-def _tolerances(key: Key, label: str, rows: Sequence[Row]) -> tuple[tuple[tuple[str, int], ...], Widening | None]:
+def _rules(key: Key) -> dict[str, list[Mapping[str, object]]]:
+    """Per part label, each student's tolerance as the key has it (read a student at a time: one look-up of
+    every label's part)."""
+    labels = key.labels
+    if len(labels) < 2:  # itemgetter of one label gives the part, not a tuple of one
+        return {label: [student.parts[label].tolerance for student in key.students] for label in labels}
+    by_student = map(itemgetter(*labels), map(attrgetter("parts"), key.students))
+    by_label = zip(*by_student, strict=True) if key.students else ((),) * len(labels)
+    return {label: list(map(attrgetter("tolerance"), parts)) for label, parts in zip(labels, by_label, strict=True)}
+
+
+def _tolerances(rules: Sequence[Mapping[str, object]],
+                rows: Sequence[Row]) -> tuple[tuple[tuple[str, int], ...], Widening | None]:
     """The tolerances in words of the part's verdicts that were not widened, with their counts; and the
-    :class:`~grader.model.tolerance.Widening` of those that were (the key's parts share one mapping for
-    equal tolerances, so each distinct one is read once)."""
-    rules = list(map(attrgetter("tolerance"), map(itemgetter(label), map(attrgetter("parts"), key.students))))
-    distinct = dict(zip(map(id, rules), rules, strict=True))
-    counted = [(Tolerance.from_json(distinct[found]), count) for found, count in Counter(map(id, rules)).items()]
+    :class:`~grader.model.tolerance.Widening` of those that were, from each student's tolerance as the key has
+    it, ``rules`` (the key's parts share one mapping for equal tolerances, so each distinct one is read once)."""
+    if rules and all(map(is_, rules, repeat(rules[0]))):  # one mapping for the class (most parts): no counting
+        counted = [(Tolerance.from_json(rules[0]), len(rules))]
+    else:
+        distinct = dict(zip(map(id, rules), rules, strict=True))
+        counted = [(Tolerance.from_json(distinct[found]), count) for found, count in Counter(map(id, rules)).items()]
     widened = {rule.explained() for rule, _ in counted if rule.reason}  # the words grading gave them
     words = Counter(map(attrgetter("tolerance"), rows))
     return _by_count(Counter({text: count for text, count in words.items() if text not in widened})), \

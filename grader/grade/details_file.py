@@ -2,23 +2,33 @@
 
 A class of 100,000 has a million rows of 18 cells. Each cell is the report's rule for its field (text guarded
 against formulas with its control characters shown, :mod:`grader.grade.report`; a number as its shortest text;
-an error to 6 significant figures), and the rule is applied a column at a time, over a piece of students: a
-column of a few distinct values (verdicts, credits, units, tolerances) is worked out once per value, and a
-column of text is checked for control characters in one call before each cell is guarded. The rows are the
-columns zipped, written by the one CSV writer (:func:`grader.base.spreadsheet.csv_pieces`), so the bytes are
-those a row at a time gives (``tests/test_fast_paths.py`` holds the two to the same bytes on hostile text).
+an error to 6 significant figures), and the rule is applied a column at a time, over a piece of students: the
+cells of a few distinct values (a verdict with its credit, points and score; units, tolerances, diagnoses;
+lateness) are worked out and quoted as the CSV writer quotes them once per value, the errors are formatted in
+one call per column, and a column of text is checked for control characters, and for what the writer quotes,
+each in one search of its joined text. A part's rows are joined a row at a time, and the parts' rows interleaved
+student by student, so the bytes are those the one CSV writer (:func:`grader.base.spreadsheet.csv_pieces`)
+gives a row at a time (``tests/test_fast_paths.py`` holds the two to the same bytes on hostile text).
 """
 
 from __future__ import annotations
 
 import itertools
-import math
-import operator
 from collections.abc import Callable, Iterable, Iterator, Sequence
+from typing import Generic, NamedTuple, TypeVar
+
+import numpy as np
 
 from grader.base.errors import visible
-from grader.base.spreadsheet import csv_columns_text, csv_text, number_cell, safe_cell, safe_cells
-from grader.grade.compare import number_text
+from grader.base.spreadsheet import (
+    csv_columns_text,
+    csv_text,
+    number_cell,
+    quoted_cell,
+    quoted_cells,
+    safe_cell,
+    safe_cells,
+)
 from grader.grade.grading import Graded, Row
 
 DETAILS_HEADER = ("student_id", "label", "submitted", "verdict", "credit", "points", "score", "expected", "parsed",
@@ -31,40 +41,61 @@ def details_csv(graded: Graded, students_per_piece: int = 2000) -> Iterator[str]
     of ``students_per_piece`` students, to be written as it comes (a class of 100,000 has a million rows)."""
     yield csv_text([DETAILS_HEADER])
     students, labels, late = graded.key.students, graded.key.labels, graded.late
-    numbers = _Cells(report_cell)  # credits, points, scores, minutes, shares: a few values
-    words = _Cells(report_cell)  # verdicts, units, tolerances, diagnoses: a few texts
-    guarded, step = [safe_cell(label) for label in labels], max(1, students_per_piece)
+    cells = _Rules(Cells(_marks), Cells(written_cell), Cells(_lateness))
+    guarded, step = [quoted_cell(safe_cell(label)) for label in labels], max(1, students_per_piece)
     for start in range(0, len(students), step):
         piece = slice(start, start + step)
-        ids = [safe_cell(student.id) for student in students[piece]]
-        by_label = [_label_cells(graded.columns[label][piece], numbers, words) for label in labels]
-        for index, label in enumerate(labels):
-            unknown = [None] * len(ids)  # no due time: no lateness, no deduction
-            minutes = late.minutes[label][piece] if late else unknown
-            shares = late.shares[label][piece] if late else unknown
-            by_label[index][16:] = _mapped(minutes, numbers), _mapped([share or 0.0 for share in shares], numbers)
-        columns = [[who for who in ids for _ in labels], guarded * len(ids)]
-        columns += [_interleaved([cells[field] for cells in by_label]) for field in range(2, 18)]
-        yield csv_columns_text(columns)
+        ids = quoted_cells(safe_cells([student.id for student in students[piece]]))
+        lines = [_label_lines(ids, label_cell, graded.columns[label][piece],
+                              (late.minutes[label][piece], late.shares[label][piece]) if late else None, cells)
+                 for label, label_cell in zip(labels, guarded, strict=True)]
+        text = "\n".join(itertools.chain.from_iterable(zip(*lines, strict=True)))  # student by student
+        yield text + "\n" if text else ""
 
 
-def _label_cells(rows: Sequence[Row], numbers: _Cells, words: _Cells) -> list[list[str]]:
-    """The cells of one part's rows, by details.csv's column (the first two, and the last two, left empty)."""
+def _label_lines(ids: Sequence[str], label: str, rows: Sequence[Row],
+                 late: tuple[Sequence[int | None], Sequence[float | None]] | None, rules: _Rules) -> list[str]:
+    """The lines (without their ends) of one part's rows, one per student of ``ids`` (their cells as written)."""
     if not rows:
-        return [[] for _ in DETAILS_HEADER]
+        return []
     (submitted, verdict, credit, points, expected, parsed, unit, abs_error, rel_error, tolerance, feedback, diagnosis,
      source) = zip(*rows, strict=True)
-    return [[], [], _texts(["" if text is None else text for text in submitted]), _mapped(verdict, words),
-            _mapped(credit, numbers), _mapped(points, numbers),
-            _mapped(list(map(operator.mul, credit, points)), numbers),
-            safe_cells(expected), _texts(parsed), _mapped(unit, words), _errors(abs_error),
-            _errors(rel_error), _mapped(tolerance, words), _texts(feedback), _mapped(diagnosis, words),
-            _texts(source), [], []]
+    given = ["" if text is None else text for text in submitted] if None in submitted else submitted
+    marks = map(rules.marks.__getitem__, zip(verdict, credit, points, strict=True))
+    when = map(rules.lateness.__getitem__, zip(*late, strict=True)) if late else itertools.repeat(rules.lateness[()])
+    words = rules.words.__getitem__
+    cells = (ids, itertools.repeat(label), written_texts(given), marks, quoted_cells(safe_cells(expected)),
+             written_texts(parsed), map(words, unit), _errors(abs_error, rel_error), map(words, tolerance),
+             written_texts(feedback), map(words, diagnosis), written_texts(source), when)
+    return list(map(",".join, zip(*cells, strict=False)))  # strict=False: the label and lateness repeat
 
 
-def _interleaved(columns: Sequence[Sequence[str]]) -> list[str]:
-    """The parts' cells of one field, student by student: the first part's first cell, the second part's, ..."""
-    return list(itertools.chain.from_iterable(zip(*columns, strict=True)))
+def _marks(mark: tuple[str, float, float]) -> str:
+    """A verdict's cells ``verdict,credit,points,score``, from (verdict, credit, points)."""
+    verdict, credit, points = mark
+    return ",".join(quoted_cell(report_cell(cell)) for cell in (verdict, credit, points, credit * points))
+
+
+def written_cell(value: object) -> str:
+    """A report's cell (:func:`report_cell`) as the CSV writer writes it.
+
+    >>> written_cell("±1 %, widened"), written_cell(2.0)
+    ('"±1 %, widened"', '2')
+    """
+    return quoted_cell(report_cell(value))
+
+
+def _lateness(when: tuple[int | None, float | None] | tuple[()]) -> str:
+    """The cells ``late,deduction`` from (minutes late, the part's share of the deduction); () for a key
+    without due times (no lateness, no deduction)."""
+    minutes, share = when or (None, None)
+    return report_cell(minutes) + "," + report_cell(share or 0.0)
+
+
+def written_texts(texts: Sequence[str]) -> Sequence[str]:
+    """A column of text as a report writes it: each text guarded with its control characters shown
+    (:func:`_texts`), and quoted where the CSV writer quotes it."""
+    return quoted_cells(_texts(texts))
 
 
 def _texts(texts: Sequence[str]) -> list[str]:
@@ -87,6 +118,16 @@ def report_pieces(rows: Iterable[Sequence[object]], rows_per_piece: int = 2000) 
             yield csv_columns_text([_column_cells(column) for column in zip(*piece, strict=True)])
 
 
+def report_columns(columns: Sequence[Sequence[object]]) -> str:
+    """The CSV text of the rows that ``columns`` make, each value a report's cell (:func:`report_cell`), worked
+    out a column at a time as :func:`report_pieces` does.
+
+    >>> report_columns([["=a", "b"], [1.0, None]])
+    "'=a,1\\nb,\\n"
+    """
+    return csv_columns_text([_column_cells(column) for column in columns])
+
+
 def _column_cells(column: Sequence[object]) -> list[str]:
     """A column's report cells: text checked for control characters in one call; numbers of one type (scores,
     totals: a few hundred distinct values in a class) formatted once per value."""
@@ -94,14 +135,14 @@ def _column_cells(column: Sequence[object]) -> list[str]:
     if kinds == {str}:
         return _texts(column)  # type: ignore[arg-type]  # every cell a str
     if kinds <= _FLOATS or kinds <= _INTS:  # equal values of one type have one text (0.0 and -0.0 both "0")
-        return _mapped(column, _Cells(report_cell))
+        return _mapped(column, Cells[object](report_cell))
     return list(map(report_cell, column))
 
 
 _FLOATS, _INTS = {float, type(None)}, {int, type(None)}  # exactly: a bool is an int equal to 1 or 0, not its text
 
 
-def _mapped(values: Sequence[object], cells: _Cells) -> list[str]:
+def _mapped(values: Sequence[object], cells: Cells[object]) -> list[str]:
     return list(map(cells.__getitem__, values))
 
 
@@ -121,21 +162,48 @@ def report_cell(value: object) -> str:
     return safe_cell(visible(str(value)))
 
 
-def _errors(values: Sequence[float | None]) -> list[str]:
-    """``abs_error`` or ``rel_error``, for people: 6 significant figures, as ``expected`` and ``parsed`` (the
-    verdict was decided on the numbers unrounded)."""
-    if not all(map(math.isfinite, filter(None, values))):  # 0.0 and None left out: both finite
+def _errors(abs_error: Sequence[float | None], rel_error: Sequence[float | None]) -> list[str]:
+    """The cells ``abs_error,rel_error`` of a part's rows, for people: each error as :func:`number_text`
+    writes it (6 significant figures, as ``expected`` and ``parsed``; the verdict was decided on the numbers
+    unrounded; never ``-0``), formatted in one call (None, read as NaN, written as empty)."""
+    values = np.array([abs_error, rel_error], dtype=np.float64).T + 0.0  # + 0.0: -0.0 is written "0"
+    absent = abs_error.count(None) + rel_error.count(None)
+    if int(np.isfinite(values).sum()) != values.size - absent:
         raise ValueError("a report cell is not a finite number")  # a bug: verdicts never hold one
-    return ["" if value is None else number_text(value) for value in values]
+    text = "%.6g,%.6g\n" * len(values) % tuple(values.ravel().tolist())  # number_text's format
+    lines = (text.replace("nan", "") if absent else text).split("\n")  # no number written with %g holds "nan"
+    lines.pop()  # after the last line end
+    return lines
 
 
-class _Cells(dict[object, str]):
+def number_texts(values: Sequence[float]) -> list[str]:
+    """:func:`number_text` of each value (6 significant figures, never ``-0``), formatted in one call.
+
+    >>> number_texts([2.83138271, -0.0, 1.5e-7])
+    ['2.83138', '0', '1.5e-07']
+    """
+    text = "%.6g\n" * len(values) % tuple(value + 0.0 for value in values)  # number_text's format
+    return text.split("\n")[:-1]
+
+
+class _Rules(NamedTuple):
+    """The cells of the columns of a few distinct values, each value's worked out once."""
+
+    marks: Cells[tuple[str, float, float]]  # (verdict, credit, points): ``verdict,credit,points,score``
+    words: Cells[object]  # units, tolerances, diagnoses
+    lateness: Cells[tuple[int | None, float | None] | tuple[()]]  # (minutes, share), or (): ``late,deduction``
+
+
+Value = TypeVar("Value")
+
+
+class Cells(dict[Value, str], Generic[Value]):
     """A cell rule applied to each distinct value once: for the columns that hold a few."""
 
-    def __init__(self, rule: Callable[[object], str]) -> None:
+    def __init__(self, rule: Callable[[Value], str]) -> None:
         super().__init__()
         self.rule = rule
 
-    def __missing__(self, value: object) -> str:
+    def __missing__(self, value: Value) -> str:
         self[value] = self.rule(value)
         return self[value]

@@ -14,15 +14,24 @@ from __future__ import annotations
 
 import itertools
 import math
-from collections.abc import Iterable, Iterator, Sequence
+from collections.abc import Callable, Iterable, Iterator, Sequence
+from operator import itemgetter
 from pathlib import Path
 
 from grader.base.files import write_atomic
-from grader.base.spreadsheet import csv_pieces, number_cell
+from grader.base.spreadsheet import csv_columns_text, csv_pieces, csv_text, number_cell, number_cells
 from grader.grade.canvas_file import CanvasFile
 from grader.grade.class_report import REPORT, class_report
-from grader.grade.compare import number_text
-from grader.grade.details_file import details_csv, report_pieces
+from grader.grade.details_file import (
+    Cells,
+    details_csv,
+    number_texts,
+    report_cell,
+    report_columns,
+    report_pieces,
+    written_cell,
+    written_texts,
+)
 from grader.grade.grading import Graded, final_scores, lateness, totals
 from grader.grade.integrity import Integrity, check
 
@@ -45,16 +54,18 @@ def grades_csv(graded: Graded) -> str:
     """One row per student of the key: a column per problem, the minutes late of their latest answer that
     counts (empty: not known, or nothing submitted), the points the late policy took, the total after it,
     and what was possible."""
-    key = graded.key
+    key, students, deductions = graded.key, graded.key.students, graded.deductions
     scores = totals(graded)
-    final, late = final_scores(graded, scores), lateness(graded)
-    rows: list[list[object]] = [["student_id", "name", "section", *(f"problem {p.key}" for p in key.problems),
-                                 "late", "deduction", "total", "possible"]]
-    for student, minutes in zip(key.students, late, strict=True):
-        per_problem = [scores[student.id][p.key] for p in key.problems]
-        rows.append([student.id, student.name, student.section, *per_problem, minutes,
-                     graded.deductions.get(student.id, 0.0), final[student.id], student.possible])
-    return _csv(rows)
+    final, ids = final_scores(graded, scores), [student.id for student in students]
+    header = ["student_id", "name", "section", *(f"problem {p.key}" for p in key.problems), "late", "deduction",
+              "total", "possible"]
+    by_student = list(map(scores.__getitem__, ids))
+    columns: list[Sequence[object]] = [
+        ids, [student.name for student in students], [student.section for student in students],
+        *(list(map(itemgetter(problem.key), by_student)) for problem in key.problems), lateness(graded),
+        [deductions.get(student_id, 0.0) for student_id in ids], list(map(final.__getitem__, ids)),
+        [student.possible for student in students]]
+    return _csv([header]) + report_columns(columns)
 
 
 INTEGRITY_HEADER = ("student_id", "label", "submitted", "parsed", "matches_id", "matches_value", "students_matched",
@@ -62,7 +73,7 @@ INTEGRITY_HEADER = ("student_id", "label", "submitted", "parsed", "matches_id", 
                     "corrected_chance", "flagged")
 
 
-def integrity_csv(graded: Graded, integrity: Integrity) -> Iterator[str]:
+def integrity_csv(graded: Graded, integrity: Integrity, rows_per_piece: int = 10_000) -> Iterator[str]:
     """A row per wrong answer and student whose key accepts it (up to
     :data:`~grader.grade.integrity.LISTED` per answer): what was typed and read, whose variant it matches
     and that variant's value (6 significant figures, as ``details.csv``'s ``expected``), how many students'
@@ -71,30 +82,54 @@ def integrity_csv(graded: Graded, integrity: Integrity) -> Iterator[str]:
     chance counts and how close the least close of them is (in half-units of the last digit the student typed;
     empty: not read), the chance of so many matches so close by accident and that chance corrected for the
     pairs examined, and whether the pair is flagged (``yes``: at
-    most the assignment's ``integrity_threshold``). In pieces, as :func:`_csv_pieces`. A report: it changes
-    no grade."""
-    students = graded.key.students
-    flagged = set(integrity.flagged)
-    # A row per matching answer, most of them a pair's own; their chances and closeness repeat (a third distinct).
-    shown: dict[float, str] = {}
+    most the assignment's ``integrity_threshold``). In pieces of ``rows_per_piece`` rows, each cell a report's
+    cell (:func:`report_cell`) as the CSV writer writes it. A report: it changes no grade."""
+    yield csv_text([list(map(report_cell, INTEGRITY_HEADER))])
+    students, matches, flagged = graded.key.students, integrity.matches, set(integrity.flagged)
+    # Most rows are a pair's own and name students, parts, values and figures that other rows name too (a
+    # third of the chances are distinct): the cells of each are worked out once.
+    who: Cells[int] = Cells(lambda index: written_cell(students[index].id))
+    words: Cells[object] = Cells(written_cell)
+    counts: Cells[int | None] = Cells(written_cell)
+    # A value to 6 significant figures, a figure to 3 (columns for people): a number's text, which neither the
+    # formula guard nor the CSV writer changes; the values new to a piece are formatted in one call.
+    values: dict[float | None, str] = {}
+    shown: dict[float | None, str] = {None: ""}
+    step = max(1, rows_per_piece)
+    for start in range(0, len(matches), step):
+        piece = matches[start:start + step]
+        rows = [graded.columns[match.label][match.student] for match in piece]
+        pairs = [integrity.pair(match.student, match.partner) for match in piece]  # None: not listed
+        lines = map(",".join, zip(
+            map(who.__getitem__, [match.student for match in piece]), map(words.__getitem__, [m.label for m in piece]),
+            written_texts(["" if row.submitted is None else row.submitted for row in rows]),
+            written_texts([row.parsed for row in rows]), map(who.__getitem__, [match.partner for match in piece]),
+            _formatted([match.value for match in piece], values, number_texts),
+            map(counts.__getitem__, [match.matches for match in piece]),
+            map(counts.__getitem__, [None if pair is None else len(pair.labels) for pair in pairs]),
+            written_texts(["" if pair is None else " ".join(pair.labels) for pair in pairs]),
+            map(counts.__getitem__, [None if pair is None else pair.wrong for pair in pairs]),
+            map(counts.__getitem__, [None if pair is None else pair.closest for pair in pairs]),
+            _formatted([pair.closeness if pair is not None and math.isfinite(pair.closeness) else None
+                        for pair in pairs], shown, _figures),
+            _formatted([None if pair is None else pair.chance for pair in pairs], shown, _figures),
+            _formatted([None if pair is None else pair.corrected for pair in pairs], shown, _figures),
+            ["" if pair is None else "yes" if pair in flagged else "no" for pair in pairs], strict=True))
+        yield "\n".join(lines) + "\n"
 
-    def cell(value: float) -> str:
-        """A chance or closeness to 3 significant figures (a column for people), once per value."""
-        return shown.get(value) or shown.setdefault(value, number_cell(value, 3))
 
-    def rows() -> Iterator[Sequence[object]]:
-        yield INTEGRITY_HEADER
-        for match in integrity.matches:
-            row = graded.columns[match.label][match.student]
-            pair = integrity.pair(match.student, match.partner)
-            figures: list[object] = [None] * 8 if pair is None else [
-                len(pair.labels), " ".join(pair.labels), pair.wrong, pair.closest,
-                cell(pair.closeness) if math.isfinite(pair.closeness) else None, cell(pair.chance),
-                cell(pair.corrected), "yes" if pair in flagged else "no"]
-            yield [students[match.student].id, match.label, row.submitted, row.parsed, students[match.partner].id,
-                   number_text(match.value), match.matches, *figures]
+def _formatted(column: Sequence[float | None], known: dict[float | None, str],
+               rule: Callable[[list[float]], list[str]]) -> list[str]:
+    """The cells of a column of numbers (None: empty): those ``known`` has, and the new ones (distinct) by
+    ``rule`` in one call, kept in ``known``."""
+    new = [value for value in dict.fromkeys(column) if value is not None and value not in known]
+    known.update(zip(new, rule(new), strict=True))
+    return list(map(known.__getitem__, column))
 
-    return _csv_pieces(rows())
+
+def _figures(values: list[float]) -> list[str]:
+    """Chances and closeness for people: 3 significant figures."""
+    return number_cells(values, 3)
 
 
 def problems_csv(graded: Graded, canvas: CanvasFile | None = None) -> Iterator[str]:
@@ -106,14 +141,25 @@ def problems_csv(graded: Graded, canvas: CanvasFile | None = None) -> Iterator[s
     return _csv_pieces(itertools.chain(header, rows))
 
 
-def canvas_csv(canvas: CanvasFile) -> Iterator[str]:
+def canvas_csv(canvas: CanvasFile, rows_per_piece: int = 10_000) -> Iterator[str]:
     """A Canvas gradebook import: the student columns, one column of the assignment, and its ``Points
     Possible`` row, every cell exactly as :class:`CanvasFile` has it (no formula guard: Canvas matches on
-    the text), numbers as their shortest text. In pieces (an export may have 100,000 students)."""
+    the text), numbers as their shortest text. In pieces (an export may have 100,000 students), a piece's
+    cells a column at a time (the scores, a few hundred distinct, each formatted once)."""
     head: list[Sequence[object]] = [[*canvas.columns, canvas.title],
                                     ["Points Possible", *[""] * (len(canvas.columns) - 1), canvas.points]]
-    body = ([*identity, cell] for identity, cell in zip(canvas.identities, canvas.cells, strict=True))
-    return csv_pieces([_exact(value) for value in row] for row in itertools.chain(head, body))
+    yield csv_text([[_exact(value) for value in row] for row in head])
+    identities, cells, width = canvas.identities, canvas.cells, len(canvas.columns)
+    if not width or any(len(identity) != width for identity in identities):  # rows not all of two cells or more
+        body = ([*identity, cell] for identity, cell in zip(identities, cells, strict=True))
+        yield from csv_pieces([_exact(value) for value in row] for row in body)
+        return
+    scores: Cells[object] = Cells(_exact)
+    step = max(1, rows_per_piece)
+    for start in range(0, len(identities), step):
+        columns = [*zip(*identities[start:start + step], strict=True), cells[start:start + step]]
+        yield csv_columns_text([column if set(map(type, column)) == {str} else list(map(_exact, column))
+                                for column in columns[:-1]] + [list(map(scores.__getitem__, columns[-1]))])
 
 
 def _exact(value: object) -> str:

@@ -32,7 +32,7 @@ from collections import Counter
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from itertools import repeat
-from operator import attrgetter, eq, is_not, itemgetter
+from operator import attrgetter, eq, is_not
 
 import numpy as np
 import numpy.typing as npt
@@ -245,7 +245,7 @@ def _tolerances(key: Key, label: str, rows: Sequence[Row]) -> tuple[tuple[tuple[
     """The tolerances in words of the part's verdicts that were not widened, with their counts; and the
     :class:`~grader.model.tolerance.Widening` of those that were (the key's parts share one mapping for
     equal tolerances, so each distinct one is read once)."""
-    rules = list(map(attrgetter("tolerance"), map(itemgetter(label), map(attrgetter("parts"), key.students))))
+    rules = list(map(attrgetter("tolerance"), key.part_column(label)))
     distinct = dict(zip(map(id, rules), rules, strict=True))
     counted = [(Tolerance.from_json(distinct[found]), count) for found, count in Counter(map(id, rules)).items()]
     widened = {rule.explained() for rule, _ in counted if rule.reason}  # the words grading gave them

@@ -169,7 +169,7 @@ def check(graded: Graded, block: int = PAIRS) -> Integrity:
         first = key.students[0].parts[label] if students else None
         if first is None or first.symbolic or label not in graded.numbers:
             continue
-        column = [student.parts[label] for student in key.students]
+        column = key.part_column(label)
         values = np.fromiter((_number(entry.value) for entry in column), dtype=np.float64, count=students)
         part = bands(label, values, [entry.tolerance for entry in column], first.unit)
         numbers = graded.numbers[label]

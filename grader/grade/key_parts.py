@@ -90,8 +90,19 @@ class PartTable:
         """The students' parts: a student's rows start at ``starts[i]``, and their labels are at
         ``offsets[layout_of[i]]`` from there (each label's rows found at once by :meth:`column`)."""
         self._starts, self._layout_of, self._offsets = starts, layout_of, offsets
+        sizes = np.array([len(found) for found in offsets] or [0], np.int64)[layout_of]
+        possible: list[float] = [0] * len(starts)
+        points = np.array(self._points or [0.0])[self._kinds]
+        for size in np.unique(sizes[sizes > 0]).tolist():  # no parts: 0, as a sum of none is
+            members = np.flatnonzero(sizes == size)
+            # The sum of each distinct row of points, as a sum over the parts gives it (a class has a few).
+            distinct, inverse = np.unique(points[starts[members][:, None] + np.arange(size)], axis=0,
+                                          return_inverse=True)
+            sums = [sum(row) for row in distinct.tolist()]
+            for member, which in zip(members.tolist(), inverse.ravel().tolist(), strict=True):
+                possible[member] = sums[which]
         return list(map(StudentParts, itertools.repeat(self), starts.tolist(), map(offsets.__getitem__,
-                                                                                     layout_of.tolist())))
+                                                                                     layout_of.tolist()), possible))
 
     def part(self, row: int) -> KeyPart:
         """The part of ``row``."""
@@ -111,19 +122,16 @@ class PartTable:
             parts[index] = self.part(int(rows[index]))
         return parts
 
-    def points(self, start: int, stop: int) -> Iterator[float]:
-        """The points of rows ``start`` to ``stop``, in order."""
-        return map(self._points.__getitem__, self._shape_of[start:stop])
-
 
 class StudentParts(Mapping[str, KeyPart]):
     """A student's parts by label, in the sheet's order: rows ``start + offsets[label]`` of ``table`` (the
-    students of one layout share ``offsets``). A part is made each time it is asked for."""
+    students of one layout share ``offsets``), and the sum of their points. A part is made each time it is
+    asked for."""
 
-    __slots__ = ("_offsets", "_start", "_table")
+    __slots__ = ("_offsets", "_possible", "_start", "_table")
 
-    def __init__(self, table: PartTable, start: int, offsets: dict[str, int]) -> None:
-        self._table, self._start, self._offsets = table, start, offsets
+    def __init__(self, table: PartTable, start: int, offsets: dict[str, int], possible: float) -> None:
+        self._table, self._start, self._offsets, self._possible = table, start, offsets, possible
 
     def __getitem__(self, label: str) -> KeyPart:
         return self._table.part(self._start + self._offsets[label])
@@ -147,8 +155,4 @@ class StudentParts(Mapping[str, KeyPart]):
 
     def possible(self) -> float:
         """The sum of the parts' points, in order (as a sum over the parts themselves gives it)."""
-        return sum(self._table.points(self._start, self._start + len(self._offsets)))
-
-    def row(self, label: str) -> int:
-        """The table's row of the part ``label``."""
-        return self._start + self._offsets[label]
+        return self._possible

@@ -245,7 +245,7 @@ def _tolerances(key: Key, label: str, rows: Sequence[Row]) -> tuple[tuple[tuple[
     """The tolerances in words of the part's verdicts that were not widened, with their counts; and the
     :class:`~grader.model.tolerance.Widening` of those that were (the key's parts share one mapping for
     equal tolerances, so each distinct one is read once)."""
-    rules = list(map(attrgetter("tolerance"), key.part_column(label)))
+    rules = key.part_entries(label, "tolerance")
     distinct = dict(zip(map(id, rules), rules, strict=True))
     counted = [(Tolerance.from_json(distinct[found]), count) for found, count in Counter(map(id, rules)).items()]
     widened = {rule.explained() for rule, _ in counted if rule.reason}  # the words grading gave them

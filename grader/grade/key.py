@@ -149,6 +149,14 @@ class Key:
             return first.table.column(label)
         return [student.parts[label] for student in self.students]
 
+    def part_entries(self, label: str, field: str) -> list[Any]:
+        """Every student's entry ``field`` (``value``, ``tolerance``, any of :class:`KeyPart`'s) of their part
+        ``label``, in the students' order: where the key was read from its sidecar, without making the parts."""
+        first = self.students[0].parts if self.students else None
+        if isinstance(first, StudentParts) and first.table.students is self.students:
+            return first.table.entries(label, field)
+        return [getattr(student.parts[label], field) for student in self.students]
+
     @functools.cached_property
     def positions(self) -> dict[str, int]:
         """Each student's place in :attr:`students`, by id; worked out once (``grader check --batch`` looks

@@ -14,6 +14,8 @@ value took 136, and a student's mapping 80 bytes where a dict took 500.
 (0.7, 0.6, None, ['1a', '1b'], 3.0)
 >>> [part.value for part in table.column("1b")]  # a label's parts of every student at once
 [1.5, None]
+>>> table.entries("1b", "value"), table.entries("1b", "unit")  # or one entry of them, without the parts
+([1.5, None], ['m', 'm'])
 """
 
 from __future__ import annotations
@@ -62,6 +64,7 @@ class PartTable:
         "_offsets",
         "_points",
         "_shape_of",
+        "_shapes",
         "_special",
         "_specials",
         "_starts",
@@ -72,6 +75,7 @@ class PartTable:
 
     def __init__(self, shapes: list[KeyPart], shape_of: np.ndarray, values: np.ndarray,
                  specials: dict[int, tuple[str | None, Mapping[str, tuple[float, float]]]]) -> None:
+        self._shapes = shapes
         self._heads = [shape[:3] for shape in shapes]  # problem, name, label
         self._tails = [shape[4:] for shape in shapes]  # unit, points, tolerance, undefined, symbols
         self._points = [shape.points for shape in shapes]
@@ -114,13 +118,32 @@ class PartTable:
 
     def column(self, label: str) -> list[KeyPart]:
         """Every placed student's part ``label``, made together (:class:`KeyError` where one has none)."""
-        rows = self._starts + np.array([offsets[label] for offsets in self._offsets], np.int64)[self._layout_of]
+        rows = self._rows(label)
         shapes, values = self._kinds[rows].tolist(), self._numbers[rows].tolist()
         parts = list(map(_NEW, itertools.repeat(KeyPart), map(operator.add, map(
             operator.add, map(self._heads.__getitem__, shapes), zip(values)), map(self._tails.__getitem__, shapes))))
         for index in np.flatnonzero(self._special[rows]).tolist():
             parts[index] = self.part(int(rows[index]))
         return parts
+
+    def entries(self, label: str, field: str) -> list[Any]:
+        """Every placed student's entry ``field`` (``value``, ``tolerance``, ...) of their part ``label``, without
+        making the parts."""
+        rows = self._rows(label)
+        found: list[Any]
+        if field == "value":
+            found = self._numbers[rows].tolist()
+        else:
+            position = KeyPart._fields.index(field)
+            found = list(map([shape[position] for shape in self._shapes].__getitem__, self._kinds[rows].tolist()))
+        if field in ("value", "symbols"):  # where the value is an expression or null, the table's own
+            for index in np.flatnonzero(self._special[rows]).tolist():
+                found[index] = getattr(self.part(int(rows[index])), field)
+        return found
+
+    def _rows(self, label: str) -> np.ndarray:
+        """Each placed student's row of their part ``label``."""
+        return self._starts + np.array([offsets[label] for offsets in self._offsets], np.int64)[self._layout_of]
 
 
 class StudentParts(Mapping[str, KeyPart]):

@@ -66,7 +66,8 @@ def test_generate_writes_a_sidecar_that_gives_the_key_key_json_gives(graded_clas
 
 def test_a_label_of_every_student_at_once_is_each_students_part(graded_class: Path, tmp_path: Path) -> None:
     """Key.part_column (the sidecar's table, made together) gives each student's own part, symbolic ones and
-    points as key.json gives them, and Key.part_entries each entry of them; a student's possible points are the sum over their parts, in order."""
+    points as key.json gives them, and Key.part_entries each entry of them; a student's possible points are the
+    sum over their parts, in order."""
     key = graded_class / "hw" / "key.json"
     alone = tmp_path / "key.json"
     shutil.copyfile(key, alone)

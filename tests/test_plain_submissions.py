@@ -24,6 +24,7 @@ PLAIN = {  # read as plain answers
     "CRLF and quoted cells": "student_id,label,answer\r\n007,1a,\"1,5\"\r\n042,1b,\" 7 \"\r\n100,2a,\"\"\"x\"\"\"\r\n",
     "no line end at the end": "student_id,label,answer\n007,1a,6.2\n042,1b,7",
     "the longest cell, CRLF": "student_id,label,answer\r\n007,1a," + "9" * 1000 + "\r\n",
+    "a header name over two lines": "student_id,label,answer,\"a\nnote\"\n007,1a,6.2,x\n042,1b,7,\n",
 }
 ROW_BY_ROW = {  # anything else: read row by row
     "twice": "student_id,label,answer\n007,1a,6.2\n007,1a,6.3\n",

@@ -208,6 +208,8 @@ def _line_pieces(table: CsvStream, wanted: tuple[int, int, int]) -> Iterator[_Pi
 
     text, width = table.text, len(table.header)
     start, line = text.find("\n") + 1 or len(text), table.header_line + 1  # the header is the text's first line
+    if '"' in text[:start]:  # unless a quoted name of it goes on to the next
+        raise _NotALineARowError
     while start < len(text):
         end = text.find("\n", start + _PLAIN_PIECE)
         end = len(text) - text.endswith("\n") if end < 0 else end

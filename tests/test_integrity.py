@@ -277,7 +277,7 @@ def test_answers_counted_from_the_sorted_band_ends_count_as_those_tested_one_by_
     key = make_key(values.tolist())
     wide = {"mode": "rtol", "rtol": 0.03, "atol": 0.0}
     key = dataclasses.replace(key, students=tuple(
-        dataclasses.replace(student, parts={label: dataclasses.replace(part, tolerance=wide) if i % 7 == 0 else part
+        dataclasses.replace(student, parts={label: part._replace(tolerance=wide) if i % 7 == 0 else part
                                             for label, part in student.parts.items()})
         for i, student in enumerate(key.students)))
     slips = {0: 1.1, 1: 1.015}

@@ -53,7 +53,7 @@ def classes(draw: st.DrawFn) -> tuple[list[list[float]], dict[tuple[str, str], s
 def _key(values: list[list[float]], unit: str) -> Key:
     """:func:`make_key`'s key with the parts in ``unit`` (``deg``: angles, compared modulo a turn)."""
     key = make_key(values)
-    students = tuple(dataclasses.replace(student, parts={label: dataclasses.replace(part, unit=unit)
+    students = tuple(dataclasses.replace(student, parts={label: part._replace(unit=unit)
                                                          for label, part in student.parts.items()})
                      for student in key.students)
     return dataclasses.replace(key, students=students)

@@ -19,7 +19,7 @@ from grader.assign.variants import generate
 from grader.bank.template import load_bank
 from grader.base.resources import sample_dir
 from grader.cli import main
-from grader.grade.key import load_key
+from grader.grade.key import KeyPart, load_key
 from grader.grade.run import run
 
 # The sample's five problems (units, a symbolic problem, errors carried forward and diagnosed mistakes in the
@@ -62,6 +62,27 @@ def test_generate_writes_a_sidecar_that_gives_the_key_key_json_gives(graded_clas
     assert from_columns.late is not None and any(student.due for student in from_columns.students)
     assert any(part.symbolic for part in from_columns.students[0].parts.values())
     assert [s.parameters for s in from_columns.students] == [s.parameters for s in from_json.students]
+
+
+def test_a_label_of_every_student_at_once_is_each_students_part(graded_class: Path, tmp_path: Path) -> None:
+    """Key.part_column (the sidecar's table, made together) gives each student's own part, symbolic ones and
+    points as key.json gives them, and Key.part_entries each entry of them; a student's possible points are the
+    sum over their parts, in order."""
+    key = graded_class / "hw" / "key.json"
+    alone = tmp_path / "key.json"
+    shutil.copyfile(key, alone)
+    from_json, from_columns = load_key(alone), load_key(key)
+    for label in from_columns.labels:
+        assert from_columns.part_column(label) == [s.parts[label] for s in from_json.students], label
+        assert from_json.part_column(label) == [s.parts[label] for s in from_columns.students], label
+        for field in KeyPart._fields:
+            assert from_columns.part_entries(label, field) == [getattr(s.parts[label], field)
+                                                               for s in from_json.students], (label, field)
+    assert [s.possible for s in from_columns.students] == [sum(p.points for p in s.parts.values())
+                                                           for s in from_json.students]
+    first = from_columns.students[0].parts
+    assert list(first) == list(from_json.students[0].parts) and len(first) == len(from_json.students[0].parts)
+    assert "no such label" not in first and next(iter(first)) in first
 
 
 def test_grading_with_the_sidecar_is_byte_identical_to_grading_without(graded_class: Path) -> None:

@@ -20,6 +20,11 @@ PLAIN = {  # read as plain answers
     "semicolons and a decimal comma": "id;label;answer\n007;1a;6,2\n042;2a;\"6;2\"\n",
     "blank lines and a cell over two lines": "student_id,label,answer\n\n007,1a,\"6.2\n m/s\"\n\n\n042,1a,7\n",
     "other columns": "name,student_id,label,answer,note\nAna,007,1a,6.2,x\nBen,042,1b,7,\n",
+    "rows of only delimiters or spaces": "student_id,label,answer\n007,1a,6.2\n,,\n   \n042,1b,7\n",
+    "CRLF and quoted cells": "student_id,label,answer\r\n007,1a,\"1,5\"\r\n042,1b,\" 7 \"\r\n100,2a,\"\"\"x\"\"\"\r\n",
+    "no line end at the end": "student_id,label,answer\n007,1a,6.2\n042,1b,7",
+    "the longest cell, CRLF": "student_id,label,answer\r\n007,1a," + "9" * 1000 + "\r\n",
+    "a header name over two lines": "student_id,label,answer,\"a\nnote\"\n007,1a,6.2,x\n042,1b,7,\n",
 }
 ROW_BY_ROW = {  # anything else: read row by row
     "twice": "student_id,label,answer\n007,1a,6.2\n007,1a,6.3\n",
@@ -33,6 +38,7 @@ ROW_BY_ROW = {  # anything else: read row by row
     "by email": "email,label,answer\nana@x.edu,1a,6.2\n",
     "wide": "student_id,1a,1b\n007,6.2,7\n",
     "a long cell": "student_id,label,answer\n007,1a," + "9" * 5000 + "\n",
+    "a cell one too long": "student_id,label,answer\n007,1a,\"" + "9" * 1001 + "\"\n",
     "no student": "student_id,label,answer\n,1a,6.2\n",
 }
 

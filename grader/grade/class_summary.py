@@ -32,7 +32,7 @@ from collections import Counter
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from itertools import repeat
-from operator import attrgetter, eq, is_, is_not, itemgetter
+from operator import attrgetter, eq, is_, is_not
 
 import numpy as np
 import numpy.typing as npt
@@ -192,7 +192,6 @@ def summarize(graded: Graded) -> ClassSummary:
     parts = []
     invalid: set[int] = set()  # students with an answer that could not be read
     answered = np.zeros(count, dtype=bool)
-    rules = _rules(key)
     for problem in key.problems:
         for label in problem.labels:
             rows = graded.columns[label]
@@ -203,7 +202,7 @@ def summarize(graded: Graded) -> ClassSummary:
             missing[label] = _is(verdicts, "missing")
             answered |= np.fromiter(map(is_not, map(attrgetter("submitted"), rows), repeat(None)), bool, count)
             parts.append(_part(graded, problem.key, label, rows, verdicts, scores[label], worth, kinds,
-                               rules[label]))
+                               key.part_entries(label, "tolerance")))
             if parts[-1].counts.get("invalid"):
                 invalid.update(np.flatnonzero(_is(verdicts, "invalid")).tolist())
     possible = sum(points.values(), np.zeros(count))
@@ -241,17 +240,6 @@ def _part(graded: Graded, problem: str, label: str, rows: Sequence[Row], verdict
     return PartSummary(label, problem, first.name if first else "", first.unit if first else "",
                        tuple(sorted(set(worth.tolist()))), {kind: found.get(kind, 0) for kind in kinds}, credit,
                        *_tolerances(rules, rows), top, sum(mistakes.values()), says)
-
-
-def _rules(key: Key) -> dict[str, list[Mapping[str, object]]]:
-    """Per part label, each student's tolerance as the key has it (read a student at a time: one look-up of
-    every label's part)."""
-    labels = key.labels
-    if len(labels) < 2:  # itemgetter of one label gives the part, not a tuple of one
-        return {label: [student.parts[label].tolerance for student in key.students] for label in labels}
-    by_student = map(itemgetter(*labels), map(attrgetter("parts"), key.students))
-    by_label = zip(*by_student, strict=True) if key.students else ((),) * len(labels)
-    return {label: list(map(attrgetter("tolerance"), parts)) for label, parts in zip(labels, by_label, strict=True)}
 
 
 def _tolerances(rules: Sequence[Mapping[str, object]],

@@ -164,14 +164,14 @@ def grade(key: Key, submissions: Submissions, physics: Physics | None = None) ->
     numbers: dict[str, np.ndarray] = {}
     stamps: dict[str, list[datetime | None]] = {}
     everyone = np.arange(len(key.students))
-    parts_of, ids = [student.parts for student in key.students], [student.id for student in key.students]
+    ids = [student.id for student in key.students]
     timed = _timed(key)  # else no answer's lateness is measured: its timestamp is not kept
     for problem in key.problems:
         earlier: list[Earlier] = []
         for label in problem.labels:
             answers = _best(key, label, by_label.pop(label), again.pop(label), physics.problems.get(problem.key),
                             problems)
-            parts, given = [found[label] for found in parts_of], list(map(answers.get, ids))
+            parts, given = key.part_column(label), list(map(answers.get, ids))
             columns[label], numbers[label] = _grade_label(parts, given, key, everyone,
                                                           physics.problems.get(problem.key), earlier)
             if timed:

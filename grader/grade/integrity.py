@@ -169,9 +169,8 @@ def check(graded: Graded, block: int = PAIRS) -> Integrity:
         first = key.students[0].parts[label] if students else None
         if first is None or first.symbolic or label not in graded.numbers:
             continue
-        column = [student.parts[label] for student in key.students]
-        values = np.fromiter((_number(entry.value) for entry in column), dtype=np.float64, count=students)
-        part = bands(label, values, [entry.tolerance for entry in column], first.unit)
+        values = np.fromiter(map(_number, key.part_entries(label, "value")), dtype=np.float64, count=students)
+        part = bands(label, values, key.part_entries(label, "tolerance"), first.unit)
         numbers = graded.numbers[label]
         verdicts = np.array([row.verdict for row in graded.columns[label]])
         incorrect, correct = verdicts == "incorrect", verdicts == "correct"

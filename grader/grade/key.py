@@ -31,11 +31,12 @@ import math
 import re
 import sys
 import zoneinfo
-from collections.abc import Callable, Mapping
+from array import array
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from datetime import UTC, datetime, tzinfo
 from pathlib import Path
-from typing import Any, NamedTuple, TypeVar
+from typing import Any, TypeVar
 
 import numpy as np
 
@@ -52,6 +53,8 @@ from grader.assign.key_columns import (
 )
 from grader.base.errors import GraderError, TemplateError, shown
 from grader.base.inputs import CELL_CHARS, decode_text, read_bytes, regular_size
+from grader.grade.key_parts import KeyPart as KeyPart  # grading's parts, made here
+from grader.grade.key_parts import PartTable, StudentParts
 from grader.grade.notation import ReadError, check_powers
 from grader.model.expr import names, parse
 from grader.model.quantities import parse_unit
@@ -67,26 +70,6 @@ _T = TypeVar("_T")
 
 
 @dataclass(frozen=True, slots=True)
-class KeyPart:
-    """One answer part of one student: what is expected and how it is graded."""
-
-    problem: str
-    name: str
-    label: str
-    value: float | str | None  # a number, an expression's text (symbolic), or None (undefined)
-    unit: str
-    points: float
-    tolerance: Mapping[str, Any]  # the key's form: {"mode", "rtol", "atol"} or {"mode", "digits"}
-    undefined: str | None
-    symbols: Mapping[str, tuple[float, float]]  # symbolic answers: where each name is drawn
-
-    @property
-    def symbolic(self) -> bool:
-        """Whether an expression, not a number, is expected."""
-        return isinstance(self.value, str)
-
-
-@dataclass(frozen=True)
 class KeyStudent:
     """A student of the key, their answer parts by label, and their parameters as printed, by problem key."""
 
@@ -99,12 +82,14 @@ class KeyStudent:
     # ``values[i]`` is parameter ``parameters[i]``, a (problem key, name) pair; the class shares one
     # ``parameters`` tuple. A key without ``params`` (or a value that is no number) leaves them out.
     parameters: tuple[tuple[str, str], ...] = ()
-    values: tuple[float, ...] = ()
+    values: Sequence[float] = ()  # a key read from a file gives them as an array('d'): 8 bytes each
     due: datetime | None = None  # the student's own due time (an extension), if any
 
     @property
     def possible(self) -> float:
         """The points this student could earn."""
+        if isinstance(self.parts, StudentParts):
+            return self.parts.possible()  # without making the parts
         return sum(part.points for part in self.parts.values())
 
     def params(self, problem: str) -> dict[str, float]:
@@ -155,6 +140,22 @@ class Key:
     def possible(self) -> float:
         """The most points a student can earn (Canvas' "points possible" of the assignment)."""
         return max((student.possible for student in self.students), default=0.0)
+
+    def part_column(self, label: str) -> list[KeyPart]:
+        """Every student's part ``label``, in the students' order: made together where the key was read from
+        its sidecar (a part at a time, each looked up, takes five times as long)."""
+        first = self.students[0].parts if self.students else None
+        if isinstance(first, StudentParts) and first.table.students is self.students:
+            return first.table.column(label)
+        return [student.parts[label] for student in self.students]
+
+    def part_entries(self, label: str, field: str) -> list[Any]:
+        """Every student's entry ``field`` (``value``, ``tolerance``, any of :class:`KeyPart`'s) of their part
+        ``label``, in the students' order: where the key was read from its sidecar, without making the parts."""
+        first = self.students[0].parts if self.students else None
+        if isinstance(first, StudentParts) and first.table.students is self.students:
+            return first.table.entries(label, field)
+        return [getattr(student.parts[label], field) for student in self.students]
 
     @functools.cached_property
     def positions(self) -> dict[str, int]:
@@ -573,12 +574,12 @@ def _student(raw: Mapping[str, Any], symbols: Mapping[str, Mapping[str, tuple[fl
         for name, value in printed.items() if isinstance(printed, dict) else ():
             if type(value) in (int, float) and _printable(value):  # not bool
                 parameters.append((key, str(name)))
-                values.append(_one(shared, float(value)))
+                values.append(float(value))
     name, email, section = (_text(raw.get(entry, ""), f"student {student_id}: {entry}")
                             for entry in ("name", "email", "section"))
     due = None if raw.get("due") is None else _instant(raw["due"], f"student {student_id}: due")
     return KeyStudent(student_id, name, email, section, parts, _one(shared, ("parameters", tuple(parameters)))[1],
-                      tuple(values), due)
+                      array("d", values), due)
 
 
 def _part(problem: str, name: str, raw: Mapping[str, Any],
@@ -679,6 +680,7 @@ def _printable(value: float) -> bool:
 
 # --- the sidecar: the same students from columns (grader.assign.key_columns) ------------------------
 
+
 def _key_from_columns(columns: KeyColumns, where: str) -> Key | None:
     """The key the sidecar's columns hold, checked as :func:`load_key` checks ``key.json``; None where any
     check fails: ``key.json`` is then read, and refused with its own message, in its own order."""
@@ -688,86 +690,120 @@ def _key_from_columns(columns: KeyColumns, where: str) -> Key | None:
             or version not in VERSIONS:
         return None
     try:
-        students = _columns_students(columns, _symbols(_field(header, "problems", "the key")))
-        return _key({**header, "students": students}, where, version)
+        students, table = _columns_students(columns, _symbols(_field(header, "problems", "the key")))
+        key = _key({**header, "students": students}, where, version)
     except _EntryError:
         return None
-
-
-class _PartShape(NamedTuple):
-    """What the parts of many students share: all of a :class:`KeyPart` but its value."""
-
-    problem: str
-    name: str
-    label: str
-    unit: str
-    points: float
-    tolerance: Mapping[str, Any]
-    undefined: str | None
-    symbols: Mapping[str, tuple[float, float]]
+    table.students = key.students  # Key.part_column reads the table's columns for these students
+    return key
 
 
 def _columns_students(columns: KeyColumns, symbols: Mapping[str, Mapping[str, tuple[float, float]]]
-                      ) -> list[KeyStudent]:
+                      ) -> tuple[list[KeyStudent], PartTable]:
     """The students of the columns, each entry checked as :func:`_student` checks it (once per distinct
-    text, unit, tolerance and points); :class:`_EntryError` where one fails."""
+    text, unit, tolerance and points), and the table their parts are rows of; :class:`_EntryError` where one
+    fails. Parts are not made here: a student's are made when they are asked for."""
     shared: dict[Any, Any] = {}
-    texts, values = columns.texts, columns.value
-    numbers = columns.code[:, TEXT] == NUMBER
-    if not np.isfinite(values[numbers]).all():
+    kinds = columns.code[:, TEXT]
+    if not np.isfinite(columns.value[kinds == NUMBER]).all():
         raise _EntryError("a value that is not finite")
-    shapes: dict[tuple[Any, ...], _PartShape] = {}
     layouts = [_layout(shape, shared) for shape in columns.shapes]
-    value_list, kinds = values.tolist(), columns.code[:, TEXT].tolist()
-    first, inverse = _combinations(columns)
-    rests, points, which = columns.code[first, UNIT:].tolist(), columns.points[first].tolist(), inverse.tolist()
-    del inverse
-    found: dict[tuple[str, str, int], _PartShape] = {}
-    params, every_printed = columns.params.tolist(), bool((np.abs(columns.params) < 1.7e308).all())
+    sizes = np.array([size for _, _, size in layouts] or [0], np.int64)
+    counts = sizes[columns.shape]
+    starts = np.cumsum(counts) - counts  # each student's first row
+    shapes, shape_of = _shapes(columns, layouts, sizes, starts, counts, symbols, shared)
+    others = np.flatnonzero(kinds != NUMBER)  # rows whose value is an expression, or null
+    specials = {row: _valued(shapes[shape], None if kind == NONE else columns.texts[kind], shared)
+                for row, kind, shape in zip(others.tolist(), kinds[others].tolist(), shape_of[others].tolist(),
+                                            strict=True)}
+    table = PartTable(shapes, shape_of, columns.value, specials)
+    layout_of, offsets = _label_layouts(columns.shape, layouts, starts, shapes, shape_of)
+    parts = table.place(starts, layout_of, offsets)
+    _check_people(columns)
+    params = array("d", np.ascontiguousarray(columns.params, np.float64).tobytes())
+    every_printed = bool((np.abs(columns.params) < 1.7e308).all())
     dues: dict[str, datetime] = {}
-    students, answer, parameter = [], 0, 0
-    for student_id, name, email, section, due, shape in zip(columns.ids, columns.names, columns.emails,
-                                                            columns.sections, columns.dues, columns.shape.tolist(),
-                                                            strict=True):
-        if not _text(student_id, "a student's id").strip():
-            raise _EntryError("a student's id: expected an id")
-        parts: dict[str, KeyPart] = {}
-        for problem, answers in layouts[shape][0]:
-            for answer_name in answers:
-                kind, value, combination = kinds[answer], value_list[answer], which[answer]
-                part = found.get((problem, answer_name, combination))
-                if part is None:
-                    key = (problem, answer_name, *rests[combination], points[combination])
-                    part = shapes.get(key)  # -0.0 points are 0.0's: one shape, the first found, as before
-                    if part is None:
-                        part = shapes[key] = _part_shape(key, texts, columns.tolerances, symbols, shared)
-                    found[problem, answer_name, combination] = part
-                if kind == NUMBER:
-                    parts[part.label] = KeyPart(part.problem, part.name, part.label, value, part.unit, part.points,
-                                                part.tolerance, part.undefined, part.symbols)
-                else:
-                    parts[part.label] = _part_valued(part, None if kind == NONE else texts[kind], shared)
-                answer += 1
-        if len(parts) != layouts[shape][2]:
-            raise _EntryError(f"student {student_id}: a label appears twice")
-        names, count = layouts[shape][1], len(layouts[shape][1])
-        printed = params[parameter:parameter + count]
-        parameter += count
+    students, parameter = [], 0
+    for student_id, name, email, section, due, shape, own in zip(columns.ids, columns.names, columns.emails,
+                                                                 columns.sections, columns.dues, columns.shape.tolist(),
+                                                                 parts, strict=True):
+        names = layouts[shape][1]
+        printed = params[parameter:parameter + len(names)]
+        parameter += len(names)
         if not every_printed:
-            names = tuple(pair for pair, number in zip(names, printed, strict=True) if _printable(number))
-            printed = [number for number in printed if _printable(number)]
-            names = _one(shared, ("parameters", names))[1]
+            names = _one(shared, ("parameters", tuple(pair for pair, number in zip(names, printed, strict=True)
+                                                      if _printable(number))))[1]
+            printed = array("d", [number for number in printed if _printable(number)])
         when = None if due is None else dues.get(due) or dues.setdefault(due, _instant(due, "due"))
-        students.append(KeyStudent(student_id, _text(name, "name"), _text(email, "email"), _text(section, "section"),
-                                   parts, names, tuple(printed), when))
-    return students
+        students.append(KeyStudent(student_id, name, email, section, own, names, printed, when))
+    return students, table
+
+
+def _shapes(columns: KeyColumns, layouts: list[tuple[list[tuple[str, list[str]]], Any, int]], sizes: np.ndarray,
+            starts: np.ndarray, counts: np.ndarray, symbols: Mapping[str, Mapping[str, tuple[float, float]]],
+            shared: dict[Any, Any]) -> tuple[list[KeyPart], np.ndarray]:
+    """The distinct parts of the class but their values (each checked once, as :func:`_part` checks it) and
+    which of them each row is. A row's part is told by its place in its student's layout (the problem and the
+    answer's name) and its combination of entries (:func:`_combinations`)."""
+    places = [(problem, name) for answers, _, _ in layouts for problem, names in answers for name in names]
+    rows = len(columns.value)
+    place = np.repeat((np.cumsum(sizes) - sizes)[columns.shape] - starts, counts) + np.arange(rows)
+    first, which = _combinations(columns)
+    distinct, at, inverse = np.unique(place * len(first) + which, return_index=True, return_inverse=True)
+    rests, points = columns.code[first, UNIT:].tolist(), columns.points[first].tolist()
+    shapes: list[KeyPart] = []
+    found: dict[tuple[Any, ...], int] = {}
+    number = np.zeros(len(distinct), np.int32)
+    # In the order the rows first have them: -0.0 points are 0.0's, one shape, the first found (as before).
+    for index in np.argsort(at, kind="stable").tolist():
+        slot, combination = divmod(int(distinct[index]), len(first))
+        key = (*places[slot], *rests[combination], points[combination])
+        if key not in found:
+            found[key] = len(shapes)
+            shapes.append(_part_shape(key, columns.texts, columns.tolerances, symbols, shared))
+        number[index] = found[key]
+    return shapes, number[inverse.ravel()]
+
+
+def _label_layouts(shape: np.ndarray, layouts: list[tuple[Any, Any, int]], starts: np.ndarray,
+                   shapes: list[KeyPart], shape_of: np.ndarray) -> tuple[np.ndarray, list[dict[str, int]]]:
+    """Each student's labels in order, as the place of each label among their rows (one mapping for the
+    students who share it) and which of them each student has; :class:`_EntryError` where a student has a
+    label twice."""
+    numbered: dict[str, int] = {}
+    label_of = np.array([numbered.setdefault(part.label, len(numbered)) for part in shapes], np.int64)
+    labels = list(numbered)
+    layout_of = np.zeros(len(shape), np.int64)
+    offsets: list[dict[str, int]] = []
+    for layout, (_, _, size) in enumerate(layouts):
+        members = np.flatnonzero(shape == layout)
+        if not members.size:
+            continue
+        grid = label_of[shape_of[starts[members][:, None] + np.arange(size)]] if size else np.zeros((1, 0), np.int64)
+        distinct, inverse = np.unique(grid, axis=0, return_inverse=True)
+        layout_of[members] = len(offsets) + inverse.ravel()
+        for found in distinct.tolist():
+            offsets.append({labels[number]: place for place, number in enumerate(found)})
+            if len(offsets[-1]) != size:
+                raise _EntryError("a label appears twice in a student's parts")
+    return layout_of, offsets
+
+
+def _check_people(columns: KeyColumns) -> None:
+    """The students' ids, names, emails and sections: text of at most CELL_CHARS characters, each id some."""
+    for entries, what in ((columns.ids, "id"), (columns.names, "name"), (columns.emails, "email"),
+                          (columns.sections, "section")):
+        if set(map(type, entries)) - {str} or max(map(len, entries), default=0) > CELL_CHARS:
+            raise _EntryError(f"a student's {what}: expected text of at most {CELL_CHARS} characters")
+    if not all(map(str.strip, columns.ids)):
+        raise _EntryError("a student's id: expected an id")
 
 
 def _combinations(columns: KeyColumns) -> tuple[np.ndarray, np.ndarray]:
     """Each answer's entries but its value (unit, label, tolerance, reason, points) as one index into the
     combinations the class has (a few thousand), and where each is first found: a list of five numbers an
     answer took, for a moment, half again what the key then holds (points compared by their bits: -0.0 is not
-    0.0 here, and :func:`_columns_students` makes them one shape, as equal points).
+    0.0 here, and :func:`_shapes` makes them one shape, as equal points).
 
     >>> import types
     >>> code = np.array([[-1, 0, 1, 0, -2], [-1, 0, 2, 0, -2], [-1, 0, 1, 0, -2]], dtype=np.int32)
@@ -798,18 +834,18 @@ def _layout(shape: list[tuple[str, list[str], list[str]]], shared: dict[Any, Any
 
 
 def _part_shape(key: tuple[Any, ...], texts: list[str], tolerances: list[Any],
-                symbols: Mapping[str, Mapping[str, tuple[float, float]]], shared: dict[Any, Any]) -> _PartShape:
-    """A part's entries but its value, checked as :func:`_part` checks them."""
+                symbols: Mapping[str, Mapping[str, tuple[float, float]]], shared: dict[Any, Any]) -> KeyPart:
+    """A part's entries but its value (None here), checked as :func:`_part` checks them."""
     problem, name, unit, label, tolerance, undefined, points = key
     label = _one(shared, _text(texts[label], f"answer {name}", "label"))
-    return _PartShape(problem, _one(shared, name), label, _unit(texts[unit], name, shared),
-                      _one(shared, _points(points, name)), _tolerance(tolerances[tolerance], name, shared),
-                      None if undefined == NONE else texts[undefined], symbols.get(label, {}))
+    return KeyPart(problem, _one(shared, name), label, None, _unit(texts[unit], name, shared),
+                   _one(shared, _points(points, name)), _tolerance(tolerances[tolerance], name, shared),
+                   None if undefined == NONE else texts[undefined], symbols.get(label, {}))
 
 
-def _part_valued(part: _PartShape, value: str | None, shared: dict[Any, Any]) -> KeyPart:
-    """A part whose value is an expression (its names checked, and drawn where :func:`_part` draws them) or
-    null."""
+def _valued(part: KeyPart, value: str | None, shared: dict[Any, Any]) -> tuple[str | None, Mapping[str, Any]]:
+    """The value and symbols' ranges of a part whose value is an expression (its names checked, and drawn where
+    :func:`_part` draws them) or null."""
     domains = part.symbols
     if isinstance(value, str):
         used = shared.get(("names", value))
@@ -820,5 +856,4 @@ def _part_valued(part: _PartShape, value: str | None, shared: dict[Any, Any]) ->
                 ("symbols", value), dict.fromkeys(sorted(used), SYMBOL_RANGE))
         elif not used <= domains.keys():
             raise _EntryError(f"answer {part.name}: the expression uses names not among its symbols")
-    return KeyPart(part.problem, part.name, part.label, value, part.unit, part.points, part.tolerance, part.undefined,
-                   domains)
+    return value, domains

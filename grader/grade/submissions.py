@@ -42,13 +42,15 @@ import functools
 import itertools
 import os
 from collections import defaultdict
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from datetime import UTC, datetime, tzinfo
 from functools import lru_cache
 from operator import itemgetter
 from pathlib import Path
-from typing import Literal
+from typing import Literal, cast
+
+import numpy as np
 
 from grader.base.errors import GraderError, shown
 from grader.base.files import shown_path
@@ -148,38 +150,100 @@ def _plain_answers(table: CsvStream, layout: Layout, ids: Mapping[str, str], lab
     if layout.wide or layout.by_email or layout.timestamp is not None or layout.label is None \
             or layout.answer is None:
         return None
-    header, known = table.header, {label: label for label in labels}
-    width, student, label, answer = (len(header), header.index(layout.student), header.index(layout.label),
-                                     header.index(layout.answer))
+    header = table.header
+    wanted = (header.index(layout.student), header.index(layout.label), header.index(layout.answer))
+    try:
+        return _answers(_line_pieces(table, wanted), ids, labels, name, table.delimiter)
+    except _NotALineARowError:  # blank lines, or a quoted cell over several lines: read as records instead
+        return _answers(_record_pieces(table, wanted), ids, labels, name, table.delimiter)
+
+
+def _answers(pieces: Iterator[_Piece | None], ids: Mapping[str, str], labels: Sequence[str], name: str,
+             delimiter: str) -> list[Answer] | None:
+    """The answers of the rows of ``pieces`` as :func:`_plain_answers` reads them; None where one is not so."""
+    # Each (student, label) as one number, student * labels + label: taken once each, checked a piece at a time.
+    students, numbers = list(ids.values()), {student: index for index, student in enumerate(ids)}
+    places = {label: index for index, label in enumerate(labels)}
+    taken = np.zeros(len(numbers) * len(labels), bool)
     answers: list[Answer] = []
-    seen: set[tuple[str, str]] = set()
     typed: dict[str, str] = {}
-    records = table.records()
-    # A piece of rows at a time (a file of a million rows is not held as cells beside its answers), each check
-    # and each cell of the three columns (stripped, as _Reader strips them) a column at a time.
-    while piece := list(itertools.islice(records, _PLAIN_PIECE)):
-        lines, rows = zip(*piece, strict=True)
-        if set(map(len, rows)) != {width} or max(map(len, itertools.chain.from_iterable(rows))) > CELL_CHARS:
+    # A piece of rows at a time (a file of a million rows is not held as cells beside its answers), each cell
+    # of the three columns stripped, as _Reader strips them, a column at a time.
+    for piece in pieces:
+        if piece is None:
             return None
-        who = list(map(str.strip, map(itemgetter(student), rows)))
-        part = list(map(str.strip, map(itemgetter(label), rows)))
-        if not (all(map(ids.__contains__, who)) and all(map(known.__contains__, part))):
+        lines, who_cells, part_cells, typed_cells = piece
+        found = list(map(numbers.get, map(str.strip, who_cells))), list(map(places.get, map(str.strip, part_cells)))
+        if None in found[0] or None in found[1]:
             return None
+        who_number, part_number = cast(tuple[list[int], list[int]], found)
+        cells = np.array(who_number, np.int64) * len(labels) + np.array(part_number, np.int64)
+        if taken[cells].any() or np.unique(cells).size != cells.size:  # a student's label twice
+            return None
+        taken[cells] = True
         # The key's own id and label texts, not the file's: one object a student and a part, not three a row.
-        who, part = list(map(ids.__getitem__, who)), list(map(known.__getitem__, part))
-        seen.update(zip(who, part, strict=True))
-        if len(seen) != len(answers) + len(rows):  # a student's label twice
-            return None
+        who, part = list(map(students.__getitem__, who_number)), list(map(labels.__getitem__, part_number))
         # One text object for equal answers (a class types a few thousand distinct ones): a verdict keeps it.
-        stripped = list(map(str.strip, map(itemgetter(answer), rows)))
+        stripped = list(map(str.strip, typed_cells))
         texts = map(typed.setdefault, stripped, stripped)
         # tuple.__new__: the named tuple's own __new__ is a Python call per answer.
         answers += map(functools.partial(tuple.__new__, Answer), zip(
-            itertools.repeat(name), lines, who, part, texts, itertools.repeat(table.delimiter), itertools.repeat(None)))
+            itertools.repeat(name), lines, who, part, texts, itertools.repeat(delimiter), itertools.repeat(None)))
     return answers
 
 
-_PLAIN_PIECE = 65536  # rows
+_Piece = tuple[Sequence[int], list[str], list[str], list[str]]  # rows' lines, and their cells of three columns
+
+
+class _NotALineARowError(Exception):
+    """A file whose data lines are not each one row: it is read as the csv module's records instead."""
+
+
+def _line_pieces(table: CsvStream, wanted: tuple[int, int, int]) -> Iterator[_Piece | None]:
+    """The data rows, about :data:`_PLAIN_PIECE` characters of lines at a time, each line read by the csv module
+    as one row (as :meth:`CsvStream.records` reads it: a line's end dropped), with their cells of the ``wanted``
+    columns; None where a row has not one cell per column, or one too long; :class:`_NotALineARowError` where a
+    line is no row (blank), or not one (a quoted cell over several lines, a quote left open)."""
+    import csv  # here: `grader solve --set` and `grader list` read no CSV
+
+    text, width = table.text, len(table.header)
+    start, line = text.find("\n") + 1 or len(text), table.header_line + 1  # the header is the text's first line
+    if '"' in text[:start]:  # unless a quoted name of it goes on to the next
+        raise _NotALineARowError
+    while start < len(text):
+        end = text.find("\n", start + _PLAIN_PIECE)
+        end = len(text) - text.endswith("\n") if end < 0 else end
+        lines = text[start:end].split("\n")
+        start = end + 1
+        try:
+            rows = list(csv.reader(lines, delimiter=table.delimiter, strict=True))
+        except csv.Error:
+            raise _NotALineARowError from None
+        if len(rows) != len(lines) or not all(map(str.strip, map("".join, rows))):
+            raise _NotALineARowError
+        # A row is a line: no cell is longer than its line.
+        if set(map(len, rows)) != {width} or (max(map(len, lines)) > CELL_CHARS and max(
+                map(len, itertools.chain.from_iterable(rows))) > CELL_CHARS):
+            yield None
+            return
+        yield range(line, line + len(lines)), *(list(map(itemgetter(column), rows)) for column in wanted)  # type: ignore[misc]
+        line += len(lines)
+
+
+def _record_pieces(table: CsvStream, wanted: tuple[int, int, int]) -> Iterator[_Piece | None]:
+    """The rows of any file as the csv module reads them (:meth:`CsvStream.records`), 65,536 at a time (of
+    :data:`_PLAIN_PIECE` characters, 16 a row), and their cells of the ``wanted`` columns; None where a row has
+    not one cell per column, or one too long."""
+    records, width = table.records(), len(table.header)
+    while piece := list(itertools.islice(records, max(1, _PLAIN_PIECE >> 4))):
+        lines, rows = zip(*piece, strict=True)
+        if set(map(len, rows)) != {width} or max(map(len, itertools.chain.from_iterable(rows))) > CELL_CHARS:
+            yield None
+            return
+        yield lines, *(list(map(itemgetter(column), rows)) for column in wanted)  # type: ignore[misc]
+
+
+_PLAIN_PIECE = 1 << 20  # about 50,000 rows of three short cells
 
 
 # The most of one submissions file: its text is held whole while its rows are read (1 byte a character of

@@ -301,19 +301,3 @@ def test_grading_a_class_never_imports_matplotlib(demo_run: DemoRun, tmp_path: P
                             cwd=Path(__file__).resolve().parent.parent)
     assert result.stdout.split()[-1] == "False"
     assert (tmp_path / "grades" / "report.html").stat().st_size > 10_000
-
-
-@pytest.mark.parametrize("students", [0, 1, 3])
-def test_each_parts_tolerances_are_read_student_by_student(students: int) -> None:
-    """The tolerances the report counts are each student's own, part by part, whatever the number of parts."""
-    shared, own = {"mode": "rtol", "rtol": 0.01, "atol": 0.0}, {"mode": "sigfigs", "digits": 3}
-    for labels in (("1a",), ("1a", "1b", "2a")):
-        people = tuple(KeyStudent(f"s{index}", "", "", "1", {
-            label: KeyPart("1", "v", label, 1.0, "", 1.0, own if index == 1 and label != "1a" else shared, None, {})
-            for label in labels}) for index in range(students))
-        key = Key("key.json", 2, "HW", True, (KeyProblem("1", "P", labels),), people)
-        rules = class_summary._rules(key)
-        assert list(rules) == list(labels)
-        for label in labels:
-            assert all(map(lambda a, b: a is b, rules[label], [s.parts[label].tolerance for s in people]))
-            assert len(rules[label]) == students

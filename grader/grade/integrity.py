@@ -42,11 +42,11 @@ from typing import NamedTuple
 import numpy as np
 import numpy.typing as npt
 
-from grader.grade.cells import typed_place
 from grader.grade.compare import errors
 from grader.grade.grading import Graded, Row
 from grader.grade.integrity_chance import UNRELATED, Spread
 from grader.grade.integrity_close import bound, close_pairs
+from grader.grade.integrity_typed import step, steps
 from grader.grade.integrity_search import (
     Bands,
     Floats,
@@ -131,7 +131,7 @@ class _Answers(NamedTuple):
     right: Mapping[str, Floats]
     rows: Mapping[str, Sequence[Row]]
     per_student: Ints
-    read: dict[str, dict[int, float]]  # per part, the half-units of the right answers read so far, by student
+    read: dict[str, Floats]  # per part and student, the half-unit of the right answer, once read (NaN: not yet)
 
     def centres(self, part: Bands, owners: Ints, partners: Ints) -> Floats:
         """Where each owner's answer's closeness to the partner's is measured from: the number the partner
@@ -139,14 +139,17 @@ class _Answers(NamedTuple):
         as its source typed it is there exactly), else the partner's value. An angle's is taken within half a
         turn of the value."""
         values, typed = part.values[partners], self.right[part.label][partners]
-        have = np.flatnonzero(np.isfinite(typed))
-        steps = np.full(len(partners), np.inf)  # of the partners' right answers, read only for the pairs asked
-        rows, numbers, read = self.rows[part.label], self.numbers[part.label], self.read.setdefault(part.label, {})
-        for row, partner in zip(have.tolist(), partners[have].tolist(), strict=True):
-            if partner not in read:
-                read[partner] = _step(rows[partner].submitted, float(numbers[partner]))
-            steps[row] = read[partner]
-        found = np.where(np.isfinite(typed) & (steps <= self.steps[part.label][owners]), typed, values)
+        have = np.isfinite(typed)
+        read = self.read.get(part.label)
+        if read is None:
+            read = self.read[part.label] = np.full(len(self.per_student), np.nan)  # NaN: not read (a step never is)
+        asked = np.unique(partners[have])
+        asked = asked[np.isnan(read[asked])]
+        rows, numbers = self.rows[part.label], self.numbers[part.label]
+        read[asked] = [step(rows[partner].submitted, number)
+                       for partner, number in zip(asked.tolist(), numbers[asked].tolist(), strict=True)]
+        halves = np.where(have, read[partners], np.inf)
+        found = np.where(have & (halves <= self.steps[part.label][owners]), typed, values)
         period = part.period
         return found if period is None else values + np.mod(found - values + period / 2, period) - period / 2
 
@@ -181,14 +184,14 @@ def check(graded: Graded, block: int = PAIRS) -> Integrity:
     per_student = np.zeros(students, dtype=np.int64)
     for members in wrong.values():
         per_student[members] += 1
-    steps = {part.label: _steps(graded.columns[part.label], wrong[part.label], graded.numbers[part.label])
+    typed = {part.label: steps(graded.columns[part.label], wrong[part.label], graded.numbers[part.label])
              for part in parts}
     spread = Spread.of(np.concatenate([graded.numbers[p.label][wrong[p.label]] for p in parts] or [np.zeros(0)]),
                        np.concatenate([p.values[wrong[p.label]] for p in parts] or [np.zeros(0)]),
                        np.concatenate([wrong[p.label] for p in parts] or [np.zeros(0, np.int64)]), students)
     examined = int(np.count_nonzero(per_student >= 2)) * max(students - 1, 0)
     found = [holding(part, wrong[part.label], graded.numbers[part.label]) for part in parts]
-    answers = _Answers(wrong, graded.numbers, steps, right, graded.columns, per_student, {})
+    answers = _Answers(wrong, graded.numbers, typed, right, graded.columns, per_student, {})
     pairs = _pairs(parts, answers, spread, found, examined, block)
     matches = _listed(parts, wrong, graded.numbers, found, pairs)
     # Every listed match has its pair's figures.
@@ -201,27 +204,6 @@ def check(graded: Graded, block: int = PAIRS) -> Integrity:
     return Integrity(tuple(matches), tuple(ranked), examined, key.integrity_threshold,
                      sum(len(members) for members in wrong.values()),
                      sum(int(np.count_nonzero(counts)) for counts, _ in found))
-
-
-def _steps(rows: Sequence[Row], students: Ints, numbers: Floats) -> Floats:
-    """Per student (of ``students``; inf for the others), the half-unit of the last digit of their answer as
-    typed (:func:`_step`)."""
-    steps = np.full(len(rows), np.inf)
-    steps[students] = [_step(rows[student].submitted, number)
-                       for student, number in zip(students.tolist(), numbers[students].tolist(), strict=True)]
-    return steps
-
-
-def _step(text: str | None, number: float) -> float:
-    """The half-unit of the last digit of a number as typed, in the sheet's unit: the place value of the typed
-    number times the unit's factor (the number read over the number typed); inf: not a plain number."""
-    typed = _typed_place(text) if text is not None else None
-    if typed is None or typed[0] == 0:
-        return math.inf
-    return 0.5 * typed[1] * abs(number / typed[0])
-
-
-_typed_place = functools.lru_cache(maxsize=1 << 16)(typed_place)
 
 
 def _number(value: object) -> float:

@@ -35,7 +35,7 @@ from __future__ import annotations
 
 import functools
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Collection, Mapping, Sequence
 from dataclasses import dataclass
 from typing import NamedTuple
 
@@ -55,6 +55,7 @@ from grader.grade.integrity_search import (
     bands,
     blocks,
     candidates,
+    distinct,
     holding,
     nearest,
     range_least,
@@ -143,7 +144,7 @@ class _Answers(NamedTuple):
         read = self.read.get(part.label)
         if read is None:
             read = self.read[part.label] = np.full(len(self.per_student), np.nan)  # NaN: not read (a step never is)
-        asked = np.unique(partners[have])
+        asked = distinct(partners[have])
         asked = asked[np.isnan(read[asked])]
         rows, numbers = self.rows[part.label], self.numbers[part.label]
         read[asked] = [step(rows[partner].submitted, number)
@@ -193,17 +194,38 @@ def check(graded: Graded, block: int = PAIRS) -> Integrity:
     found = [holding(part, wrong[part.label], graded.numbers[part.label]) for part in parts]
     answers = _Answers(wrong, graded.numbers, typed, right, graded.columns, per_student, {})
     pairs = _pairs(parts, answers, spread, found, examined, block)
-    matches = _listed(parts, wrong, graded.numbers, found, pairs)
+    matches = _listed(parts, wrong, graded.numbers, found, _ranked(pairs.values()))
     # Every listed match has its pair's figures.
-    others = sorted({(match.student, match.partner) for match in matches} - pairs.keys())
-    if others:
-        owners, partners = np.array(others, dtype=np.int64).T
+    listed = distinct(np.fromiter((match.student * students + match.partner for match in matches), np.int64,
+                                  len(matches)))
+    known = np.sort(np.fromiter((student * students + partner for student, partner in pairs), np.int64, len(pairs)))
+    others = listed[~_among(listed, known)]
+    if len(others):
         pairs.update(((pair.student, pair.partner), pair) for pair in _figures(
-            parts, answers, spread, owners, partners, examined))
-    ranked = sorted(pairs.values(), key=lambda pair: (pair.corrected, pair.chance, pair.student, pair.partner))
+            parts, answers, spread, others // students, others % students, examined))
+    ranked = _ranked(pairs.values())
     return Integrity(tuple(matches), tuple(ranked), examined, key.integrity_threshold,
                      sum(len(members) for members in wrong.values()),
                      sum(int(np.count_nonzero(counts)) for counts, _ in found))
+
+
+def _ranked(pairs: Collection[Pair]) -> list[Pair]:
+    """The pairs, most suspicious first: by corrected chance, chance, student and partner (a sort of arrays, not
+    of a million tuples)."""
+    listed = list(pairs)
+    corrected, chance = (np.fromiter((getattr(pair, name) for pair in listed), np.float64, len(listed))
+                         for name in ("corrected", "chance"))
+    if np.isnan(corrected).any() or np.isnan(chance).any():  # not ordered as Python orders them: none is NaN
+        return sorted(listed, key=lambda pair: (pair.corrected, pair.chance, pair.student, pair.partner))
+    student, partner = (np.fromiter((getattr(pair, name) for pair in listed), np.int64, len(listed))
+                        for name in ("student", "partner"))
+    return [listed[index] for index in np.lexsort((partner, student, chance, corrected)).tolist()]
+
+
+def _among(keys: Ints, known: Ints) -> npt.NDArray[np.bool_]:
+    """Whether each key is one of ``known`` (sorted)."""
+    at = np.minimum(np.searchsorted(known, keys), max(len(known) - 1, 0))
+    return np.asarray(known[at] == keys) if len(known) else np.zeros(len(keys), dtype=bool)
 
 
 def _number(value: object) -> float:
@@ -393,7 +415,7 @@ def _figures(parts: Sequence[Bands], answers: _Answers, spread: Spread, owners: 
     # The matched parts' labels, worked out once per pattern of parts (a class has a few hundred patterns).
     patterns = hits.astype(np.int64) @ (np.int64(1) << np.arange(len(parts), dtype=np.int64))
     named: dict[int, tuple[str, ...]] = {}
-    for pattern in np.unique(patterns).tolist():
+    for pattern in distinct(patterns).tolist():
         named[pattern] = tuple(part.label for index, part in enumerate(parts) if pattern >> index & 1)
     return [Pair(owner, partner, named[pattern], wrong, chance, fixed, closest, near)
             for owner, partner, pattern, wrong, chance, fixed, closest, near in zip(
@@ -446,12 +468,12 @@ def _chance(part: Bands, spread: Spread, owners: Ints, partners: Ints, closeness
 
 
 def _listed(parts: Sequence[Bands], wrong: Mapping[str, Ints], numbers: Mapping[str, Floats],
-            found: Sequence[tuple[Ints, list[tuple[Ints, Ints]]]],
-            pairs: Mapping[tuple[int, int], Pair]) -> list[Match]:
+            found: Sequence[tuple[Ints, list[tuple[Ints, Ints]]]], ranked: Sequence[Pair]) -> list[Match]:
     """Each wrong answer that matches anyone, with up to :data:`LISTED` of the students it matches: the
-    partners of its pairs first, then the nearest values (by distance over the band)."""
+    partners of its pairs (``ranked``: most suspicious first, :func:`_ranked`) first, then the nearest values
+    (by distance over the band)."""
     partners_of: dict[tuple[int, str], list[int]] = {}
-    for pair in sorted(pairs.values(), key=lambda pair: (pair.corrected, pair.chance, pair.partner)):
+    for pair in ranked:  # a student's pairs in the order of their corrected chance, chance and partner
         for label in pair.labels:
             partners_of.setdefault((pair.student, label), []).append(pair.partner)
     matches = []

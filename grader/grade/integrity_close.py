@@ -33,7 +33,7 @@ import numpy.typing as npt
 
 from grader.grade.compare import errors
 from grader.grade.integrity_chance import UNRELATED, Spread
-from grader.grade.integrity_search import Bands, Floats, Ints, accepts, blocks, expanded, range_least
+from grader.grade.integrity_search import Bands, Floats, Ints, accepts, blocks, distinct, expanded, range_least
 
 CLOSE = True  # False: the band search alone, as before the close search (for the tests' comparison)
 MARGIN = 2.0  # the bound is loosened by this factor against floating-point rounding in the chances
@@ -180,8 +180,8 @@ def close_pairs(parts: Sequence[Bands], spread: Spread, wrong: Mapping[str, Ints
             for which, positions in expanded(source.starts[rows], source.ends[rows]):
                 owner, partners = owners[which], source.at[positions]
                 ok = accepts(part, owner, partners, numbers[part.label])
-                keys.append(np.unique(owner[ok] * students + partners[ok]))
-        pairs = np.unique(np.concatenate(keys))
+                keys.append(distinct(owner[ok] * students + partners[ok]))
+        pairs = distinct(np.concatenate(keys))
         yield pairs // students, pairs % students
 
 

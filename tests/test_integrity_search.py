@@ -37,8 +37,9 @@ def test_an_angles_matches_counted_by_ends_are_those_counted_one_by_one(seed: in
     # Answers at a band's ends exactly (as float64 gives them), across the turn, and anywhere.
     reach = part.reach
     others = rng.integers(0, count, count)
-    numbers = np.where(ends & (rng.random(count) < 0.5), values[others] + rng.choice([-1.0, 1.0], count) * reach[others],
-                       values[others] + rng.uniform(-3, 3, count) * reach[others])
+    on_end = values[others] + rng.choice([-1.0, 1.0], count) * reach[others]
+    anywhere = values[others] + rng.uniform(-3, 3, count) * reach[others]
+    numbers = np.where(ends & (rng.random(count) < 0.5), on_end, anywhere)
     numbers += rng.choice([0.0, turn, -turn], count)
     wrong = np.flatnonzero(rng.random(count) < 0.8)
     counts, _ = holding(part, wrong, numbers)

@@ -5,12 +5,13 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from grader.grade.cells import typed_place
-from grader.grade.integrity_typed import place, step
+from grader.grade.integrity_typed import halves, place, step
 
 # Pieces students type: digits, points, signs, exponents, spaces of several kinds, units, superscripts, text.
 PIECES = ["0", "1", "7", "12", "3.41", ".", "-", "+", "e", "E", "e+03", "e-4", " ", "\u2009", "\u00a0", "m", "/s",
@@ -34,6 +35,9 @@ def test_a_typed_number_reads_as_typed_place_reads_it(text: str, expected: tuple
 def test_any_text_reads_as_typed_place_reads_it(pieces: list[str]) -> None:
     text = "".join(pieces)
     assert place(text) == typed_place(text)
+    typed = typed_place(text)
+    expected = math.inf if typed is None or typed[0] == 0 else 0.5 * typed[1] * abs(1.7 / typed[0])
+    assert halves([text], np.array([1.7])) == [step(text, 1.7)] == [expected]
 
 
 def test_the_half_unit_is_of_the_last_digit_in_the_sheets_unit() -> None:

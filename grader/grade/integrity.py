@@ -46,7 +46,6 @@ from grader.grade.compare import errors
 from grader.grade.grading import Graded, Row
 from grader.grade.integrity_chance import UNRELATED, Spread
 from grader.grade.integrity_close import bound, close_pairs
-from grader.grade.integrity_typed import step, steps
 from grader.grade.integrity_search import (
     Bands,
     Floats,
@@ -60,6 +59,7 @@ from grader.grade.integrity_search import (
     nearest,
     range_least,
 )
+from grader.grade.integrity_typed import halves, steps
 
 LISTED = 5  # students named per wrong answer in integrity.csv; the rest are counted
 KEPT = 1.0  # pairs with two or more matched parts are kept when their corrected chance is below this
@@ -147,10 +147,9 @@ class _Answers(NamedTuple):
         asked = distinct(partners[have])
         asked = asked[np.isnan(read[asked])]
         rows, numbers = self.rows[part.label], self.numbers[part.label]
-        read[asked] = [step(rows[partner].submitted, number)
-                       for partner, number in zip(asked.tolist(), numbers[asked].tolist(), strict=True)]
-        halves = np.where(have, read[partners], np.inf)
-        found = np.where(have & (halves <= self.steps[part.label][owners]), typed, values)
+        read[asked] = halves([rows[partner].submitted for partner in asked.tolist()], numbers[asked])
+        half_units = np.where(have, read[partners], np.inf)
+        found = np.where(have & (half_units <= self.steps[part.label][owners]), typed, values)
         period = part.period
         return found if period is None else values + np.mod(found - values + period / 2, period) - period / 2
 

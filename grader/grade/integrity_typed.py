@@ -33,8 +33,26 @@ def steps(rows: Sequence[Row], students: Ints, numbers: Floats) -> Floats:
     """Per student (of ``students``; inf for the others), the half-unit of the last digit of their answer as
     typed (:func:`step`)."""
     found = np.full(len(rows), np.inf)
-    found[students] = [step(rows[student].submitted, number)
-                       for student, number in zip(students.tolist(), numbers[students].tolist(), strict=True)]
+    found[students] = halves([rows[student].submitted for student in students.tolist()], numbers[students])
+    return found
+
+
+def halves(texts: Sequence[str | None], numbers: Floats) -> list[float]:
+    """:func:`step` of each text and number, read as it reads them (a loop of its own: a class has millions)."""
+    head, unit_after, short = _HEAD.match, _unit_after, SHORT
+    found = []
+    for text, number in zip(texts, numbers.tolist(), strict=True):
+        if text is not None and len(text) <= short and (plain := head(text)) and unit_after(plain[3],
+                                                                                              text[plain.end():]):
+            exponent = plain[3][1:] or "0"
+            value = float(f"{plain[1]}{plain[2]}e{exponent}")
+            if value == 0 or not math.isfinite(value):
+                found.append(math.inf)
+            else:
+                power = int(exponent) - len(plain[2].partition(".")[2])
+                found.append(0.5 * float(f"1e{power}") * abs(number / value))
+        else:
+            found.append(step(text, number))
     return found
 
 

@@ -133,6 +133,7 @@ class _Answers(NamedTuple):
     rows: Mapping[str, Sequence[Row]]
     per_student: Ints
     read: dict[str, Floats]  # per part and student, the half-unit of the right answer, once read (NaN: not yet)
+    answering: dict[str, npt.NDArray[np.bool_]]  # per part, :meth:`answered`, once worked out
 
     def centres(self, part: Bands, owners: Ints, partners: Ints) -> Floats:
         """Where each owner's answer's closeness to the partner's is measured from: the number the partner
@@ -154,9 +155,11 @@ class _Answers(NamedTuple):
         return found if period is None else values + np.mod(found - values + period / 2, period) - period / 2
 
     def answered(self, label: str) -> npt.NDArray[np.bool_]:
-        """Per student, whether their answer to the part is one of the wrong ones."""
-        found = np.zeros(len(self.per_student), dtype=bool)
-        found[self.wrong[label]] = True
+        """Per student, whether their answer to the part is one of the wrong ones (worked out once a part)."""
+        found = self.answering.get(label)
+        if found is None:
+            found = self.answering[label] = np.zeros(len(self.per_student), dtype=bool)
+            found[self.wrong[label]] = True
         return found
 
 
@@ -191,7 +194,7 @@ def check(graded: Graded, block: int = PAIRS) -> Integrity:
                        np.concatenate([wrong[p.label] for p in parts] or [np.zeros(0, np.int64)]), students)
     examined = int(np.count_nonzero(per_student >= 2)) * max(students - 1, 0)
     found = [holding(part, wrong[part.label], graded.numbers[part.label]) for part in parts]
-    answers = _Answers(wrong, graded.numbers, typed, right, graded.columns, per_student, {})
+    answers = _Answers(wrong, graded.numbers, typed, right, graded.columns, per_student, {}, {})
     pairs = _pairs(parts, answers, spread, found, examined, block)
     matches = _listed(parts, wrong, graded.numbers, found, _ranked(pairs.values()))
     # Every listed match has its pair's figures.

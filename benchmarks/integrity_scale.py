@@ -5,7 +5,9 @@ For each size, a key (``grader generate --no-pdf`` of the sample assignment) and
 with others, so a wrong answer lands in many bands), graded once in process; then the check alone, with the close
 search (:mod:`grader.grade.integrity_close`) and with the band search alone (``CLOSE = False``, as before it),
 alternated, CPU and wall time of each, and whether the two found the same (they must). ``--band-until`` leaves
-the band search out above that size (it grows as the square).
+the band search out above that size (it grows as the square). The check runs with the cycle collector paused, as
+``grader grade`` runs it; submissions over what ``grade`` reads in one file are split into files under it, as
+its refusal says to.
 
 Run: ``python benchmarks/integrity_scale.py [--sizes 20000,100000] [--runs 2] [--folder DIR]``; it writes
 ``benchmarks/results/integrity-scale.md``.
@@ -35,13 +37,37 @@ def inputs(folder: Path, size: int) -> Path:
     import million
 
     out = folder / f"class-{size}"
-    if not (out / "answers.csv").exists():
+    if not (out / "answers.csv").exists() and not (out / "answers-1.csv").exists():
         out.mkdir(parents=True, exist_ok=True)
         subprocess.run([sys.executable, "-m", "grader", "generate", str(million.ASSIGNMENT), "--roster",
                         str(million.roster(size, out)), "--out", str(out / "hw"), "--no-pdf"], check=True,
                        capture_output=True)
         million.submissions(out / "hw" / "key.csv", out / "answers.csv", random.Random(7))
+        pieces(out / "answers.csv")
     return out
+
+
+def pieces(path: Path) -> list[Path]:
+    """The submissions file, or, over what ``grade`` reads in one file, its rows split into files under that
+    (``answers-1.csv``, ...; the whole file removed)."""
+    from grader.grade.submissions import SUBMISSIONS_BYTES
+
+    if path.exists() and path.stat().st_size <= SUBMISSIONS_BYTES:
+        return [path]
+    if path.exists():
+        count, lines, size = 0, [], 0
+        with open(path, encoding="utf-8", newline="") as source:
+            header = source.readline()
+            for line in [*source, None]:
+                if line is None or (size + len(line.encode()) > SUBMISSIONS_BYTES - 1024 and lines):
+                    count += 1
+                    path.with_name(f"answers-{count}.csv").write_text(header + "".join(lines), encoding="utf-8")
+                    lines, size = [], 0
+                if line is not None:
+                    lines.append(line)
+                    size += len(line.encode())
+        path.unlink()
+    return sorted(path.parent.glob("answers-*.csv"), key=lambda piece: int(piece.stem.split("-")[1]))
 
 
 def measure(folder: Path, runs: int, band: bool) -> dict[str, object]:
@@ -54,14 +80,15 @@ def measure(folder: Path, runs: int, band: bool) -> dict[str, object]:
     from grader.grade.run import _graded
 
     with collector_paused():
-        graded = _graded(load_key(folder / "hw" / "key.json"), [folder / "answers.csv"], "auto", (), load_bank())
+        graded = _graded(load_key(folder / "hw" / "key.json"), pieces(folder / "answers.csv"), "auto", (), load_bank())
     times: dict[bool, list[tuple[float, float]]] = {True: [], False: []}
     found = {}
     for _ in range(runs):
         for close in (True, False) if band else (True,):
             integrity_close.CLOSE = close
             cpu, wall = time.process_time(), time.perf_counter()
-            found[close] = check(graded)
+            with collector_paused():  # as grader grade runs it
+                found[close] = check(graded)
             times[close].append((time.process_time() - cpu, time.perf_counter() - wall))
     integrity_close.CLOSE = True
     result = found[True]

@@ -35,14 +35,13 @@ from __future__ import annotations
 
 import functools
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Collection, Mapping, Sequence
 from dataclasses import dataclass
 from typing import NamedTuple
 
 import numpy as np
 import numpy.typing as npt
 
-from grader.grade.cells import typed_place
 from grader.grade.compare import errors
 from grader.grade.grading import Graded, Row
 from grader.grade.integrity_chance import UNRELATED, Spread
@@ -55,10 +54,12 @@ from grader.grade.integrity_search import (
     bands,
     blocks,
     candidates,
+    distinct,
     holding,
     nearest,
     range_least,
 )
+from grader.grade.integrity_typed import halves, steps
 
 LISTED = 5  # students named per wrong answer in integrity.csv; the rest are counted
 KEPT = 1.0  # pairs with two or more matched parts are kept when their corrected chance is below this
@@ -131,7 +132,8 @@ class _Answers(NamedTuple):
     right: Mapping[str, Floats]
     rows: Mapping[str, Sequence[Row]]
     per_student: Ints
-    read: dict[str, dict[int, float]]  # per part, the half-units of the right answers read so far, by student
+    read: dict[str, Floats]  # per part and student, the half-unit of the right answer, once read (NaN: not yet)
+    answering: dict[str, npt.NDArray[np.bool_]]  # per part, :meth:`answered`, once worked out
 
     def centres(self, part: Bands, owners: Ints, partners: Ints) -> Floats:
         """Where each owner's answer's closeness to the partner's is measured from: the number the partner
@@ -139,21 +141,25 @@ class _Answers(NamedTuple):
         as its source typed it is there exactly), else the partner's value. An angle's is taken within half a
         turn of the value."""
         values, typed = part.values[partners], self.right[part.label][partners]
-        have = np.flatnonzero(np.isfinite(typed))
-        steps = np.full(len(partners), np.inf)  # of the partners' right answers, read only for the pairs asked
-        rows, numbers, read = self.rows[part.label], self.numbers[part.label], self.read.setdefault(part.label, {})
-        for row, partner in zip(have.tolist(), partners[have].tolist(), strict=True):
-            if partner not in read:
-                read[partner] = _step(rows[partner].submitted, float(numbers[partner]))
-            steps[row] = read[partner]
-        found = np.where(np.isfinite(typed) & (steps <= self.steps[part.label][owners]), typed, values)
+        have = np.isfinite(typed)
+        read = self.read.get(part.label)
+        if read is None:
+            read = self.read[part.label] = np.full(len(self.per_student), np.nan)  # NaN: not read (a step never is)
+        asked = distinct(partners[have])
+        asked = asked[np.isnan(read[asked])]
+        rows, numbers = self.rows[part.label], self.numbers[part.label]
+        read[asked] = halves([rows[partner].submitted for partner in asked.tolist()], numbers[asked])
+        half_units = np.where(have, read[partners], np.inf)
+        found = np.where(have & (half_units <= self.steps[part.label][owners]), typed, values)
         period = part.period
         return found if period is None else values + np.mod(found - values + period / 2, period) - period / 2
 
     def answered(self, label: str) -> npt.NDArray[np.bool_]:
-        """Per student, whether their answer to the part is one of the wrong ones."""
-        found = np.zeros(len(self.per_student), dtype=bool)
-        found[self.wrong[label]] = True
+        """Per student, whether their answer to the part is one of the wrong ones (worked out once a part)."""
+        found = self.answering.get(label)
+        if found is None:
+            found = self.answering[label] = np.zeros(len(self.per_student), dtype=bool)
+            found[self.wrong[label]] = True
         return found
 
 
@@ -180,47 +186,47 @@ def check(graded: Graded, block: int = PAIRS) -> Integrity:
     per_student = np.zeros(students, dtype=np.int64)
     for members in wrong.values():
         per_student[members] += 1
-    steps = {part.label: _steps(graded.columns[part.label], wrong[part.label], graded.numbers[part.label])
+    typed = {part.label: steps(graded.columns[part.label], wrong[part.label], graded.numbers[part.label])
              for part in parts}
     spread = Spread.of(np.concatenate([graded.numbers[p.label][wrong[p.label]] for p in parts] or [np.zeros(0)]),
                        np.concatenate([p.values[wrong[p.label]] for p in parts] or [np.zeros(0)]),
                        np.concatenate([wrong[p.label] for p in parts] or [np.zeros(0, np.int64)]), students)
     examined = int(np.count_nonzero(per_student >= 2)) * max(students - 1, 0)
     found = [holding(part, wrong[part.label], graded.numbers[part.label]) for part in parts]
-    answers = _Answers(wrong, graded.numbers, steps, right, graded.columns, per_student, {})
+    answers = _Answers(wrong, graded.numbers, typed, right, graded.columns, per_student, {}, {})
     pairs = _pairs(parts, answers, spread, found, examined, block)
-    matches = _listed(parts, wrong, graded.numbers, found, pairs)
+    matches = _listed(parts, wrong, graded.numbers, found, _ranked(pairs.values()))
     # Every listed match has its pair's figures.
-    others = sorted({(match.student, match.partner) for match in matches} - pairs.keys())
-    if others:
-        owners, partners = np.array(others, dtype=np.int64).T
+    listed = distinct(np.fromiter((match.student * students + match.partner for match in matches), np.int64,
+                                  len(matches)))
+    known = np.sort(np.fromiter((student * students + partner for student, partner in pairs), np.int64, len(pairs)))
+    others = listed[~_among(listed, known)]
+    if len(others):
         pairs.update(((pair.student, pair.partner), pair) for pair in _figures(
-            parts, answers, spread, owners, partners, examined))
-    ranked = sorted(pairs.values(), key=lambda pair: (pair.corrected, pair.chance, pair.student, pair.partner))
+            parts, answers, spread, others // students, others % students, examined))
+    ranked = _ranked(pairs.values())
     return Integrity(tuple(matches), tuple(ranked), examined, key.integrity_threshold,
                      sum(len(members) for members in wrong.values()),
                      sum(int(np.count_nonzero(counts)) for counts, _ in found))
 
 
-def _steps(rows: Sequence[Row], students: Ints, numbers: Floats) -> Floats:
-    """Per student (of ``students``; inf for the others), the half-unit of the last digit of their answer as
-    typed (:func:`_step`)."""
-    steps = np.full(len(rows), np.inf)
-    steps[students] = [_step(rows[student].submitted, number)
-                       for student, number in zip(students.tolist(), numbers[students].tolist(), strict=True)]
-    return steps
+def _ranked(pairs: Collection[Pair]) -> list[Pair]:
+    """The pairs, most suspicious first: by corrected chance, chance, student and partner (a sort of arrays, not
+    of a million tuples)."""
+    listed = list(pairs)
+    corrected, chance = (np.fromiter((getattr(pair, name) for pair in listed), np.float64, len(listed))
+                         for name in ("corrected", "chance"))
+    if np.isnan(corrected).any() or np.isnan(chance).any():  # not ordered as Python orders them: none is NaN
+        return sorted(listed, key=lambda pair: (pair.corrected, pair.chance, pair.student, pair.partner))
+    student, partner = (np.fromiter((getattr(pair, name) for pair in listed), np.int64, len(listed))
+                        for name in ("student", "partner"))
+    return [listed[index] for index in np.lexsort((partner, student, chance, corrected)).tolist()]
 
 
-def _step(text: str | None, number: float) -> float:
-    """The half-unit of the last digit of a number as typed, in the sheet's unit: the place value of the typed
-    number times the unit's factor (the number read over the number typed); inf: not a plain number."""
-    typed = _typed_place(text) if text is not None else None
-    if typed is None or typed[0] == 0:
-        return math.inf
-    return 0.5 * typed[1] * abs(number / typed[0])
-
-
-_typed_place = functools.lru_cache(maxsize=1 << 16)(typed_place)
+def _among(keys: Ints, known: Ints) -> npt.NDArray[np.bool_]:
+    """Whether each key is one of ``known`` (sorted)."""
+    at = np.minimum(np.searchsorted(known, keys), max(len(known) - 1, 0))
+    return np.asarray(known[at] == keys) if len(known) else np.zeros(len(keys), dtype=bool)
 
 
 def _number(value: object) -> float:
@@ -410,7 +416,7 @@ def _figures(parts: Sequence[Bands], answers: _Answers, spread: Spread, owners: 
     # The matched parts' labels, worked out once per pattern of parts (a class has a few hundred patterns).
     patterns = hits.astype(np.int64) @ (np.int64(1) << np.arange(len(parts), dtype=np.int64))
     named: dict[int, tuple[str, ...]] = {}
-    for pattern in np.unique(patterns).tolist():
+    for pattern in distinct(patterns).tolist():
         named[pattern] = tuple(part.label for index, part in enumerate(parts) if pattern >> index & 1)
     return [Pair(owner, partner, named[pattern], wrong, chance, fixed, closest, near)
             for owner, partner, pattern, wrong, chance, fixed, closest, near in zip(
@@ -463,12 +469,12 @@ def _chance(part: Bands, spread: Spread, owners: Ints, partners: Ints, closeness
 
 
 def _listed(parts: Sequence[Bands], wrong: Mapping[str, Ints], numbers: Mapping[str, Floats],
-            found: Sequence[tuple[Ints, list[tuple[Ints, Ints]]]],
-            pairs: Mapping[tuple[int, int], Pair]) -> list[Match]:
+            found: Sequence[tuple[Ints, list[tuple[Ints, Ints]]]], ranked: Sequence[Pair]) -> list[Match]:
     """Each wrong answer that matches anyone, with up to :data:`LISTED` of the students it matches: the
-    partners of its pairs first, then the nearest values (by distance over the band)."""
+    partners of its pairs (``ranked``: most suspicious first, :func:`_ranked`) first, then the nearest values
+    (by distance over the band)."""
     partners_of: dict[tuple[int, str], list[int]] = {}
-    for pair in sorted(pairs.values(), key=lambda pair: (pair.corrected, pair.chance, pair.partner)):
+    for pair in ranked:  # a student's pairs in the order of their corrected chance, chance and partner
         for label in pair.labels:
             partners_of.setdefault((pair.student, label), []).append(pair.partner)
     matches = []

@@ -33,7 +33,7 @@ import numpy.typing as npt
 
 from grader.grade.compare import errors
 from grader.grade.integrity_chance import UNRELATED, Spread
-from grader.grade.integrity_search import Bands, Floats, Ints, accepts, blocks, expanded, range_least
+from grader.grade.integrity_search import Bands, Floats, Ints, accepts, blocks, distinct, expanded, range_least
 
 CLOSE = True  # False: the band search alone, as before the close search (for the tests' comparison)
 MARGIN = 2.0  # the bound is loosened by this factor against floating-point rounding in the chances
@@ -157,21 +157,31 @@ def close_pairs(parts: Sequence[Bands], spread: Spread, wrong: Mapping[str, Ints
                                            weights=np.maximum(source.ends - source.starts, 0))
     by_close = (cost[0] < cost[1]) & CLOSE
     searching = np.flatnonzero(cost.min(axis=0) > 0)
-    for group in blocks(cost.min(axis=0)[searching].astype(np.int64), chunk):
-        inside = np.zeros(students, dtype=bool)
-        inside[searching[group]] = True
+    groups = list(blocks(cost.min(axis=0)[searching].astype(np.int64), chunk))
+    block_of = np.full(students, -1, dtype=np.int64)
+    for index, group in enumerate(groups):
+        block_of[searching[group]] = index
+    # Each source's answers, by their owner's block (in their order within it): a block takes a run of each.
+    runs = []
+    for part, close_sources, band_sources in zip(parts, close, banded, strict=True):
+        members = wrong[part.label]
+        for source, is_close in [*((source, True) for source in close_sources),
+                                 *((source, False) for source in band_sources)]:
+            who = members[source.rows]
+            use = np.flatnonzero((by_close[who] == is_close) & (block_of[who] >= 0))
+            use = use[np.argsort(block_of[who[use]], kind="stable")]
+            bounds = np.searchsorted(block_of[who[use]], np.arange(len(groups) + 1))
+            runs.append((part, source, who[use], use, bounds))
+    for index in range(len(groups)):
         keys = [np.zeros(0, dtype=np.int64)]
-        for part, close_sources, band_sources in zip(parts, close, banded, strict=True):
-            members = wrong[part.label]
-            for source, is_close in [*((source, True) for source in close_sources),
-                                     *((source, False) for source in band_sources)]:
-                who = members[source.rows]
-                use = (by_close[who] == is_close) & inside[who]
-                for which, positions in expanded(source.starts[use], source.ends[use]):
-                    owner, partners = who[use][which], source.at[positions]
-                    ok = accepts(part, owner, partners, numbers[part.label])
-                    keys.append(np.unique(owner[ok] * students + partners[ok]))
-        pairs = np.unique(np.concatenate(keys))
+        for part, source, who, use, bounds in runs:
+            run = slice(bounds[index], bounds[index + 1])
+            owners, rows = who[run], use[run]
+            for which, positions in expanded(source.starts[rows], source.ends[rows]):
+                owner, partners = owners[which], source.at[positions]
+                ok = accepts(part, owner, partners, numbers[part.label])
+                keys.append(distinct(owner[ok] * students + partners[ok]))
+        pairs = distinct(np.concatenate(keys))
         yield pairs // students, pairs % students
 
 

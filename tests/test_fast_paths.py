@@ -39,11 +39,19 @@ from grader.grade.cells import (
     _without_prefix,
     read_number,
 )
-from grader.grade.compare import _difference, _period, _Words, errors, feedback, is_correct, number_text
+from grader.grade.compare import (
+    _difference,
+    _period,
+    _Words,
+    errors,
+    feedback,
+    is_correct,
+    number_text,
+    number_texts,
+)
 from grader.grade.details_file import (
     DETAILS_HEADER,
     details_csv,
-    number_texts,
     report_cell,
     report_columns,
     report_pieces,

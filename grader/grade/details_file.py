@@ -176,16 +176,6 @@ def _errors(abs_error: Sequence[float | None], rel_error: Sequence[float | None]
     return lines
 
 
-def number_texts(values: Sequence[float]) -> list[str]:
-    """:func:`number_text` of each value (6 significant figures, never ``-0``), formatted in one call.
-
-    >>> number_texts([2.83138271, -0.0, 1.5e-7])
-    ['2.83138', '0', '1.5e-07']
-    """
-    text = "%.6g\n" * len(values) % tuple(value + 0.0 for value in values)  # number_text's format
-    return text.split("\n")[:-1]
-
-
 class _Rules(NamedTuple):
     """The cells of the columns of a few distinct values, each value's worked out once."""
 

@@ -22,10 +22,10 @@ from grader.base.files import write_atomic
 from grader.base.spreadsheet import csv_columns_text, csv_pieces, csv_text, number_cell, number_cells
 from grader.grade.canvas_file import CanvasFile
 from grader.grade.class_report import REPORT, class_report
+from grader.grade.compare import number_texts
 from grader.grade.details_file import (
     Cells,
     details_csv,
-    number_texts,
     report_cell,
     report_columns,
     report_pieces,

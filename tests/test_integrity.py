@@ -10,6 +10,7 @@ import dataclasses
 import io
 import json
 import math
+import warnings
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 
@@ -297,6 +298,17 @@ def test_a_wrong_answer_near_the_float64_limit_makes_no_overflow() -> None:
 
     spread = Spread.of(np.array([1.6e308, 0.5, 0.45]), np.array([0.47, 0.47, 0.47]), np.arange(3), 3)
     assert np.isfinite(spread.start) and np.isfinite(spread.step)
+
+
+def test_an_undefined_own_value_gives_a_chance_of_one_and_no_warning() -> None:
+    """A part whose key value is null (undefined) for the owner: no ratio tells, so the chance is 1, and
+    numpy says nothing on stderr (the hostile-input sweep saw 'All-NaN slice encountered' from grader grade)."""
+    spread = Spread.of(np.array([0.5, 0.45, 2.0]), np.array([0.47, 0.47, 1.0]), np.arange(3), 4)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        got = spread.chance(np.array([np.nan, 0.0, 1.0]), np.array([0.4, 0.0, 0.4]), np.array([0.6, 0.0, 0.6]),
+                            np.array([3, 3, 3]))
+    assert got[:2].tolist() == [1.0, 1.0] and 0.0 <= got[2] <= 1.0
 
 
 def slipping_class(seed: int) -> tuple[Key, np.ndarray, dict[tuple[str, str], str]]:

@@ -25,6 +25,14 @@ PLAIN = {  # read as plain answers
     "no line end at the end": "student_id,label,answer\n007,1a,6.2\n042,1b,7",
     "the longest cell, CRLF": "student_id,label,answer\r\n007,1a," + "9" * 1000 + "\r\n",
     "a header name over two lines": "student_id,label,answer,\"a\nnote\"\n007,1a,6.2,x\n042,1b,7,\n",
+    # from the hostile-input sweep of grader grade (each read the same by both readers there too)
+    "lone CRs (Excel for Mac), tabs": "student_id\tlabel\tanswer\r007\t1a\t6,2\r042\t1b\t165 cm/s\r100\t2a\t\"a\tb\"\r",
+    "blank lines before the header, a byte-order mark mid file":
+        "\n\r\n\ufeffstudent_id,label,answer\n007,1a,6.2\n\ufeff042,1b,7\n",
+    "hostile answers": "student_id,label,answer\n007,1a,\"=1+1\"\n007,1b,\u202e6.2\x01\n007,2a,\uff11\uff12.\uff15\n"
+                       "042,1a,\u0666\u066b\u0662\n042,1b,1e400\n042,2a,\"6\"\"2\"\n100,1a,-0\n"
+                       "100,1b,\u00a06.2\u00a0 m / s\n",
+    "a quote inside a cell": "student_id,label,answer\n007,1a,6\"2\n042,1b,55\u00b030'\n",
 }
 ROW_BY_ROW = {  # anything else: read row by row
     "twice": "student_id,label,answer\n007,1a,6.2\n007,1a,6.3\n",
@@ -40,6 +48,7 @@ ROW_BY_ROW = {  # anything else: read row by row
     "a long cell": "student_id,label,answer\n007,1a," + "9" * 5000 + "\n",
     "a cell one too long": "student_id,label,answer\n007,1a,\"" + "9" * 1001 + "\"\n",
     "no student": "student_id,label,answer\n,1a,6.2\n",
+    "a student's row over two pieces' edge twice": "student_id,label,answer\r\n007,1a,1\r\n042,1a,2\r\n007,1a,3\r\n",
 }
 
 
@@ -76,3 +85,17 @@ def test_a_quote_left_open_is_refused_naming_its_line_as_before(tmp_path: Path) 
     path.write_text('student_id,label,answer\n007,1a,6.2\n042,1a,"7\n', encoding="utf-8")
     with pytest.raises(Exception, match="line 3"):
         _read(path)
+
+
+@pytest.mark.parametrize("text", ['student_id,label,answer\n007,1a,6.2\n042,1a,"6"2\n',
+                                  'student_id,label,answer\r\n007,1a,"6"2\r\n042,1b,7\r\n'])
+def test_a_quote_closed_mid_cell_is_refused_as_the_row_by_row_reading_refuses_it(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch, text: str) -> None:
+    path = tmp_path / "answers.csv"
+    path.write_text(text, encoding="utf-8")
+    with pytest.raises(Exception) as plain:
+        _read(path)
+    monkeypatch.setattr(submissions, "_plain_answers", lambda *given: None)
+    with pytest.raises(Exception) as row_by_row:
+        _read(path)
+    assert str(plain.value) == str(row_by_row.value) and "expected after '\"'" in str(plain.value)

@@ -117,7 +117,9 @@ class Spread:
             ends = np.log(np.abs(np.stack([first, second])))
         same = (first > 0) & (second > 0)
         other = (first < 0) & (second < 0)
-        a, b = np.nanmin(ends, axis=0), np.nanmax(ends, axis=0)
+        # fmin and fmax skip a NaN end as nanmin and nanmax do, without their warning where both are NaN (an
+        # undefined own value, a null in the key: no ratio tells, and the chance is 1 below)
+        a, b = np.fmin(ends[0], ends[1]), np.fmax(ends[0], ends[1])
         whole = np.where(same, self._mass(self.same, a, b), self._mass(self.other, a, b))
         mine = self.cells[owners]
         theirs = np.isfinite(mine).sum(axis=1)

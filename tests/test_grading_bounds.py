@@ -68,7 +68,7 @@ def test_an_out_folder_that_will_be_refused_is_refused_before_anything_is_read_o
     def must_not_run(*_: object, **__: object) -> None:
         raise AssertionError("read or graded before --out was checked")
 
-    for name in ("load_key", "read_submissions", "grade", "read_export"):
+    for name in ("load_key", "read_submissions", "grade_class", "read_export"):
         monkeypatch.setattr(grader.grade.run, name, must_not_run)
     out = tmp_path / "theirs"
     out.mkdir()

@@ -26,6 +26,7 @@ import html
 import numpy as np
 
 from grader.base.errors import visible
+from grader.grade.class_grades import ClassGrades, classwide, lateness
 from grader.grade.class_summary import (
     DRAWN_UP_TO,
     HARD_DROP,
@@ -35,7 +36,7 @@ from grader.grade.class_summary import (
     ProblemSummary,
     summarize,
 )
-from grader.grade.grading import Graded, lateness
+from grader.grade.grading import Graded
 from grader.grade.integrity import Integrity, check
 from grader.model.tolerance import Widening
 
@@ -78,8 +79,9 @@ ul.corners li { margin: 2px 0; }
 FLAGGED_SHOWN = 50  # flagged pairs listed in the report; integrity.csv has every one
 
 
-def class_report(graded: Graded, integrity: Integrity | None = None) -> str:
+def class_report(graded: Graded | ClassGrades, integrity: Integrity | None = None) -> str:
     """The page, for a grading run (``integrity``: its integrity check, worked out here if not given)."""
+    graded = classwide(graded)
     summary = summarize(graded)
     figures = _figures(summary)
     title = f"{summary.key.title}: class report"
@@ -135,7 +137,7 @@ def _who(student_id: str, reason: str) -> str:
     return f"{visible(student_id)}: " if student_id and student_id not in reason else ""
 
 
-def _late(graded: Graded) -> str:
+def _late(graded: ClassGrades) -> str:
     """How many students submitted late, by how much, and what the late policy took (nothing without a
     due time in the key)."""
     key = graded.key
@@ -300,7 +302,7 @@ def _tolerances(summary: ClassSummary) -> str:
             + "\n".join(rows) + "\n</table>")
 
 
-def _integrity(graded: Graded, integrity: Integrity) -> str:
+def _integrity(graded: ClassGrades, integrity: Integrity) -> str:
     """The pairs of students whose wrong answers match each other's numbers too often to be chance."""
     students, flagged = graded.key.students, integrity.flagged
     text = ["<h2 id=\"integrity\">Answers from another student's variant</h2>\n<p>Every student has their own "

@@ -32,12 +32,13 @@ from collections import Counter
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from itertools import repeat
-from operator import attrgetter, eq, is_, is_not
+from operator import is_
 
 import numpy as np
 import numpy.typing as npt
 
-from grader.grade.grading import VERDICTS, Graded, Row
+from grader.grade.class_grades import ClassGrades, Outcomes, classwide
+from grader.grade.grading import VERDICTS, Graded
 from grader.grade.key import Key, KeyStudent
 from grader.grade.row_problems import RowProblem
 from grader.model.tolerance import Tolerance, Widening, widening
@@ -181,8 +182,9 @@ class ClassSummary:
     notes: tuple[str, ...]
 
 
-def summarize(graded: Graded) -> ClassSummary:
+def summarize(graded: Graded | ClassGrades) -> ClassSummary:
     """The report's aggregates of a grading run."""
+    graded = classwide(graded)
     key = graded.key
     count = len(key.students)
     kinds = shown_kinds(tuple(dict.fromkeys((*VERDICTS, *_kinds_found(graded)))))
@@ -194,17 +196,16 @@ def summarize(graded: Graded) -> ClassSummary:
     answered = np.zeros(count, dtype=bool)
     for problem in key.problems:
         for label in problem.labels:
-            rows = graded.columns[label]
-            verdicts = list(map(attrgetter("verdict"), rows))
-            worth = np.fromiter(map(attrgetter("points"), rows), np.float64, count)
-            scores[label] = np.fromiter(map(attrgetter("credit"), rows), np.float64, count) * worth
+            column = graded.columns[label]
+            worth = column.points
+            scores[label] = column.credit * worth
             points[label] = worth
-            missing[label] = _is(verdicts, "missing")
-            answered |= np.fromiter(map(is_not, map(attrgetter("submitted"), rows), repeat(None)), bool, count)
-            parts.append(_part(graded, problem.key, label, rows, verdicts, scores[label], worth, kinds,
+            missing[label] = column.are("missing")
+            answered |= column.submitted.given
+            parts.append(_part(graded, problem.key, label, column, scores[label], worth, kinds,
                                key.part_entries(label, "tolerance")))
             if parts[-1].counts.get("invalid"):
-                invalid.update(np.flatnonzero(_is(verdicts, "invalid")).tolist())
+                invalid.update(np.flatnonzero(column.are("invalid")).tolist())
     possible = sum(points.values(), np.zeros(count))
     earned = sum(scores.values(), np.zeros(count))
     percent = np.divide(100.0 * earned, possible, out=np.zeros(count), where=possible > 0)
@@ -215,35 +216,27 @@ def summarize(graded: Graded) -> ClassSummary:
                         tuple(problem for problem in not_graded if problem.rows == 1)[:NOT_GRADED_SHOWN], graded.notes)
 
 
-def _is(verdicts: list[str], kind: str) -> npt.NDArray[np.bool_]:
-    """Which verdicts are of ``kind`` (``map`` with C functions: a class of 100,000 in a few ms)."""
-    return np.fromiter(map(eq, verdicts, repeat(kind)), bool, len(verdicts))
+def _kinds_found(graded: ClassGrades) -> set[str]:
+    """Kinds in the verdicts that :data:`VERDICTS` does not name (none, unless grading and VERDICTS disagree)."""
+    return {kind for column in graded.columns.values() for kind in column.counted()} - set(VERDICTS)
 
 
-def _kinds_found(graded: Graded) -> set[str]:
-    """Kinds in the rows that :data:`VERDICTS` does not name (none, unless grading and VERDICTS disagree)."""
-    found: set[str] = set()
-    for rows in graded.columns.values():
-        found.update(map(attrgetter("verdict"), rows))
-    return found - set(VERDICTS)
-
-
-def _part(graded: Graded, problem: str, label: str, rows: Sequence[Row], verdicts: list[str], scores: Floats,
-          worth: Floats, kinds: tuple[str, ...], rules: Sequence[Mapping[str, object]]) -> PartSummary:
+def _part(graded: ClassGrades, problem: str, label: str, column: Outcomes, scores: Floats, worth: Floats,
+          kinds: tuple[str, ...], rules: Sequence[Mapping[str, object]]) -> PartSummary:
     key = graded.key
-    found = Counter(verdicts)
-    mistakes = Counter(row.diagnosis for row in rows if row.verdict == "mistake")  # ecf rows name their part
+    found = column.counted()
+    mistakes = Counter(column.diagnosed("mistake"))  # ecf rows name their part
     first = key.students[0].parts[label] if key.students else None
     credit = float(scores.sum() / worth.sum()) if worth.sum() > 0 else 0.0
     top = _by_count(mistakes)[:TOP_MISTAKES]
     says = {mistake: graded.mistakes[label, mistake] for mistake, _ in top if (label, mistake) in graded.mistakes}
     return PartSummary(label, problem, first.name if first else "", first.unit if first else "",
                        tuple(sorted(set(worth.tolist()))), {kind: found.get(kind, 0) for kind in kinds}, credit,
-                       *_tolerances(rules, rows), top, sum(mistakes.values()), says)
+                       *_tolerances(rules, column), top, sum(mistakes.values()), says)
 
 
 def _tolerances(rules: Sequence[Mapping[str, object]],
-                rows: Sequence[Row]) -> tuple[tuple[tuple[str, int], ...], Widening | None]:
+                column: Outcomes) -> tuple[tuple[tuple[str, int], ...], Widening | None]:
     """The tolerances in words of the part's verdicts that were not widened, with their counts; and the
     :class:`~grader.model.tolerance.Widening` of those that were, from each student's tolerance as the key has
     it, ``rules`` (the key's parts share one mapping for equal tolerances, so each distinct one is read once)."""
@@ -253,7 +246,7 @@ def _tolerances(rules: Sequence[Mapping[str, object]],
         distinct = dict(zip(map(id, rules), rules, strict=True))
         counted = [(Tolerance.from_json(distinct[found]), count) for found, count in Counter(map(id, rules)).items()]
     widened = {rule.explained() for rule, _ in counted if rule.reason}  # the words grading gave them
-    words = Counter(map(attrgetter("tolerance"), rows))
+    words = column.tolerance_counts()
     return _by_count(Counter({text: count for text, count in words.items() if text not in widened})), \
         widening(counted)
 
@@ -263,16 +256,18 @@ def _by_count(found: Counter[str]) -> tuple[tuple[str, int], ...]:
     return tuple(sorted(found.items(), key=lambda item: (-item[1], item[0])))
 
 
-def _invalid(graded: Graded, students: list[int]) -> tuple[tuple[KeyStudent, tuple[InvalidCell, ...]], ...]:
+def _invalid(graded: ClassGrades,
+             students: list[int]) -> tuple[tuple[KeyStudent, tuple[InvalidCell, ...]], ...]:
     """The students (their indices in the key) with the answers of theirs that could not be read."""
-    found = []
-    for index in students:
-        rows = ((label, graded.columns[label][index]) for label in graded.key.labels)
-        found.append((graded.key.students[index], tuple(
-            InvalidCell(label, "" if row.submitted is None else str(row.submitted),
-                        str(row.feedback).removeprefix("could not read this answer: "))
-            for label, row in rows if row.verdict == "invalid")))
-    return tuple(found)
+    found: dict[int, list[InvalidCell]] = {index: [] for index in students}
+    for label in graded.key.labels:
+        column = graded.columns[label]
+        mine = [index for index in students if column.verdict[index] == column.kinds.index("invalid")] \
+            if "invalid" in column.kinds else []
+        for index, typed, said in zip(mine, column.submitted.take(mine), column.feedback.take(mine), strict=True):
+            found[index].append(InvalidCell(label, "" if typed is None else typed,
+                                            str(said).removeprefix("could not read this answer: ")))
+    return tuple((graded.key.students[index], tuple(cells)) for index, cells in found.items())
 
 
 def _problems(key: Key, scores: dict[str, Floats], points: dict[str, Floats],

@@ -39,7 +39,15 @@ def details_csv(graded: Graded, students_per_piece: int = 2000) -> Iterator[str]
     """One row per (student, part): what was submitted, the verdict and why, and how many minutes late the
     row it came from was (empty: not known) with the points the late policy took. The text comes in pieces
     of ``students_per_piece`` students, to be written as it comes (a class of 100,000 has a million rows)."""
-    yield csv_text([DETAILS_HEADER])
+    yield DETAILS_HEAD
+    yield from details_lines(graded, students_per_piece)
+
+
+DETAILS_HEAD = csv_text([DETAILS_HEADER])
+
+
+def details_lines(graded: Graded, students_per_piece: int = 2000) -> Iterator[str]:
+    """:func:`details_csv`'s rows without its header (a piece of a class's: :func:`grader.grade.run.run`)."""
     students, labels, late = graded.key.students, graded.key.labels, graded.late
     cells = _Rules(Cells(_marks), Cells(written_cell), Cells(_lateness))
     guarded, step = [quoted_cell(safe_cell(label)) for label in labels], max(1, students_per_piece)

@@ -53,6 +53,12 @@ class Physics:
     problems: Mapping[str, ProblemPhysics]
     notes: tuple[str, ...] = ()
 
+    def piece(self, start: int, stop: int) -> Physics:
+        """The physics of the key's students ``start`` to ``stop`` alone (:meth:`grader.grade.key.Key.piece`)."""
+        return Physics({key: ProblemPhysics(found.alternatives, {name: column[start:stop]
+                                                                  for name, column in found.params.items()})
+                        for key, found in self.problems.items()}, self.notes)
+
 
 @dataclass(frozen=True)
 class Earlier:

@@ -28,17 +28,18 @@ from grader.assign.returned import MarkedPart, Returned, key_variants
 from grader.assign.variants import Generation
 from grader.bank.template import Template
 from grader.base.errors import GraderError, visible
+from grader.grade.class_grades import ClassGrades, final_scores, lateness
 from grader.grade.class_report import _lateness
 from grader.grade.diagnosis import template_of
-from grader.grade.grading import Graded, final_scores, lateness
+from grader.grade.grading import Graded
 from grader.grade.key import Key
 from grader.model.tolerance import with_unit
 
 
 def returned(graded: Graded) -> list[Returned]:
     """Every student of the key, in its order, with their graded parts."""
-    key, late = graded.key, graded.late
-    final, minutes = final_scores(graded), lateness(graded)
+    key, late, whole = graded.key, graded.late, ClassGrades.of(graded)
+    final, minutes = final_scores(whole), lateness(whole)
     back = []
     for index, student in enumerate(key.students):
         parts = []

@@ -14,9 +14,8 @@ from __future__ import annotations
 import functools
 import itertools
 import operator
-from collections import Counter
-from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field
+from collections.abc import Iterator, Mapping, Sequence
+from dataclasses import dataclass, field, replace
 from datetime import datetime
 from typing import Any, NamedTuple
 
@@ -109,6 +108,7 @@ class LateWork:
     minutes: Mapping[str, Sequence[int | None]]
     shares: Mapping[str, Sequence[float]]
     deductions: Mapping[str, float]
+    unknown: int = 0  # answers with a due time whose lateness is not known (no timestamp, or one that does not read)
 
 
 @dataclass(frozen=True)
@@ -128,6 +128,9 @@ class Graded:
     # Per part label, the number each student's answer was read as, in the sheet's unit (NaN: no number):
     # what the integrity check compares with the other students' keys (:mod:`grader.grade.integrity`).
     numbers: Mapping[str, np.ndarray] = field(default_factory=dict)
+    # Per problem of the attempts not counted (a key's ``attempts: best``), its student's first answer to the
+    # part: the class's problems come in the order of these (:func:`graded_pieces`).
+    first_given: tuple[Answer, ...] = ()
 
     @property
     def deductions(self) -> Mapping[str, float]:
@@ -149,17 +152,62 @@ def grade(key: Key, submissions: Submissions, physics: Physics | None = None) ->
     student gave several answers to a part (the key's ``attempts`` is ``best``), the best counts; then
     the key's late policy is applied (:func:`_late_work`)."""
     physics = physics_for(key) if physics is None else physics
+    problems_read, ignored, notes_read = submissions.problems, submissions.ignored_columns, submissions.notes
+    # Handed over, not kept: the answers are let go a part at a time, as it is graded.
+    graded = grade_piece(key, submissions.answers, physics)
+    return replace(graded, problems=(*problems_read, *graded.problems), ignored_columns=ignored,
+                   notes=(*notes_read, *physics.notes, *late_notes(graded.late)))
+
+
+PIECE = 20_000
+"""Students graded at a time by :func:`graded_pieces`: a piece's verdicts (about 0.5 KiB a cell) are written and
+let go before the next piece is graded."""
+
+
+def graded_pieces(key: Key, submissions: Submissions, physics: Physics, size: int = PIECE) -> Iterator[Graded]:
+    """The class graded ``size`` students at a time, in the key's order: each piece as :func:`grade_piece` grades
+    it (its key :meth:`Key.piece`, its students' answers, the physics' rows of its students). What a student gets
+    depends on their own answers alone, so the pieces' verdicts are the class's. The submissions' problems and
+    notes are the caller's (:attr:`Submissions.problems`): a piece has its own (the attempts not counted).
+
+    Where answers of a student are let go (``submissions`` handed over, not kept), a piece's are let go once it
+    is graded."""
+    count, answers = len(key.students), submissions.answers
+    del submissions
+    if count <= size:
+        yield grade_piece(key, answers, physics)
+        return
+    positions = key.positions
+    piece_of = np.fromiter(map(positions.get, map(_STUDENT, answers), itertools.repeat(-size)), np.int64,
+                           len(answers)) // size
+    order = np.argsort(piece_of, kind="stable")
+    bounds = np.searchsorted(piece_of[order], np.arange(count // size + 2)).tolist()
+    given: list[list[Answer] | None] = [list(map(answers.__getitem__, order[low:high].tolist()))
+                                        for low, high in itertools.pairwise(bounds)]
+    del answers, piece_of, order
+    for index, start in enumerate(range(0, count, size)):
+        mine, given[index] = given[index], None
+        stop = min(start + size, count)
+        yield grade_piece(key.piece(start, stop), tuple(mine or ()), physics.piece(start, stop))
+        del mine
+
+
+_STUDENT = operator.attrgetter("student_id")
+
+
+def grade_piece(key: Key, answers: Sequence[Answer], physics: Physics) -> Graded:
+    """Every student of ``key`` graded against ``answers`` (theirs): the verdicts, the attempts not counted
+    (problems, routine) and the lateness; no notes (the class's are the caller's, :func:`late_notes`)."""
     # Per label, each student's first answer; and, for a part a student answered more than once, all of them.
     by_label: dict[str, dict[str, Answer]] = {label: {} for label in key.labels}
     again: dict[str, dict[str, list[Answer]]] = {label: {} for label in key.labels}
-    for answer in submissions.answers:
+    for answer in answers:
         first = by_label[answer.label].setdefault(answer.student_id, answer)
         if first is not answer:
             again[answer.label].setdefault(answer.student_id, [first]).append(answer)
-    # The answers are let go a part at a time, as it is graded (where the caller keeps no reference to them).
-    problems_read, ignored, notes_read = submissions.problems, submissions.ignored_columns, submissions.notes
-    del submissions
+    del answers
     problems: list[RowProblem] = []
+    firsts: list[Answer] = []
     columns: dict[str, list[Row]] = {}
     numbers: dict[str, np.ndarray] = {}
     stamps: dict[str, list[datetime | None]] = {}
@@ -169,16 +217,22 @@ def grade(key: Key, submissions: Submissions, physics: Physics | None = None) ->
     for problem in key.problems:
         earlier: list[Earlier] = []
         for label in problem.labels:
-            answers = _best(key, label, by_label.pop(label), again.pop(label), physics.problems.get(problem.key),
-                            problems)
-            parts, given = key.part_column(label), list(map(answers.get, ids))
+            answers_to = _best(key, label, by_label.pop(label), again.pop(label), physics.problems.get(problem.key),
+                               problems, firsts)
+            parts, given = key.part_column(label), list(map(answers_to.get, ids))
             columns[label], numbers[label] = _grade_label(parts, given, key, everyone,
                                                           physics.problems.get(problem.key), earlier)
             if timed:
                 stamps[label] = [None if answer is None else answer.timestamp for answer in given]
-    late, notes = _late_work(key, columns, stamps)
-    return Graded(key, columns, (*problems_read, *problems), ignored, (*notes_read, *physics.notes, *notes),
-                  mistake_words(key, physics), late, numbers)
+    return Graded(key, columns, tuple(problems), (), (), mistake_words(key, physics), _late_work(key, columns, stamps),
+                  numbers, tuple(firsts))
+
+
+def late_notes(late: LateWork | None) -> list[str]:
+    """The notes of a class's lateness: answers whose lateness is not known."""
+    unknown = 0 if late is None else late.unknown
+    return [f"{unknown:,} answers have no timestamp (or one that does not read): how late they were is not "
+            "known, and they lose nothing; see problems.csv"] if unknown else []
 
 
 def mistake_words(key: Key, physics: Physics) -> dict[tuple[str, str], str]:
@@ -202,12 +256,12 @@ def _due(key: Key, index: int) -> datetime | None:
 
 
 def _best(key: Key, label: str, chosen: dict[str, Answer], several: Mapping[str, list[Answer]],
-          physics: ProblemPhysics | None, problems: list[RowProblem]) -> dict[str, Answer]:
+          physics: ProblemPhysics | None, problems: list[RowProblem], firsts: list[Answer]) -> dict[str, Answer]:
     """Per student, the answer to ``label`` that counts (``chosen``: each one's first, which this updates):
     the only one, or, of ``several`` (``attempts: best``), the one that scores most after its own late
     deduction (ties: the earliest). Every attempt is graded on its own (an error is not carried forward
     while choosing: the earlier parts are not chosen yet); each one not counted is a problem (routine)
-    naming the one that is."""
+    naming the one that is, and its student's first answer to the part is added to ``firsts``."""
     if not several:
         return chosen
     positions = key.positions
@@ -228,6 +282,7 @@ def _best(key: Key, label: str, chosen: dict[str, Answer], several: Mapping[str,
     for student_id, tried in scored.items():
         tried.sort(key=lambda pair: (-pair[0], instant(pair[1].timestamp), pair[1].line))
         (best, winner), *others = tried
+        firsts += [chosen[student_id]] * len(others)
         chosen[student_id] = winner
         problems.extend(RowProblem(answer.file, answer.line, student_id, label, f"not counted: {winner.file} line "
                                    f"{winner.line} scored more ({best:g} points, this one {score:g}; the best "
@@ -243,11 +298,11 @@ def _timed(key: Key) -> bool:
 
 
 def _late_work(key: Key, columns: Mapping[str, Sequence[Row]],
-               stamps: Mapping[str, Sequence[datetime | None]]) -> tuple[LateWork | None, list[str]]:
-    """How late each answer was and what the key's late policy takes for it (:mod:`grader.grade.lateness`),
-    and notes (answers whose lateness is not known); None for a key without due times."""
+               stamps: Mapping[str, Sequence[datetime | None]]) -> LateWork | None:
+    """How late each answer was and what the key's late policy takes for it (:mod:`grader.grade.lateness`);
+    None for a key without due times."""
     if not _timed(key):
-        return None, []
+        return None
     policy, everyone = key.late, range(len(key.students))
     dues = [_due(key, index) for index in everyone]
     found: dict[tuple[datetime | None, datetime | None], tuple[int | None, int]] = {}  # rows share stamps
@@ -274,9 +329,7 @@ def _late_work(key: Key, columns: Mapping[str, Sequence[Row]],
             deducted[key.students[index].id] = float(total)
             for label, share in zip(columns, exact, strict=True):
                 shares[label][index] = float(share)
-    notes = [f"{unknown:,} answers have no timestamp (or one that does not read): how late they were is not "
-             "known, and they lose nothing; see problems.csv"] if unknown else []
-    return LateWork(minutes_late, shares, deducted), notes
+    return LateWork(minutes_late, shares, deducted, unknown)
 
 
 def grade_part(part: KeyPart, student_id: str, answer: Answer | None, key: Key,
@@ -551,50 +604,3 @@ def _expected(part: KeyPart) -> str:
     if part.value is None:
         return f"undefined ({part.undefined})"
     return part.value if isinstance(part.value, str) else number_text(part.value)
-
-
-def final_scores(graded: Graded, scores: Mapping[str, Mapping[str, float]] | None = None) -> dict[str, float]:
-    """Per student, the total after the late policy's deduction (what grades.csv and canvas.csv carry);
-    ``scores``: the :func:`totals`, when the caller has them."""
-    return {student_id: sum(by_problem.values()) - graded.deductions.get(student_id, 0.0)
-            for student_id, by_problem in (totals(graded) if scores is None else scores).items()}
-
-
-def lateness(graded: Graded) -> list[int | None]:
-    """Per student of the key, in its order, the minutes late of their latest answer that counts (None:
-    no answer whose lateness is known)."""
-    found: list[int | None] = [None] * len(graded.key.students)
-    for late in graded.late.minutes.values() if graded.late else ():
-        found = [mine if theirs is None else max(theirs, mine or 0) for mine, theirs in zip(found, late, strict=True)]
-    return found
-
-
-def totals(graded: Graded) -> Mapping[str, Mapping[str, float]]:
-    """Per student, per problem key: the score before any late deduction (its parts' scores added in the
-    key's order)."""
-    key = graded.key
-    sums: dict[str, list[float]] = {}
-    for problem in key.problems:
-        scores = sums.setdefault(problem.key, [0.0] * len(key.students))
-        for label in problem.labels:
-            scores[:] = [total + row.credit * row.points
-                         for total, row in zip(scores, graded.columns[label], strict=True)]
-    return {student.id: {problem: scores[index] for problem, scores in sums.items()}
-            for index, student in enumerate(key.students)}
-
-
-def counts(graded: Graded) -> dict[str, int]:
-    """How many verdicts of each kind."""
-    found = dict.fromkeys(VERDICTS, 0)
-    for rows in graded.columns.values():
-        for verdict, count in Counter(row.verdict for row in rows).items():
-            found[verdict] += count
-    return found
-
-
-def answered(graded: Graded) -> list[bool]:
-    """Per student of the key, in its order, whether they answered any part (submitted anything)."""
-    found = [False] * len(graded.key.students)
-    for rows in graded.columns.values():
-        found = [known or row.submitted is not None for known, row in zip(found, rows, strict=True)]
-    return found

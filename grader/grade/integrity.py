@@ -42,8 +42,9 @@ from typing import NamedTuple
 import numpy as np
 import numpy.typing as npt
 
+from grader.grade.class_grades import ClassGrades, Texts, classwide
 from grader.grade.compare import errors
-from grader.grade.grading import Graded, Row
+from grader.grade.grading import Graded
 from grader.grade.integrity_chance import UNRELATED, Spread
 from grader.grade.integrity_close import bound, close_pairs
 from grader.grade.integrity_search import (
@@ -124,13 +125,13 @@ class _Answers(NamedTuple):
     """The class's answers the check compares: per part label, the students whose answer was wrong, each
     student's number (NaN: none), the half-unit of the last typed digit of each wrong one in the sheet's
     unit (inf: not a plain number, so no closeness can be read from it), the right ones' numbers (NaN: not
-    right) and the verdict rows; and each student's count of wrong parts."""
+    right) and what each student typed; and each student's count of wrong parts."""
 
     wrong: Mapping[str, Ints]
     numbers: Mapping[str, Floats]
     steps: Mapping[str, Floats]
     right: Mapping[str, Floats]
-    rows: Mapping[str, Sequence[Row]]
+    typed: Mapping[str, Texts]
     per_student: Ints
     read: dict[str, Floats]  # per part and student, the half-unit of the right answer, once read (NaN: not yet)
     answering: dict[str, npt.NDArray[np.bool_]]  # per part, :meth:`answered`, once worked out
@@ -147,8 +148,7 @@ class _Answers(NamedTuple):
             read = self.read[part.label] = np.full(len(self.per_student), np.nan)  # NaN: not read (a step never is)
         asked = distinct(partners[have])
         asked = asked[np.isnan(read[asked])]
-        rows, numbers = self.rows[part.label], self.numbers[part.label]
-        read[asked] = halves([rows[partner].submitted for partner in asked.tolist()], numbers[asked])
+        read[asked] = halves(self.typed[part.label].take(asked), self.numbers[part.label][asked])
         half_units = np.where(have, read[partners], np.inf)
         found = np.where(have & (half_units <= self.steps[part.label][owners]), typed, values)
         period = part.period
@@ -163,9 +163,10 @@ class _Answers(NamedTuple):
         return found
 
 
-def check(graded: Graded, block: int = PAIRS) -> Integrity:
+def check(graded: Graded | ClassGrades, block: int = PAIRS) -> Integrity:
     """The integrity check of a grading run (the key's numeric parts; symbolic ones are left out), its
     candidate pairs worked out about ``block`` at a time (the findings are the same whatever the block)."""
+    graded = classwide(graded)
     key = graded.key
     students = len(key.students)
     parts: list[Bands] = []
@@ -178,22 +179,22 @@ def check(graded: Graded, block: int = PAIRS) -> Integrity:
         values = np.fromiter(map(_number, key.part_entries(label, "value")), dtype=np.float64, count=students)
         part = bands(label, values, key.part_entries(label, "tolerance"), first.unit)
         numbers = graded.numbers[label]
-        verdicts = np.array([row.verdict for row in graded.columns[label]])
-        incorrect, correct = verdicts == "incorrect", verdicts == "correct"
+        column = graded.columns[label]
+        incorrect, correct = column.are("incorrect"), column.are("correct")
         wrong[label] = np.flatnonzero(incorrect & np.isfinite(numbers) & np.isfinite(values))
         right[label] = np.where(correct & np.isfinite(numbers), numbers, np.nan)
         parts.append(part)
     per_student = np.zeros(students, dtype=np.int64)
     for members in wrong.values():
         per_student[members] += 1
-    typed = {part.label: steps(graded.columns[part.label], wrong[part.label], graded.numbers[part.label])
-             for part in parts}
+    texts = {label: column.submitted for label, column in graded.columns.items()}
+    typed = {part.label: steps(texts[part.label], wrong[part.label], graded.numbers[part.label]) for part in parts}
     spread = Spread.of(np.concatenate([graded.numbers[p.label][wrong[p.label]] for p in parts] or [np.zeros(0)]),
                        np.concatenate([p.values[wrong[p.label]] for p in parts] or [np.zeros(0)]),
                        np.concatenate([wrong[p.label] for p in parts] or [np.zeros(0, np.int64)]), students)
     examined = int(np.count_nonzero(per_student >= 2)) * max(students - 1, 0)
     found = [holding(part, wrong[part.label], graded.numbers[part.label]) for part in parts]
-    answers = _Answers(wrong, graded.numbers, typed, right, graded.columns, per_student, {}, {})
+    answers = _Answers(wrong, graded.numbers, typed, right, texts, per_student, {}, {})
     pairs = _pairs(parts, answers, spread, found, examined, block)
     matches = _listed(parts, wrong, graded.numbers, found, _ranked(pairs.values()))
     # Every listed match has its pair's figures.

@@ -20,7 +20,7 @@ import numpy as np
 import numpy.typing as npt
 
 from grader.grade.cells import typed_place
-from grader.grade.grading import Row
+from grader.grade.class_grades import Texts
 
 Floats = npt.NDArray[np.float64]
 Ints = npt.NDArray[np.int64]
@@ -29,11 +29,11 @@ SHORT = 20  # characters: a text this short is at most 40 once cleaned, so its u
 _HEAD = re.compile(r"(-?)([0-9]+(?:\.[0-9]*)?)((?:[eE][-+]?[0-9]{1,4})?)")
 
 
-def steps(rows: Sequence[Row], students: Ints, numbers: Floats) -> Floats:
+def steps(typed: Texts, students: Ints, numbers: Floats) -> Floats:
     """Per student (of ``students``; inf for the others), the half-unit of the last digit of their answer as
-    typed (:func:`step`)."""
-    found = np.full(len(rows), np.inf)
-    found[students] = halves([rows[student].submitted for student in students.tolist()], numbers[students])
+    ``typed`` (:func:`step`)."""
+    found = np.full(len(typed), np.inf)
+    found[students] = halves(typed.take(students), numbers[students])
     return found
 
 

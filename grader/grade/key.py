@@ -33,7 +33,7 @@ import sys
 import zoneinfo
 from array import array
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from datetime import UTC, datetime, tzinfo
 from pathlib import Path
 from typing import Any, TypeVar
@@ -130,6 +130,8 @@ class Key:
     zone: tzinfo = UTC  # of timestamps that give none
     late: LatePolicy | None = None  # None: late work is accepted as on time
     integrity_threshold: float = 0.05  # pairs whose matches are at most this likely by accident are flagged
+    # Where :attr:`students` are in the key they were read with, for a piece of it (:meth:`piece`): (start, stop).
+    span: tuple[int, int] | None = field(default=None, compare=False, repr=False)
 
     @functools.cached_property
     def labels(self) -> tuple[str, ...]:
@@ -144,18 +146,36 @@ class Key:
     def part_column(self, label: str) -> list[KeyPart]:
         """Every student's part ``label``, in the students' order: made together where the key was read from
         its sidecar (a part at a time, each looked up, takes five times as long)."""
-        first = self.students[0].parts if self.students else None
-        if isinstance(first, StudentParts) and first.table.students is self.students:
-            return first.table.column(label)
+        table = self._table()
+        if table is not None:
+            return table.column(label, *self.span or (0, len(self.students)))
         return [student.parts[label] for student in self.students]
 
     def part_entries(self, label: str, field: str) -> list[Any]:
         """Every student's entry ``field`` (``value``, ``tolerance``, any of :class:`KeyPart`'s) of their part
         ``label``, in the students' order: where the key was read from its sidecar, without making the parts."""
-        first = self.students[0].parts if self.students else None
-        if isinstance(first, StudentParts) and first.table.students is self.students:
-            return first.table.entries(label, field)
+        table = self._table()
+        if table is not None:
+            return table.entries(label, field, *self.span or (0, len(self.students)))
         return [getattr(student.parts[label], field) for student in self.students]
+
+    def _table(self) -> PartTable | None:
+        """The sidecar's table the students' parts are rows of (None: the key was not read from one)."""
+        first = self.students[0].parts if self.students else None
+        if not isinstance(first, StudentParts):
+            return None
+        table = first.table
+        return table if table.students is self.students or self.span is not None else None
+
+    def piece(self, start: int, stop: int) -> Key:
+        """The key of students ``start`` to ``stop`` (in its order) alone, as grading takes a class a piece at a
+        time: their parts read from the same columns, their parameters the same columns' rows."""
+        base = self.span[0] if self.span else 0
+        found = replace(self, students=self.students[start:stop], span=(base + start, base + stop))
+        if "parameter_columns" in self.__dict__:  # worked out for the class: its rows, not worked out again
+            found.__dict__["parameter_columns"] = {name: column[start:stop]
+                                                   for name, column in self.parameter_columns.items()}
+        return found
 
     @functools.cached_property
     def positions(self) -> dict[str, int]:

@@ -116,9 +116,10 @@ class PartTable:
             return _NEW(KeyPart, self._heads[shape] + (self._values[row],) + self._tails[shape])
         return _NEW(KeyPart, (*self._heads[shape], special[0], *self._tails[shape][:-1], special[1]))
 
-    def column(self, label: str) -> list[KeyPart]:
-        """Every placed student's part ``label``, made together (:class:`KeyError` where one has none)."""
-        rows = self._rows(label)
+    def column(self, label: str, start: int = 0, stop: int | None = None) -> list[KeyPart]:
+        """Every placed student's part ``label`` (of students ``start`` to ``stop``), made together
+        (:class:`KeyError` where one has none)."""
+        rows = self._rows(label, start, stop)
         shapes, values = self._kinds[rows].tolist(), self._numbers[rows].tolist()
         parts = list(map(_NEW, itertools.repeat(KeyPart), map(operator.add, map(
             operator.add, map(self._heads.__getitem__, shapes), zip(values)), map(self._tails.__getitem__, shapes))))
@@ -126,10 +127,10 @@ class PartTable:
             parts[index] = self.part(int(rows[index]))
         return parts
 
-    def entries(self, label: str, field: str) -> list[Any]:
-        """Every placed student's entry ``field`` (``value``, ``tolerance``, ...) of their part ``label``, without
-        making the parts."""
-        rows = self._rows(label)
+    def entries(self, label: str, field: str, start: int = 0, stop: int | None = None) -> list[Any]:
+        """Every placed student's entry ``field`` (``value``, ``tolerance``, ...) of their part ``label`` (of
+        students ``start`` to ``stop``), without making the parts."""
+        rows = self._rows(label, start, stop)
         found: list[Any]
         if field == "value":
             found = self._numbers[rows].tolist()
@@ -141,9 +142,10 @@ class PartTable:
                 found[index] = getattr(self.part(int(rows[index])), field)
         return found
 
-    def _rows(self, label: str) -> np.ndarray:
-        """Each placed student's row of their part ``label``."""
-        return self._starts + np.array([offsets[label] for offsets in self._offsets], np.int64)[self._layout_of]
+    def _rows(self, label: str, start: int = 0, stop: int | None = None) -> np.ndarray:
+        """Each placed student's row of their part ``label`` (of students ``start`` to ``stop``)."""
+        return self._starts[start:stop] + np.array([offsets[label] for offsets in self._offsets],
+                                                   np.int64)[self._layout_of[start:stop]]
 
 
 class StudentParts(Mapping[str, KeyPart]):

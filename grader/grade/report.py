@@ -15,42 +15,60 @@ from __future__ import annotations
 import itertools
 import math
 from collections.abc import Callable, Iterable, Iterator, Sequence
-from operator import itemgetter
+from contextlib import contextmanager
 from pathlib import Path
 
-from grader.base.files import write_atomic
+from grader.base.files import atomic_file, write_atomic
 from grader.base.spreadsheet import csv_columns_text, csv_pieces, csv_text, number_cell, number_cells
 from grader.grade.canvas_file import CanvasFile
+from grader.grade.class_grades import ClassGrades, classwide, final_scores, lateness, totals
 from grader.grade.class_report import REPORT, class_report
 from grader.grade.compare import number_texts
 from grader.grade.details_file import (
+    DETAILS_HEAD,
     Cells,
-    details_csv,
+    details_lines,
     report_cell,
     report_columns,
     report_pieces,
     written_cell,
     written_texts,
 )
-from grader.grade.grading import Graded, final_scores, lateness, totals
-from grader.grade.integrity import Integrity, check
+from grader.grade.grading import Graded
+from grader.grade.integrity import Integrity, Match, check
 
 GRADES, DETAILS, PROBLEMS, CANVAS = "grades.csv", "details.csv", "problems.csv", "canvas.csv"
 INTEGRITY = "integrity.csv"
 
 
-def write_reports(graded: Graded, folder: Path, canvas: CanvasFile) -> list[Path]:
-    """Write the six files into ``folder`` (``canvas.csv`` as ``canvas`` says); returns their paths."""
+@contextmanager
+def write_details(folder: Path) -> Iterator[Callable[[Graded], None]]:
+    """``details.csv`` in ``folder``, written as a class is graded: the block gets a function to call with each
+    piece of the class's verdicts (:func:`grader.grade.class_grades.grade_class`), in the key's order. The
+    file appears when the block ends without an error."""
+    with atomic_file(folder / DETAILS) as stream:
+        stream.write(DETAILS_HEAD.encode("utf-8"))
+
+        def written(graded: Graded) -> None:
+            for text in details_lines(graded):
+                stream.write(text.encode("utf-8"))
+
+        yield written
+
+
+def write_reports(graded: Graded | ClassGrades, folder: Path, canvas: CanvasFile) -> list[Path]:
+    """Write the files but ``details.csv`` (:func:`write_details`) into ``folder`` (``canvas.csv`` as ``canvas``
+    says); returns their paths."""
+    graded = classwide(graded)
     integrity = check(graded)
-    files = {GRADES: grades_csv(graded), DETAILS: details_csv(graded), PROBLEMS: problems_csv(graded, canvas),
-             CANVAS: canvas_csv(canvas), INTEGRITY: integrity_csv(graded, integrity),
-             REPORT: class_report(graded, integrity)}
+    files = {GRADES: grades_csv(graded), PROBLEMS: problems_csv(graded, canvas), CANVAS: canvas_csv(canvas),
+             INTEGRITY: integrity_csv(graded, integrity), REPORT: class_report(graded, integrity)}
     for name, text in files.items():
         write_atomic(folder / name, text)
     return [folder / name for name in files]
 
 
-def grades_csv(graded: Graded) -> str:
+def grades_csv(graded: ClassGrades) -> str:
     """One row per student of the key: a column per problem, the minutes late of their latest answer that
     counts (empty: not known, or nothing submitted), the points the late policy took, the total after it,
     and what was possible."""
@@ -59,10 +77,9 @@ def grades_csv(graded: Graded) -> str:
     final, ids = final_scores(graded, scores), [student.id for student in students]
     header = ["student_id", "name", "section", *(f"problem {p.key}" for p in key.problems), "late", "deduction",
               "total", "possible"]
-    by_student = list(map(scores.__getitem__, ids))
     columns: list[Sequence[object]] = [
         ids, [student.name for student in students], [student.section for student in students],
-        *(list(map(itemgetter(problem.key), by_student)) for problem in key.problems), lateness(graded),
+        *(scores[problem.key].tolist() for problem in key.problems), lateness(graded),
         [deductions.get(student_id, 0.0) for student_id in ids], list(map(final.__getitem__, ids)),
         [student.possible for student in students]]
     return _csv([header]) + report_columns(columns)
@@ -73,7 +90,7 @@ INTEGRITY_HEADER = ("student_id", "label", "submitted", "parsed", "matches_id", 
                     "corrected_chance", "flagged")
 
 
-def integrity_csv(graded: Graded, integrity: Integrity, rows_per_piece: int = 10_000) -> Iterator[str]:
+def integrity_csv(graded: Graded | ClassGrades, integrity: Integrity, rows_per_piece: int = 10_000) -> Iterator[str]:
     """A row per wrong answer and student whose key accepts it (up to
     :data:`~grader.grade.integrity.LISTED` per answer): what was typed and read, whose variant it matches
     and that variant's value (6 significant figures, as ``details.csv``'s ``expected``), how many students'
@@ -85,6 +102,7 @@ def integrity_csv(graded: Graded, integrity: Integrity, rows_per_piece: int = 10
     most the assignment's ``integrity_threshold``). In pieces of ``rows_per_piece`` rows, each cell a report's
     cell (:func:`report_cell`) as the CSV writer writes it. A report: it changes no grade."""
     yield csv_text([list(map(report_cell, INTEGRITY_HEADER))])
+    graded = classwide(graded)
     students, matches, flagged = graded.key.students, integrity.matches, set(integrity.flagged)
     # Most rows are a pair's own and name students, parts, values and figures that other rows name too (a
     # third of the chances are distinct): the cells of each are worked out once.
@@ -98,12 +116,11 @@ def integrity_csv(graded: Graded, integrity: Integrity, rows_per_piece: int = 10
     step = max(1, rows_per_piece)
     for start in range(0, len(matches), step):
         piece = matches[start:start + step]
-        rows = [graded.columns[match.label][match.student] for match in piece]
+        submitted, parsed = _typed(graded, piece)
         pairs = [integrity.pair(match.student, match.partner) for match in piece]  # None: not listed
         lines = map(",".join, zip(
             map(who.__getitem__, [match.student for match in piece]), map(words.__getitem__, [m.label for m in piece]),
-            written_texts(["" if row.submitted is None else row.submitted for row in rows]),
-            written_texts([row.parsed for row in rows]), map(who.__getitem__, [match.partner for match in piece]),
+            written_texts(submitted), written_texts(parsed), map(who.__getitem__, [match.partner for match in piece]),
             _formatted([match.value for match in piece], values, number_texts),
             map(counts.__getitem__, [match.matches for match in piece]),
             map(counts.__getitem__, [None if pair is None else len(pair.labels) for pair in pairs]),
@@ -116,6 +133,20 @@ def integrity_csv(graded: Graded, integrity: Integrity, rows_per_piece: int = 10
             _formatted([None if pair is None else pair.corrected for pair in pairs], shown, _figures),
             ["" if pair is None else "yes" if pair in flagged else "no" for pair in pairs], strict=True))
         yield "\n".join(lines) + "\n"
+
+
+def _typed(graded: ClassGrades, matches: Sequence[Match]) -> tuple[list[str], list[str]]:
+    """What was typed and what it was read as, of each match's answer (one of the incorrect ones)."""
+    submitted, parsed = [""] * len(matches), [""] * len(matches)
+    by_label: dict[str, list[int]] = {}
+    for index, match in enumerate(matches):
+        by_label.setdefault(match.label, []).append(index)
+    for label, indices in by_label.items():
+        column, students = graded.columns[label], [matches[index].student for index in indices]
+        for index, typed, read in zip(indices, column.submitted.take(students), column.parsed.take(students),
+                                      strict=True):
+            submitted[index], parsed[index] = typed or "", read or ""
+    return submitted, parsed
 
 
 def _formatted(column: Sequence[float | None], known: dict[float | None, str],
@@ -132,7 +163,7 @@ def _figures(values: list[float]) -> list[str]:
     return number_cells(values, 3)
 
 
-def problems_csv(graded: Graded, canvas: CanvasFile | None = None) -> Iterator[str]:
+def problems_csv(graded: ClassGrades, canvas: CanvasFile | None = None) -> Iterator[str]:
     """Every input row not graded, or graded with a caveat, with the reason; then the Canvas
     export's caveats (line empty: a key student the export lacks). In pieces, as :func:`_csv_pieces`."""
     header = [["file", "line", "student_id", "label", "reason"]]

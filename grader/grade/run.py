@@ -20,11 +20,12 @@ from grader.base.files import output_folder, write_manifest
 from grader.base.heap import collector_paused
 from grader.grade.canvas import CanvasExport, read_export
 from grader.grade.canvas_file import CanvasFile, canvas_file
+from grader.grade.class_grades import ClassGrades, answered, counts, final_scores, grade_class
 from grader.grade.diagnosis import physics_for
-from grader.grade.grading import Graded, answered, counts, final_scores, grade
+from grader.grade.grading import PIECE, Graded
 from grader.grade.key import Key, load_key
-from grader.grade.report import write_reports
-from grader.grade.submissions import StudentRef, read_submissions
+from grader.grade.report import write_details, write_reports
+from grader.grade.submissions import StudentRef, Submissions, read_submissions
 
 COMMAND = "grader grade"
 Extra = Callable[[Graded, Path], object]  # more files a run writes from its verdicts (each student's feedback)
@@ -74,11 +75,9 @@ def run(key_path: Path, paths: Sequence[Path], out: Path, fmt: Literal["auto", "
     with collector_paused(), output_folder(out, command=COMMAND, inputs=inputs, force=force) as staging:
         key = load_key(key_path)
         export = read_export(canvas, key) if canvas is not None else None
-        graded = _graded(key, paths, fmt, (), bank)
+        graded = _graded(key, paths, fmt, (), bank, staging=staging, feedback=feedback)
         made = _canvas(graded, export, missing)
         write_reports(graded, staging, made)
-        if feedback is not None:
-            feedback(graded, staging)
     return _summary(graded, out, started, made)
 
 
@@ -92,31 +91,42 @@ def grade_into(folder: Path, key_path: Path, paths: Sequence[Path], out: Path, n
     ``feedback``: as for :func:`run`."""
     started = time.perf_counter()
     with collector_paused():
-        graded = _graded(load_key(key_path), paths, "auto", names, bank, now)
+        graded = _graded(load_key(key_path), paths, "auto", names, bank, now, folder, feedback)
         made = _canvas(graded, None, None)
         write_reports(graded, folder, made)
-        if feedback is not None:
-            feedback(graded, folder)
         write_manifest(folder, COMMAND)
     return _summary(graded, out, started, made)
 
 
 def _graded(key: Key, paths: Sequence[Path], fmt: Literal["auto", "long", "wide"], names: Sequence[str],
-            bank: Path | Mapping[str, Template] | None, now: datetime | None = None) -> Graded:
-    # Handed over, not kept: grading lets a part's answers go once it is graded.
-    return grade(key, read_submissions(paths, [StudentRef(s.id, s.email) for s in key.students], key.labels, fmt,
-                                       names, now=now, zone=key.zone, attempts=key.attempts), physics_for(key, bank))
+            bank: Path | Mapping[str, Template] | None, now: datetime | None = None, staging: Path | None = None,
+            feedback: Extra | None = None) -> ClassGrades:
+    """The class graded a piece of students at a time (:func:`grade_class`), each piece's rows written to
+    ``staging``'s details.csv (when given) and let go; with ``feedback``, the class is one piece (each student's
+    files and their index are written from the verdicts at once)."""
+
+    def read() -> Submissions:
+        return read_submissions(paths, [StudentRef(s.id, s.email) for s in key.students], key.labels, fmt, names,
+                                now=now, zone=key.zone, attempts=key.attempts)
+
+    physics, size = physics_for(key, bank), PIECE if feedback is None else max(1, len(key.students))
+    if staging is None:
+        return grade_class(key, read, physics, size=size)
+    with write_details(staging) as written:
+        return grade_class(key, read, physics, written if feedback is None else
+                           lambda graded: (written(graded), feedback(graded, staging)), size)
 
 
-def _canvas(graded: Graded, export: CanvasExport | None, missing: str | None) -> CanvasFile:
+def _canvas(graded: ClassGrades, export: CanvasExport | None, missing: str | None) -> CanvasFile:
     """``canvas.csv`` of a run: who submitted anything is who has an answer to any part."""
-    submitted = {student.id for student, gave in zip(graded.key.students, answered(graded), strict=True) if gave}
+    submitted = {student.id for student, gave in zip(graded.key.students, answered(graded).tolist(), strict=True)
+                 if gave}
     return canvas_file(graded.key, final_scores(graded), submitted, export, missing)
 
 
-def _summary(graded: Graded, out: Path, started: float, canvas: CanvasFile) -> GradeSummary:
+def _summary(graded: ClassGrades, out: Path, started: float, canvas: CanvasFile) -> GradeSummary:
     students = len(graded.key.students)
-    return GradeSummary(out, students, sum(answered(graded)), students * len(graded.columns),
+    return GradeSummary(out, students, int(answered(graded).sum()), students * len(graded.columns),
                         sum(problem.rows for problem in graded.problems if problem.not_graded),
                         sum(problem.rows for problem in graded.problems if problem.routine), counts(graded),
                         graded.ignored_columns, (*graded.notes, *canvas.notes),

@@ -96,6 +96,7 @@ class Submissions:
     problems: tuple[RowProblem, ...]
     ignored_columns: tuple[str, ...]
     notes: tuple[str, ...]
+    files: tuple[str, ...] = ()  # the files as answers name them, in the order given (the answers' order)
 
 
 def read_submissions(paths: Sequence[Path], students: Sequence[StudentRef], labels: Sequence[str],
@@ -138,7 +139,7 @@ def read_submissions(paths: Sequence[Path], students: Sequence[StudentRef], labe
     return Submissions(tuple(answers) if plain is not None else
                        tuple(sorted(answers, key=lambda a: (order[a.file], a.line, position[a.label]))),
                        tuple(sorted(problems, key=lambda p: (order[p.file], p.rows > 1, p.line, p.caveat, p.label))),
-                       tuple(ignored), (*notes, *reader.notes()))
+                       tuple(ignored), (*notes, *reader.notes()), tuple(shown_as))
 
 
 def _plain_answers(table: CsvStream, layout: Layout, ids: Mapping[str, str], labels: Sequence[str],

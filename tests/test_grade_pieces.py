@@ -7,14 +7,19 @@ from __future__ import annotations
 import csv
 import json
 import shutil
+from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 import pytest
 
 import grader.grade.run
+import grader.grade.submissions
 from grader.assign.key_columns import write_key_columns
 from grader.cli import main
+from grader.grade.answer_columns import AnswerColumns
 from grader.grade.key import load_key
+from grader.grade.submissions import Submissions
 from tests.conftest import DemoRun
 
 POLICY = {"grace": "15 min", "deduct": "10 %", "per": "day", "lowest": "40 %", "after": "7 days"}
@@ -59,7 +64,7 @@ def test_a_class_graded_in_pieces_writes_the_bytes_it_writes_graded_at_once(
     key, files = hard_class(tmp_path, demo_run, sidecar)
     students = len(load_key(key).students)
     written = {}
-    for size in (students, 1, 4, 7):
+    for size in (students, 1, 7):
         monkeypatch.setattr(grader.grade.run, "PIECE", size)
         out = tmp_path / f"out-{size}"
         assert main(["grade", "--key", str(key), *map(str, files), "--out", str(out)]) in (0, 3)
@@ -73,3 +78,49 @@ def test_a_class_graded_in_pieces_writes_the_bytes_it_writes_graded_at_once(
     assert any(line.split(",")[-1] not in ("0", "0\r") for line in details.splitlines()[1:])  # a deduction
     for size, files_written in written.items():
         assert files_written == whole, size
+
+
+def test_plain_files_kept_in_columns_grade_in_pieces_as_read_row_by_row(
+        tmp_path: Path, demo_run: DemoRun, monkeypatch: pytest.MonkeyPatch) -> None:
+    """The key's values, some changed, some unreadable, a student's left out, each answer once and without a
+    timestamp, in two files: kept in columns and made a piece of students at a time, they grade to the bytes the
+    row-by-row reading grades them to, at once."""
+    rows = [["student_id", "label", "answer"]]
+    with (demo_run.out / "key.csv").open(encoding="utf-8", newline="") as stream:
+        for number, row in enumerate(csv.DictReader(stream)):
+            if not row["student_id"].endswith("7"):
+                rows.append([row["student_id"], row["label"], [row["value"], f"{row['value']}1", "12 parsecs",
+                                                               f" {row['value']} {row['unit']}"][number % 4]])
+    files = [tmp_path / "first.csv", tmp_path / "second.csv"]
+    for path, part in zip(files, (rows[1:200], rows[200:]), strict=True):
+        with path.open("w", encoding="utf-8", newline="") as stream:
+            csv.writer(stream).writerows([rows[0], *part])
+    key = demo_run.out / "key.json"
+    written = {}
+    for size, plain in ((1000, False), (1000, True), (4, True)):
+        monkeypatch.setattr(grader.grade.run, "PIECE", size)
+        if not plain:
+            monkeypatch.setattr(grader.grade.submissions, "_plain_answers", lambda *given: None)
+        else:
+            monkeypatch.undo()
+            monkeypatch.setattr(grader.grade.run, "PIECE", size)
+        out = tmp_path / f"out-{size}-{plain}"
+        kinds: list[type] = []
+        monkeypatch.setattr(grader.grade.run, "read_submissions", spied(kinds))
+        assert main(["grade", "--key", str(key), *map(str, files), "--out", str(out)]) in (0, 3)
+        assert kinds == [AnswerColumns if plain else tuple]
+        written[size, plain] = {path.name: path.read_bytes() for path in sorted(out.iterdir())}
+    assert written[1000, True] == written[1000, False] == written[4, True]
+    assert b",invalid," in written[4, True]["details.csv"]
+
+
+def spied(kinds: list[type]) -> Callable[..., Submissions]:
+    """``read_submissions``, noting the kind of the answers it read into ``kinds``."""
+    read = grader.grade.submissions.read_submissions
+
+    def reading(*given: Any, **named: Any) -> Submissions:
+        found = read(*given, **named)
+        kinds.append(type(found.answers))
+        return found
+
+    return reading

@@ -9,6 +9,7 @@ from pathlib import Path
 import pytest
 
 import grader.grade.submissions as submissions
+from grader.grade.answer_columns import AnswerColumns
 from grader.grade.submissions import StudentRef, Submissions, read_submissions
 
 STUDENTS = [StudentRef("007", "ana@x.edu"), StudentRef("042", "ben@x.edu"), StudentRef("100", "cy@x.edu")]
@@ -99,3 +100,36 @@ def test_a_quote_closed_mid_cell_is_refused_as_the_row_by_row_reading_refuses_it
     with pytest.raises(Exception) as row_by_row:
         _read(path)
     assert str(plain.value) == str(row_by_row.value) and "expected after '\"'" in str(plain.value)
+
+
+SEVERAL = {  # several files: (files, whether all are read as plain answers)
+    "plain files": (["student_id,label,answer\n007,1a,6.2\n042,1b,7\n", "id;label;answer\n100;2a;6,2\n007;1b;8\n",
+                     "student_id,label,answer\r\n042,2a,x\r\n"], True),
+    "a student's label in two files": (["student_id,label,answer\n007,1a,6.2\n", "student_id,label,answer\n007,1a,7\n"],
+                                       False),
+    "a plain file, then one with timestamps": (["student_id,label,answer\n007,1a,6.2\n042,1a,5\n",
+                                                 "student_id,label,answer,timestamp\n007,1a,7,2026-12-01 10:00\n"],
+                                                False),
+    "a plain file between others": (["student_id,label,answer\n007,1a,6.2\n", "student_id,label,answer\n9,1a,1\n",
+                                     "student_id,label,answer\n042,1b,7\n100,2a,1\n"], False),
+}
+
+
+@pytest.mark.parametrize("attempts", ["latest", "best"])
+@pytest.mark.parametrize("name", SEVERAL)
+def test_several_plain_files_are_read_as_the_row_by_row_reading_reads_them(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch, name: str, attempts: str) -> None:
+    """Each (student, label) once in all the files, and every file plain: read without the rows' machinery, the
+    files' answers one after another; else every file is read row by row (the files before the first that is not
+    plain read again)."""
+    texts, plain = SEVERAL[name]
+    paths = []
+    for index, text in enumerate(texts):
+        paths.append(tmp_path / f"answers-{index}.csv")
+        paths[-1].write_bytes(text.encode("utf-8"))
+    fast = read_submissions(paths, STUDENTS, LABELS, attempts=attempts)
+    assert isinstance(fast.answers, AnswerColumns) == plain
+    monkeypatch.setattr(submissions, "_plain_answers", lambda *given: None)
+    slow = read_submissions(paths, STUDENTS, LABELS, attempts=attempts)
+    assert fast == slow and list(fast.answers) == list(slow.answers) and fast.answers
+    assert [answer.file for answer in fast.answers] == sorted(answer.file for answer in fast.answers)

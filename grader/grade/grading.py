@@ -22,6 +22,7 @@ from typing import Any, NamedTuple
 import numpy as np
 
 from grader.base.inputs import CELL_CHARS
+from grader.grade.answer_columns import AnswerColumns
 from grader.grade.cells import (
     CellBlank,
     CellInvalid,
@@ -177,19 +178,39 @@ def graded_pieces(key: Key, submissions: Submissions, physics: Physics, size: in
     if count <= size:
         yield grade_piece(key, answers, physics)
         return
-    positions = key.positions
-    piece_of = np.fromiter(map(positions.get, map(_STUDENT, answers), itertools.repeat(-size)), np.int64,
-                           len(answers)) // size
+    for index, (start, mine) in enumerate(_by_piece(key, answers, size)):
+        if not index:
+            del answers  # a piece's answers are all that is left of them
+        stop = min(start + size, count)
+        yield grade_piece(key.piece(start, stop), mine, physics.piece(start, stop))
+        del mine
+
+
+def _by_piece(key: Key, answers: Sequence[Answer], size: int) -> Iterator[tuple[int, tuple[Answer, ...]]]:
+    """The answers of each piece of ``size`` students of the key (its first student's index, and theirs, in the
+    order given); answers of students the key lacks are left out. Answers in columns are made a piece at a
+    time; others are sorted into pieces at once (and let go here, where the caller keeps no reference)."""
+    count = len(key.students)
+    if isinstance(answers, AnswerColumns):  # each answer's student is a number already
+        student = answers.student.astype(np.int64)
+    else:
+        positions = key.positions
+        student = np.fromiter(map(positions.get, map(_STUDENT, answers), itertools.repeat(-size)), np.int64,
+                              len(answers))
+    piece_of = student // size
     order = np.argsort(piece_of, kind="stable")
     bounds = np.searchsorted(piece_of[order], np.arange(count // size + 2)).tolist()
-    given: list[list[Answer] | None] = [list(map(answers.__getitem__, order[low:high].tolist()))
-                                        for low, high in itertools.pairwise(bounds)]
-    del answers, piece_of, order
+    del student, piece_of
+    if isinstance(answers, AnswerColumns):
+        for index, start in enumerate(range(0, count, size)):
+            yield start, tuple(answers.take(order[bounds[index]:bounds[index + 1]]))
+        return
+    made: list[list[Answer] | None] = [list(map(answers.__getitem__, order[low:high].tolist()))
+                                       for low, high in itertools.pairwise(bounds)]
+    del answers, order
     for index, start in enumerate(range(0, count, size)):
-        mine, given[index] = given[index], None
-        stop = min(start + size, count)
-        yield grade_piece(key.piece(start, stop), tuple(mine or ()), physics.piece(start, stop))
-        del mine
+        mine, made[index] = made[index], None
+        yield start, tuple(mine or ())
 
 
 _STUDENT = operator.attrgetter("student_id")

@@ -42,7 +42,7 @@ from typing import NamedTuple
 import numpy as np
 import numpy.typing as npt
 
-from grader.grade.class_grades import ClassGrades, Texts, classwide
+from grader.grade.class_grades import ClassGrades, classwide
 from grader.grade.compare import errors
 from grader.grade.grading import Graded
 from grader.grade.integrity_chance import UNRELATED, Spread
@@ -61,6 +61,7 @@ from grader.grade.integrity_search import (
     range_least,
 )
 from grader.grade.integrity_typed import halves, steps
+from grader.grade.texts import Texts
 
 LISTED = 5  # students named per wrong answer in integrity.csv; the rest are counted
 KEPT = 1.0  # pairs with two or more matched parts are kept when their corrected chance is below this

@@ -20,7 +20,7 @@ import numpy as np
 import numpy.typing as npt
 
 from grader.grade.cells import typed_place
-from grader.grade.class_grades import Texts
+from grader.grade.texts import Texts
 
 Floats = npt.NDArray[np.float64]
 Ints = npt.NDArray[np.int64]

@@ -38,7 +38,6 @@ caveat and a note: a clock was wrong, or the time was typed.
 
 from __future__ import annotations
 
-import functools
 import itertools
 import os
 from collections import defaultdict
@@ -56,6 +55,7 @@ from grader.base.errors import GraderError, shown
 from grader.base.files import shown_path
 from grader.base.inputs import CELL_CHARS, CSV_BYTES, CsvRow, CsvStream, open_csv, regular_size
 from grader.grade import timestamps
+from grader.grade.answer_columns import AnswerColumns
 from grader.grade.columns import Layout, find_layout
 from grader.grade.latest import Answer, Contests, SubmittedRow
 from grader.grade.row_problems import (
@@ -73,6 +73,7 @@ from grader.grade.row_problems import (
     ProblemLog,
     RowProblem,
 )
+from grader.grade.texts import Texts
 from grader.grade.timestamps import in_zone, instant, read_timestamp
 
 __all__ = ["Answer", "RowProblem", "StudentRef", "Submissions", "find_label", "read_submissions"]
@@ -92,7 +93,7 @@ class Submissions:
     """The answers to grade, the rows (or answers) not used, the columns no rule claimed, and notes
     about the files as a whole (an encoding guessed, time zones assumed)."""
 
-    answers: tuple[Answer, ...]
+    answers: Sequence[Answer]  # a tuple, or the plain files' in columns (:class:`AnswerColumns`)
     problems: tuple[RowProblem, ...]
     ignored_columns: tuple[str, ...]
     notes: tuple[str, ...]
@@ -118,56 +119,78 @@ def read_submissions(paths: Sequence[Path], students: Sequence[StudentRef], labe
     ignored: dict[str, None] = {}
     notes: list[str] = []
     shown_as = [shown_path(name) for name in names or paths]
-    plain: list[Answer] | None = None
+    # The files' answers while every file so far is plain, read without the rows' machinery (the usual files);
+    # each (student, label) is answered once in all of them.
+    plain: list[_Block] | None = []
+    taken = np.zeros(len(reader.roster.ids) * len(labels), bool)
+    files: list[tuple[str, str]] = []
     for index, (path, name) in enumerate(zip(paths, shown_as, strict=True)):
-        table = open_csv(_within_limit(path), exports=True)
-        layout = find_layout(table, labels, fmt, reader.roster.known)
+        table, layout = _opened(path, labels, fmt, reader)
+        files.append((name, table.delimiter))
         ignored.update(dict.fromkeys(layout.ignored))
         if table.encoding == "Windows-1252":
             notes.append(f"{name}: not UTF-8; read as Windows-1252 (Latin-1): check accented text, or save the "
                          'file as "CSV UTF-8"')
-        # One file whose rows are all plain answers (the usual file) is read without the rows' machinery.
-        plain = _plain_answers(table, layout, reader.roster.ids, labels, name) if len(paths) == 1 else None
-        for row in table.rows() if plain is None else ():
+        if plain is not None:
+            found = _plain_answers(table, layout, reader.roster.ids, labels, index, taken)
+            if found is not None:
+                plain += found
+                continue
+            for earlier in range(index):  # the files before were plain, this one is not: all are read row by row
+                again, again_layout = _opened(paths[earlier], labels, fmt, reader)
+                for row in again.rows():
+                    reader.read(shown_as[earlier], earlier, row, again, again_layout)
+            plain = None
+        for row in table.rows():
             reader.read(name, index, row, table, layout)
         del table  # its rows are read: the next file's text need not wait beside it
-    answers = reader.contests.answers(labels) if plain is None else plain
+    if plain is not None:
+        # The plain files' answers are one a row, in the files' order: already sorted.
+        return Submissions(AnswerColumns.joined(list(reader.roster.ids.values()), labels, files, plain), (),
+                           tuple(ignored), tuple(notes), tuple(shown_as))
+    answers = reader.contests.answers(labels)
     problems = reader.log.problems()
     order = {name: index for index, name in enumerate(shown_as)}
     position = {label: index for index, label in enumerate(labels)}
-    # A plain file's answers are one a row, in the file's order: already sorted.
-    return Submissions(tuple(answers) if plain is not None else
-                       tuple(sorted(answers, key=lambda a: (order[a.file], a.line, position[a.label]))),
+    return Submissions(tuple(sorted(answers, key=lambda a: (order[a.file], a.line, position[a.label]))),
                        tuple(sorted(problems, key=lambda p: (order[p.file], p.rows > 1, p.line, p.caveat, p.label))),
                        tuple(ignored), (*notes, *reader.notes()), tuple(shown_as))
 
 
-def _plain_answers(table: CsvStream, layout: Layout, ids: Mapping[str, str], labels: Sequence[str],
-                   name: str) -> list[Answer] | None:
+def _opened(path: Path, labels: Sequence[str], fmt: Literal["auto", "long", "wide"],
+            reader: _Reader) -> tuple[CsvStream, Layout]:
+    """A submissions file opened (refused over :data:`SUBMISSIONS_BYTES`), and its layout."""
+    table = open_csv(_within_limit(path), exports=True)
+    return table, find_layout(table, labels, fmt, reader.roster.known)
+
+
+def _plain_answers(table: CsvStream, layout: Layout, ids: Mapping[str, str], labels: Sequence[str], file: int,
+                   taken: np.ndarray) -> list[_Block] | None:
     """The answers of a long file without timestamps each of whose rows has a cell per column, none too
     long, and names a student of the key by their id and a label as they are written, each student's label
-    once: an answer a row, in the file's order, as :class:`_Reader` would read them (with no problem and no
-    note). None for any other file, whose rows are then read one by one."""
+    once (``taken``: each student * len(labels) + label already answered, in this file or one before): an
+    answer a row, in the file's order, as :class:`_Reader` would read them (with no problem and no note), in
+    blocks of the file (its index ``file``). None for any other file, whose rows are then read one by one."""
     if layout.wide or layout.by_email or layout.timestamp is not None or layout.label is None \
             or layout.answer is None:
         return None
     header = table.header
     wanted = (header.index(layout.student), header.index(layout.label), header.index(layout.answer))
+    before = taken.copy()
     try:
-        return _answers(_line_pieces(table, wanted), ids, labels, name, table.delimiter)
+        return _answers(_line_pieces(table, wanted), ids, labels, file, taken)
     except _NotALineARowError:  # blank lines, or a quoted cell over several lines: read as records instead
-        return _answers(_record_pieces(table, wanted), ids, labels, name, table.delimiter)
+        taken[:] = before  # (what the lines before were taken as)
+        return _answers(_record_pieces(table, wanted), ids, labels, file, taken)
 
 
-def _answers(pieces: Iterator[_Piece | None], ids: Mapping[str, str], labels: Sequence[str], name: str,
-             delimiter: str) -> list[Answer] | None:
+def _answers(pieces: Iterator[_Piece | None], ids: Mapping[str, str], labels: Sequence[str], file: int,
+             taken: np.ndarray) -> list[_Block] | None:
     """The answers of the rows of ``pieces`` as :func:`_plain_answers` reads them; None where one is not so."""
     # Each (student, label) as one number, student * labels + label: taken once each, checked a piece at a time.
-    students, numbers = list(ids.values()), {student: index for index, student in enumerate(ids)}
+    numbers = {student: index for index, student in enumerate(ids)}
     places = {label: index for index, label in enumerate(labels)}
-    taken = np.zeros(len(numbers) * len(labels), bool)
-    answers: list[Answer] = []
-    typed: dict[str, str] = {}
+    blocks: list[_Block] = []
     # A piece of rows at a time (a file of a million rows is not held as cells beside its answers), each cell
     # of the three columns stripped, as _Reader strips them, a column at a time.
     for piece in pieces:
@@ -182,15 +205,11 @@ def _answers(pieces: Iterator[_Piece | None], ids: Mapping[str, str], labels: Se
         if taken[cells].any() or np.unique(cells).size != cells.size:  # a student's label twice
             return None
         taken[cells] = True
-        # The key's own id and label texts, not the file's: one object a student and a part, not three a row.
-        who, part = list(map(students.__getitem__, who_number)), list(map(labels.__getitem__, part_number))
-        # One text object for equal answers (a class types a few thousand distinct ones): a verdict keeps it.
-        stripped = list(map(str.strip, typed_cells))
-        texts = map(typed.setdefault, stripped, stripped)
-        # tuple.__new__: the named tuple's own __new__ is a Python call per answer.
-        answers += map(functools.partial(tuple.__new__, Answer), zip(
-            itertools.repeat(name), lines, who, part, texts, itertools.repeat(delimiter), itertools.repeat(None)))
-    return answers
+        blocks.append((file, who_number, part_number, lines, Texts.of(list(map(str.strip, typed_cells)))))
+    return blocks
+
+
+_Block = tuple[int, Sequence[int], Sequence[int], Sequence[int], Texts]  # a file's, its students, labels, lines, texts
 
 
 _Piece = tuple[Sequence[int], list[str], list[str], list[str]]  # rows' lines, and their cells of three columns

@@ -21,13 +21,14 @@ Ints = npt.NDArray[np.int64]
 
 class AnswerColumns(Sequence[Answer]):
     """Answers in columns: each one's student (an index into ``ids``, the key's order), label (into
-    ``labels``), file (into ``files``, each with its delimiter), line, and text; none has a timestamp."""
+    ``labels``), file (into ``files``, each with its delimiter), line (a file under 64 MiB has fewer than 2**31),
+    and text; none has a timestamp."""
 
     __slots__ = ("_delimiters", "_file", "_files", "_ids", "_label", "_labels", "_line", "_texts", "student")
 
     def __init__(self, ids: Sequence[str], labels: Sequence[str], files: Sequence[tuple[str, str]],
                  student: npt.NDArray[np.int32], label: npt.NDArray[np.int16], file: npt.NDArray[np.int16],
-                 line: Ints, texts: Texts) -> None:
+                 line: npt.NDArray[np.int32], texts: Texts) -> None:
         self._ids, self._labels = ids, labels
         self._files, self._delimiters = [name for name, _ in files], [delimiter for _, delimiter in files]
         self.student, self._label, self._file, self._line, self._texts = student, label, file, line, texts
@@ -40,7 +41,7 @@ class AnswerColumns(Sequence[Answer]):
         return cls(ids, labels, files, _column([block[1] for block in blocks], np.int32),
                    _column([block[2] for block in blocks], np.int16),
                    _column([np.full(len(block[3]), block[0]) for block in blocks], np.int16),
-                   _column([block[3] for block in blocks], np.int64), Texts.joined([block[4] for block in blocks]))
+                   _column([block[3] for block in blocks], np.int32), Texts.joined([block[4] for block in blocks]))
 
     def __len__(self) -> int:
         return len(self.student)

@@ -13,6 +13,7 @@ from __future__ import annotations
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from operator import attrgetter
+from typing import Generic, TypeVar
 
 import numpy as np
 import numpy.typing as npt
@@ -26,27 +27,65 @@ from grader.grade.texts import Texts
 
 Floats = npt.NDArray[np.float64]
 Ints = npt.NDArray[np.int64]
+Word = TypeVar("Word")
 
 
-class Coder(dict[str, int]):
-    """Numbers for the few distinct texts of a column (a verdict, a tolerance in words), shared by its pieces."""
+class Coder(dict[Word, int], Generic[Word]):
+    """Numbers for the few distinct values of a column (a verdict, a tolerance in words), shared by its pieces."""
 
-    def codes(self, texts: Sequence[str]) -> npt.NDArray[np.int32]:
-        """Each text's number (new texts numbered as they come)."""
-        for text in dict.fromkeys(texts):
-            self.setdefault(text, len(self))
-        return np.fromiter(map(self.__getitem__, texts), np.int32, len(texts))
+    def codes(self, values: Sequence[Word]) -> np.ndarray:
+        """Each value's number (new values numbered as they come): 2 bytes each, or 4 past 65,536 values."""
+        for value in dict.fromkeys(values):
+            self.setdefault(value, len(self))
+        return np.fromiter(map(self.__getitem__, values), np.uint16 if len(self) <= 1 << 16 else np.int32,
+                           len(values))
 
-    def words(self) -> tuple[str, ...]:
-        """The texts, by number."""
-        return tuple(self)
+    def coded(self, pieces: Sequence[Coded[Word]]) -> Coded[Word]:
+        """The pieces' columns (coded by this coder), one after another."""
+        return Coded(np.concatenate([piece.codes for piece in pieces] or [np.zeros(0, np.uint16)]), tuple(self))
+
+
+@dataclass(frozen=True)
+class Coded(Generic[Word]):
+    """A column of a few distinct values: each cell's number (``codes``) in ``words``."""
+
+    codes: np.ndarray
+    words: tuple[Word, ...] = ()
+
+    def __len__(self) -> int:
+        return len(self.codes)
+
+    def are(self, word: Word) -> npt.NDArray[np.bool_]:
+        """Which cells are ``word``."""
+        return self.codes == self.words.index(word) if word in self.words else np.zeros(len(self), bool)
+
+    def counted(self) -> dict[Word, int]:
+        """How many cells of each value there are (values with none left out)."""
+        return {self.words[code]: count for code, count in enumerate(np.bincount(
+            self.codes, minlength=len(self.words)).tolist()) if count}
+
+    def values(self, cells: npt.NDArray[np.bool_] | None = None) -> list[Word]:
+        """Each cell's value (of ``cells`` only, when given), in order."""
+        return list(map(self.words.__getitem__, (self.codes if cells is None else self.codes[cells]).tolist()))
+
+
+def _floats(coded: Coded[int]) -> Floats:
+    """A column of numbers coded by their bits (:func:`_bits`), as numbers."""
+    numbers: Floats = np.array(coded.words or [0], np.int64).view(np.float64)
+    found: Floats = numbers[coded.codes]
+    return found
+
+
+def _bits(values: npt.NDArray[np.float64]) -> list[int]:
+    """Each number's bits: numbers coded so are told apart exactly (0.0 from -0.0)."""
+    return values.view(np.int64).tolist()  # type: ignore[no-any-return]
 
 
 @dataclass(frozen=True)
 class Some:
     """The texts of some cells of a column: ``cells`` (in order) and theirs."""
 
-    cells: Ints
+    cells: npt.NDArray[np.int32]
     texts: Texts
 
     def take(self, indices: Sequence[int] | Ints) -> list[str | None]:
@@ -59,73 +98,67 @@ class Some:
 
 @dataclass(frozen=True)
 class Outcomes:
-    """One part's verdicts for the class, a cell per student of the key in its order: the kind (a number in
-    ``kinds``), credit and points, what was typed, the tolerance in words and the diagnosis (numbers in their
-    words); what was read, for the ``incorrect`` cells; the feedback, for the ``invalid`` ones."""
+    """One part's verdicts for the class, a cell per student of the key in its order: the kind, credit and
+    points, what was typed, the tolerance in words and the diagnosis; what was read, for the ``incorrect`` cells;
+    the feedback, for the ``invalid`` ones. About 30 bytes a cell."""
 
-    verdict: npt.NDArray[np.int32]
-    kinds: tuple[str, ...]
-    credit: Floats
-    points: Floats
+    verdict: Coded[str]
+    credit: Coded[int]  # the numbers' bits
+    points: Coded[int]
     submitted: Texts
-    tolerance: npt.NDArray[np.int32]
-    tolerances: tuple[str, ...]
-    diagnosis: npt.NDArray[np.int32]
-    diagnoses: tuple[str, ...]
+    tolerance: Coded[str]
+    diagnosis: Coded[str]
     parsed: Some  # of the incorrect cells
     feedback: Some  # of the invalid cells
 
     def __len__(self) -> int:
         return len(self.verdict)
 
-    def are(self, kind: str) -> npt.NDArray[np.bool_]:
-        """Which cells' verdict is ``kind``."""
-        return self.verdict == self.kinds.index(kind) if kind in self.kinds else np.zeros(len(self), bool)
+    def worth(self) -> Floats:
+        """Each cell's points."""
+        return _floats(self.points)
 
-    def counted(self) -> dict[str, int]:
-        """How many cells of each kind there are (kinds with none left out)."""
-        return {self.kinds[code]: count for code, count in enumerate(np.bincount(self.verdict,
-                                                                                 minlength=len(self.kinds)).tolist())
-                if count}
-
-    def tolerance_counts(self) -> dict[str, int]:
-        """How many cells each tolerance in words decided."""
-        return {self.tolerances[code]: count for code, count in enumerate(np.bincount(
-            self.tolerance, minlength=len(self.tolerances)).tolist()) if count}
-
-    def diagnosed(self, kind: str) -> list[str]:
-        """The diagnosis of each cell of ``kind``, in the cells' order."""
-        return list(map(self.diagnoses.__getitem__, self.diagnosis[self.are(kind)].tolist()))
+    def scores(self) -> Floats:
+        """Each cell's points earned: its credit times its points."""
+        return _floats(self.credit) * _floats(self.points)
 
 
 class _Part:
     """The numbers shared by a part's pieces as they are kept (:class:`Outcomes` of each piece, joined at the end)."""
 
     def __init__(self) -> None:
-        self.kinds, self.tolerances, self.diagnoses = Coder({kind: index for index, kind in enumerate(VERDICTS)}), \
-            Coder(), Coder({"": 0})
+        self.kinds: Coder[str] = Coder({kind: index for index, kind in enumerate(VERDICTS)})
+        self.credits: Coder[int] = Coder()
+        self.points: Coder[int] = Coder()
+        self.tolerances: Coder[str] = Coder()
+        self.diagnoses: Coder[str] = Coder({"": 0})
         self.pieces: list[Outcomes] = []
         self.start = 0
 
     def add(self, rows: Sequence[Row]) -> None:
-        verdicts = list(map(_VERDICT, rows))
-        codes = self.kinds.codes(verdicts)
+        count = len(rows)
+        codes = self.kinds.codes(list(map(_VERDICT, rows)))
         incorrect = np.flatnonzero(codes == self.kinds["incorrect"])
         invalid = np.flatnonzero(codes == self.kinds["invalid"])
         self.pieces.append(Outcomes(
-            codes, (), np.fromiter(map(_CREDIT, rows), np.float64, len(rows)),
-            np.fromiter(map(_POINTS, rows), np.float64, len(rows)), Texts.of(list(map(_SUBMITTED, rows))),
-            self.tolerances.codes(list(map(_TOLERANCE, rows))), (), self.diagnoses.codes(list(map(_DIAGNOSIS, rows))),
-            (), Some(incorrect + self.start, Texts.of([rows[index].parsed for index in incorrect.tolist()])),
-            Some(invalid + self.start, Texts.of([rows[index].feedback for index in invalid.tolist()]))))
-        self.start += len(rows)
+            Coded(codes), Coded(self.credits.codes(_bits(np.fromiter(map(_CREDIT, rows), np.float64, count)))),
+            Coded(self.points.codes(_bits(np.fromiter(map(_POINTS, rows), np.float64, count)))),
+            Texts.of(list(map(_SUBMITTED, rows))), Coded(self.tolerances.codes(list(map(_TOLERANCE, rows)))),
+            Coded(self.diagnoses.codes(list(map(_DIAGNOSIS, rows)))),
+            Some((incorrect + self.start).astype(np.int32),
+                 Texts.of([rows[index].parsed for index in incorrect.tolist()])),
+            Some((invalid + self.start).astype(np.int32),
+                 Texts.of([rows[index].feedback for index in invalid.tolist()]))))
+        self.start += count
 
     def joined(self) -> Outcomes:
         pieces = self.pieces
-        return Outcomes(_joined(pieces, "verdict", np.int32), self.kinds.words(), _joined(pieces, "credit"),
-                        _joined(pieces, "points"), Texts.joined([piece.submitted for piece in pieces]),
-                        _joined(pieces, "tolerance", np.int32), self.tolerances.words(),
-                        _joined(pieces, "diagnosis", np.int32), self.diagnoses.words(),
+        return Outcomes(self.kinds.coded([piece.verdict for piece in pieces]),
+                        self.credits.coded([piece.credit for piece in pieces]),
+                        self.points.coded([piece.points for piece in pieces]),
+                        Texts.joined([piece.submitted for piece in pieces]),
+                        self.tolerances.coded([piece.tolerance for piece in pieces]),
+                        self.diagnoses.coded([piece.diagnosis for piece in pieces]),
                         _some([piece.parsed for piece in pieces]), _some([piece.feedback for piece in pieces]))
 
 
@@ -133,13 +166,20 @@ _VERDICT, _CREDIT, _POINTS = attrgetter("verdict"), attrgetter("credit"), attrge
 _SUBMITTED, _TOLERANCE, _DIAGNOSIS = attrgetter("submitted"), attrgetter("tolerance"), attrgetter("diagnosis")
 
 
-def _joined(pieces: Sequence[Outcomes], name: str, dtype: type = np.float64) -> np.ndarray:
-    return np.concatenate([getattr(piece, name) for piece in pieces] or [np.zeros(0, dtype)])
-
-
 def _some(pieces: Sequence[Some]) -> Some:
-    return Some(np.concatenate([piece.cells for piece in pieces] or [np.zeros(0, np.int64)]),
+    return Some(np.concatenate([piece.cells for piece in pieces] or [np.zeros(0, np.int32)]),
                 Texts.joined([piece.texts for piece in pieces]))
+
+
+@dataclass(frozen=True)
+class Lateness:
+    """How late a class's answers came: per student of the key, in its order, the minutes late of their latest
+    answer that counts (None: no answer whose lateness is known); per student id, the points the late policy took
+    (only those who lost any); and how many answers' lateness is not known."""
+
+    latest: Sequence[int | None]
+    deductions: Mapping[str, float]
+    unknown: int
 
 
 @dataclass(frozen=True)
@@ -156,7 +196,7 @@ class ClassGrades:
     ignored_columns: tuple[str, ...]
     notes: tuple[str, ...]
     mistakes: Mapping[tuple[str, str], str] = field(default_factory=dict)
-    late: LateWork | None = None
+    late: Lateness | None = None
     numbers: Mapping[str, Floats] = field(default_factory=dict)
 
     @property
@@ -169,8 +209,9 @@ class ClassGrades:
         """The class's verdicts of one grading run (all of its students graded together)."""
         kept = Keeping(graded.key)
         kept.add(graded)
+        late = late_notes(graded.late.unknown if graded.late else 0)  # the last of its notes, made again here
         return kept.joined(graded.problems[:len(graded.problems) - len(graded.first_given)], graded.ignored_columns,
-                           graded.notes[:len(graded.notes) - len(late_notes(graded.late))])
+                           graded.notes[:len(graded.notes) - len(late)])
 
 
 def grade_class(key: Key, read: Callable[[], Submissions], physics: Physics,
@@ -208,7 +249,9 @@ class Keeping:
         self.numbers: dict[str, list[Floats]] = {label: [] for label in key.labels}
         self.problems: list[RowProblem] = []
         self.firsts: list[Answer] = []
-        self.lates: list[LateWork] = []
+        self.latest: list[int | None] = []
+        self.deductions: dict[str, float] = {}
+        self.unknown: int | None = None  # None: the key has no due time
         self.mistakes: dict[tuple[str, str], str] = {}
         self.pieces = 0
 
@@ -222,7 +265,9 @@ class Keeping:
         self.problems += graded.problems[len(graded.problems) - own:] if own else ()
         self.firsts += graded.first_given
         if graded.late is not None:
-            self.lates.append(graded.late)
+            self.latest += latest(graded.late, len(graded.key.students))
+            self.deductions.update(graded.late.deductions)
+            self.unknown = (self.unknown or 0) + graded.late.unknown
         for found, says in graded.mistakes.items():
             self.mistakes.setdefault(found, says)
         self.pieces += 1
@@ -240,19 +285,20 @@ class Keeping:
             ranks = [(labels[problem.label], order[first.file], first.line)
                      for problem, first in zip(own, self.firsts, strict=True)]
             own = [own[index] for index in sorted(range(len(own)), key=ranks.__getitem__)]
-        late = _late(self.lates) if self.lates else None
+        late = None if self.unknown is None else Lateness(self.latest, self.deductions, self.unknown)
         return ClassGrades(self.key, {label: part.joined() for label, part in self.parts.items()},
-                           (*problems, *own), ignored, (*notes, *late_notes(late)), self.mistakes, late,
+                           (*problems, *own), ignored, (*notes, *late_notes(self.unknown or 0)), self.mistakes, late,
                            {label: np.concatenate(found) for label, found in self.numbers.items() if found})
 
 
-def _late(lates: Sequence[LateWork]) -> LateWork:
-    """The lateness of the pieces, one after another."""
-    labels = list(lates[0].minutes)
-    return LateWork({label: [minutes for late in lates for minutes in late.minutes[label]] for label in labels},
-                    {label: [share for late in lates for share in late.shares[label]] for label in labels},
-                    {student: points for late in lates for student, points in late.deductions.items()},
-                    sum(late.unknown for late in lates))
+def latest(late: LateWork, count: int) -> list[int | None]:
+    """Per student of ``count``, the minutes late of their latest answer that counts (None: no answer whose
+    lateness is known)."""
+    found: list[int | None] = [None] * count
+    for minutes in late.minutes.values():
+        found = [mine if theirs is None else max(theirs, mine or 0)
+                 for mine, theirs in zip(found, minutes, strict=True)]
+    return found
 
 
 def totals(graded: ClassGrades) -> dict[str, Floats]:
@@ -264,7 +310,7 @@ def totals(graded: ClassGrades) -> dict[str, Floats]:
         scores = sums.get(problem.key, np.zeros(count))
         for label in problem.labels:
             column = graded.columns[label]
-            scores = scores + column.credit * column.points
+            scores = scores + column.scores()
         sums[problem.key] = scores
     return sums
 
@@ -283,20 +329,17 @@ def final_scores(graded: ClassGrades, scores: Mapping[str, Floats] | None = None
             for student_id, score in zip(ids, total.tolist(), strict=True)}
 
 
-def lateness(graded: ClassGrades) -> list[int | None]:
+def lateness(graded: ClassGrades) -> Sequence[int | None]:
     """Per student of the key, in its order, the minutes late of their latest answer that counts (None:
     no answer whose lateness is known)."""
-    found: list[int | None] = [None] * len(graded.key.students)
-    for late in graded.late.minutes.values() if graded.late else ():
-        found = [mine if theirs is None else max(theirs, mine or 0) for mine, theirs in zip(found, late, strict=True)]
-    return found
+    return graded.late.latest if graded.late else [None] * len(graded.key.students)
 
 
 def counts(graded: ClassGrades) -> dict[str, int]:
     """How many verdicts of each kind."""
     found = dict.fromkeys(VERDICTS, 0)
     for column in graded.columns.values():
-        for verdict, count in column.counted().items():
+        for verdict, count in column.verdict.counted().items():
             found[verdict] = found.get(verdict, 0) + count
     return found
 

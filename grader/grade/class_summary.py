@@ -197,15 +197,15 @@ def summarize(graded: Graded | ClassGrades) -> ClassSummary:
     for problem in key.problems:
         for label in problem.labels:
             column = graded.columns[label]
-            worth = column.points
-            scores[label] = column.credit * worth
+            worth = column.worth()
+            scores[label] = column.scores()
             points[label] = worth
-            missing[label] = column.are("missing")
+            missing[label] = column.verdict.are("missing")
             answered |= column.submitted.given
             parts.append(_part(graded, problem.key, label, column, scores[label], worth, kinds,
                                key.part_entries(label, "tolerance")))
             if parts[-1].counts.get("invalid"):
-                invalid.update(np.flatnonzero(column.are("invalid")).tolist())
+                invalid.update(np.flatnonzero(column.verdict.are("invalid")).tolist())
     possible = sum(points.values(), np.zeros(count))
     earned = sum(scores.values(), np.zeros(count))
     percent = np.divide(100.0 * earned, possible, out=np.zeros(count), where=possible > 0)
@@ -218,14 +218,14 @@ def summarize(graded: Graded | ClassGrades) -> ClassSummary:
 
 def _kinds_found(graded: ClassGrades) -> set[str]:
     """Kinds in the verdicts that :data:`VERDICTS` does not name (none, unless grading and VERDICTS disagree)."""
-    return {kind for column in graded.columns.values() for kind in column.counted()} - set(VERDICTS)
+    return {kind for column in graded.columns.values() for kind in column.verdict.counted()} - set(VERDICTS)
 
 
 def _part(graded: ClassGrades, problem: str, label: str, column: Outcomes, scores: Floats, worth: Floats,
           kinds: tuple[str, ...], rules: Sequence[Mapping[str, object]]) -> PartSummary:
     key = graded.key
-    found = column.counted()
-    mistakes = Counter(column.diagnosed("mistake"))  # ecf rows name their part
+    found = column.verdict.counted()
+    mistakes = Counter(column.diagnosis.values(column.verdict.are("mistake")))  # ecf rows name their part
     first = key.students[0].parts[label] if key.students else None
     credit = float(scores.sum() / worth.sum()) if worth.sum() > 0 else 0.0
     top = _by_count(mistakes)[:TOP_MISTAKES]
@@ -246,7 +246,7 @@ def _tolerances(rules: Sequence[Mapping[str, object]],
         distinct = dict(zip(map(id, rules), rules, strict=True))
         counted = [(Tolerance.from_json(distinct[found]), count) for found, count in Counter(map(id, rules)).items()]
     widened = {rule.explained() for rule, _ in counted if rule.reason}  # the words grading gave them
-    words = column.tolerance_counts()
+    words = column.tolerance.counted()
     return _by_count(Counter({text: count for text, count in words.items() if text not in widened})), \
         widening(counted)
 
@@ -262,8 +262,8 @@ def _invalid(graded: ClassGrades,
     found: dict[int, list[InvalidCell]] = {index: [] for index in students}
     for label in graded.key.labels:
         column = graded.columns[label]
-        mine = [index for index in students if column.verdict[index] == column.kinds.index("invalid")] \
-            if "invalid" in column.kinds else []
+        invalid = column.verdict.are("invalid")
+        mine = [index for index in students if invalid[index]]
         for index, typed, said in zip(mine, column.submitted.take(mine), column.feedback.take(mine), strict=True):
             found[index].append(InvalidCell(label, "" if typed is None else typed,
                                             str(said).removeprefix("could not read this answer: ")))

@@ -157,7 +157,7 @@ def grade(key: Key, submissions: Submissions, physics: Physics | None = None) ->
     # Handed over, not kept: the answers are let go a part at a time, as it is graded.
     graded = grade_piece(key, submissions.answers, physics)
     return replace(graded, problems=(*problems_read, *graded.problems), ignored_columns=ignored,
-                   notes=(*notes_read, *physics.notes, *late_notes(graded.late)))
+                   notes=(*notes_read, *physics.notes, *late_notes(graded.late.unknown if graded.late else 0)))
 
 
 PIECE = 20_000
@@ -249,9 +249,8 @@ def grade_piece(key: Key, answers: Sequence[Answer], physics: Physics) -> Graded
                   numbers, tuple(firsts))
 
 
-def late_notes(late: LateWork | None) -> list[str]:
-    """The notes of a class's lateness: answers whose lateness is not known."""
-    unknown = 0 if late is None else late.unknown
+def late_notes(unknown: int) -> list[str]:
+    """The notes of a class's lateness: ``unknown`` answers whose lateness is not known."""
     return [f"{unknown:,} answers have no timestamp (or one that does not read): how late they were is not "
             "known, and they lose nothing; see problems.csv"] if unknown else []
 

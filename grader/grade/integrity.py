@@ -181,7 +181,7 @@ def check(graded: Graded | ClassGrades, block: int = PAIRS) -> Integrity:
         part = bands(label, values, key.part_entries(label, "tolerance"), first.unit)
         numbers = graded.numbers[label]
         column = graded.columns[label]
-        incorrect, correct = column.are("incorrect"), column.are("correct")
+        incorrect, correct = column.verdict.are("incorrect"), column.verdict.are("correct")
         wrong[label] = np.flatnonzero(incorrect & np.isfinite(numbers) & np.isfinite(values))
         right[label] = np.where(correct & np.isfinite(numbers), numbers, np.nan)
         parts.append(part)

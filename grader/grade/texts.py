@@ -19,7 +19,7 @@ class Texts:
 
     __slots__ = ("_ends", "_given", "_text")
 
-    def __init__(self, text: str, ends: Ints, given: npt.NDArray[np.bool_]) -> None:
+    def __init__(self, text: str, ends: np.ndarray, given: npt.NDArray[np.bool_]) -> None:
         self._text, self._ends, self._given = text, ends, given
 
     @classmethod
@@ -28,15 +28,16 @@ class Texts:
         count = len(texts)
         given = np.fromiter(map(is_not, texts, itertools.repeat(None)), bool, count)
         plain: Sequence[str] = texts if given.all() else ["" if text is None else text for text in texts]  # type: ignore[assignment]
-        return cls("".join(plain), np.cumsum(np.fromiter(map(len, plain), np.int64, count)), given)
+        return cls("".join(plain), _narrow(np.cumsum(np.fromiter(map(len, plain), np.int64, count))), given)
 
     @classmethod
     def joined(cls, pieces: Sequence[Texts]) -> Texts:
         """The columns ``pieces``, one after another."""
         shifts = np.cumsum([0, *(len(piece._text) for piece in pieces)])
         return cls("".join(piece._text for piece in pieces),
-                   np.concatenate([piece._ends + shift for piece, shift in zip(pieces, shifts.tolist(), strict=False)]
-                                  or [np.zeros(0, np.int64)]),
+                   _narrow(np.concatenate([piece._ends.astype(np.int64) + shift
+                                           for piece, shift in zip(pieces, shifts.tolist(), strict=False)]
+                                          or [np.zeros(0, np.int64)])),
                    np.concatenate([piece._given for piece in pieces] or [np.zeros(0, bool)]))
 
     def __len__(self) -> int:
@@ -58,3 +59,8 @@ class Texts:
         for index in np.flatnonzero(~self._given[at]).tolist():
             found[index] = None
         return found
+
+
+def _narrow(ends: Ints) -> np.ndarray:
+    """Where each text ends, in 4 bytes each where the texts are under 2 GiB characters (a part's of a class are)."""
+    return ends.astype(np.int32) if not len(ends) or ends[-1] < 1 << 31 else ends

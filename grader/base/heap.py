@@ -18,8 +18,10 @@ True
 
 from __future__ import annotations
 
+import functools
 import gc
-from collections.abc import Iterator
+import sys
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 
 
@@ -36,3 +38,25 @@ def collector_paused(*, keep_frozen: bool = False) -> Iterator[None]:
             gc.unfreeze()
         if enabled:
             gc.enable()
+
+
+def hand_back() -> None:
+    """Hand the memory freed since the last call back to the system, where the C library keeps it otherwise
+    (glibc's ``malloc_trim``: a million students' key read leaves about 1 GiB free but held, and each piece of a
+    class graded a little more). Elsewhere nothing: the memory is reused all the same."""
+    trim = _trim()
+    if trim is not None:
+        trim(0)
+
+
+@functools.cache
+def _trim() -> Callable[[int], int] | None:
+    """glibc's ``malloc_trim``, where the C library is glibc."""
+    if sys.platform != "linux":
+        return None
+    import ctypes  # here: only a run that frees much memory needs it
+
+    try:
+        return ctypes.CDLL("libc.so.6").malloc_trim
+    except (OSError, AttributeError):  # musl (no malloc_trim), or no libc.so.6
+        return None

@@ -18,6 +18,7 @@ from typing import Generic, TypeVar
 import numpy as np
 import numpy.typing as npt
 
+from grader.base.heap import hand_back
 from grader.grade.diagnosis import Physics
 from grader.grade.grading import PIECE, VERDICTS, Graded, LateWork, Row, graded_pieces, late_notes
 from grader.grade.key import Key
@@ -220,6 +221,7 @@ def grade_class(key: Key, read: Callable[[], Submissions], physics: Physics,
     else holds them: a piece's answers are let go once it is graded), ``size`` students at a time
     (:func:`~grader.grade.grading.graded_pieces`); each piece is handed to ``each`` (which writes its rows), then
     let go but for what the class's reports read."""
+    hand_back()  # what reading the key freed
     submissions = read()
     problems, ignored, notes, files = submissions.problems, submissions.ignored_columns, submissions.notes, \
         submissions.files
@@ -231,7 +233,11 @@ def grade_class(key: Key, read: Callable[[], Submissions], physics: Physics,
             each(graded)
         kept.add(graded)
         del graded
-    return kept.joined(problems, ignored, (*notes, *physics.notes), files)
+        hand_back()
+    whole = kept.joined(problems, ignored, (*notes, *physics.notes), files)
+    del kept
+    hand_back()
+    return whole
 
 
 def classwide(graded: Graded | ClassGrades) -> ClassGrades:
@@ -277,7 +283,7 @@ class Keeping:
         """The class: ``problems``, ``ignored`` and ``notes`` the submissions' (and the physics'), then the
         pieces' own (the attempts not counted, in the order grading the class at once finds them: by part, then
         by where each student first answered it, ``files`` the order of the files; and the answers whose
-        lateness is not known)."""
+        lateness is not known). Once: the pieces are let go as they are joined."""
         own = self.problems
         if self.pieces > 1 and own:
             labels = {label: index for index, label in enumerate(self.key.labels)}
@@ -286,9 +292,12 @@ class Keeping:
                      for problem, first in zip(own, self.firsts, strict=True)]
             own = [own[index] for index in sorted(range(len(own)), key=ranks.__getitem__)]
         late = None if self.unknown is None else Lateness(self.latest, self.deductions, self.unknown)
-        return ClassGrades(self.key, {label: part.joined() for label, part in self.parts.items()},
+        # A part's pieces let go once joined: the class's columns are not held twice.
+        columns = {label: self.parts.pop(label).joined() for label in list(self.parts)}
+        return ClassGrades(self.key, columns,
                            (*problems, *own), ignored, (*notes, *late_notes(self.unknown or 0)), self.mistakes, late,
-                           {label: np.concatenate(found) for label, found in self.numbers.items() if found})
+                           {label: np.concatenate(self.numbers.pop(label)) for label in list(self.numbers)
+                            if self.numbers[label]})
 
 
 def latest(late: LateWork, count: int) -> list[int | None]:

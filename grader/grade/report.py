@@ -19,6 +19,7 @@ from contextlib import contextmanager
 from pathlib import Path
 
 from grader.base.files import atomic_file, write_atomic
+from grader.base.heap import hand_back
 from grader.base.spreadsheet import csv_columns_text, csv_pieces, csv_text, number_cell, number_cells
 from grader.grade.canvas_file import CanvasFile
 from grader.grade.class_grades import ClassGrades, classwide, final_scores, lateness, totals
@@ -61,6 +62,7 @@ def write_reports(graded: Graded | ClassGrades, folder: Path, canvas: CanvasFile
     says); returns their paths."""
     graded = classwide(graded)
     integrity = check(graded)
+    hand_back()
     files = {GRADES: grades_csv(graded), PROBLEMS: problems_csv(graded, canvas), CANVAS: canvas_csv(canvas),
              INTEGRITY: integrity_csv(graded, integrity), REPORT: class_report(graded, integrity)}
     for name, text in files.items():

@@ -35,7 +35,7 @@ class AnswerColumns(Sequence[Answer]):
 
     @classmethod
     def joined(cls, ids: Sequence[str], labels: Sequence[str], files: Sequence[tuple[str, str]],
-               blocks: Sequence[tuple[int, Sequence[int], Sequence[int], Sequence[int], Texts]]) -> AnswerColumns:
+               blocks: Sequence[tuple[int, np.ndarray, np.ndarray, np.ndarray, Texts]]) -> AnswerColumns:
         """The answers of ``blocks``, one after another: each (its file's index in ``files``, the students'
         indices, the labels' indices, the lines, the texts)."""
         return cls(ids, labels, files, _column([block[1] for block in blocks], np.int32),

@@ -223,6 +223,7 @@ def grade_class(key: Key, read: Callable[[], Submissions], physics: Physics,
     let go but for what the class's reports read."""
     hand_back()  # what reading the key freed
     submissions = read()
+    hand_back()  # what reading the files freed (their text)
     problems, ignored, notes, files = submissions.problems, submissions.ignored_columns, submissions.notes, \
         submissions.files
     pieces = graded_pieces(key, submissions, physics, size)

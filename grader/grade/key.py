@@ -743,6 +743,7 @@ def _columns_students(columns: KeyColumns, symbols: Mapping[str, Mapping[str, tu
     params = array("d", np.ascontiguousarray(columns.params, np.float64).tobytes())
     every_printed = bool((np.abs(columns.params) < 1.7e308).all())
     dues: dict[str, datetime] = {}
+    sections: dict[str, str] = {}  # one text a section (a class has a few), not one a student
     students, parameter = [], 0
     for student_id, name, email, section, due, shape, own in zip(columns.ids, columns.names, columns.emails,
                                                                  columns.sections, columns.dues, columns.shape.tolist(),
@@ -755,7 +756,8 @@ def _columns_students(columns: KeyColumns, symbols: Mapping[str, Mapping[str, tu
                                                       if _printable(number))))[1]
             printed = array("d", [number for number in printed if _printable(number)])
         when = None if due is None else dues.get(due) or dues.setdefault(due, _instant(due, "due"))
-        students.append(KeyStudent(student_id, name, email, section, own, names, printed, when))
+        students.append(KeyStudent(student_id, name, email, sections.setdefault(section, section), own, names, printed,
+                                   when))
     return students, table
 
 

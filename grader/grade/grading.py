@@ -154,7 +154,6 @@ def grade(key: Key, submissions: Submissions, physics: Physics | None = None) ->
     the key's late policy is applied (:func:`_late_work`)."""
     physics = physics_for(key) if physics is None else physics
     problems_read, ignored, notes_read = submissions.problems, submissions.ignored_columns, submissions.notes
-    # Handed over, not kept: the answers are let go a part at a time, as it is graded.
     graded = grade_piece(key, submissions.answers, physics)
     return replace(graded, problems=(*problems_read, *graded.problems), ignored_columns=ignored,
                    notes=(*notes_read, *physics.notes, *late_notes(graded.late.unknown if graded.late else 0)))
@@ -178,9 +177,9 @@ def graded_pieces(key: Key, submissions: Submissions, physics: Physics, size: in
     if count <= size:
         yield grade_piece(key, answers, physics)
         return
-    for index, (start, mine) in enumerate(_by_piece(key, answers, size)):
-        if not index:
-            del answers  # a piece's answers are all that is left of them
+    pieces = _by_piece(key, answers, size)
+    del answers  # the pieces' answers are all that is kept of them
+    for start, mine in pieces:
         stop = min(start + size, count)
         yield grade_piece(key.piece(start, stop), mine, physics.piece(start, stop))
         del mine

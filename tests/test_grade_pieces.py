@@ -124,3 +124,27 @@ def spied(kinds: list[type]) -> Callable[..., Submissions]:
         return found
 
     return reading
+
+
+def test_a_piece_whose_students_have_no_due_time_is_timed_as_its_class(
+        tmp_path: Path, demo_run: DemoRun, monkeypatch: pytest.MonkeyPatch) -> None:
+    """No assignment due time, one student's own: the class's lateness is measured. A piece without that student
+    measured none, and grades.csv's late column came out short: a traceback (ValueError from zip), where the
+    class graded at once writes its files (found by the differential sweep of several submissions files)."""
+    document = json.loads((demo_run.out / "key.json").read_text(encoding="utf-8"))
+    assignment = document["assignment"]
+    assignment["due"], assignment["late"] = "", None
+    assignment.pop("deadline", None)
+    document["students"][3]["due"] = "2026-12-08T23:59:00+00:00"
+    key = tmp_path / "key.json"
+    key.write_text(json.dumps(document), encoding="utf-8")
+    submitted = tmp_path / "submissions.csv"
+    shutil.copyfile(demo_run.out / "submissions.csv", submitted)
+    written = {}
+    for size in (1000, 2):
+        monkeypatch.setattr(grader.grade.run, "PIECE", size)
+        out = tmp_path / f"out-{size}"
+        assert main(["grade", "--key", str(key), str(submitted), "--out", str(out)]) in (0, 3)
+        written[size] = {path.name: path.read_bytes() for path in sorted(out.iterdir())}
+    assert written[2] == written[1000]
+    assert b"late" in written[2]["grades.csv"]

@@ -4,6 +4,7 @@ other file is read row by row."""
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 import pytest
@@ -133,3 +134,23 @@ def test_several_plain_files_are_read_as_the_row_by_row_reading_reads_them(
     slow = read_submissions(paths, STUDENTS, LABELS, attempts=attempts)
     assert fast == slow and list(fast.answers) == list(slow.answers) and fast.answers
     assert [answer.file for answer in fast.answers] == sorted(answer.file for answer in fast.answers)
+
+
+@pytest.mark.skipif(not Path("/dev/fd").is_dir(), reason="no /dev/fd")
+@pytest.mark.parametrize("pipe_first", [True, False])
+def test_a_plain_pipe_before_a_file_that_is_not_plain_is_read_once(tmp_path: Path, pipe_first: bool) -> None:
+    """``grader grade <(cat a.csv) b.csv``: a pipe cannot be read again when a later file turns out not plain.
+    It was, and read empty: "empty file; expected a header line" (the row-by-row reading read it once)."""
+    plain_text = "student_id,label,answer\n007,1a,6.2\n042,1b,7\n"
+    stamped = tmp_path / "stamped.csv"
+    stamped.write_text("student_id,label,answer,timestamp\n100,2a,5,2026-12-01 10:00\n", encoding="utf-8")
+    read_end, write_end = os.pipe()
+    os.write(write_end, plain_text.encode("utf-8"))  # well within a pipe's buffer
+    os.close(write_end)
+    try:
+        pipe = Path(f"/dev/fd/{read_end}")
+        got = read_submissions([pipe, stamped] if pipe_first else [stamped, pipe], STUDENTS, LABELS)
+    finally:
+        os.close(read_end)
+    assert sorted((a.student_id, a.label, a.text) for a in got.answers) == [
+        ("007", "1a", "6.2"), ("042", "1b", "7"), ("100", "2a", "5")]

@@ -233,7 +233,7 @@ def grade_piece(key: Key, answers: Sequence[Answer], physics: Physics) -> Graded
     stamps: dict[str, list[datetime | None]] = {}
     everyone = np.arange(len(key.students))
     ids = [student.id for student in key.students]
-    timed = _timed(key)  # else no answer's lateness is measured: its timestamp is not kept
+    timed = key.timed  # else no answer's lateness is measured: its timestamp is not kept
     for problem in key.problems:
         earlier: list[Earlier] = []
         for label in problem.labels:
@@ -311,16 +311,11 @@ def _best(key: Key, label: str, chosen: dict[str, Answer], several: Mapping[str,
     return chosen
 
 
-def _timed(key: Key) -> bool:
-    """Whether the key has due times (the assignment's, or a student's own)."""
-    return key.deadline is not None or any(student.due for student in key.students)
-
-
 def _late_work(key: Key, columns: Mapping[str, Sequence[Row]],
                stamps: Mapping[str, Sequence[datetime | None]]) -> LateWork | None:
     """How late each answer was and what the key's late policy takes for it (:mod:`grader.grade.lateness`);
     None for a key without due times."""
-    if not _timed(key):
+    if not key.timed:
         return None
     policy, everyone = key.late, range(len(key.students))
     dues = [_due(key, index) for index in everyone]

@@ -172,10 +172,18 @@ class Key:
         time: their parts read from the same columns, their parameters the same columns' rows."""
         base = self.span[0] if self.span else 0
         found = replace(self, students=self.students[start:stop], span=(base + start, base + stop))
+        found.__dict__["timed"] = self.timed  # a piece whose students have no due time is still the class's
         if "parameter_columns" in self.__dict__:  # worked out for the class: its rows, not worked out again
             found.__dict__["parameter_columns"] = {name: column[start:stop]
                                                    for name, column in self.parameter_columns.items()}
         return found
+
+    @functools.cached_property
+    def timed(self) -> bool:
+        """Whether the class has due times (the assignment's, or a student's own): then every answer's lateness
+        is measured (a student without a due time: not known). A piece of the key (:meth:`piece`) is timed as its
+        class is, though none of its own students has a due time."""
+        return self.deadline is not None or any(student.due for student in self.students)
 
     @functools.cached_property
     def positions(self) -> dict[str, int]:

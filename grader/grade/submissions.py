@@ -131,11 +131,13 @@ def read_submissions(paths: Sequence[Path], students: Sequence[StudentRef], labe
         if table.encoding == "Windows-1252":
             notes.append(f"{name}: not UTF-8; read as Windows-1252 (Latin-1): check accented text, or save the "
                          'file as "CSV UTF-8"')
-        if plain is not None:
+        # A file the files after it might make read again must be one that can be (not a pipe, <(...)).
+        if plain is not None and (index == len(paths) - 1 or path.is_file()):
             found = _plain_answers(table, layout, reader.roster.ids, labels, index, taken)
             if found is not None:
                 plain += found
                 continue
+        if plain is not None:
             for earlier in range(index):  # the files before were plain, this one is not: all are read row by row
                 again, again_layout = _opened(paths[earlier], labels, fmt, reader)
                 for row in again.rows():

@@ -432,7 +432,7 @@ def test_a_flagged_pair_changes_no_grade_and_is_in_no_feedback_file(tmp_path: Pa
                if row["flagged"] == "yes"]
     assert {(row["student_id"], row["matches_id"]) for row in flagged} == {(first["id"], second["id"])}
     assert len(flagged) == 3
-    monkeypatch.setattr(report, "check", lambda graded: Integrity((), (), 0, 0.05, 0, 0))
+    monkeypatch.setattr(report, "check", lambda graded: Integrity.of((), (), 0, 0.05, 0, 0))
     unchecked = graded_into("unchecked")
     differ = sorted(name for name in checked if checked[name] != unchecked.get(name))
     assert set(differ) <= {"integrity.csv", "report.html", ".grader-manifest.json"}, differ

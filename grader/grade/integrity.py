@@ -33,10 +33,8 @@ time, so time and memory grow with the class, not its square.
 
 from __future__ import annotations
 
-import functools
 import math
-from collections.abc import Collection, Mapping, Sequence
-from dataclasses import dataclass
+from collections.abc import Mapping, Sequence
 from typing import NamedTuple
 
 import numpy as np
@@ -47,6 +45,7 @@ from grader.grade.compare import errors
 from grader.grade.grading import Graded
 from grader.grade.integrity_chance import UNRELATED, Spread
 from grader.grade.integrity_close import bound, close_pairs
+from grader.grade.integrity_found import Integrity, Match, Matches, Pair, Pairs
 from grader.grade.integrity_search import (
     Bands,
     Floats,
@@ -66,59 +65,7 @@ LISTED = 5  # students named per wrong answer in integrity.csv; the rest are cou
 KEPT = 1.0  # pairs with two or more matched parts are kept when their corrected chance is below this
 PAIRS = 1 << 19  # candidate pairs worked out at a time (a few hundred bytes each): memory bounded, whatever the class
 
-
-class Match(NamedTuple):
-    """A wrong answer that another student's key accepts: who answered (index in the key), the part, whose
-    variant it matches (index), that student's value, and how many students' values it matches in all."""
-
-    student: int
-    label: str
-    partner: int
-    value: float
-    matches: int
-
-
-class Pair(NamedTuple):
-    """A student's wrong answers against another student's key: the parts matched, how many of the first
-    student's parts were wrong (and so could match), the chance of so many matches by accident, and that
-    chance corrected for the pairs examined; and what the chance counted: the closest matches, how many, and
-    how close the least close of them is, in half-units of the student's typed answers (inf: not read)."""
-
-    student: int
-    partner: int
-    labels: tuple[str, ...]
-    wrong: int
-    chance: float
-    corrected: float
-    closest: int = 0
-    closeness: float = math.inf
-
-
-@dataclass(frozen=True)
-class Integrity:
-    """What the check found: each wrong answer's listed matches, every pair with two or more matched parts
-    (and the pairs of the listed matches), most suspicious first; the number of pairs examined; the
-    threshold; and how many wrong answers were compared (and matched anyone)."""
-
-    matches: tuple[Match, ...]
-    pairs: tuple[Pair, ...]
-    examined: int
-    threshold: float
-    wrong: int
-    matched: int
-
-    @property
-    def flagged(self) -> tuple[Pair, ...]:
-        """The pairs whose corrected chance is at most the threshold."""
-        return tuple(pair for pair in self.pairs if len(pair.labels) >= 2 and pair.corrected <= self.threshold)
-
-    def pair(self, student: int, partner: int) -> Pair | None:
-        """The pair of two students (by index), if it is listed."""
-        return self._by_students.get((student, partner))
-
-    @functools.cached_property
-    def _by_students(self) -> dict[tuple[int, int], Pair]:
-        return {(pair.student, pair.partner): pair for pair in self.pairs}
+__all__ = ["LISTED", "Integrity", "Match", "Pair", "check"]
 
 
 class _Answers(NamedTuple):
@@ -195,33 +142,32 @@ def check(graded: Graded | ClassGrades, block: int = PAIRS) -> Integrity:
     examined = int(np.count_nonzero(per_student >= 2)) * max(students - 1, 0)
     found = [holding(part, wrong[part.label], graded.numbers[part.label]) for part in parts]
     answers = _Answers(wrong, graded.numbers, typed, right, texts, per_student, {}, {})
-    pairs = _pairs(parts, answers, spread, found, examined, block)
-    matches = _listed(parts, wrong, graded.numbers, found, _ranked(pairs.values()))
+    kept = _pairs(parts, answers, spread, found, examined, block)
+    kept = kept.take(_ranked(kept))
+    matches = _listed(parts, wrong, graded.numbers, found, kept)
     # Every listed match has its pair's figures.
-    listed = distinct(np.fromiter((match.student * students + match.partner for match in matches), np.int64,
-                                  len(matches)))
-    known = np.sort(np.fromiter((student * students + partner for student, partner in pairs), np.int64, len(pairs)))
+    listed = distinct(matches.student.astype(np.int64) * students + matches.partner)
+    known = np.sort(kept.student.astype(np.int64) * students + kept.partner)
     others = listed[~_among(listed, known)]
-    if len(others):
-        pairs.update(((pair.student, pair.partner), pair) for pair in _figures(
-            parts, answers, spread, others // students, others % students, examined))
-    ranked = _ranked(pairs.values())
-    return Integrity(tuple(matches), tuple(ranked), examined, key.integrity_threshold,
+    del listed, known
+    step = max(block, 1)
+    more = [_figures(parts, answers, spread, others[start:start + step] // students,
+                     others[start:start + step] % students, examined) for start in range(0, len(others), step)]
+    found_pairs = Pairs.joined([kept, *more]) if more else kept
+    del kept, more
+    return Integrity(matches, found_pairs.take(_ranked(found_pairs)), examined, key.integrity_threshold,
                      sum(len(members) for members in wrong.values()),
                      sum(int(np.count_nonzero(counts)) for counts, _ in found))
 
 
-def _ranked(pairs: Collection[Pair]) -> list[Pair]:
-    """The pairs, most suspicious first: by corrected chance, chance, student and partner (a sort of arrays, not
-    of a million tuples)."""
-    listed = list(pairs)
-    corrected, chance = (np.fromiter((getattr(pair, name) for pair in listed), np.float64, len(listed))
-                         for name in ("corrected", "chance"))
+def _ranked(pairs: Pairs) -> Ints:
+    """The order of the pairs, most suspicious first: by corrected chance, chance, student and partner (a sort
+    of arrays, not of a million tuples)."""
+    corrected, chance, student, partner = pairs.corrected, pairs.chance, pairs.student, pairs.partner
     if np.isnan(corrected).any() or np.isnan(chance).any():  # not ordered as Python orders them: none is NaN
-        return sorted(listed, key=lambda pair: (pair.corrected, pair.chance, pair.student, pair.partner))
-    student, partner = (np.fromiter((getattr(pair, name) for pair in listed), np.int64, len(listed))
-                        for name in ("student", "partner"))
-    return [listed[index] for index in np.lexsort((partner, student, chance, corrected)).tolist()]
+        keys = list(zip(corrected.tolist(), chance.tolist(), student.tolist(), partner.tolist(), strict=True))
+        return np.array(sorted(range(len(keys)), key=keys.__getitem__), np.int64)
+    return np.lexsort((partner, student, chance, corrected))
 
 
 def _among(keys: Ints, known: Ints) -> npt.NDArray[np.bool_]:
@@ -238,7 +184,7 @@ def _number(value: object) -> float:
 
 def _pairs(parts: Sequence[Bands], answers: _Answers, spread: Spread,
            found: Sequence[tuple[Ints, list[tuple[Ints, Ints]]]], examined: int,
-           block: int = PAIRS) -> dict[tuple[int, int], Pair]:
+           block: int = PAIRS) -> Pairs:
     """Every pair with two or more matched parts whose corrected chance is below :data:`KEPT`.
 
     A pair needs as many matched parts as the fewest whose chance could be that small (:func:`_needed`); a
@@ -271,17 +217,16 @@ def _pairs(parts: Sequence[Bands], answers: _Answers, spread: Spread,
         if two.any():
             kept.append((owners[two], partners[two], hits[two]))
     if not kept:
-        return {}
+        return Pairs.of(())
     owners = np.concatenate([owners for owners, _, _ in kept])
     partners = np.concatenate([partners for _, partners, _ in kept])
     hits = np.concatenate([hits for _, _, hits in kept])
+    del kept
     most = _most(parts, answers, found, candidate, int(per_student[owners].max()), block)
-    pairs: dict[tuple[int, int], Pair] = {}
-    for start in range(0, len(owners), max(block, 1)):
-        rows = slice(start, start + max(block, 1))
-        pairs.update(((pair.student, pair.partner), pair) for pair in _figures(
-            parts, answers, spread, owners[rows], partners[rows], examined, 2, KEPT, hits[rows], most))
-    return pairs
+    step = max(block, 1)
+    return Pairs.joined([_figures(parts, answers, spread, owners[start:start + step], partners[start:start + step],
+                                  examined, 2, KEPT, hits[start:start + step], most)
+                         for start in range(0, len(owners), step)])
 
 
 def _most(parts: Sequence[Bands], answers: _Answers, found: Sequence[tuple[Ints, list[tuple[Ints, Ints]]]],
@@ -372,7 +317,7 @@ def _hits(parts: Sequence[Bands], answers: _Answers, owners: Ints, partners: Int
 
 def _figures(parts: Sequence[Bands], answers: _Answers, spread: Spread, owners: Ints, partners: Ints,
              examined: int, least: int = 0, below: float = math.inf, hits: npt.NDArray[np.bool_] | None = None,
-             most: int | None = None) -> list[Pair]:
+             most: int | None = None) -> Pairs:
     """Each pair's matched parts and chances; only the pairs with ``least`` matched parts or more and a
     corrected chance under ``below``. For ``j`` from 2 to the matches (1 for a pair of one match): the chance
     that ``j`` or more of the owner's wrong parts land by accident as close to the partner's values as the
@@ -416,13 +361,12 @@ def _figures(parts: Sequence[Bands], answers: _Answers, spread: Spread, owners: 
     corrected, counted, closeness = corrected[kept], counted[kept], closeness[kept]
     # The matched parts' labels, worked out once per pattern of parts (a class has a few hundred patterns).
     patterns = hits.astype(np.int64) @ (np.int64(1) << np.arange(len(parts), dtype=np.int64))
-    named: dict[int, tuple[str, ...]] = {}
-    for pattern in distinct(patterns).tolist():
-        named[pattern] = tuple(part.label for index, part in enumerate(parts) if pattern >> index & 1)
-    return [Pair(owner, partner, named[pattern], wrong, chance, fixed, closest, near)
-            for owner, partner, pattern, wrong, chance, fixed, closest, near in zip(
-                owners.tolist(), partners.tolist(), patterns.tolist(), per_student[owners].tolist(),
-                chances.tolist(), corrected.tolist(), counted.tolist(), closeness.tolist(), strict=True)]
+    table = distinct(patterns)
+    named = tuple(tuple(part.label for index, part in enumerate(parts) if pattern >> index & 1)
+                  for pattern in table.tolist())
+    return Pairs(named, owners.astype(np.int32), partners.astype(np.int32),
+                 np.searchsorted(table, patterns).astype(np.int32), per_student[owners].astype(np.int32), chances,
+                 corrected, counted.astype(np.int32), closeness)
 
 
 def _tails(parts: Sequence[Bands], answers: _Answers, spread: Spread, owners: Ints, partners: Ints,
@@ -470,27 +414,54 @@ def _chance(part: Bands, spread: Spread, owners: Ints, partners: Ints, closeness
 
 
 def _listed(parts: Sequence[Bands], wrong: Mapping[str, Ints], numbers: Mapping[str, Floats],
-            found: Sequence[tuple[Ints, list[tuple[Ints, Ints]]]], ranked: Sequence[Pair]) -> list[Match]:
+            found: Sequence[tuple[Ints, list[tuple[Ints, Ints]]]], ranked: Pairs) -> Matches:
     """Each wrong answer that matches anyone, with up to :data:`LISTED` of the students it matches: the
     partners of its pairs (``ranked``: most suspicious first, :func:`_ranked`) first, then the nearest values
-    (by distance over the band)."""
-    partners_of: dict[tuple[int, str], list[int]] = {}
-    for pair in ranked:  # a student's pairs in the order of their corrected chance, chance and partner
-        for label in pair.labels:
-            partners_of.setdefault((pair.student, label), []).append(pair.partner)
-    matches = []
-    for part, (counts, _) in zip(parts, found, strict=True):
-        members = wrong[part.label]
+    (by distance over the band); by student, then label."""
+    labels = [part.label for part in parts]
+    columns: list[tuple[Ints, Ints, Ints, Ints]] = []  # per part: the answers' students, partners, counts, rows
+    for index, (part, (counts, _)) in enumerate(zip(parts, found, strict=True)):
         some = np.flatnonzero(counts > 0)
-        closest = nearest(part, members[some], numbers[part.label], LISTED)
-        for row, index in enumerate(some):
-            student = int(members[index])
-            chosen = partners_of.get((student, part.label), [])[:LISTED]
-            nearer = [int(other) for other in closest[row] if other >= 0 and other not in chosen]
-            chosen += nearer[:LISTED - len(chosen)]
-            matches += [Match(student, part.label, other, float(part.values[other]), int(counts[index]))
-                        for other in chosen]
-    matches.sort(key=lambda match: (match.student, match.label))
-    return matches
+        answering = wrong[part.label][some]  # sorted, as the wrong answers are
+        # The partners of the answers' pairs, each answer's in their order, then their nearest values.
+        having = np.array([part.label in named for named in ranked.patterns], bool)[ranked.pattern]
+        rows = np.flatnonzero(having)
+        at = np.minimum(np.searchsorted(answering, ranked.student[rows]), max(len(answering) - 1, 0))
+        mine = np.asarray(answering[at] == ranked.student[rows]) if len(answering) else np.zeros(len(rows), bool)
+        rows, at = rows[mine], at[mine]
+        by_answer = np.argsort(at, kind="stable")
+        first, first_partner = at[by_answer], ranked.partner[rows[by_answer]].astype(np.int64)
+        place = _places(first)
+        first, first_partner, place = first[place < LISTED], first_partner[place < LISTED], place[place < LISTED]
+        closest = nearest(part, answering, numbers[part.label], LISTED)
+        near = np.repeat(np.arange(len(answering)), LISTED)
+        near_partner = closest.ravel()
+        chosen = np.sort(first * len(part.values) + first_partner)
+        fresh = (near_partner >= 0) & ~_among(near * len(part.values) + near_partner, chosen)
+        every = np.concatenate([first, near[fresh]])
+        order = np.lexsort((np.concatenate([place, LISTED + np.tile(np.arange(LISTED), len(answering))[fresh]]),
+                            every))
+        every, partners = every[order], np.concatenate([first_partner, near_partner[fresh]])[order]
+        shown = _places(every) < LISTED
+        every, partners = every[shown], partners[shown]
+        columns.append((answering[every], np.full(len(every), index), partners, counts[some][every]))
+    student = np.concatenate([column[0] for column in columns] or [np.zeros(0, np.int64)])
+    part_of = np.concatenate([column[1] for column in columns] or [np.zeros(0, np.int64)])
+    partner = np.concatenate([column[2] for column in columns] or [np.zeros(0, np.int64)])
+    value = np.concatenate([part.values[column[2]] for part, column in zip(parts, columns, strict=True)]
+                           or [np.zeros(0)])
+    matched = np.concatenate([column[3] for column in columns] or [np.zeros(0, np.int64)])
+    in_words = np.argsort(np.argsort(np.array(labels, dtype=object), kind="stable"), kind="stable")
+    order = np.lexsort((np.arange(len(student)), in_words[part_of] if len(labels) else part_of, student))
+    return Matches(tuple(labels), student[order].astype(np.int32), part_of[order].astype(np.int32),
+                   partner[order].astype(np.int32), value[order], matched[order].astype(np.int32))
 
 
+def _places(groups: Ints) -> Ints:
+    """Each entry's place in its run of equal ``groups`` (sorted): 0, 1, ...
+
+    >>> _places(np.array([0, 0, 3, 5, 5, 5])).tolist()
+    [0, 1, 0, 0, 1, 2]
+    """
+    starts = np.flatnonzero(np.r_[True, groups[1:] != groups[:-1]]) if len(groups) else np.zeros(0, np.int64)
+    return np.arange(len(groups)) - np.repeat(starts, np.diff(np.r_[starts, len(groups)]))

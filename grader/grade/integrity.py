@@ -64,6 +64,7 @@ from grader.grade.integrity_typed import halves, steps
 LISTED = 5  # students named per wrong answer in integrity.csv; the rest are counted
 KEPT = 1.0  # pairs with two or more matched parts are kept when their corrected chance is below this
 PAIRS = 1 << 19  # candidate pairs worked out at a time (a few hundred bytes each): memory bounded, whatever the class
+FIGURED = 1 << 16  # pairs whose chances are worked out at a time (about 500 bytes each while they are)
 
 __all__ = ["LISTED", "Integrity", "Match", "Pair", "check"]
 
@@ -150,9 +151,12 @@ def check(graded: Graded | ClassGrades, block: int = PAIRS) -> Integrity:
     known = np.sort(kept.student.astype(np.int64) * students + kept.partner)
     others = listed[~_among(listed, known)]
     del listed, known
-    step = max(block, 1)
+    # The chances are counted up to the most wrong parts of any of these pairs' students, whatever the block.
+    most = int(per_student[distinct(others // students)].max()) if len(others) else 0
+    step = max(min(block, FIGURED), 1)
     more = [_figures(parts, answers, spread, others[start:start + step] // students,
-                     others[start:start + step] % students, examined) for start in range(0, len(others), step)]
+                     others[start:start + step] % students, examined, most=most)
+            for start in range(0, len(others), step)]
     found_pairs = Pairs.joined([kept, *more]) if more else kept
     del kept, more
     return Integrity(matches, found_pairs.take(_ranked(found_pairs)), examined, key.integrity_threshold,
@@ -223,7 +227,7 @@ def _pairs(parts: Sequence[Bands], answers: _Answers, spread: Spread,
     hits = np.concatenate([hits for _, _, hits in kept])
     del kept
     most = _most(parts, answers, found, candidate, int(per_student[owners].max()), block)
-    step = max(block, 1)
+    step = max(min(block, FIGURED), 1)
     return Pairs.joined([_figures(parts, answers, spread, owners[start:start + step], partners[start:start + step],
                                   examined, 2, KEPT, hits[start:start + step], most)
                          for start in range(0, len(owners), step)])

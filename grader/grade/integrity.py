@@ -34,8 +34,8 @@ time, so time and memory grow with the class, not its square.
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping, Sequence
-from typing import NamedTuple
+from collections.abc import Iterator, Mapping, Sequence
+from typing import Any, NamedTuple
 
 import numpy as np
 import numpy.typing as npt
@@ -59,37 +59,68 @@ from grader.grade.integrity_search import (
     nearest,
     range_least,
 )
-from grader.grade.integrity_typed import halves, steps
+from grader.grade.integrity_typed import halves
 
 LISTED = 5  # students named per wrong answer in integrity.csv; the rest are counted
 KEPT = 1.0  # pairs with two or more matched parts are kept when their corrected chance is below this
 PAIRS = 1 << 19  # candidate pairs worked out at a time (a few hundred bytes each): memory bounded, whatever the class
 FIGURED = 1 << 16  # pairs whose chances are worked out at a time (about 500 bytes each while they are)
+ROWS = 1 << 14  # students whose figures per part are laid out in a matrix at a time
 
 __all__ = ["LISTED", "Integrity", "Match", "Pair", "check"]
+
+
+class _Right(Mapping[str, Floats]):
+    """Per part label, each student's number when their answer was right (NaN: not right): worked out from the
+    verdicts and numbers the run keeps when asked, not kept (8 bytes a student and part)."""
+
+    def __init__(self, graded: ClassGrades, labels: Sequence[str]) -> None:
+        self._graded, self._labels = graded, tuple(labels)
+        self._codes = {label: graded.columns[label].kinds.index("correct")
+                       if "correct" in graded.columns[label].kinds else -1 for label in labels}
+
+    def of(self, label: str, students: Ints | slice) -> Floats:
+        """The right numbers of ``students`` for the part."""
+        numbers = self._graded.numbers[label][students]
+        right = (self._graded.columns[label].verdict[students] == self._codes[label]) & np.isfinite(numbers)
+        return np.where(right, numbers, np.nan)
+
+    def __getitem__(self, label: str) -> Floats:
+        return self.of(label, slice(None))
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self._labels)
+
+    def __len__(self) -> int:
+        return len(self._labels)
 
 
 class _Answers(NamedTuple):
     """The class's answers the check compares: per part label, the students whose answer was wrong, each
     student's number (NaN: none), the half-unit of the last typed digit of each wrong one in the sheet's
-    unit (inf: not a plain number, so no closeness can be read from it), the right ones' numbers (NaN: not
-    right) and what each student typed; and each student's count of wrong parts."""
+    unit, in the order of the wrong ones (inf: not a plain number, so no closeness can be read from it), the
+    right ones' numbers (NaN: not right) and what each student typed; and each student's count of wrong
+    parts."""
 
     wrong: Mapping[str, Ints]
     numbers: Mapping[str, Floats]
     steps: Mapping[str, Floats]
-    right: Mapping[str, Floats]
+    right: _Right
     typed: Mapping[str, Texts]
     per_student: Ints
     read: dict[str, Floats]  # per part and student, the half-unit of the right answer, once read (NaN: not yet)
     answering: dict[str, npt.NDArray[np.bool_]]  # per part, :meth:`answered`, once worked out
+
+    def step(self, label: str, owners: Ints) -> Floats:
+        """The half-unit of the typed answers of ``owners``, each one of the part's wrong ones."""
+        return self.steps[label][np.searchsorted(self.wrong[label], owners)]
 
     def centres(self, part: Bands, owners: Ints, partners: Ints) -> Floats:
         """Where each owner's answer's closeness to the partner's is measured from: the number the partner
         typed for the part, when it was right and typed with no fewer digits than the owner's (a copy typed
         as its source typed it is there exactly), else the partner's value. An angle's is taken within half a
         turn of the value."""
-        values, typed = part.values[partners], self.right[part.label][partners]
+        values, typed = part.values[partners], self.right.of(part.label, partners)
         have = np.isfinite(typed)
         read = self.read.get(part.label)
         if read is None:
@@ -98,7 +129,7 @@ class _Answers(NamedTuple):
         asked = asked[np.isnan(read[asked])]
         read[asked] = halves(self.typed[part.label].take(asked), self.numbers[part.label][asked])
         half_units = np.where(have, read[partners], np.inf)
-        found = np.where(have & (half_units <= self.steps[part.label][owners]), typed, values)
+        found = np.where(have & (half_units <= self.step(part.label, owners)), typed, values)
         period = part.period
         return found if period is None else values + np.mod(found - values + period / 2, period) - period / 2
 
@@ -115,11 +146,19 @@ def check(graded: Graded | ClassGrades, block: int = PAIRS) -> Integrity:
     """The integrity check of a grading run (the key's numeric parts; symbolic ones are left out), its
     candidate pairs worked out about ``block`` at a time (the findings are the same whatever the block)."""
     graded = classwide(graded)
+    matches, pieces, examined, wrong, matched = _search(graded, block)  # what the search held is let go
+    pairs = Pairs.joined(pieces)
+    del pieces
+    return Integrity(matches, pairs.take(_ranked(pairs)), examined, graded.key.integrity_threshold, wrong, matched)
+
+
+def _search(graded: ClassGrades, block: int) -> tuple[Matches, list[Pairs], int, int, int]:
+    """The listed matches; the pairs, in pieces; the pairs examined; the wrong answers compared, and those that
+    matched anyone."""
     key = graded.key
     students = len(key.students)
     parts: list[Bands] = []
     wrong: dict[str, Ints] = {}
-    right: dict[str, Floats] = {}
     for label in key.labels:
         first = key.students[0].parts[label] if students else None
         if first is None or first.symbolic or label not in graded.numbers:
@@ -127,22 +166,22 @@ def check(graded: Graded | ClassGrades, block: int = PAIRS) -> Integrity:
         values = np.fromiter(map(_number, key.part_entries(label, "value")), dtype=np.float64, count=students)
         part = bands(label, values, key.part_entries(label, "tolerance"), first.unit)
         numbers = graded.numbers[label]
-        column = graded.columns[label]
-        incorrect, correct = column.are("incorrect"), column.are("correct")
-        wrong[label] = np.flatnonzero(incorrect & np.isfinite(numbers) & np.isfinite(values))
-        right[label] = np.where(correct & np.isfinite(numbers), numbers, np.nan)
+        wrong[label] = np.flatnonzero(graded.columns[label].are("incorrect") & np.isfinite(numbers)
+                                      & np.isfinite(values))
         parts.append(part)
     per_student = np.zeros(students, dtype=np.int64)
     for members in wrong.values():
         per_student[members] += 1
     texts = {label: column.submitted for label, column in graded.columns.items()}
-    typed = {part.label: steps(texts[part.label], wrong[part.label], graded.numbers[part.label]) for part in parts}
+    typed = {part.label: np.array(halves(texts[part.label].take(wrong[part.label]),
+                                         graded.numbers[part.label][wrong[part.label]]), np.float64).reshape(-1)
+             for part in parts}
     spread = Spread.of(np.concatenate([graded.numbers[p.label][wrong[p.label]] for p in parts] or [np.zeros(0)]),
                        np.concatenate([p.values[wrong[p.label]] for p in parts] or [np.zeros(0)]),
                        np.concatenate([wrong[p.label] for p in parts] or [np.zeros(0, np.int64)]), students)
     examined = int(np.count_nonzero(per_student >= 2)) * max(students - 1, 0)
     found = [holding(part, wrong[part.label], graded.numbers[part.label]) for part in parts]
-    answers = _Answers(wrong, graded.numbers, typed, right, texts, per_student, {}, {})
+    answers = _Answers(wrong, graded.numbers, typed, _Right(graded, list(wrong)), texts, per_student, {}, {})
     kept = _pairs(parts, answers, spread, found, examined, block)
     kept = kept.take(_ranked(kept))
     matches = _listed(parts, wrong, graded.numbers, found, kept)
@@ -157,11 +196,8 @@ def check(graded: Graded | ClassGrades, block: int = PAIRS) -> Integrity:
     more = [_figures(parts, answers, spread, others[start:start + step] // students,
                      others[start:start + step] % students, examined, most=most)
             for start in range(0, len(others), step)]
-    found_pairs = Pairs.joined([kept, *more]) if more else kept
-    del kept, more
-    return Integrity(matches, found_pairs.take(_ranked(found_pairs)), examined, key.integrity_threshold,
-                     sum(len(members) for members in wrong.values()),
-                     sum(int(np.count_nonzero(counts)) for counts, _ in found))
+    return (matches, [kept, *more], examined, sum(len(members) for members in wrong.values()),
+            sum(int(np.count_nonzero(counts)) for counts, _ in found))
 
 
 def _ranked(pairs: Pairs) -> Ints:
@@ -199,16 +235,19 @@ def _pairs(parts: Sequence[Bands], answers: _Answers, spread: Spread,
     class, not its square. The chances are counted up to as many wrong parts as the most of any candidate's
     student with two matched parts (:func:`_figures`'s ``most``), as one block of all candidates would."""
     wrong, students, per_student = answers.wrong, len(answers.per_student), answers.per_student
-    counts = np.zeros((students, len(parts)), dtype=np.int64)  # per student and part, the students matched
-    for index, (part, (found_counts, _)) in enumerate(zip(parts, found, strict=True)):
-        counts[wrong[part.label], index] = found_counts
-    matched = np.count_nonzero(counts, axis=1)
     needed = _needed(parts, answers, spread, found, examined)
-    # Each part's rank among the student's, most students matched first: the needed - 1 first are not searched.
-    rank = np.argsort(np.argsort(-counts, axis=1, kind="stable"), axis=1, kind="stable")
-    candidate = (counts > 0) & (matched >= needed)[:, None] & (rank >= (needed - 1)[:, None])
+    columns = [(wrong[part.label], found_counts) for part, (found_counts, _) in zip(parts, found, strict=True)]
+    candidate = np.zeros((students, len(parts)), dtype=bool)
+    for rows in _row_blocks(students):
+        counts = _laid_out(rows, columns, 0)  # per student and part, the students matched
+        matched = np.count_nonzero(counts, axis=1)
+        # Each part's rank among the student's, most students matched first: the needed - 1 first are not searched.
+        rank = np.argsort(np.argsort(-counts, axis=1, kind="stable"), axis=1, kind="stable")
+        candidate[rows] = ((counts > 0) & (matched >= needed[rows])[:, None] & (rank >= (needed[rows] - 1)[:, None])
+                           )[:, :len(parts)]
+    del columns
     ranges = [part_ranges for _, part_ranges in found]
-    owners_in = candidate.any(axis=1)
+    owners_in: npt.NDArray[np.bool_] = np.any(candidate, axis=1)
     searched = [np.flatnonzero((found_counts > 0) & owners_in[wrong[part.label]])
                 for part, (found_counts, _) in zip(parts, found, strict=True)]
     chosen = [np.flatnonzero(candidate[wrong[part.label], index]) for index, part in enumerate(parts)]
@@ -266,16 +305,44 @@ def _needed(parts: Sequence[Bands], answers: _Answers, spread: Spread,
     (more than their wrong parts: none could). ``k`` matches have a chance of at least the product of the
     ``k`` least of their parts' chances (:func:`_least`), and the correction is at least ``examined``."""
     students = len(answers.per_student)
-    least = np.full((students, max(len(parts), 1)), np.inf)
-    for index, (part, (_, ranges)) in enumerate(zip(parts, found, strict=True)):
-        members = answers.wrong[part.label]
-        least[members, index] = _least(part, spread, members, answers.numbers[part.label][members],
-                                       answers.steps[part.label][members], ranges)
-    # log 0 = -inf (a part no chance bounds) then log inf (a part that matches nobody) make NaN: not possible.
-    with np.errstate(divide="ignore", invalid="ignore"):
-        bound = math.log(max(examined, 1)) + np.cumsum(np.log(np.sort(least, axis=1)), axis=1)
-    possible = ((bound < math.log(KEPT)) | (KEPT > 1)) & (np.arange(least.shape[1]) >= 1)  # > 1: every pair
-    return np.where(possible.any(axis=1), np.argmax(possible, axis=1) + 1, least.shape[1] + 1).astype(np.int64)
+    columns = [(answers.wrong[part.label], _least(part, spread, answers.wrong[part.label],
+                                                  answers.numbers[part.label][answers.wrong[part.label]],
+                                                  answers.steps[part.label], ranges))
+               for part, (_, ranges) in zip(parts, found, strict=True)]
+    needed = np.zeros(students, dtype=np.int64)
+    for rows in _row_blocks(students):
+        least = _laid_out(rows, columns, np.inf)
+        # log 0 = -inf (a part no chance bounds) then log inf (a part that matches nobody) make NaN: not possible.
+        with np.errstate(divide="ignore", invalid="ignore"):
+            bound = math.log(max(examined, 1)) + np.cumsum(np.log(np.sort(least, axis=1)), axis=1)
+        possible = ((bound < math.log(KEPT)) | (KEPT > 1)) & (np.arange(least.shape[1]) >= 1)  # > 1: every pair
+        needed[rows] = np.where(possible.any(axis=1), np.argmax(possible, axis=1) + 1, least.shape[1] + 1)
+    return needed
+
+
+def _row_blocks(students: int) -> Iterator[slice]:
+    """The students in runs of :data:`ROWS`.
+
+    >>> [(rows.start, rows.stop) for rows in _row_blocks(ROWS + 1)] == [(0, ROWS), (ROWS, ROWS + 1)]
+    True
+    """
+    return (slice(start, min(start + ROWS, students)) for start in range(0, students, ROWS))
+
+
+def _laid_out(rows: slice, columns: Sequence[tuple[Ints, npt.NDArray[Any]]], fill: float) -> npt.NDArray[Any]:
+    """Per student of ``rows`` (a row) and part (a column; one column of ``fill`` when there are no parts), the
+    part's entry of that student (``fill``: none); ``columns``: per part, its students (sorted) and their
+    entries.
+
+    >>> _laid_out(slice(1, 3), [(np.array([0, 2]), np.array([5.0, 6.0]))], np.inf).tolist()
+    [[inf], [6.0]]
+    """
+    dtype = np.result_type(*(entries.dtype for _, entries in columns)) if columns else np.float64
+    found = np.full((rows.stop - rows.start, max(len(columns), 1)), fill, dtype=dtype)
+    for index, (members, entries) in enumerate(columns):
+        first, last = np.searchsorted(members, (rows.start, rows.stop))
+        found[members[first:last] - rows.start, index] = entries[first:last]
+    return found
 
 
 def _least(part: Bands, spread: Spread, owners: Ints, numbers: Floats, steps: Floats,
@@ -342,7 +409,7 @@ def _figures(parts: Sequence[Bands], answers: _Answers, spread: Spread, owners: 
                           angle_unit=part.unit if part.period is not None else None)[0]
         # inf / inf (a number typed as arithmetic) is NaN: such a match claims no closeness (0 sets none).
         with np.errstate(divide="ignore", invalid="ignore"):
-            units[rows, index] = np.nan_to_num(distance / answers.steps[part.label][owners[rows]], nan=0.0,
+            units[rows, index] = np.nan_to_num(distance / answers.step(part.label, owners[rows]), nan=0.0,
                                                posinf=np.inf)
     ordered = np.sort(units, axis=1)
     chances, counted, closeness = np.ones(len(owners)), matched.copy(), np.full(len(owners), np.inf)
@@ -389,7 +456,7 @@ def _tails(parts: Sequence[Bands], answers: _Answers, spread: Spread, owners: In
         if not len(rows):
             continue
         chance = _chance(part, spread, owners[rows], partners[rows], closeness[rows],
-                         answers.steps[part.label][owners[rows]],
+                         answers.step(part.label, owners[rows]),
                          answers.centres(part, owners[rows], partners[rows]))[:, None]
         shifted = np.zeros((len(rows), most + 1))
         shifted[:, 1:] = distribution[rows, :-1]

@@ -32,7 +32,7 @@ from grader.model.tolerance import Tolerance
 Floats = npt.NDArray[np.float64]
 Ints = npt.NDArray[np.int64]
 
-CHUNK = 1 << 22  # candidate pairs tested at a time: a bounded amount of memory, whatever the class
+CHUNK = 1 << 19  # candidate pairs tested at a time (about 100 bytes each): memory bounded, whatever the class
 BY_ENDS = True  # count an answer's matches from the sorted ends of the bands (False: test each candidate)
 PERIOD = {"deg": 360.0, "rad": 2 * math.pi}
 

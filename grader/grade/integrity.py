@@ -45,7 +45,7 @@ from grader.grade.compare import errors
 from grader.grade.grading import Graded
 from grader.grade.integrity_chance import UNRELATED, Spread
 from grader.grade.integrity_close import bound, close_pairs
-from grader.grade.integrity_found import Integrity, Match, Matches, Pair, Pairs
+from grader.grade.integrity_found import Integrity, Match, Matches, Pair, Pairs, Small
 from grader.grade.integrity_search import (
     Bands,
     Floats,
@@ -490,8 +490,8 @@ def _listed(parts: Sequence[Bands], wrong: Mapping[str, Ints], numbers: Mapping[
     partners of its pairs (``ranked``: most suspicious first, :func:`_ranked`) first, then the nearest values
     (by distance over the band); by student, then label."""
     labels = [part.label for part in parts]
-    columns: list[tuple[Ints, Ints, Ints, Ints]] = []  # per part: the answers' students, partners, counts, rows
-    for index, (part, (counts, _)) in enumerate(zip(parts, found, strict=True)):
+    columns: list[tuple[Small, Small, Small, Floats]] = []  # per part: students, partners, counts, values
+    for part, (counts, _) in zip(parts, found, strict=True):
         some = np.flatnonzero(counts > 0)
         answering = wrong[part.label][some]  # sorted, as the wrong answers are
         # The partners of the answers' pairs, each answer's in their order, then their nearest values.
@@ -515,17 +515,21 @@ def _listed(parts: Sequence[Bands], wrong: Mapping[str, Ints], numbers: Mapping[
         every, partners = every[order], np.concatenate([first_partner, near_partner[fresh]])[order]
         shown = _places(every) < LISTED
         every, partners = every[shown], partners[shown]
-        columns.append((answering[every], np.full(len(every), index), partners, counts[some][every]))
-    student = np.concatenate([column[0] for column in columns] or [np.zeros(0, np.int64)])
-    part_of = np.concatenate([column[1] for column in columns] or [np.zeros(0, np.int64)])
-    partner = np.concatenate([column[2] for column in columns] or [np.zeros(0, np.int64)])
-    value = np.concatenate([part.values[column[2]] for part, column in zip(parts, columns, strict=True)]
-                           or [np.zeros(0)])
-    matched = np.concatenate([column[3] for column in columns] or [np.zeros(0, np.int64)])
-    in_words = np.argsort(np.argsort(np.array(labels, dtype=object), kind="stable"), kind="stable")
-    order = np.lexsort((np.arange(len(student)), in_words[part_of] if len(labels) else part_of, student))
-    return Matches(tuple(labels), student[order].astype(np.int32), part_of[order].astype(np.int32),
-                   partner[order].astype(np.int32), value[order], matched[order].astype(np.int32))
+        columns.append((answering[every].astype(np.int32), partners.astype(np.int32),
+                        counts[some][every].astype(np.int32), part.values[partners]))
+    # By student, then label (as Python orders them), each answer's in the order chosen (the sort is stable).
+    in_words = np.argsort(np.argsort(np.array(labels, dtype=object), kind="stable"), kind="stable") if labels else []
+    part_of = np.concatenate([np.full(len(column[0]), in_words[index], np.int64)
+                              for index, column in enumerate(columns)] or [np.zeros(0, np.int64)])
+    order = np.argsort(np.concatenate([column[0] for column in columns] or [np.zeros(0, np.int32)]).astype(np.int64)
+                       * max(len(labels), 1) + part_of, kind="stable")
+    del part_of
+    label = np.concatenate([np.full(len(column[0]), index, np.int32) for index, column in enumerate(columns)]
+                           or [np.zeros(0, np.int32)])[order]
+    student, partner, matched, value = (
+        np.concatenate([column[at] for column in columns] or [np.zeros(0, kind)])[order]
+        for at, kind in enumerate((np.int32, np.int32, np.int32, np.float64)))
+    return Matches(tuple(labels), student, label, partner, value, matched)
 
 
 def _places(groups: Ints) -> Ints:

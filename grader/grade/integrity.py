@@ -518,7 +518,8 @@ def _listed(parts: Sequence[Bands], wrong: Mapping[str, Ints], numbers: Mapping[
         columns.append((answering[every].astype(np.int32), partners.astype(np.int32),
                         counts[some][every].astype(np.int32), part.values[partners]))
     # By student, then label (as Python orders them), each answer's in the order chosen (the sort is stable).
-    in_words = np.argsort(np.argsort(np.array(labels, dtype=object), kind="stable"), kind="stable") if labels else []
+    in_words: Ints = (np.argsort(np.argsort(np.array(labels, dtype=object), kind="stable"), kind="stable") if labels
+                      else np.zeros(0, np.int64))
     part_of = np.concatenate([np.full(len(column[0]), in_words[index], np.int64)
                               for index, column in enumerate(columns)] or [np.zeros(0, np.int64)])
     order = np.argsort(np.concatenate([column[0] for column in columns] or [np.zeros(0, np.int32)]).astype(np.int64)

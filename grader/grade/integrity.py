@@ -192,7 +192,7 @@ def _search(graded: ClassGrades, block: int) -> tuple[Matches, list[Pairs], int,
     del listed, known
     # The chances are counted up to the most wrong parts of any of these pairs' students, whatever the block.
     most = int(per_student[distinct(others // students)].max()) if len(others) else 0
-    step = max(min(block, FIGURED), 1)
+    step = max(FIGURED, 1)
     more = [_figures(parts, answers, spread, others[start:start + step] // students,
                      others[start:start + step] % students, examined, most=most)
             for start in range(0, len(others), step)]

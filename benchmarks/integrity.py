@@ -142,8 +142,8 @@ def scale(students: int) -> dict[str, object]:
             result = check(graded)
             checking = time.perf_counter() - started
     return {"students": students, "cells": cells, "grading": grading, "check": checking,
-            "wrong": result.wrong, "matched": result.matched, "rows": len(result.matches),
-            "pairs": sum(len(pair.labels) >= 2 for pair in result.pairs), "flagged": len(result.flagged)}
+            "wrong": result.wrong, "matched": result.matched, "rows": len(result.listed),
+            "pairs": int((result.ranked.parts() >= 2).sum()), "flagged": len(result.flagged)}
 
 
 def report(run: dict[str, object], big: dict[str, object] | None, seconds: float, jobs: int) -> str:

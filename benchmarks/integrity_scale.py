@@ -93,7 +93,7 @@ def measure(folder: Path, runs: int, band: bool) -> dict[str, object]:
     integrity_close.CLOSE = True
     result = found[True]
     return {"students": len(graded.key.students), "close": min(times[True]), "band": min(times[False], default=None),
-            "same": found[True] == found[False] if band else None, "pairs": len(result.pairs),
+            "same": found[True] == found[False] if band else None, "pairs": len(result.ranked),
             "flagged": len(result.flagged), "peak": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024,
             "load": "/".join(f"{x:.2f}" for x in os.getloadavg())}
 

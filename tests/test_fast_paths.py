@@ -164,7 +164,7 @@ def test_integrity_csv_is_the_cell_at_a_time_rule(students: int, piece: int) -> 
     for match in matches:  # a match is a wrong answer's, as the check lists them (what was read is kept of those)
         column = graded.columns[match.label]
         column[match.student] = column[match.student]._replace(verdict="incorrect", credit=0.0)  # type: ignore[index]
-    integrity = Integrity(matches, tuple(pairs.values()), 100, 0.05, 10, 5)
+    integrity = Integrity.of(matches, tuple(pairs.values()), 100, 0.05, 10, 5)
     assert (integrity.flagged and len(integrity.flagged) < len(pairs)) or not students
     assert "".join(integrity_csv(graded, integrity, piece)) == integrity_rule(graded, integrity)
 

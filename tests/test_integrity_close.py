@@ -84,7 +84,7 @@ def _every_pair(result_graded: object, kept: float,
     most = int(answers.per_student[owners[two]].max())
     found = integrity._figures(parts, answers, spread, owners[two], partners[two], captured["examined"], 2, kept,
                                hits[two], most)
-    return {(pair.student, pair.partner, pair.labels) for pair in found}
+    return {(pair.student, pair.partner, pair.labels) for pair in found.records()}
 
 
 def _two(result: Integrity) -> set[tuple[int, int, tuple[str, ...]]]:

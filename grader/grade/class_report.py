@@ -304,7 +304,7 @@ def _tolerances(summary: ClassSummary) -> str:
 
 def _integrity(graded: ClassGrades, integrity: Integrity) -> str:
     """The pairs of students whose wrong answers match each other's numbers too often to be chance."""
-    students, flagged = graded.key.students, integrity.flagged
+    students, flagged = graded.key.students, np.flatnonzero(integrity.ranked.flagged(integrity.threshold))
     text = ["<h2 id=\"integrity\">Answers from another student's variant</h2>\n<p>Every student has their own "
             "numbers, so a wrong answer that another student's key accepts (same part, within that student's "
             "tolerance; not a diagnosed mistake of the student's own) is worth a look. "
@@ -314,14 +314,14 @@ def _integrity(graded: ClassGrades, integrity: Integrity) -> str:
             f"{_e(f'{integrity.threshold:g}')} (the assignment's <code>grading.integrity_threshold</code>; "
             "docs/grading.md says how it is estimated). This is evidence to look at, not proof, and it changes "
             "no grade.</p>"]
-    if not flagged:
+    if not len(flagged):
         text.append("<p>No pair of students is flagged.</p>")
         return "\n".join(text)
     rows = [f"<tr><td>{_e(students[p.student].id)}</td><td>{_e(students[p.student].name)}</td>"
             f"<td>{_e(students[p.partner].id)}</td><td>{_e(students[p.partner].name)}</td>"
             f"<td>{_e(', '.join(p.labels))}</td><td class=\"n\">{len(p.labels)} of {p.wrong}</td>"
             f"<td class=\"n\">{_e(f'{p.chance:.2g}')}</td><td class=\"n\">{_e(f'{p.corrected:.2g}')}</td></tr>"
-            for p in flagged[:FLAGGED_SHOWN]]
+            for p in integrity.ranked.records(flagged[:FLAGGED_SHOWN])]
     text.append("<table>\n<tr><th>student</th><th>name</th><th>answers match the key of</th><th>name</th>"
                 "<th>parts</th><th class=\"n\">of the wrong parts</th><th class=\"n\">chance</th>"
                 "<th class=\"n\">corrected</th></tr>\n" + "\n".join(rows) + "\n</table>")

@@ -33,11 +33,9 @@ time, so time and memory grow with the class, not its square.
 
 from __future__ import annotations
 
-import functools
 import math
-from collections.abc import Collection, Mapping, Sequence
-from dataclasses import dataclass
-from typing import NamedTuple
+from collections.abc import Iterator, Mapping, Sequence
+from typing import Any, NamedTuple
 
 import numpy as np
 import numpy.typing as npt
@@ -47,6 +45,7 @@ from grader.grade.compare import errors
 from grader.grade.grading import Graded
 from grader.grade.integrity_chance import UNRELATED, Spread
 from grader.grade.integrity_close import bound, close_pairs
+from grader.grade.integrity_found import Integrity, Match, Matches, Pair, Pairs, Small
 from grader.grade.integrity_search import (
     Bands,
     Floats,
@@ -60,89 +59,69 @@ from grader.grade.integrity_search import (
     nearest,
     range_least,
 )
-from grader.grade.integrity_typed import halves, steps
+from grader.grade.integrity_typed import halves
 from grader.grade.texts import Texts
 
 LISTED = 5  # students named per wrong answer in integrity.csv; the rest are counted
 KEPT = 1.0  # pairs with two or more matched parts are kept when their corrected chance is below this
 PAIRS = 1 << 19  # candidate pairs worked out at a time (a few hundred bytes each): memory bounded, whatever the class
+FIGURED = 1 << 16  # pairs whose chances are worked out at a time (about 500 bytes each while they are)
+ROWS = 1 << 14  # students whose figures per part are laid out in a matrix at a time
+
+__all__ = ["LISTED", "Integrity", "Match", "Pair", "check"]
 
 
-class Match(NamedTuple):
-    """A wrong answer that another student's key accepts: who answered (index in the key), the part, whose
-    variant it matches (index), that student's value, and how many students' values it matches in all."""
+class _Right(Mapping[str, Floats]):
+    """Per part label, each student's number when their answer was right (NaN: not right): worked out from the
+    verdicts and numbers the run keeps when asked, not kept (8 bytes a student and part)."""
 
-    student: int
-    label: str
-    partner: int
-    value: float
-    matches: int
+    def __init__(self, graded: ClassGrades, labels: Sequence[str]) -> None:
+        self._graded, self._labels = graded, tuple(labels)
+        self._codes = {label: graded.columns[label].verdict.words.index("correct")
+                       if "correct" in graded.columns[label].verdict.words else -1 for label in labels}
 
+    def of(self, label: str, students: Ints | slice) -> Floats:
+        """The right numbers of ``students`` for the part."""
+        numbers = self._graded.numbers[label][students]
+        right = (self._graded.columns[label].verdict.codes[students] == self._codes[label]) & np.isfinite(numbers)
+        return np.where(right, numbers, np.nan)
 
-class Pair(NamedTuple):
-    """A student's wrong answers against another student's key: the parts matched, how many of the first
-    student's parts were wrong (and so could match), the chance of so many matches by accident, and that
-    chance corrected for the pairs examined; and what the chance counted: the closest matches, how many, and
-    how close the least close of them is, in half-units of the student's typed answers (inf: not read)."""
+    def __getitem__(self, label: str) -> Floats:
+        return self.of(label, slice(None))
 
-    student: int
-    partner: int
-    labels: tuple[str, ...]
-    wrong: int
-    chance: float
-    corrected: float
-    closest: int = 0
-    closeness: float = math.inf
+    def __iter__(self) -> Iterator[str]:
+        return iter(self._labels)
 
-
-@dataclass(frozen=True)
-class Integrity:
-    """What the check found: each wrong answer's listed matches, every pair with two or more matched parts
-    (and the pairs of the listed matches), most suspicious first; the number of pairs examined; the
-    threshold; and how many wrong answers were compared (and matched anyone)."""
-
-    matches: tuple[Match, ...]
-    pairs: tuple[Pair, ...]
-    examined: int
-    threshold: float
-    wrong: int
-    matched: int
-
-    @property
-    def flagged(self) -> tuple[Pair, ...]:
-        """The pairs whose corrected chance is at most the threshold."""
-        return tuple(pair for pair in self.pairs if len(pair.labels) >= 2 and pair.corrected <= self.threshold)
-
-    def pair(self, student: int, partner: int) -> Pair | None:
-        """The pair of two students (by index), if it is listed."""
-        return self._by_students.get((student, partner))
-
-    @functools.cached_property
-    def _by_students(self) -> dict[tuple[int, int], Pair]:
-        return {(pair.student, pair.partner): pair for pair in self.pairs}
+    def __len__(self) -> int:
+        return len(self._labels)
 
 
 class _Answers(NamedTuple):
     """The class's answers the check compares: per part label, the students whose answer was wrong, each
     student's number (NaN: none), the half-unit of the last typed digit of each wrong one in the sheet's
-    unit (inf: not a plain number, so no closeness can be read from it), the right ones' numbers (NaN: not
-    right) and what each student typed; and each student's count of wrong parts."""
+    unit, in the order of the wrong ones (inf: not a plain number, so no closeness can be read from it), the
+    right ones' numbers (NaN: not right) and what each student typed; and each student's count of wrong
+    parts."""
 
     wrong: Mapping[str, Ints]
     numbers: Mapping[str, Floats]
     steps: Mapping[str, Floats]
-    right: Mapping[str, Floats]
+    right: _Right
     typed: Mapping[str, Texts]
     per_student: Ints
     read: dict[str, Floats]  # per part and student, the half-unit of the right answer, once read (NaN: not yet)
     answering: dict[str, npt.NDArray[np.bool_]]  # per part, :meth:`answered`, once worked out
+
+    def step(self, label: str, owners: Ints) -> Floats:
+        """The half-unit of the typed answers of ``owners``, each one of the part's wrong ones."""
+        return self.steps[label][np.searchsorted(self.wrong[label], owners)]
 
     def centres(self, part: Bands, owners: Ints, partners: Ints) -> Floats:
         """Where each owner's answer's closeness to the partner's is measured from: the number the partner
         typed for the part, when it was right and typed with no fewer digits than the owner's (a copy typed
         as its source typed it is there exactly), else the partner's value. An angle's is taken within half a
         turn of the value."""
-        values, typed = part.values[partners], self.right[part.label][partners]
+        values, typed = part.values[partners], self.right.of(part.label, partners)
         have = np.isfinite(typed)
         read = self.read.get(part.label)
         if read is None:
@@ -151,7 +130,7 @@ class _Answers(NamedTuple):
         asked = asked[np.isnan(read[asked])]
         read[asked] = halves(self.typed[part.label].take(asked), self.numbers[part.label][asked])
         half_units = np.where(have, read[partners], np.inf)
-        found = np.where(have & (half_units <= self.steps[part.label][owners]), typed, values)
+        found = np.where(have & (half_units <= self.step(part.label, owners)), typed, values)
         period = part.period
         return found if period is None else values + np.mod(found - values + period / 2, period) - period / 2
 
@@ -168,11 +147,19 @@ def check(graded: Graded | ClassGrades, block: int = PAIRS) -> Integrity:
     """The integrity check of a grading run (the key's numeric parts; symbolic ones are left out), its
     candidate pairs worked out about ``block`` at a time (the findings are the same whatever the block)."""
     graded = classwide(graded)
+    matches, pieces, examined, wrong, matched = _search(graded, block)  # what the search held is let go
+    pairs = Pairs.joined(pieces)
+    del pieces
+    return Integrity(matches, pairs.take(_ranked(pairs)), examined, graded.key.integrity_threshold, wrong, matched)
+
+
+def _search(graded: ClassGrades, block: int) -> tuple[Matches, list[Pairs], int, int, int]:
+    """The listed matches; the pairs, in pieces; the pairs examined; the wrong answers compared, and those that
+    matched anyone."""
     key = graded.key
     students = len(key.students)
     parts: list[Bands] = []
     wrong: dict[str, Ints] = {}
-    right: dict[str, Floats] = {}
     for label in key.labels:
         first = key.students[0].parts[label] if students else None
         if first is None or first.symbolic or label not in graded.numbers:
@@ -180,49 +167,48 @@ def check(graded: Graded | ClassGrades, block: int = PAIRS) -> Integrity:
         values = np.fromiter(map(_number, key.part_entries(label, "value")), dtype=np.float64, count=students)
         part = bands(label, values, key.part_entries(label, "tolerance"), first.unit)
         numbers = graded.numbers[label]
-        column = graded.columns[label]
-        incorrect, correct = column.verdict.are("incorrect"), column.verdict.are("correct")
-        wrong[label] = np.flatnonzero(incorrect & np.isfinite(numbers) & np.isfinite(values))
-        right[label] = np.where(correct & np.isfinite(numbers), numbers, np.nan)
+        wrong[label] = np.flatnonzero(graded.columns[label].verdict.are("incorrect") & np.isfinite(numbers)
+                                      & np.isfinite(values))
         parts.append(part)
     per_student = np.zeros(students, dtype=np.int64)
     for members in wrong.values():
         per_student[members] += 1
     texts = {label: column.submitted for label, column in graded.columns.items()}
-    typed = {part.label: steps(texts[part.label], wrong[part.label], graded.numbers[part.label]) for part in parts}
+    typed = {part.label: np.array(halves(texts[part.label].take(wrong[part.label]),
+                                         graded.numbers[part.label][wrong[part.label]]), np.float64).reshape(-1)
+             for part in parts}
     spread = Spread.of(np.concatenate([graded.numbers[p.label][wrong[p.label]] for p in parts] or [np.zeros(0)]),
                        np.concatenate([p.values[wrong[p.label]] for p in parts] or [np.zeros(0)]),
                        np.concatenate([wrong[p.label] for p in parts] or [np.zeros(0, np.int64)]), students)
     examined = int(np.count_nonzero(per_student >= 2)) * max(students - 1, 0)
     found = [holding(part, wrong[part.label], graded.numbers[part.label]) for part in parts]
-    answers = _Answers(wrong, graded.numbers, typed, right, texts, per_student, {}, {})
-    pairs = _pairs(parts, answers, spread, found, examined, block)
-    matches = _listed(parts, wrong, graded.numbers, found, _ranked(pairs.values()))
+    answers = _Answers(wrong, graded.numbers, typed, _Right(graded, list(wrong)), texts, per_student, {}, {})
+    kept = _pairs(parts, answers, spread, found, examined, block)
+    kept = kept.take(_ranked(kept))
+    matches = _listed(parts, wrong, graded.numbers, found, kept)
     # Every listed match has its pair's figures.
-    listed = distinct(np.fromiter((match.student * students + match.partner for match in matches), np.int64,
-                                  len(matches)))
-    known = np.sort(np.fromiter((student * students + partner for student, partner in pairs), np.int64, len(pairs)))
+    listed = distinct(matches.student.astype(np.int64) * students + matches.partner)
+    known = np.sort(kept.student.astype(np.int64) * students + kept.partner)
     others = listed[~_among(listed, known)]
-    if len(others):
-        pairs.update(((pair.student, pair.partner), pair) for pair in _figures(
-            parts, answers, spread, others // students, others % students, examined))
-    ranked = _ranked(pairs.values())
-    return Integrity(tuple(matches), tuple(ranked), examined, key.integrity_threshold,
-                     sum(len(members) for members in wrong.values()),
-                     sum(int(np.count_nonzero(counts)) for counts, _ in found))
+    del listed, known
+    # The chances are counted up to the most wrong parts of any of these pairs' students, whatever the block.
+    most = int(per_student[distinct(others // students)].max()) if len(others) else 0
+    step = max(FIGURED, 1)
+    more = [_figures(parts, answers, spread, others[start:start + step] // students,
+                     others[start:start + step] % students, examined, most=most)
+            for start in range(0, len(others), step)]
+    return (matches, [kept, *more], examined, sum(len(members) for members in wrong.values()),
+            sum(int(np.count_nonzero(counts)) for counts, _ in found))
 
 
-def _ranked(pairs: Collection[Pair]) -> list[Pair]:
-    """The pairs, most suspicious first: by corrected chance, chance, student and partner (a sort of arrays, not
-    of a million tuples)."""
-    listed = list(pairs)
-    corrected, chance = (np.fromiter((getattr(pair, name) for pair in listed), np.float64, len(listed))
-                         for name in ("corrected", "chance"))
+def _ranked(pairs: Pairs) -> Ints:
+    """The order of the pairs, most suspicious first: by corrected chance, chance, student and partner (a sort
+    of arrays, not of a million tuples)."""
+    corrected, chance, student, partner = pairs.corrected, pairs.chance, pairs.student, pairs.partner
     if np.isnan(corrected).any() or np.isnan(chance).any():  # not ordered as Python orders them: none is NaN
-        return sorted(listed, key=lambda pair: (pair.corrected, pair.chance, pair.student, pair.partner))
-    student, partner = (np.fromiter((getattr(pair, name) for pair in listed), np.int64, len(listed))
-                        for name in ("student", "partner"))
-    return [listed[index] for index in np.lexsort((partner, student, chance, corrected)).tolist()]
+        keys = list(zip(corrected.tolist(), chance.tolist(), student.tolist(), partner.tolist(), strict=True))
+        return np.array(sorted(range(len(keys)), key=keys.__getitem__), np.int64)
+    return np.lexsort((partner, student, chance, corrected))
 
 
 def _among(keys: Ints, known: Ints) -> npt.NDArray[np.bool_]:
@@ -239,7 +225,7 @@ def _number(value: object) -> float:
 
 def _pairs(parts: Sequence[Bands], answers: _Answers, spread: Spread,
            found: Sequence[tuple[Ints, list[tuple[Ints, Ints]]]], examined: int,
-           block: int = PAIRS) -> dict[tuple[int, int], Pair]:
+           block: int = PAIRS) -> Pairs:
     """Every pair with two or more matched parts whose corrected chance is below :data:`KEPT`.
 
     A pair needs as many matched parts as the fewest whose chance could be that small (:func:`_needed`); a
@@ -250,16 +236,19 @@ def _pairs(parts: Sequence[Bands], answers: _Answers, spread: Spread,
     class, not its square. The chances are counted up to as many wrong parts as the most of any candidate's
     student with two matched parts (:func:`_figures`'s ``most``), as one block of all candidates would."""
     wrong, students, per_student = answers.wrong, len(answers.per_student), answers.per_student
-    counts = np.zeros((students, len(parts)), dtype=np.int64)  # per student and part, the students matched
-    for index, (part, (found_counts, _)) in enumerate(zip(parts, found, strict=True)):
-        counts[wrong[part.label], index] = found_counts
-    matched = np.count_nonzero(counts, axis=1)
     needed = _needed(parts, answers, spread, found, examined)
-    # Each part's rank among the student's, most students matched first: the needed - 1 first are not searched.
-    rank = np.argsort(np.argsort(-counts, axis=1, kind="stable"), axis=1, kind="stable")
-    candidate = (counts > 0) & (matched >= needed)[:, None] & (rank >= (needed - 1)[:, None])
+    columns = [(wrong[part.label], found_counts) for part, (found_counts, _) in zip(parts, found, strict=True)]
+    candidate = np.zeros((students, len(parts)), dtype=bool)
+    for rows in _row_blocks(students):
+        counts = _laid_out(rows, columns, 0)  # per student and part, the students matched
+        matched = np.count_nonzero(counts, axis=1)
+        # Each part's rank among the student's, most students matched first: the needed - 1 first are not searched.
+        rank = np.argsort(np.argsort(-counts, axis=1, kind="stable"), axis=1, kind="stable")
+        candidate[rows] = ((counts > 0) & (matched >= needed[rows])[:, None] & (rank >= (needed[rows] - 1)[:, None])
+                           )[:, :len(parts)]
+    del columns
     ranges = [part_ranges for _, part_ranges in found]
-    owners_in = candidate.any(axis=1)
+    owners_in: npt.NDArray[np.bool_] = np.any(candidate, axis=1)
     searched = [np.flatnonzero((found_counts > 0) & owners_in[wrong[part.label]])
                 for part, (found_counts, _) in zip(parts, found, strict=True)]
     chosen = [np.flatnonzero(candidate[wrong[part.label], index]) for index, part in enumerate(parts)]
@@ -272,17 +261,16 @@ def _pairs(parts: Sequence[Bands], answers: _Answers, spread: Spread,
         if two.any():
             kept.append((owners[two], partners[two], hits[two]))
     if not kept:
-        return {}
+        return Pairs.of(())
     owners = np.concatenate([owners for owners, _, _ in kept])
     partners = np.concatenate([partners for _, partners, _ in kept])
     hits = np.concatenate([hits for _, _, hits in kept])
+    del kept
     most = _most(parts, answers, found, candidate, int(per_student[owners].max()), block)
-    pairs: dict[tuple[int, int], Pair] = {}
-    for start in range(0, len(owners), max(block, 1)):
-        rows = slice(start, start + max(block, 1))
-        pairs.update(((pair.student, pair.partner), pair) for pair in _figures(
-            parts, answers, spread, owners[rows], partners[rows], examined, 2, KEPT, hits[rows], most))
-    return pairs
+    step = max(min(block, FIGURED), 1)
+    return Pairs.joined([_figures(parts, answers, spread, owners[start:start + step], partners[start:start + step],
+                                  examined, 2, KEPT, hits[start:start + step], most)
+                         for start in range(0, len(owners), step)])
 
 
 def _most(parts: Sequence[Bands], answers: _Answers, found: Sequence[tuple[Ints, list[tuple[Ints, Ints]]]],
@@ -318,16 +306,44 @@ def _needed(parts: Sequence[Bands], answers: _Answers, spread: Spread,
     (more than their wrong parts: none could). ``k`` matches have a chance of at least the product of the
     ``k`` least of their parts' chances (:func:`_least`), and the correction is at least ``examined``."""
     students = len(answers.per_student)
-    least = np.full((students, max(len(parts), 1)), np.inf)
-    for index, (part, (_, ranges)) in enumerate(zip(parts, found, strict=True)):
-        members = answers.wrong[part.label]
-        least[members, index] = _least(part, spread, members, answers.numbers[part.label][members],
-                                       answers.steps[part.label][members], ranges)
-    # log 0 = -inf (a part no chance bounds) then log inf (a part that matches nobody) make NaN: not possible.
-    with np.errstate(divide="ignore", invalid="ignore"):
-        bound = math.log(max(examined, 1)) + np.cumsum(np.log(np.sort(least, axis=1)), axis=1)
-    possible = ((bound < math.log(KEPT)) | (KEPT > 1)) & (np.arange(least.shape[1]) >= 1)  # > 1: every pair
-    return np.where(possible.any(axis=1), np.argmax(possible, axis=1) + 1, least.shape[1] + 1).astype(np.int64)
+    columns = [(answers.wrong[part.label], _least(part, spread, answers.wrong[part.label],
+                                                  answers.numbers[part.label][answers.wrong[part.label]],
+                                                  answers.steps[part.label], ranges))
+               for part, (_, ranges) in zip(parts, found, strict=True)]
+    needed = np.zeros(students, dtype=np.int64)
+    for rows in _row_blocks(students):
+        least = _laid_out(rows, columns, np.inf)
+        # log 0 = -inf (a part no chance bounds) then log inf (a part that matches nobody) make NaN: not possible.
+        with np.errstate(divide="ignore", invalid="ignore"):
+            bound = math.log(max(examined, 1)) + np.cumsum(np.log(np.sort(least, axis=1)), axis=1)
+        possible = ((bound < math.log(KEPT)) | (KEPT > 1)) & (np.arange(least.shape[1]) >= 1)  # > 1: every pair
+        needed[rows] = np.where(possible.any(axis=1), np.argmax(possible, axis=1) + 1, least.shape[1] + 1)
+    return needed
+
+
+def _row_blocks(students: int) -> Iterator[slice]:
+    """The students in runs of :data:`ROWS`.
+
+    >>> [(rows.start, rows.stop) for rows in _row_blocks(ROWS + 1)] == [(0, ROWS), (ROWS, ROWS + 1)]
+    True
+    """
+    return (slice(start, min(start + ROWS, students)) for start in range(0, students, ROWS))
+
+
+def _laid_out(rows: slice, columns: Sequence[tuple[Ints, npt.NDArray[Any]]], fill: float) -> npt.NDArray[Any]:
+    """Per student of ``rows`` (a row) and part (a column; one column of ``fill`` when there are no parts), the
+    part's entry of that student (``fill``: none); ``columns``: per part, its students (sorted) and their
+    entries.
+
+    >>> _laid_out(slice(1, 3), [(np.array([0, 2]), np.array([5.0, 6.0]))], np.inf).tolist()
+    [[inf], [6.0]]
+    """
+    dtype = np.result_type(*(entries.dtype for _, entries in columns)) if columns else np.float64
+    found = np.full((rows.stop - rows.start, max(len(columns), 1)), fill, dtype=dtype)
+    for index, (members, entries) in enumerate(columns):
+        first, last = np.searchsorted(members, (rows.start, rows.stop))
+        found[members[first:last] - rows.start, index] = entries[first:last]
+    return found
 
 
 def _least(part: Bands, spread: Spread, owners: Ints, numbers: Floats, steps: Floats,
@@ -373,7 +389,7 @@ def _hits(parts: Sequence[Bands], answers: _Answers, owners: Ints, partners: Int
 
 def _figures(parts: Sequence[Bands], answers: _Answers, spread: Spread, owners: Ints, partners: Ints,
              examined: int, least: int = 0, below: float = math.inf, hits: npt.NDArray[np.bool_] | None = None,
-             most: int | None = None) -> list[Pair]:
+             most: int | None = None) -> Pairs:
     """Each pair's matched parts and chances; only the pairs with ``least`` matched parts or more and a
     corrected chance under ``below``. For ``j`` from 2 to the matches (1 for a pair of one match): the chance
     that ``j`` or more of the owner's wrong parts land by accident as close to the partner's values as the
@@ -394,7 +410,7 @@ def _figures(parts: Sequence[Bands], answers: _Answers, spread: Spread, owners: 
                           angle_unit=part.unit if part.period is not None else None)[0]
         # inf / inf (a number typed as arithmetic) is NaN: such a match claims no closeness (0 sets none).
         with np.errstate(divide="ignore", invalid="ignore"):
-            units[rows, index] = np.nan_to_num(distance / answers.steps[part.label][owners[rows]], nan=0.0,
+            units[rows, index] = np.nan_to_num(distance / answers.step(part.label, owners[rows]), nan=0.0,
                                                posinf=np.inf)
     ordered = np.sort(units, axis=1)
     chances, counted, closeness = np.ones(len(owners)), matched.copy(), np.full(len(owners), np.inf)
@@ -417,13 +433,12 @@ def _figures(parts: Sequence[Bands], answers: _Answers, spread: Spread, owners: 
     corrected, counted, closeness = corrected[kept], counted[kept], closeness[kept]
     # The matched parts' labels, worked out once per pattern of parts (a class has a few hundred patterns).
     patterns = hits.astype(np.int64) @ (np.int64(1) << np.arange(len(parts), dtype=np.int64))
-    named: dict[int, tuple[str, ...]] = {}
-    for pattern in distinct(patterns).tolist():
-        named[pattern] = tuple(part.label for index, part in enumerate(parts) if pattern >> index & 1)
-    return [Pair(owner, partner, named[pattern], wrong, chance, fixed, closest, near)
-            for owner, partner, pattern, wrong, chance, fixed, closest, near in zip(
-                owners.tolist(), partners.tolist(), patterns.tolist(), per_student[owners].tolist(),
-                chances.tolist(), corrected.tolist(), counted.tolist(), closeness.tolist(), strict=True)]
+    table = distinct(patterns)
+    named = tuple(tuple(part.label for index, part in enumerate(parts) if pattern >> index & 1)
+                  for pattern in table.tolist())
+    return Pairs(named, owners.astype(np.int32), partners.astype(np.int32),
+                 np.searchsorted(table, patterns).astype(np.int32), per_student[owners].astype(np.int32), chances,
+                 corrected, counted.astype(np.int32), closeness)
 
 
 def _tails(parts: Sequence[Bands], answers: _Answers, spread: Spread, owners: Ints, partners: Ints,
@@ -442,7 +457,7 @@ def _tails(parts: Sequence[Bands], answers: _Answers, spread: Spread, owners: In
         if not len(rows):
             continue
         chance = _chance(part, spread, owners[rows], partners[rows], closeness[rows],
-                         answers.steps[part.label][owners[rows]],
+                         answers.step(part.label, owners[rows]),
                          answers.centres(part, owners[rows], partners[rows]))[:, None]
         shifted = np.zeros((len(rows), most + 1))
         shifted[:, 1:] = distribution[rows, :-1]
@@ -471,27 +486,59 @@ def _chance(part: Bands, spread: Spread, owners: Ints, partners: Ints, closeness
 
 
 def _listed(parts: Sequence[Bands], wrong: Mapping[str, Ints], numbers: Mapping[str, Floats],
-            found: Sequence[tuple[Ints, list[tuple[Ints, Ints]]]], ranked: Sequence[Pair]) -> list[Match]:
+            found: Sequence[tuple[Ints, list[tuple[Ints, Ints]]]], ranked: Pairs) -> Matches:
     """Each wrong answer that matches anyone, with up to :data:`LISTED` of the students it matches: the
     partners of its pairs (``ranked``: most suspicious first, :func:`_ranked`) first, then the nearest values
-    (by distance over the band)."""
-    partners_of: dict[tuple[int, str], list[int]] = {}
-    for pair in ranked:  # a student's pairs in the order of their corrected chance, chance and partner
-        for label in pair.labels:
-            partners_of.setdefault((pair.student, label), []).append(pair.partner)
-    matches = []
+    (by distance over the band); by student, then label."""
+    labels = [part.label for part in parts]
+    columns: list[tuple[Small, Small, Small, Floats]] = []  # per part: students, partners, counts, values
     for part, (counts, _) in zip(parts, found, strict=True):
-        members = wrong[part.label]
         some = np.flatnonzero(counts > 0)
-        closest = nearest(part, members[some], numbers[part.label], LISTED)
-        for row, index in enumerate(some):
-            student = int(members[index])
-            chosen = partners_of.get((student, part.label), [])[:LISTED]
-            nearer = [int(other) for other in closest[row] if other >= 0 and other not in chosen]
-            chosen += nearer[:LISTED - len(chosen)]
-            matches += [Match(student, part.label, other, float(part.values[other]), int(counts[index]))
-                        for other in chosen]
-    matches.sort(key=lambda match: (match.student, match.label))
-    return matches
+        answering = wrong[part.label][some]  # sorted, as the wrong answers are
+        # The partners of the answers' pairs, each answer's in their order, then their nearest values.
+        having = np.array([part.label in named for named in ranked.patterns], bool)[ranked.pattern]
+        rows = np.flatnonzero(having)
+        at = np.minimum(np.searchsorted(answering, ranked.student[rows]), max(len(answering) - 1, 0))
+        mine = np.asarray(answering[at] == ranked.student[rows]) if len(answering) else np.zeros(len(rows), bool)
+        rows, at = rows[mine], at[mine]
+        by_answer = np.argsort(at, kind="stable")
+        first, first_partner = at[by_answer], ranked.partner[rows[by_answer]].astype(np.int64)
+        place = _places(first)
+        first, first_partner, place = first[place < LISTED], first_partner[place < LISTED], place[place < LISTED]
+        closest = nearest(part, answering, numbers[part.label], LISTED)
+        near = np.repeat(np.arange(len(answering)), LISTED)
+        near_partner = closest.ravel()
+        chosen = np.sort(first * len(part.values) + first_partner)
+        fresh = (near_partner >= 0) & ~_among(near * len(part.values) + near_partner, chosen)
+        every = np.concatenate([first, near[fresh]])
+        order = np.lexsort((np.concatenate([place, LISTED + np.tile(np.arange(LISTED), len(answering))[fresh]]),
+                            every))
+        every, partners = every[order], np.concatenate([first_partner, near_partner[fresh]])[order]
+        shown = _places(every) < LISTED
+        every, partners = every[shown], partners[shown]
+        columns.append((answering[every].astype(np.int32), partners.astype(np.int32),
+                        counts[some][every].astype(np.int32), part.values[partners]))
+    # By student, then label (as Python orders them), each answer's in the order chosen (the sort is stable).
+    in_words: Ints = (np.argsort(np.argsort(np.array(labels, dtype=object), kind="stable"), kind="stable") if labels
+                      else np.zeros(0, np.int64))
+    part_of = np.concatenate([np.full(len(column[0]), in_words[index], np.int64)
+                              for index, column in enumerate(columns)] or [np.zeros(0, np.int64)])
+    order = np.argsort(np.concatenate([column[0] for column in columns] or [np.zeros(0, np.int32)]).astype(np.int64)
+                       * max(len(labels), 1) + part_of, kind="stable")
+    del part_of
+    label = np.concatenate([np.full(len(column[0]), index, np.int32) for index, column in enumerate(columns)]
+                           or [np.zeros(0, np.int32)])[order]
+    student, partner, matched, value = (
+        np.concatenate([column[at] for column in columns] or [np.zeros(0, kind)])[order]
+        for at, kind in enumerate((np.int32, np.int32, np.int32, np.float64)))
+    return Matches(tuple(labels), student, label, partner, value, matched)
 
 
+def _places(groups: Ints) -> Ints:
+    """Each entry's place in its run of equal ``groups`` (sorted): 0, 1, ...
+
+    >>> _places(np.array([0, 0, 3, 5, 5, 5])).tolist()
+    [0, 1, 0, 0, 1, 2]
+    """
+    starts = np.flatnonzero(np.r_[True, groups[1:] != groups[:-1]]) if len(groups) else np.zeros(0, np.int64)
+    return np.arange(len(groups)) - np.repeat(starts, np.diff(np.r_[starts, len(groups)]))

@@ -73,8 +73,10 @@ class Spread:
     other: Floats
     kernel: Floats  # one answer's cumulative kernel, at the boundaries of the cells around it
     answers: int
-    cells: npt.NDArray[np.float64]  # per student, the grid cells of their answers (NaN: none), one column each
+    cells: Floats  # the grid cells of the students' answers, a student's after another's (:meth:`own`)
     signs: npt.NDArray[np.bool_]  # of the same sign as their own value
+    starts: Ints  # where each student's begin in ``cells``, and where the last one's end
+    width: int  # the most answers of a student (at least 1)
 
     @classmethod
     def of(cls, answers: Floats, own: Floats, students: Ints, count: int) -> Spread:
@@ -101,12 +103,27 @@ class Spread:
             smooth = np.convolve(counts, kernel, mode="same") / max(len(logs), 1)
             tables.append(np.concatenate([[0.0], np.cumsum(smooth)]))
         owners = students[usable]
-        column = _rank_within(owners)
-        cells = np.full((count, int(column.max()) + 1 if len(column) else 1), np.nan)
-        signs = np.zeros(cells.shape, dtype=bool)
-        cells[owners, column], signs[owners, column] = where, same
+        by_owner = np.argsort(owners, kind="stable")  # each student's answers in their order
+        starts = np.searchsorted(owners[by_owner], np.arange(count + 1), side="left").astype(np.int64)
         return cls(start - step / 2, step, tables[0], tables[1], np.concatenate([[0.0], np.cumsum(kernel)]),
-                   len(logs), cells, signs)
+                   len(logs), where[by_owner], same[by_owner], starts, max(int(np.diff(starts).max(initial=0)), 1))
+
+    def own(self, owners: Ints) -> tuple[Floats, npt.NDArray[np.bool_]]:
+        """Per student of ``owners`` (a row), the grid cells of their answers, one column each, in their order
+        (NaN: none), and whether each is of the same sign as their own value; :attr:`width` columns (a class's
+        cells kept a student's after another's, not as a matrix of the most any student has)."""
+        first = self.starts[owners]
+        sizes = self.starts[owners + 1] - first
+        rows = np.repeat(np.arange(len(owners)), sizes)
+        columns = np.arange(int(sizes.sum())) - np.repeat(np.cumsum(sizes) - sizes, sizes)
+        cells, signs = np.full((len(owners), self.width), np.nan), np.zeros((len(owners), self.width), dtype=bool)
+        at = first[rows] + columns
+        cells[rows, columns], signs[rows, columns] = self.cells[at], self.signs[at]
+        return cells, signs
+
+    def answered(self, owners: Ints) -> Ints:
+        """How many answers each of ``owners`` has among the class's."""
+        return np.asarray(self.starts[owners + 1] - self.starts[owners])
 
     def chance(self, own: Floats, low: Floats, high: Floats, owners: Ints) -> Floats:
         """The chance that a wrong answer of student ``owners`` related to their ``own`` value lands in
@@ -121,9 +138,9 @@ class Spread:
         # undefined own value, a null in the key: no ratio tells, and the chance is 1 below)
         a, b = np.fmin(ends[0], ends[1]), np.fmax(ends[0], ends[1])
         whole = np.where(same, self._mass(self.same, a, b), self._mass(self.other, a, b))
-        mine = self.cells[owners]
+        mine, signs = self.own(owners)
         theirs = np.isfinite(mine).sum(axis=1)
-        signed = np.where(np.isfinite(mine), self.signs[owners] == same[:, None], False)
+        signed = np.where(np.isfinite(mine), signs == same[:, None], False)
         # A student's own answers' kernels, over the band: in grid cells, the band's ends from each answer's.
         low_cell, high_cell = (a - self.start) / self.step - 0.5, (b - self.start) / self.step - 0.5
         offsets = np.arange(len(self.kernel)) - (len(self.kernel) - 1) / 2
@@ -140,21 +157,6 @@ class Spread:
     def _mass(self, table: Floats, a: Floats, b: Floats) -> Floats:
         grid = self.start + self.step * np.arange(len(table))
         return np.asarray(np.interp(b, grid, table) - np.interp(a, grid, table))
-
-
-def _rank_within(owners: Ints) -> Ints:
-    """Each entry's place among the entries of the same owner (0, 1, ...), in order.
-
-    >>> _rank_within(np.array([3, 1, 3, 3, 1])).tolist()
-    [0, 0, 1, 2, 1]
-    """
-    order = np.argsort(owners, kind="stable")
-    ranked = owners[order]
-    starts = np.flatnonzero(np.r_[True, ranked[1:] != ranked[:-1]])
-    places = np.arange(len(owners)) - np.repeat(starts, np.diff(np.r_[starts, len(owners)]))
-    found = np.empty(len(owners), dtype=np.int64)
-    found[order] = places
-    return found
 
 
 def _bandwidth(logs: Floats) -> float:

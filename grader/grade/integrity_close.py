@@ -82,7 +82,7 @@ def centres_window(part: Bands, spread: Spread, owners: Ints, numbers: Floats, l
     if part.period is not None or spread.answers == 0 or not count:
         return low, high
     own = part.values[owners]
-    theirs = np.isfinite(spread.cells[owners]).sum(axis=1)
+    theirs = spread.answered(owners)
     left = spread.answers - theirs
     total = float(spread.kernel[-1] - spread.kernel[0])
     # The related kind's mass wanted: the chance over its share, plus what the owner's own answers may take off.

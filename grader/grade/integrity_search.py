@@ -32,7 +32,7 @@ from grader.model.tolerance import Tolerance
 Floats = npt.NDArray[np.float64]
 Ints = npt.NDArray[np.int64]
 
-CHUNK = 1 << 22  # candidate pairs tested at a time: a bounded amount of memory, whatever the class
+CHUNK = 1 << 19  # candidate pairs tested at a time (about 100 bytes each): memory bounded, whatever the class
 BY_ENDS = True  # count an answer's matches from the sorted ends of the bands (False: test each candidate)
 PERIOD = {"deg": 360.0, "rad": 2 * math.pi}
 
@@ -41,9 +41,7 @@ PERIOD = {"deg": 360.0, "rad": 2 * math.pi}
 class Bands:
     """A numeric part over the class: each student's key value (NaN: none), accepted distance, whether the
     bound is strict (sigfigs, decimals), the chance ``p`` of their band; the students with a value sorted
-    by it (angles reduced to one turn), the lowest band start from each sorted position on and the highest
-    band end up to it (a search over them finds a superset of the bands that hold a number); the bands'
-    starts and ends, each sorted."""
+    by it (angles reduced to one turn)."""
 
     label: str
     unit: str
@@ -53,10 +51,6 @@ class Bands:
     chance: Floats
     order: Ints
     sorted_values: Floats
-    low: Floats
-    high: Floats
-    starts: Floats
-    ends: Floats
 
     @property
     def period(self) -> float | None:
@@ -82,23 +76,27 @@ def bands(label: str, values: Floats, tolerances: Sequence[Mapping[str, Any]], u
     placed = values[have] if period is None else np.mod(values[have], period)
     order = have[np.argsort(placed, kind="stable")]
     sorted_values = np.sort(placed, kind="stable")
-    bands = reach[order]
-    low = np.minimum.accumulate((sorted_values - bands)[::-1])[::-1] if len(order) else sorted_values
-    high = np.maximum.accumulate(sorted_values + bands) if len(order) else sorted_values
     return Bands(label, unit, values, reach, strict, class_density(values, reach, order, sorted_values), order,
-                 sorted_values, low, high, np.sort(sorted_values - bands), np.sort(sorted_values + bands))
+                 sorted_values)
 
 
 def _ranges(part: Bands, numbers: Floats) -> Iterator[tuple[Ints, Ints]]:
     """For each number, the positions in the part's sorted order that may hold it in their band: one
-    range, or, for an angle, one for each neighbouring turn."""
+    range, or, for an angle, one for each neighbouring turn. From the lowest band start from each sorted
+    position on and the highest band end up to it (a search over them finds a superset of the bands that hold
+    a number; worked out here, not kept: a class's part takes 16 bytes a student)."""
+    bands = part.reach[part.order]
+    sorted_values = part.sorted_values
+    low = np.minimum.accumulate((sorted_values - bands)[::-1])[::-1] if len(bands) else sorted_values
+    high = np.maximum.accumulate(sorted_values + bands) if len(bands) else sorted_values
+    del bands
     period = part.period
     shifts = (0.0,) if period is None else (0.0, -period, period)
     placed = numbers if period is None else np.mod(numbers, period)
     for shift in shifts:
         target = placed + shift
-        yield (np.searchsorted(part.high, target, side="left").astype(np.int64),
-               np.searchsorted(part.low, target, side="right").astype(np.int64))
+        yield (np.searchsorted(high, target, side="left").astype(np.int64),
+               np.searchsorted(low, target, side="right").astype(np.int64))
 
 
 def accepts(part: Bands, owners: Ints, partners: Ints, numbers: Floats) -> npt.NDArray[np.bool_]:
@@ -201,9 +199,11 @@ def holding(part: Bands, wrong: Ints, numbers: Floats) -> tuple[Ints, list[tuple
     ranges = list(_ranges(part, numbers[wrong]))
     tested = np.arange(len(wrong))
     if BY_ENDS and part.period is None and not part.strict.any():
-        typed = numbers[wrong]
-        counts = (np.searchsorted(part.starts, typed, side="right")
-                  - np.searchsorted(part.ends, typed, side="left")).astype(np.int64)
+        typed, bands = numbers[wrong], part.reach[part.order]
+        # The bands' starts and ends, each sorted (worked out here, not kept).
+        counts = (np.searchsorted(np.sort(part.sorted_values - bands), typed, side="right")
+                  - np.searchsorted(np.sort(part.sorted_values + bands), typed, side="left")).astype(np.int64)
+        del bands
         own, mine = part.values[wrong], part.reach[wrong]
         widest = -range_least(-part.reach[part.order], np.searchsorted(part.sorted_values, own - mine, side="left"),
                                np.searchsorted(part.sorted_values, own + mine, side="right"))

@@ -20,21 +20,11 @@ import numpy as np
 import numpy.typing as npt
 
 from grader.grade.cells import typed_place
-from grader.grade.texts import Texts
 
 Floats = npt.NDArray[np.float64]
-Ints = npt.NDArray[np.int64]
 
 SHORT = 20  # characters: a text this short is at most 40 once cleaned, so its unit is found as typed_place finds it
 _HEAD = re.compile(r"(-?)([0-9]+(?:\.[0-9]*)?)((?:[eE][-+]?[0-9]{1,4})?)")
-
-
-def steps(typed: Texts, students: Ints, numbers: Floats) -> Floats:
-    """Per student (of ``students``; inf for the others), the half-unit of the last digit of their answer as
-    ``typed`` (:func:`step`)."""
-    found = np.full(len(typed), np.inf)
-    found[students] = halves(typed.take(students), numbers[students])
-    return found
 
 
 def halves(texts: Sequence[str | None], numbers: Floats) -> list[float]:

@@ -105,7 +105,8 @@ def integrity_csv(graded: Graded | ClassGrades, integrity: Integrity, rows_per_p
     cell (:func:`report_cell`) as the CSV writer writes it. A report: it changes no grade."""
     yield csv_text([list(map(report_cell, INTEGRITY_HEADER))])
     graded = classwide(graded)
-    students, matches, flagged = graded.key.students, integrity.matches, set(integrity.flagged)
+    students, listed, ranked = graded.key.students, integrity.listed, integrity.ranked
+    flagged = ranked.flagged(integrity.threshold)
     # Most rows are a pair's own and name students, parts, values and figures that other rows name too (a
     # third of the chances are distinct): the cells of each are worked out once.
     who: Cells[int] = Cells(lambda index: written_cell(students[index].id))
@@ -116,10 +117,14 @@ def integrity_csv(graded: Graded | ClassGrades, integrity: Integrity, rows_per_p
     values: dict[float | None, str] = {}
     shown: dict[float | None, str] = {None: ""}
     step = max(1, rows_per_piece)
-    for start in range(0, len(matches), step):
-        piece = matches[start:start + step]
+    for start in range(0, len(listed), step):
+        piece = listed.records(start, start + step)
         submitted, parsed = _typed(graded, piece)
-        pairs = [integrity.pair(match.student, match.partner) for match in piece]  # None: not listed
+        at = ranked.find(listed.student[start:start + step], listed.partner[start:start + step])  # -1: not listed
+        some = iter(ranked.records(at[at >= 0]))
+        pairs = [None if where < 0 else next(some) for where in at.tolist()]
+        flags = ["" if where < 0 else "yes" if flag else "no"
+                 for where, flag in zip(at.tolist(), flagged[at].tolist(), strict=True)]
         lines = map(",".join, zip(
             map(who.__getitem__, [match.student for match in piece]), map(words.__getitem__, [m.label for m in piece]),
             written_texts(submitted), written_texts(parsed), map(who.__getitem__, [match.partner for match in piece]),
@@ -133,7 +138,7 @@ def integrity_csv(graded: Graded | ClassGrades, integrity: Integrity, rows_per_p
                         for pair in pairs], shown, _figures),
             _formatted([None if pair is None else pair.chance for pair in pairs], shown, _figures),
             _formatted([None if pair is None else pair.corrected for pair in pairs], shown, _figures),
-            ["" if pair is None else "yes" if pair in flagged else "no" for pair in pairs], strict=True))
+            flags, strict=True))
         yield "\n".join(lines) + "\n"
 
 

@@ -108,16 +108,17 @@ def integrity_csv(graded: Graded | ClassGrades, integrity: Integrity, rows_per_p
     students, listed, ranked = graded.key.students, integrity.listed, integrity.ranked
     flagged = ranked.flagged(integrity.threshold)
     # Most rows are a pair's own and name students, parts, values and figures that other rows name too (a
-    # third of the chances are distinct): the cells of each are worked out once.
-    who: Cells[int] = Cells(lambda index: written_cell(students[index].id))
+    # third of the chances are distinct): the cells of each are worked out once a piece (kept for the whole file,
+    # a million students' ids, values and chances would take a gigabyte).
     words: Cells[object] = Cells(written_cell)
     counts: Cells[int | None] = Cells(written_cell)
-    # A value to 6 significant figures, a figure to 3 (columns for people): a number's text, which neither the
-    # formula guard nor the CSV writer changes; the values new to a piece are formatted in one call.
-    values: dict[float | None, str] = {}
-    shown: dict[float | None, str] = {None: ""}
     step = max(1, rows_per_piece)
     for start in range(0, len(listed), step):
+        who: Cells[int] = Cells(lambda index: written_cell(students[index].id))
+        # A value to 6 significant figures, a figure to 3 (columns for people): a number's text, which neither
+        # the formula guard nor the CSV writer changes; the values new to a piece are formatted in one call.
+        values: dict[float | None, str] = {}
+        shown: dict[float | None, str] = {None: ""}
         piece = listed.records(start, start + step)
         submitted, parsed = _typed(graded, piece)
         at = ranked.find(listed.student[start:start + step], listed.partner[start:start + step])  # -1: not listed

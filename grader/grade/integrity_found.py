@@ -18,6 +18,8 @@ from typing import NamedTuple
 import numpy as np
 import numpy.typing as npt
 
+from grader.grade.class_grades import Coder
+
 Floats = npt.NDArray[np.float64]
 Ints = npt.NDArray[np.int64]
 Small = npt.NDArray[np.int32]  # a student's index, a count, a label's number: well under 2**31
@@ -64,10 +66,9 @@ class Matches:
     @classmethod
     def of(cls, records: Sequence[Match]) -> Matches:
         """The columns of ``records``."""
-        labels = tuple(dict.fromkeys(match.label for match in records))
-        number = {label: index for index, label in enumerate(labels)}
-        return cls(labels, np.array([match.student for match in records], np.int32),
-                   np.array([number[match.label] for match in records], np.int32),
+        labels: Coder[str] = Coder()
+        label = labels.codes([match.label for match in records]).astype(np.int32)
+        return cls(tuple(labels), np.array([match.student for match in records], np.int32), label,
                    np.array([match.partner for match in records], np.int32),
                    np.array([match.value for match in records], np.float64),
                    np.array([match.matches for match in records], np.int32))
@@ -101,11 +102,11 @@ class Pairs:
     @classmethod
     def of(cls, records: Sequence[Pair]) -> Pairs:
         """The columns of ``records``."""
-        patterns = tuple(dict.fromkeys(pair.labels for pair in records))
-        number = {labels: index for index, labels in enumerate(patterns)}
+        patterns: Coder[tuple[str, ...]] = Coder()
+        pattern = patterns.codes([pair.labels for pair in records]).astype(np.int32)
         columns = {name: np.array([getattr(pair, name) for pair in records], _COLUMNS[name])
                    for name in _COLUMNS if name != "pattern"}
-        return cls(patterns, pattern=np.array([number[pair.labels] for pair in records], np.int32), **columns)
+        return cls(tuple(patterns), pattern=pattern, **columns)
 
     @classmethod
     def joined(cls, pieces: Sequence[Pairs]) -> Pairs:

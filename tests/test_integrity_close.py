@@ -15,7 +15,7 @@ from test_integrity import graded, make_key
 
 from grader.grade import integrity, integrity_close
 from grader.grade.integrity import Integrity, Pair, check
-from grader.grade.integrity_close import bound, window
+from grader.grade.integrity_close import Elsewhere, bound, window
 from grader.grade.key import Key
 from grader.grade.report import integrity_csv
 
@@ -59,32 +59,56 @@ def _key(values: list[list[float]], unit: str) -> Key:
     return dataclasses.replace(key, students=students)
 
 
-def _every_pair(result_graded: object, kept: float,
-                monkeypatch: pytest.MonkeyPatch) -> set[tuple[int, int, tuple[str, ...]]]:
-    """The pairs kept when every ordered pair of the class is tested, none left out by any search."""
-    captured = {}
+def _drawn(drawn: tuple[list[list[float]], dict[tuple[str, str], str]], unit: str) -> object:
+    """The class drawn, graded; for angles (``deg``), its values and answers scaled to up to a turn (360
+    itself among them)."""
+    values, typed = drawn
+    if unit == "deg":
+        values = [[value * 120.0 for value in row] for row in values]
+        typed = {where: text if not text[:1].isdigit() else f"{float(text) * 120.0:.4g}"
+                 for where, text in typed.items()}
+    return graded(_key(values, unit), typed)
+
+
+def _every_two(result_graded: object, monkeypatch: pytest.MonkeyPatch) -> dict[str, object] | None:
+    """What the check compares, and every ordered pair of the class with two or more matched parts (none left
+    out by any search), with its matched parts: None when no pair has two."""
+    captured: dict[str, object] = {}
     original = integrity._pairs
 
     def capture(parts, answers, spread, found, examined, block=integrity.PAIRS):  # type: ignore[no-untyped-def]
-        captured.update(parts=parts, answers=answers, spread=spread, examined=examined)
+        captured.update(parts=parts, answers=answers, spread=spread, examined=examined, found=found)
         return original(parts, answers, spread, found, examined, block)
 
     monkeypatch.setattr(integrity, "_pairs", capture)
     check(result_graded)  # type: ignore[arg-type]
     monkeypatch.setattr(integrity, "_pairs", original)
     if not captured:
-        return set()
-    parts, answers, spread = captured["parts"], captured["answers"], captured["spread"]
-    students = len(answers.per_student)
+        return None
+    parts, answers = captured["parts"], captured["answers"]
+    students = len(answers.per_student)  # type: ignore[attr-defined]
     owners, partners = (grid.ravel() for grid in np.meshgrid(np.arange(students), np.arange(students), indexing="ij"))
-    hits = integrity._hits(parts, answers, owners, partners)
+    hits = integrity._hits(parts, answers, owners, partners)  # type: ignore[arg-type]
     two = hits.sum(axis=1) >= 2
     if not two.any():
+        return None
+    return captured | {"owners": owners[two], "partners": partners[two], "hits": hits[two],
+                       "most": int(answers.per_student[owners[two]].max())}  # type: ignore[attr-defined]
+
+
+def _figured(every: dict[str, object], below: float) -> integrity.Pairs:
+    """:func:`integrity._figures` of every pair with two matched parts, those under ``below``."""
+    return integrity._figures(every["parts"], every["answers"], every["spread"], every["owners"],  # type: ignore
+                              every["partners"], every["examined"], 2, below, every["hits"], every["most"])
+
+
+def _every_pair(result_graded: object, kept: float,
+                monkeypatch: pytest.MonkeyPatch) -> set[tuple[int, int, tuple[str, ...]]]:
+    """The pairs kept when every ordered pair of the class is tested, none left out by any search."""
+    every = _every_two(result_graded, monkeypatch)
+    if every is None:
         return set()
-    most = int(answers.per_student[owners[two]].max())
-    found = integrity._figures(parts, answers, spread, owners[two], partners[two], captured["examined"], 2, kept,
-                               hits[two], most)
-    return {(pair.student, pair.partner, pair.labels) for pair in found.records()}
+    return {(pair.student, pair.partner, pair.labels) for pair in _figured(every, kept).records()}
 
 
 def _two(result: Integrity) -> set[tuple[int, int, tuple[str, ...]]]:
@@ -100,12 +124,7 @@ def test_the_close_search_finds_what_the_band_search_and_every_pair_find(
     """The same findings, to the bit (and the same integrity.csv), with the close search and with the band search
     alone; the pairs kept are those of every ordered pair tested. ``kept`` below 1 narrows the windows, as a
     big class does; angles (``deg``) have windows of their own."""
-    values, typed = drawn
-    if unit == "deg":
-        values = [[value * 120.0 for value in row] for row in values]  # up to a turn, 360 itself among them
-        typed = {where: text if not text[:1].isdigit() else f"{float(text) * 120.0:.4g}"
-                 for where, text in typed.items()}
-    result_graded = graded(_key(values, unit), typed)
+    result_graded = _drawn(drawn, unit)
     monkeypatch.setattr(integrity, "KEPT", kept)
     close = check(result_graded)
     monkeypatch.setattr(integrity_close, "CLOSE", False)
@@ -115,6 +134,82 @@ def test_the_close_search_finds_what_the_band_search_and_every_pair_find(
     assert "".join(integrity_csv(result_graded, close)) == "".join(integrity_csv(result_graded, banded))
     if kept == 1.0:
         assert _two(close) == _every_pair(result_graded, kept, monkeypatch)
+
+
+@SETTINGS
+@given(drawn=classes(), unit=st.sampled_from(["m/s", "deg"]))
+def test_the_bound_that_spares_the_figures_is_at_most_every_corrected_chance(
+        monkeypatch: pytest.MonkeyPatch, drawn: tuple[list[list[float]], dict[tuple[str, str], str]],
+        unit: str) -> None:
+    """The cheap bound from below (:func:`integrity._at_least`) that leaves pairs out before their chances are
+    worked out is at most the corrected chance :func:`integrity._figures` gives every pair with two matched
+    parts, before that is capped at 1 (checked against the cap too: a capped pair is never kept): so a pair
+    it leaves out could not have been kept. Copies as typed and in full, near copies and slips are among
+    the answers; the classes are small, so the bound is tested as it is, not only where it leaves pairs out."""
+    every = _every_two(_drawn(drawn, unit), monkeypatch)
+    if every is None:
+        return
+    corrected = _figured(every, np.inf).corrected
+    least = np.exp(integrity._at_least(every["parts"], every["answers"], every["spread"],  # type: ignore[arg-type]
+                                       every["owners"], every["partners"], every["hits"],  # type: ignore[arg-type]
+                                       every["examined"]))  # type: ignore[arg-type]
+    assert len(least) == len(corrected)
+    capped = corrected >= 1.0
+    assert np.all(least[~capped] <= corrected[~capped] * (1 + 1e-9))
+    # What it leaves out at the thresholds a big class reaches is never kept.
+    for below in (1.0, 1e-3):
+        possible = integrity._possible(every["parts"], every["answers"], every["spread"],  # type: ignore[arg-type]
+                                       every["owners"], every["partners"], every["hits"],  # type: ignore[arg-type]
+                                       every["examined"], below)  # type: ignore[arg-type]
+        assert not np.any(~possible & (corrected < below))
+
+
+@SETTINGS
+@given(drawn=classes(), unit=st.sampled_from(["m/s", "deg"]))
+def test_a_partner_let_go_before_its_bands_are_compared_holds_no_other_wrong_answer(
+        monkeypatch: pytest.MonkeyPatch, drawn: tuple[list[list[float]], dict[tuple[str, str], str]],
+        unit: str) -> None:
+    """:class:`Elsewhere` keeps every pair found for a part whose partner's band holds another of the owner's
+    wrong answers (every ordered pair of the class with two matched parts, tested one by one), and lets go
+    pairs that hold no other (so it is not a check that keeps everything)."""
+    every = _every_two(_drawn(drawn, unit), monkeypatch)
+    if every is None:
+        return
+    parts, answers = every["parts"], every["answers"]
+    students = len(answers.per_student)  # type: ignore[attr-defined]
+    elsewhere = Elsewhere(parts, answers.wrong, [ranges for _, ranges in every["found"]],  # type: ignore
+                          students)
+    owners, partners = (grid.ravel() for grid in np.meshgrid(np.arange(students), np.arange(students), indexing="ij"))
+    hits = integrity._hits(parts, answers, owners, partners)  # type: ignore[arg-type]
+    for index in range(len(parts)):  # type: ignore[arg-type]
+        rows = np.flatnonzero(hits[:, index])
+        other = np.delete(hits[rows], index, axis=1).any(axis=1)
+        kept = elsewhere(index, owners[rows], partners[rows])
+        assert np.all(kept[other])
+        # A partner whose band holds none of the owner's other answers is in no other range but by the range's
+        # slack: a partner with no value in any other part is never kept.
+        valued = np.zeros(students, dtype=bool)
+        for other_index, part in enumerate(parts):  # type: ignore[arg-type]
+            if other_index != index:
+                valued[part.order] = True
+        assert not np.any(kept & ~valued[partners[rows]])
+
+
+def test_elsewhere_lets_go_a_partner_out_of_every_other_range() -> None:
+    """Two parts; student 0's wrong answers' ranges hold student 2 in the first part's order and student 1 in
+    the second's: found for the first part, student 1 is kept (in the second part's range), student 2 is not."""
+    from grader.grade.integrity_search import bands
+    from grader.model.tolerance import Tolerance
+
+    first, second = (bands(label, np.array([1.0, 2.0, 3.0]), [Tolerance().to_json()] * 3, "m")
+                     for label in ("1a", "1b"))
+    wrong = {"1a": np.array([0]), "1b": np.array([0])}
+    ranges = [[(np.array([2]), np.array([3]))], [(np.array([1]), np.array([2]))]]
+    elsewhere = Elsewhere([first, second], wrong, ranges, 3)
+    assert elsewhere(0, np.array([0, 0]), np.array([1, 2])).tolist() == [True, False]
+    assert elsewhere(1, np.array([0, 0]), np.array([1, 2])).tolist() == [False, True]
+    # A student with no other wrong answer keeps no partner.
+    assert elsewhere(0, np.array([1]), np.array([2])).tolist() == [False]
 
 
 def test_a_class_of_one_and_a_class_all_alike() -> None:

@@ -28,7 +28,8 @@ A pair whose corrected chance is at most the assignment's ``grading.integrity_th
 
 The band search (which students' bands hold an answer) is :mod:`grader.grade.integrity_search`; of the candidate
 pairs, only those that could be kept are formed (:mod:`grader.grade.integrity_close`), about :data:`PAIRS` at a
-time, so time and memory grow with the class, not its square.
+time, so time and memory grow with the class, not its square; of those, a bound from below of the corrected
+chance (:func:`_at_least`) lets go those that could not be kept before their chances are worked out.
 """
 
 from __future__ import annotations
@@ -44,7 +45,7 @@ from grader.grade.class_grades import ClassGrades, classwide
 from grader.grade.compare import errors
 from grader.grade.grading import Graded
 from grader.grade.integrity_chance import UNRELATED, Spread
-from grader.grade.integrity_close import bound, close_pairs
+from grader.grade.integrity_close import MARGIN, bound, close_pairs
 from grader.grade.integrity_found import Integrity, Match, Matches, Pair, Pairs, Small
 from grader.grade.integrity_search import (
     Bands,
@@ -130,9 +131,13 @@ class _Answers(NamedTuple):
         asked = asked[np.isnan(read[asked])]
         read[asked] = halves(self.typed[part.label].take(asked), self.numbers[part.label][asked])
         half_units = np.where(have, read[partners], np.inf)
-        found = np.where(have & (half_units <= self.step(part.label, owners)), typed, values)
-        period = part.period
-        return found if period is None else values + np.mod(found - values + period / 2, period) - period / 2
+        return _turned(part, values, np.where(have & (half_units <= self.step(part.label, owners)), typed, values))
+
+    def either(self, part: Bands, partners: Ints) -> tuple[Floats, Floats]:
+        """The two centres :meth:`centres` chooses between, without reading how the right answers were typed:
+        the number each partner typed when it was right (else their value), and their value."""
+        values, typed = part.values[partners], self.right.of(part.label, partners)
+        return _turned(part, values, np.where(np.isfinite(typed), typed, values)), values
 
     def answered(self, label: str) -> npt.NDArray[np.bool_]:
         """Per student, whether their answer to the part is one of the wrong ones (worked out once a part)."""
@@ -201,6 +206,12 @@ def _search(graded: ClassGrades, block: int) -> tuple[Matches, list[Pairs], int,
             sum(int(np.count_nonzero(counts)) for counts, _ in found))
 
 
+def _turned(part: Bands, values: Floats, found: Floats) -> Floats:
+    """An angle's ``found`` taken within half a turn of ``values`` (any other part's as they are)."""
+    period = part.period
+    return found if period is None else values + np.mod(found - values + period / 2, period) - period / 2
+
+
 def _ranked(pairs: Pairs) -> Ints:
     """The order of the pairs, most suspicious first: by corrected chance, chance, student and partner (a sort
     of arrays, not of a million tuples)."""
@@ -267,6 +278,10 @@ def _pairs(parts: Sequence[Bands], answers: _Answers, spread: Spread,
     hits = np.concatenate([hits for _, _, hits in kept])
     del kept
     most = _most(parts, answers, found, candidate, int(per_student[owners].max()), block)
+    possible = np.concatenate([_possible(parts, answers, spread, owners[start:start + FIGURED],
+                                         partners[start:start + FIGURED], hits[start:start + FIGURED], examined,
+                                         KEPT) for start in range(0, len(owners), FIGURED)])
+    owners, partners, hits = owners[possible], partners[possible], hits[possible]
     step = max(min(block, FIGURED), 1)
     return Pairs.joined([_figures(parts, answers, spread, owners[start:start + step], partners[start:start + step],
                                   examined, 2, KEPT, hits[start:start + step], most)
@@ -405,13 +420,7 @@ def _figures(parts: Sequence[Bands], answers: _Answers, spread: Spread, owners: 
     units = np.full(hits.shape, np.inf)
     for index, part in enumerate(parts):
         rows = np.flatnonzero(hits[:, index])
-        centres = answers.centres(part, owners[rows], partners[rows])
-        distance = errors(answers.numbers[part.label][owners[rows]], centres,
-                          angle_unit=part.unit if part.period is not None else None)[0]
-        # inf / inf (a number typed as arithmetic) is NaN: such a match claims no closeness (0 sets none).
-        with np.errstate(divide="ignore", invalid="ignore"):
-            units[rows, index] = np.nan_to_num(distance / answers.step(part.label, owners[rows]), nan=0.0,
-                                               posinf=np.inf)
+        units[rows, index] = _closeness(part, answers, owners[rows], partners[rows])
     ordered = np.sort(units, axis=1)
     chances, counted, closeness = np.ones(len(owners)), matched.copy(), np.full(len(owners), np.inf)
     for closest in range(1, int(matched.max()) + 1 if len(matched) else 1):
@@ -441,6 +450,48 @@ def _figures(parts: Sequence[Bands], answers: _Answers, spread: Spread, owners: 
                  corrected, counted.astype(np.int32), closeness)
 
 
+def _closeness(part: Bands, answers: _Answers, owners: Ints, partners: Ints,
+               centres: Floats | None = None) -> Floats:
+    """How close each owner's matched answer to the part is to the partner's (:meth:`_Answers.centres`), in
+    half-units of the owner's typed answer."""
+    centres = answers.centres(part, owners, partners) if centres is None else centres
+    distance = errors(answers.numbers[part.label][owners], centres,
+                      angle_unit=part.unit if part.period is not None else None)[0]
+    # inf / inf (a number typed as arithmetic) is NaN: such a match claims no closeness (0 sets none).
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.nan_to_num(distance / answers.step(part.label, owners), nan=0.0, posinf=np.inf)
+
+
+def _possible(parts: Sequence[Bands], answers: _Answers, spread: Spread, owners: Ints, partners: Ints,
+              hits: npt.NDArray[np.bool_], examined: int, below: float) -> npt.NDArray[np.bool_]:
+    """Whether each pair's corrected chance could be under ``below``, by :func:`_at_least`, loosened by
+    :data:`~grader.grade.integrity_close.MARGIN` against rounding (every pair, when ``below`` is over 1: a
+    corrected chance is at most 1)."""
+    if below > 1:
+        return np.ones(len(owners), dtype=bool)
+    return np.asarray(_at_least(parts, answers, spread, owners, partners, hits, examined) < math.log(MARGIN * below))
+
+
+def _at_least(parts: Sequence[Bands], answers: _Answers, spread: Spread, owners: Ints, partners: Ints,
+              hits: npt.NDArray[np.bool_], examined: int) -> Floats:
+    """The log of a bound from below of each pair's corrected chance before it is capped at 1, far cheaper
+    than :func:`_figures` (it does not read how anyone's answers were typed). The chance of ``j`` or more of
+    the owner's wrong parts landing is at least that of the ``j`` matched parts :func:`_figures` counts all
+    landing, each within the closeness of the least close of them, so at least the product of every matched
+    part's chance within its own closeness (:func:`_chance` ``at_least``: a chance grows with the closeness),
+    from whichever centre gives the less; ``examined`` times that is at most the corrected chance."""
+    logs = np.full(len(owners), math.log(max(examined, 1)))
+    for index, part in enumerate(parts):
+        rows = np.flatnonzero(hits[:, index])
+        who, partner = owners[rows], partners[rows]
+        steps = answers.step(part.label, who)
+        chance = np.minimum(*(_chance(part, spread, who, partner, _closeness(part, answers, who, partner, centres),
+                                      steps, centres, at_least=True) for centres in answers.either(part, partner)))
+        with np.errstate(divide="ignore"):
+            logs[rows] += np.log(np.minimum(chance, 1.0))
+    return logs
+
+
 def _tails(parts: Sequence[Bands], answers: _Answers, spread: Spread, owners: Ints, partners: Ints,
            closeness: Floats, most: int | None = None) -> Floats:
     """Per pair (a row), the chance that ``j`` (a column, up to ``most``: by default the most wrong parts of
@@ -466,12 +517,13 @@ def _tails(parts: Sequence[Bands], answers: _Answers, spread: Spread, owners: In
 
 
 def _chance(part: Bands, spread: Spread, owners: Ints, partners: Ints, closeness: Floats, steps: Floats,
-            centres: Floats) -> Floats:
+            centres: Floats, at_least: bool = False) -> Floats:
     """The chance that each owner's wrong answer to the part lands by accident in the partner's band and
     within ``closeness`` half-units ``steps`` of the owner's typed answer from ``centres``
     (:meth:`_Answers.centres`), widened by one more (a number rounded as typed is within a half-unit of where
     it was headed): over the band narrowed to that (:mod:`grader.grade.integrity_chance`; an angle's answers
-    are all taken as unrelated to their own, and its chance is the narrowed share of the band's)."""
+    are all taken as unrelated to their own, and its chance is the narrowed share of the band's). ``at_least``:
+    a bound from below of it that no wider closeness goes under (:meth:`Spread.chance`'s)."""
     middle, reach = part.values[partners], part.reach[partners]
     with np.errstate(invalid="ignore"):
         half = np.nan_to_num((closeness + 1) * steps, nan=np.inf)
@@ -481,7 +533,7 @@ def _chance(part: Bands, spread: Spread, owners: Ints, partners: Ints, closeness
     unrelated = np.nan_to_num(part.chance[partners], nan=0.0) * share
     if part.period is not None:
         return np.asarray(unrelated)
-    related = spread.chance(part.values[owners], low, np.maximum(low, high), owners)
+    related = spread.chance(part.values[owners], low, np.maximum(low, high), owners, at_least)
     return np.asarray((1 - UNRELATED) * related + UNRELATED * unrelated)
 
 

@@ -125,10 +125,12 @@ class Spread:
         """How many answers each of ``owners`` has among the class's."""
         return np.asarray(self.starts[owners + 1] - self.starts[owners])
 
-    def chance(self, own: Floats, low: Floats, high: Floats, owners: Ints) -> Floats:
+    def chance(self, own: Floats, low: Floats, high: Floats, owners: Ints, at_least: bool = False) -> Floats:
         """The chance that a wrong answer of student ``owners`` related to their ``own`` value lands in
         ``[low, high]``, from the other students' answers; 1 where the band holds zero or ``own`` is zero (no
-        ratio tells)."""
+        ratio tells). ``at_least``: a bound from below of that chance over ``[low, high]`` and over any interval
+        that holds it, the student's own answers taken off whole wherever they are (their kernels not
+        looked up: cheaper, and it cannot grow as the interval narrows)."""
         with np.errstate(divide="ignore", invalid="ignore"):
             first, second = low / own, high / own
             ends = np.log(np.abs(np.stack([first, second])))
@@ -138,8 +140,12 @@ class Spread:
         # undefined own value, a null in the key: no ratio tells, and the chance is 1 below)
         a, b = np.fmin(ends[0], ends[1]), np.fmax(ends[0], ends[1])
         whole = np.where(same, self._mass(self.same, a, b), self._mass(self.other, a, b))
+        left = self.answers - self.answered(owners)
+        if at_least:  # each of the student's answers' kernels holds at most their whole mass
+            whole = whole - (self.answers - left) * float(self.kernel[-1] - self.kernel[0]) * (1 + 1e-9) / max(
+                self.answers, 1)
+            return self._share(whole, left, same | other)
         mine, signs = self.own(owners)
-        theirs = np.isfinite(mine).sum(axis=1)
         signed = np.where(np.isfinite(mine), signs == same[:, None], False)
         # A student's own answers' kernels, over the band: in grid cells, the band's ends from each answer's.
         low_cell, high_cell = (a - self.start) / self.step - 0.5, (b - self.start) / self.step - 0.5
@@ -148,10 +154,14 @@ class Spread:
             own_mass = (np.interp(high_cell[:, None] - mine, offsets, self.kernel)
                         - np.interp(low_cell[:, None] - mine, offsets, self.kernel))
         own_mass = np.where(signed, own_mass, 0.0).sum(axis=1) / max(self.answers, 1)
-        left = self.answers - theirs
+        return self._share(whole - own_mass, left, same | other)
+
+    def _share(self, others: Floats, left: Ints, signed: npt.NDArray[np.bool_]) -> Floats:
+        """The other students' mass ``others`` (a share of all the answers) as a share of their own answers
+        (``left`` of them); 1 where the band is not on one side of zero (``signed``), or no ratio tells."""
         with np.errstate(divide="ignore", invalid="ignore"):
-            found = np.where(left > 0, (whole - own_mass) * self.answers / left, 0.0)
-        found = np.where(same | other, found, 1.0)
+            found = np.where(left > 0, others * self.answers / left, 0.0)
+        found = np.where(signed, found, 1.0)
         return np.asarray(np.clip(np.nan_to_num(found, nan=1.0), 0.0, 1.0))
 
     def _mass(self, table: Floats, a: Floats, b: Floats) -> Floats:

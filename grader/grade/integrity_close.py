@@ -12,7 +12,9 @@ partner's typed answer or value, both in the partner's band, so the narrowed ban
 what the student's own answers may add to it (at most their count over the answers). That mass grows as ``c``
 moves away from ``a``: inverting the class's cumulative distribution gives, per answer, a window of centres
 outside which no partner can be kept, and only partners whose value or typed answer lies inside it are formed.
-In a big class the window narrows as ``M`` grows, so the pairs formed grow with the class, not its square.
+In a big class the window narrows as ``M`` grows, so the pairs formed grow with the class, not its square; but
+for a student with ``k`` wrong parts only as ``M ** (-1 / k)``, so a partner found is formed into a pair only when
+it may also hold another of the student's wrong answers (:class:`Elsewhere`: a pair needs two matched parts).
 
 A partner whose typed right answer lies outside their own band (it cannot, when their tolerance accepted it; a
 safeguard), and every partner of an angle's part (its chance has no related kind), or of an answer whose ratio to
@@ -140,8 +142,9 @@ def close_pairs(parts: Sequence[Bands], spread: Spread, wrong: Mapping[str, Ints
     cheaper of two searches that both find every pair that could be kept: the close search, over the answers
     ``searched`` (rows of ``wrong``, per part: every part that matches anyone), of the partners whose centre is
     in the answer's window (:func:`centres_window`, for the chance ``least`` per owner); or the band search
-    over the answers ``chosen`` (per part), of every partner in their ranges. In pieces of about ``chunk``
-    pairs (a block of owners at a time), each sorted and without repeats."""
+    over the answers ``chosen`` (per part), of every partner in their ranges; of those, only a partner that may
+    also hold another of the owner's wrong answers (:class:`Elsewhere`). In pieces of about ``chunk`` pairs
+    looked at (a block of owners at a time), each sorted and without repeats."""
     students = len(least)
     close, banded = [], []
     cost = np.zeros((2, students))  # per owner, the partners the close and the band search would look at
@@ -159,11 +162,11 @@ def close_pairs(parts: Sequence[Bands], spread: Spread, wrong: Mapping[str, Ints
     searching = np.flatnonzero(cost.min(axis=0) > 0)
     groups = list(blocks(cost.min(axis=0)[searching].astype(np.int64), chunk))
     block_of = np.full(students, -1, dtype=np.int64)
-    for index, group in enumerate(groups):
-        block_of[searching[group]] = index
+    for number, group in enumerate(groups):
+        block_of[searching[group]] = number
     # Each source's answers, by their owner's block (in their order within it): a block takes a run of each.
     runs = []
-    for part, close_sources, band_sources in zip(parts, close, banded, strict=True):
+    for index, (part, close_sources, band_sources) in enumerate(zip(parts, close, banded, strict=True)):
         members = wrong[part.label]
         for source, is_close in [*((source, True) for source in close_sources),
                                  *((source, False) for source in band_sources)]:
@@ -171,18 +174,68 @@ def close_pairs(parts: Sequence[Bands], spread: Spread, wrong: Mapping[str, Ints
             use = np.flatnonzero((by_close[who] == is_close) & (block_of[who] >= 0))
             use = use[np.argsort(block_of[who[use]], kind="stable")]
             bounds = np.searchsorted(block_of[who[use]], np.arange(len(groups) + 1))
-            runs.append((part, source, who[use], use, bounds))
-    for index in range(len(groups)):
+            runs.append((index, part, source, who[use], use, bounds))
+    elsewhere = Elsewhere(parts, wrong, ranges, students)
+    for number in range(len(groups)):
         keys = [np.zeros(0, dtype=np.int64)]
-        for part, source, who, use, bounds in runs:
-            run = slice(bounds[index], bounds[index + 1])
+        for index, part, source, who, use, bounds in runs:
+            run = slice(bounds[number], bounds[number + 1])
             owners, rows = who[run], use[run]
             for which, positions in expanded(source.starts[rows], source.ends[rows]):
                 owner, partners = owners[which], source.at[positions]
+                other = elsewhere(index, owner, partners)
+                owner, partners = owner[other], partners[other]
                 ok = accepts(part, owner, partners, numbers[part.label])
                 keys.append(distinct(owner[ok] * students + partners[ok]))
         pairs = distinct(np.concatenate(keys))
         yield pairs // students, pairs % students
+
+
+class Elsewhere:
+    """Whether a partner may hold another of the owner's wrong answers: is in the band search's range of one
+    (:func:`~grader.grade.integrity_search.holding`: a range holds every band that holds the answer). A pair
+    is kept only with two or more matched parts, so a partner found for one part that is in no other range
+    is let go before its band is compared; a look-up of the partner's place in each of the owner's other
+    wrong parts' orders, not a comparison of bands (4 bytes a student and part, twice).
+    """
+
+    def __init__(self, parts: Sequence[Bands], wrong: Mapping[str, Ints],
+                 ranges: Sequence[Sequence[tuple[Ints, Ints]]], students: int) -> None:
+        # Per part, each student's place in its order (-1: no value) and the number of their wrong answer to it
+        # (-1: none; the answers numbered one part after another), 4 bytes each.
+        self.place = np.full((len(parts), students), -1, dtype=np.int32)
+        self.answer = np.full((len(parts), students), -1, dtype=np.int32)
+        first = 0
+        for index, part in enumerate(parts):
+            self.place[index, part.order] = np.arange(len(part.order))
+            members = wrong[part.label]
+            self.answer[index, members] = np.arange(first, first + len(members))
+            first += len(members)
+        # Each wrong answer's ranges, a turn at a time (a part with fewer turns has empty ones).
+        turns = max((len(part_ranges) for part_ranges in ranges), default=0)
+        self.starts, self.ends = (np.zeros((turns, first), dtype=np.int32) for _ in range(2))
+        first = 0
+        for part, part_ranges in zip(parts, ranges, strict=True):
+            count = len(wrong[part.label])
+            for turn, (starts, ends) in enumerate(part_ranges):
+                self.starts[turn, first:first + count], self.ends[turn, first:first + count] = starts, ends
+            first += count
+
+    def __call__(self, index: int, owners: Ints, partners: Ints) -> npt.NDArray[np.bool_]:
+        """Per pair (``owners[k]``, ``partners[k]``) found for part ``index``, whether the partner is in the range
+        of another of the owner's wrong answers."""
+        found = np.zeros(len(owners), dtype=bool)
+        for other, (answers, places) in enumerate(zip(self.answer, self.place, strict=True)):
+            if other == index:
+                continue
+            answer = answers[owners]
+            rows = np.flatnonzero(answer >= 0)
+            answer, place = answer[rows], places[partners[rows]]
+            inside = np.zeros(len(rows), dtype=bool)
+            for starts, ends in zip(self.starts, self.ends, strict=True):
+                inside |= (starts[answer] <= place) & (place < ends[answer])
+            found[rows[inside]] = True
+        return found
 
 
 def _close_sources(part: Bands, spread: Spread, owners: Ints, numbers: Floats, right: Floats,

@@ -111,8 +111,8 @@ def _every_pair(result_graded: object, kept: float,
     return {(pair.student, pair.partner, pair.labels) for pair in _figured(every, kept).records()}
 
 
-def _two(result: Integrity) -> set[tuple[int, int, tuple[str, ...]]]:
-    return {(p.student, p.partner, p.labels) for p in result.pairs if len(p.labels) >= 2 and p.corrected < 1}
+def _two(result: Integrity, kept: float) -> set[tuple[int, int, tuple[str, ...]]]:
+    return {(p.student, p.partner, p.labels) for p in result.pairs if len(p.labels) >= 2 and p.corrected < kept}
 
 
 @pytest.mark.parametrize("kept", [1.0, 1e-3, 1e-9])
@@ -123,7 +123,8 @@ def test_the_close_search_finds_what_the_band_search_and_every_pair_find(
         unit: str) -> None:
     """The same findings, to the bit (and the same integrity.csv), with the close search and with the band search
     alone; the pairs kept are those of every ordered pair tested. ``kept`` below 1 narrows the windows, as a
-    big class does; angles (``deg``) have windows of their own."""
+    big class does (and moves where each student's search is split between the two); angles (``deg``) have
+    windows of their own."""
     result_graded = _drawn(drawn, unit)
     monkeypatch.setattr(integrity, "KEPT", kept)
     close = check(result_graded)
@@ -132,8 +133,37 @@ def test_the_close_search_finds_what_the_band_search_and_every_pair_find(
     monkeypatch.setattr(integrity_close, "CLOSE", True)
     assert close == banded
     assert "".join(integrity_csv(result_graded, close)) == "".join(integrity_csv(result_graded, banded))
-    if kept == 1.0:
-        assert _two(close) == _every_pair(result_graded, kept, monkeypatch)
+    assert _two(close, kept) == _every_pair(result_graded, kept, monkeypatch)
+
+
+@SETTINGS
+@given(drawn=classes(), unit=st.sampled_from(["m/s", "deg"]), kept=st.sampled_from([1.0, 1e-3, 1e-9]),
+       seed=st.integers(0, 2**32 - 1))
+def test_the_findings_are_the_same_wherever_each_students_search_is_split(
+        monkeypatch: pytest.MonkeyPatch, drawn: tuple[list[list[float]], dict[tuple[str, str], str]], unit: str,
+        kept: float, seed: int) -> None:
+    """Each student's search split at a number of parts drawn at random (any from the band search alone to the
+    close search alone), not the cheapest: the same findings, to the bit, and the pairs kept are those of every
+    ordered pair tested (random small classes seldom make the cheapest split fall between the two)."""
+    result_graded = _drawn(drawn, unit)
+    monkeypatch.setattr(integrity, "KEPT", kept)
+    cheapest = check(result_graded)
+    original = integrity_close._formed
+    rng = np.random.default_rng(seed)
+
+    def anywhere(parts, spread, wrong, numbers, typed, ranges, rows_of, *rest):  # type: ignore[no-untyped-def]
+        rank, owners, _cheapest, cost, needed = rest[:5]
+        levels = np.zeros(len(needed), dtype=np.int64)
+        for part, rows in zip(parts, rows_of, strict=True):
+            levels[wrong[part.label][rows]] += 1
+        drawn_split = rng.integers(needed[owners] - 1, levels[owners] + 1)
+        return original(parts, spread, wrong, numbers, typed, ranges, rows_of, rank, owners, drawn_split,
+                        np.maximum(cost, 1.0), needed, *rest[5:])
+
+    monkeypatch.setattr(integrity_close, "_formed", anywhere)
+    assert check(result_graded) == cheapest
+    monkeypatch.setattr(integrity_close, "_formed", original)
+    assert _two(cheapest, kept) == _every_pair(result_graded, kept, monkeypatch)
 
 
 @SETTINGS
@@ -184,7 +214,7 @@ def test_a_partner_let_go_before_its_bands_are_compared_holds_no_other_wrong_ans
     for index in range(len(parts)):  # type: ignore[arg-type]
         rows = np.flatnonzero(hits[:, index])
         other = np.delete(hits[rows], index, axis=1).any(axis=1)
-        kept = elsewhere(index, owners[rows], partners[rows])
+        kept = elsewhere(index, owners[rows], np.arange(len(rows)), partners[rows]) > 0
         assert np.all(kept[other])
         # A partner whose band holds none of the owner's other answers is in no other range but by the range's
         # slack: a partner with no value in any other part is never kept.
@@ -206,10 +236,10 @@ def test_elsewhere_lets_go_a_partner_out_of_every_other_range() -> None:
     wrong = {"1a": np.array([0]), "1b": np.array([0])}
     ranges = [[(np.array([2]), np.array([3]))], [(np.array([1]), np.array([2]))]]
     elsewhere = Elsewhere([first, second], wrong, ranges, 3)
-    assert elsewhere(0, np.array([0, 0]), np.array([1, 2])).tolist() == [True, False]
-    assert elsewhere(1, np.array([0, 0]), np.array([1, 2])).tolist() == [False, True]
+    assert elsewhere(0, np.array([0]), np.array([0, 0]), np.array([1, 2])).tolist() == [1, 0]
+    assert elsewhere(1, np.array([0]), np.array([0, 0]), np.array([1, 2])).tolist() == [0, 1]
     # A student with no other wrong answer keeps no partner.
-    assert elsewhere(0, np.array([1]), np.array([2])).tolist() == [False]
+    assert elsewhere(0, np.array([1]), np.array([0]), np.array([2])).tolist() == [0]
 
 
 def test_a_class_of_one_and_a_class_all_alike() -> None:

@@ -45,7 +45,7 @@ from grader.grade.class_grades import ClassGrades, classwide
 from grader.grade.compare import errors
 from grader.grade.grading import Graded
 from grader.grade.integrity_chance import UNRELATED, Spread
-from grader.grade.integrity_close import MARGIN, bound, close_pairs
+from grader.grade.integrity_close import MARGIN, close_pairs
 from grader.grade.integrity_found import Integrity, Match, Matches, Pair, Pairs, Small
 from grader.grade.integrity_search import (
     Bands,
@@ -250,11 +250,13 @@ def _pairs(parts: Sequence[Bands], answers: _Answers, spread: Spread,
     needed = _needed(parts, answers, spread, found, examined)
     columns = [(wrong[part.label], found_counts) for part, (found_counts, _) in zip(parts, found, strict=True)]
     candidate = np.zeros((students, len(parts)), dtype=bool)
+    ranks = np.zeros((students, len(parts)), dtype=np.int8)  # a class has at most a few dozen parts
     for rows in _row_blocks(students):
         counts = _laid_out(rows, columns, 0)  # per student and part, the students matched
         matched = np.count_nonzero(counts, axis=1)
         # Each part's rank among the student's, most students matched first: the needed - 1 first are not searched.
         rank = np.argsort(np.argsort(-counts, axis=1, kind="stable"), axis=1, kind="stable")
+        ranks[rows] = rank
         candidate[rows] = ((counts > 0) & (matched >= needed[rows])[:, None] & (rank >= (needed[rows] - 1)[:, None])
                            )[:, :len(parts)]
     del columns
@@ -262,11 +264,9 @@ def _pairs(parts: Sequence[Bands], answers: _Answers, spread: Spread,
     owners_in: npt.NDArray[np.bool_] = np.any(candidate, axis=1)
     searched = [np.flatnonzero((found_counts > 0) & owners_in[wrong[part.label]])
                 for part, (found_counts, _) in zip(parts, found, strict=True)]
-    chosen = [np.flatnonzero(candidate[wrong[part.label], index]) for index, part in enumerate(parts)]
-    least = bound(examined, KEPT, per_student)  # a pair matches in at most the wrong parts
     kept: list[tuple[Ints, Ints, npt.NDArray[np.bool_]]] = []
     for owners, partners in close_pairs(parts, spread, wrong, answers.numbers, answers.right, ranges, searched,
-                                        chosen, least, block):
+                                        ranks, needed, examined, KEPT, block):
         hits = _hits(parts, answers, owners, partners)
         two = (hits & candidate[owners]).any(axis=1) & (hits.sum(axis=1) >= 2)
         if two.any():

@@ -136,55 +136,106 @@ class _Source(NamedTuple):
 
 def close_pairs(parts: Sequence[Bands], spread: Spread, wrong: Mapping[str, Ints], numbers: Mapping[str, Floats],
                 right: Mapping[str, Floats], ranges: Sequence[Sequence[tuple[Ints, Ints]]],
-                searched: Sequence[Ints], chosen: Sequence[Ints], least: Floats, chunk: int
-                ) -> Iterator[tuple[Ints, Ints]]:
-    """The pairs (owner, partner) whose partner's band holds a wrong answer of the owner's, per owner by the
-    cheaper of two searches that both find every pair that could be kept: the close search, over the answers
-    ``searched`` (rows of ``wrong``, per part: every part that matches anyone), of the partners whose centre is
-    in the answer's window (:func:`centres_window`, for the chance ``least`` per owner); or the band search
-    over the answers ``chosen`` (per part), of every partner in their ranges; of those, only a partner that may
-    also hold another of the owner's wrong answers (:class:`Elsewhere`). In pieces of about ``chunk`` pairs
-    looked at (a block of owners at a time), each sorted and without repeats."""
-    students = len(least)
-    close, banded = [], []
-    cost = np.zeros((2, students))  # per owner, the partners the close and the band search would look at
-    for part, part_ranges, rows, rows_chosen in zip(parts, ranges, searched, chosen, strict=True):
-        members = wrong[part.label]
-        close.append(_close_sources(part, spread, members[rows], numbers[part.label], right[part.label],
-                                    part_ranges, rows, least))
-        banded.append([_Source(rows_chosen, starts[rows_chosen], ends[rows_chosen], part.order)
-                       for starts, ends in part_ranges])
-        for search, sources in enumerate((close[-1], banded[-1])):
-            for source in sources:
-                cost[search] += np.bincount(members[source.rows], minlength=students,
-                                           weights=np.maximum(source.ends - source.starts, 0))
-    by_close = (cost[0] < cost[1]) & CLOSE
-    searching = np.flatnonzero(cost.min(axis=0) > 0)
-    groups = list(blocks(cost.min(axis=0)[searching].astype(np.int64), chunk))
+                searched: Sequence[Ints], rank: npt.NDArray[np.int8], needed: Ints, examined: int, kept: float,
+                chunk: int) -> Iterator[tuple[Ints, Ints]]:
+    """The pairs (owner, partner) whose partner's band holds a wrong answer of the owner's and may hold another
+    (:class:`Elsewhere`), that is every pair that could be kept, by two searches split at a number of parts.
+
+    Of a pair, ``r`` is how many of the owner's wrong answers have the partner in their band search's range
+    (the answers ``searched``, rows of ``wrong`` per part): at least the matched parts, and at least the
+    owner's ``needed`` if the pair can be kept. For a split ``s`` chosen per owner, the pairs with ``r`` up to
+    ``s`` are found by the close search: the partners whose centre is in a window around one of the owner's
+    answers (:func:`centres_window`) for the chance :func:`bound` gives ``s`` parts (the least likely of ``m``
+    matched parts is under the bound of ``m``, and ``m <= r <= s``). The pairs with ``r`` over ``s`` are found
+    by the band search over the owner's parts ranked ``s`` or later (``rank``: most students matched first):
+    a partner in more than ``s`` of the ranges is in one of those. Each owner takes the split whose searches
+    look at the fewest partners (only the band search, as before the close search, when ``CLOSE`` is off).
+    In pieces of about ``chunk`` partners looked at (a block of owners at a time), each sorted and without
+    repeats."""
+    students = len(needed)
+    levels = np.zeros(students, dtype=np.int64)  # per owner, the answers searched
+    for part, rows in zip(parts, searched, strict=True):
+        levels[wrong[part.label][rows]] += 1
+    owners = np.flatnonzero(levels >= np.maximum(needed, 2))
+    top = int(levels[owners].max(initial=1))
+    compact = np.full(students, -1, dtype=np.int64)
+    compact[owners] = np.arange(len(owners))
+    typed = [Typed(part, right[part.label]) for part in parts]  # each part's typed right answers, sorted once
+    # Per split and owner, the partners the band search would look at: the parts ranked at the split or later.
+    band = np.zeros((top + 2) * len(owners))
+    rows_of = [rows[compact[wrong[part.label][rows]] >= 0] for part, rows in zip(parts, searched, strict=True)]
+    for index, (part, part_ranges, rows) in enumerate(zip(parts, ranges, rows_of, strict=True)):
+        who = compact[wrong[part.label][rows]]
+        sizes = sum((np.maximum(ends[rows] - starts[rows], 0) for starts, ends in part_ranges), np.zeros(len(rows)))
+        band += np.bincount(rank[owners[who], index].astype(np.int64) * len(owners) + who, sizes,
+                            minlength=len(band))
+    band = np.cumsum(band.reshape(top + 2, len(owners))[::-1], axis=0)[::-1]
+    lowest = np.maximum(needed[owners], 2) - 1  # the split of the band search alone
+    split, cost = lowest.copy(), band[lowest, np.arange(len(owners))]
+    for level in range(2, top + 1) if CLOSE else ():
+        at = (levels[owners] >= level) & (lowest < level)
+        if not at.any():
+            continue
+        looked = np.zeros(len(owners))
+        least = np.full(students, float(bound(examined, kept, np.array([level]))[0]))
+        for index, (part, part_ranges, rows) in enumerate(zip(parts, ranges, rows_of, strict=True)):
+            use = rows[at[compact[wrong[part.label][rows]]]]
+            for source in _close_sources(part, spread, wrong[part.label][use], numbers[part.label], typed[index],
+                                         part_ranges, use, least):
+                looked += np.bincount(compact[wrong[part.label][source.rows]], minlength=len(owners),
+                                      weights=np.maximum(source.ends - source.starts, 0))
+        total = looked + band[level]
+        better = at & (total < cost)
+        split[better], cost[better] = level, total[better]
+    yield from _formed(parts, spread, wrong, numbers, typed, ranges, rows_of, rank, owners, split, cost,
+                       np.maximum(needed, 2), examined, kept, chunk)
+
+
+def _formed(parts: Sequence[Bands], spread: Spread, wrong: Mapping[str, Ints], numbers: Mapping[str, Floats],
+            typed: Sequence[Typed], ranges: Sequence[Sequence[tuple[Ints, Ints]]], rows_of: Sequence[Ints],
+            rank: npt.NDArray[np.int8], owners: Ints, split: Ints, cost: Floats, needed: Ints, examined: int,
+            kept: float, chunk: int) -> Iterator[tuple[Ints, Ints]]:
+    """:func:`close_pairs`'s searches, each owner (of ``owners``) split at ``split``."""
+    students = len(needed)
+    at = np.full(students, -1, dtype=np.int64)  # each owner's split (-1: not searched)
+    at[owners] = split
+    least = np.full(students, np.inf)
+    searching = owners[cost > 0]
+    least[searching] = bound(examined, kept, np.maximum(at[searching], 1))
+    groups = list(blocks(cost[cost > 0].astype(np.int64), chunk))
     block_of = np.full(students, -1, dtype=np.int64)
     for number, group in enumerate(groups):
         block_of[searching[group]] = number
     # Each source's answers, by their owner's block (in their order within it): a block takes a run of each.
     runs = []
-    for index, (part, close_sources, band_sources) in enumerate(zip(parts, close, banded, strict=True)):
+    for index, (part, part_ranges, rows) in enumerate(zip(parts, ranges, rows_of, strict=True)):
         members = wrong[part.label]
-        for source, is_close in [*((source, True) for source in close_sources),
-                                 *((source, False) for source in band_sources)]:
+        who = members[rows]
+        close = rows[at[who] >= needed[who]]
+        band = rows[rank[who, index] >= at[who]]
+        for source, is_close in [*((source, True) for source in _close_sources(
+                                     part, spread, members[close], numbers[part.label], typed[index],
+                                     part_ranges, close, least)),
+                                 *((_Source(band, starts[band], ends[band], part.order), False)
+                                   for starts, ends in part_ranges)]:
             who = members[source.rows]
-            use = np.flatnonzero((by_close[who] == is_close) & (block_of[who] >= 0))
+            use = np.flatnonzero(block_of[who] >= 0)
             use = use[np.argsort(block_of[who[use]], kind="stable")]
             bounds = np.searchsorted(block_of[who[use]], np.arange(len(groups) + 1))
-            runs.append((index, part, source, who[use], use, bounds))
-    elsewhere = Elsewhere(parts, wrong, ranges, students)
+            runs.append((index, part, source, is_close, who[use], use, bounds))
+    elsewhere = Elsewhere(parts, wrong, ranges, students, rows_of)  # r counts the ranges of the answers searched
     for number in range(len(groups)):
         keys = [np.zeros(0, dtype=np.int64)]
-        for index, part, source, who, use, bounds in runs:
+        for index, part, source, is_close, who, use, bounds in runs:
             run = slice(bounds[number], bounds[number + 1])
-            owners, rows = who[run], use[run]
+            owner_of, rows = who[run], use[run]
             for which, positions in expanded(source.starts[rows], source.ends[rows]):
-                owner, partners = owners[which], source.at[positions]
-                other = elsewhere(index, owner, partners)
-                owner, partners = owner[other], partners[other]
+                owner, partners = owner_of[which], source.at[positions]
+                first, last = (int(which[0]), int(which[-1]) + 1) if len(which) else (0, 0)
+                found = 1 + elsewhere(index, owner_of[first:last], which - first, partners)  # r: ranges holding it
+                wanted = ((found >= needed[owner]) & (found <= at[owner]) if is_close
+                          else (found >= needed[owner]) & (found > at[owner]))
+                owner, partners = owner[wanted], partners[wanted]
                 ok = accepts(part, owner, partners, numbers[part.label])
                 keys.append(distinct(owner[ok] * students + partners[ok]))
         pairs = distinct(np.concatenate(keys))
@@ -192,24 +243,27 @@ def close_pairs(parts: Sequence[Bands], spread: Spread, wrong: Mapping[str, Ints
 
 
 class Elsewhere:
-    """Whether a partner may hold another of the owner's wrong answers: is in the band search's range of one
-    (:func:`~grader.grade.integrity_search.holding`: a range holds every band that holds the answer). A pair
-    is kept only with two or more matched parts, so a partner found for one part that is in no other range
-    is let go before its band is compared; a look-up of the partner's place in each of the owner's other
-    wrong parts' orders, not a comparison of bands (4 bytes a student and part, twice).
-    """
+    """How many of the owner's other wrong answers a partner may hold: in how many of their band search's ranges
+    it is (:func:`~grader.grade.integrity_search.holding`: a range holds every band that holds the answer). A
+    pair is kept only with two or more matched parts, so a partner found for one part that is in no other
+    range is let go before its band is compared (:func:`close_pairs` counts ``r`` with it); a look-up of the
+    partner's place in each of the owner's other wrong parts' orders, not a comparison of bands (4 bytes a
+    student and part, twice)."""
 
     def __init__(self, parts: Sequence[Bands], wrong: Mapping[str, Ints],
-                 ranges: Sequence[Sequence[tuple[Ints, Ints]]], students: int) -> None:
+                 ranges: Sequence[Sequence[tuple[Ints, Ints]]], students: int,
+                 searched: Sequence[Ints] | None = None) -> None:
         # Per part, each student's place in its order (-1: no value) and the number of their wrong answer to it
-        # (-1: none; the answers numbered one part after another), 4 bytes each.
+        # (-1: none, or not among the answers ``searched``, rows of ``wrong`` per part; the answers numbered one
+        # part after another), 4 bytes each.
         self.place = np.full((len(parts), students), -1, dtype=np.int32)
         self.answer = np.full((len(parts), students), -1, dtype=np.int32)
         first = 0
         for index, part in enumerate(parts):
             self.place[index, part.order] = np.arange(len(part.order))
             members = wrong[part.label]
-            self.answer[index, members] = np.arange(first, first + len(members))
+            rows = np.arange(len(members)) if searched is None else searched[index]
+            self.answer[index, members[rows]] = first + rows
             first += len(members)
         # Each wrong answer's ranges, a turn at a time (a part with fewer turns has empty ones).
         turns = max((len(part_ranges) for part_ranges in ranges), default=0)
@@ -221,29 +275,34 @@ class Elsewhere:
                 self.starts[turn, first:first + count], self.ends[turn, first:first + count] = starts, ends
             first += count
 
-    def __call__(self, index: int, owners: Ints, partners: Ints) -> npt.NDArray[np.bool_]:
-        """Per pair (``owners[k]``, ``partners[k]``) found for part ``index``, whether the partner is in the range
-        of another of the owner's wrong answers."""
-        found = np.zeros(len(owners), dtype=bool)
+    def __call__(self, index: int, owners: Ints, which: Ints, partners: Ints) -> Ints:
+        """Per pair (``owners[which[k]]``, ``partners[k]``) found for part ``index``, how many of the owner's other
+        wrong answers have the partner in their range (each owner's answers and ranges looked up once, not once
+        a pair)."""
+        found = np.zeros(len(which), dtype=np.int64)
         for other, (answers, places) in enumerate(zip(self.answer, self.place, strict=True)):
             if other == index:
                 continue
             answer = answers[owners]
-            rows = np.flatnonzero(answer >= 0)
-            answer, place = answer[rows], places[partners[rows]]
+            some = answer >= 0
+            if not some.any():
+                continue
+            rows = np.flatnonzero(some[which])
+            place, at = places[partners[rows]], which[rows]
+            answer = np.maximum(answer, 0)
             inside = np.zeros(len(rows), dtype=bool)
             for starts, ends in zip(self.starts, self.ends, strict=True):
-                inside |= (starts[answer] <= place) & (place < ends[answer])
-            found[rows[inside]] = True
+                inside |= (starts[answer][at] <= place) & (place < ends[answer][at])
+            found[rows[inside]] += 1
         return found
 
 
-def _close_sources(part: Bands, spread: Spread, owners: Ints, numbers: Floats, right: Floats,
+def _close_sources(part: Bands, spread: Spread, owners: Ints, numbers: Floats, typed: Typed,
                    part_ranges: Sequence[tuple[Ints, Ints]], rows: Ints, least: Floats) -> list[_Source]:
     """The close search's sources for a part's answers ``rows`` (of ``owners``): the values in each answer's
     window within its range, the typed right answers in it, and the students whose typed right answer is
     outside their band; the whole range where no window is read."""
-    typed_numbers, typed = numbers[owners], Typed(part, right)
+    typed_numbers = numbers[owners]
     if part.period is not None:
         return _angle_sources(part, owners, typed_numbers, typed, part_ranges, rows, least[owners])
     low, high = centres_window(part, spread, owners, typed_numbers, least[owners])

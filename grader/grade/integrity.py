@@ -469,7 +469,9 @@ def _possible(parts: Sequence[Bands], answers: _Answers, spread: Spread, owners:
     corrected chance is at most 1)."""
     if below > 1:
         return np.ones(len(owners), dtype=bool)
-    return np.asarray(_at_least(parts, answers, spread, owners, partners, hits, examined) < math.log(MARGIN * below))
+    # Not "under": a bound that came out NaN lets nothing go.
+    return np.asarray(~(_at_least(parts, answers, spread, owners, partners, hits, examined)
+                        >= math.log(MARGIN * below)))
 
 
 def _at_least(parts: Sequence[Bands], answers: _Answers, spread: Spread, owners: Ints, partners: Ints,

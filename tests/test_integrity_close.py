@@ -127,6 +127,7 @@ def test_the_close_search_finds_what_the_band_search_and_every_pair_find(
     windows of their own."""
     result_graded = _drawn(drawn, unit)
     monkeypatch.setattr(integrity, "KEPT", kept)
+    monkeypatch.setattr(integrity_close, "FEW", 0)  # a small class is searched by bands alone unless told
     close = check(result_graded)
     monkeypatch.setattr(integrity_close, "CLOSE", False)
     banded = check(result_graded)
@@ -259,6 +260,7 @@ def test_a_copy_in_full_is_found_among_many_alike(monkeypatch: pytest.MonkeyPatc
              for i, row in enumerate(values) for label, v in zip(("1a", "1b"), row, strict=True)}
     typed |= {("s0", "1a"): repr(2.7), ("s0", "1b"): repr(3.9)}
     result_graded = graded(make_key(values), typed)
+    monkeypatch.setattr(integrity_close, "FEW", 0)
     close = check(result_graded)
     monkeypatch.setattr(integrity_close, "CLOSE", False)
     assert check(result_graded) == close

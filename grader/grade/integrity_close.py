@@ -37,6 +37,7 @@ from grader.grade.compare import errors
 from grader.grade.integrity_chance import UNRELATED, Spread
 from grader.grade.integrity_search import Bands, Floats, Ints, accepts, blocks, distinct, expanded, range_least
 
+FEW = 1 << 16  # partners looked at in all under which the band search alone is taken (the findings are the same)
 CLOSE = True  # False: the band search alone, as before the close search (for the tests' comparison)
 MARGIN = 2.0  # the bound is loosened by this factor against floating-point rounding in the chances
 WIDEN = 1e-9  # each window's ends are moved out by this share of their size, against rounding in log and exp
@@ -172,7 +173,8 @@ def close_pairs(parts: Sequence[Bands], spread: Spread, wrong: Mapping[str, Ints
     band = np.cumsum(band.reshape(top + 2, len(owners))[::-1], axis=0)[::-1]
     lowest = np.maximum(needed[owners], 2) - 1  # the split of the band search alone
     split, cost = lowest.copy(), band[lowest, np.arange(len(owners))]
-    for level in range(2, top + 1) if CLOSE else ():
+    # A class whose band searches look at few partners in all is searched so: weighing the splits costs more.
+    for level in range(2, top + 1) if CLOSE and cost.sum() > FEW else ():
         at = (levels[owners] >= level) & (lowest < level)
         if not at.any():
             continue

@@ -62,3 +62,34 @@ def test_an_answer_on_a_bands_end_across_the_turn_is_counted_once(monkeypatch: p
     numbers = np.array([np.nan, np.nan, 359.9 + part.reach[0] - 360.0, 359.9 - part.reach[0]])
     counts, _ = holding(part, np.array([2, 3]), numbers)
     assert counts.tolist() == _one_by_one(part, np.array([2, 3]), numbers) == [2, 2]
+
+
+@settings(max_examples=80, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1), strict=st.booleans())
+def test_answers_tested_one_by_one_skip_only_values_the_students_own_band_holds(seed: int, strict: bool) -> None:
+    """An answer tested one by one is tested past the values the student's own band surely holds (none counts as
+    a match): the counts are every band tested, for values on and just inside or outside the own band's edges,
+    ties, bands of 1 %, 3 % and a tiny absolute one, strict bounds."""
+    rng = np.random.default_rng(seed)
+    count = int(rng.integers(2, 60))
+    centre = float(rng.choice([1.0, -2.5, 1e6, 3e-4]))
+    rules = [Tolerance(), Tolerance(rtol=0.03), Tolerance(rtol=0.0, atol=abs(centre) * 1e-13)]
+    if strict:
+        rules.append(Tolerance("sigfigs", digits=3))
+    chosen = rng.integers(0, len(rules), count)
+    values = centre * (1 + rng.choice([0.0, 0.005, -0.01, 0.01, 0.02, -0.03, 0.0101], count))
+    part = bands("1a", values, [rules[i].to_json() for i in chosen], "m/s")
+    others = rng.integers(0, count, count)
+    # Values on the edges of another's band, just inside or outside; on the edges of the student's own; slips.
+    scale = rng.choice([1.0, 1 - 1e-6, 1 + 1e-6, 1 - 2e-16, 1 - 3e-6], count)
+    side = rng.choice([-1.0, 1.0], count)
+    numbers = np.select([rng.random(count) < 0.4, rng.random(count) < 0.5],
+                        [values[others] + side * part.reach[others] * scale, values + side * part.reach * scale],
+                        values * (1 + rng.uniform(-0.05, 0.05, count)))
+    wrong = np.flatnonzero(rng.random(count) < 0.9)
+    integrity_search.BY_ENDS = False  # every answer tested one by one
+    try:
+        counts, _ = holding(part, wrong, numbers)
+    finally:
+        integrity_search.BY_ENDS = True
+    assert counts.tolist() == _one_by_one(part, wrong, numbers)

@@ -267,8 +267,9 @@ class Elsewhere:
             rows = np.arange(len(members)) if searched is None else searched[index]
             self.answer[index, members[rows]] = first + rows
             first += len(members)
-        # Each wrong answer's ranges, a turn at a time (a part with fewer turns has empty ones).
-        turns = max((len(part_ranges) for part_ranges in ranges), default=0)
+        # Each wrong answer's ranges, a turn at a time (a part with fewer turns has empty ones, not looked at).
+        self.turns = [len(part_ranges) for part_ranges in ranges]
+        turns = max(self.turns, default=0)
         self.starts, self.ends = (np.zeros((turns, first), dtype=np.int32) for _ in range(2))
         first = 0
         for part, part_ranges in zip(parts, ranges, strict=True):
@@ -293,7 +294,7 @@ class Elsewhere:
             place, at = places[partners[rows]], which[rows]
             answer = np.maximum(answer, 0)
             inside = np.zeros(len(rows), dtype=bool)
-            for starts, ends in zip(self.starts, self.ends, strict=True):
+            for starts, ends in zip(self.starts[:self.turns[other]], self.ends[:self.turns[other]], strict=True):
                 inside |= (starts[answer][at] <= place) & (place < ends[answer][at])
             found[rows[inside]] += 1
         return found

@@ -25,7 +25,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from grader.grade.compare import accepted_distance, errors
+from grader.grade.compare import accepted_distance, distances, errors
 from grader.grade.integrity_chance import class_density
 from grader.model.tolerance import Tolerance
 
@@ -103,10 +103,10 @@ def accepts(part: Bands, owners: Ints, partners: Ints, numbers: Floats) -> npt.N
     """Whether each partner's band holds the owner's number, the partner being another student whose value
     the owner's own band does not hold."""
     unit = part.unit if part.period is not None else None
-    distance = errors(numbers[owners], part.values[partners], angle_unit=unit)[0]
+    distance = distances(numbers[owners], part.values[partners], angle_unit=unit)
     reach = part.reach[partners]
     inside = np.where(part.strict[partners], distance < reach, distance <= reach)
-    own = errors(part.values[partners], part.values[owners], angle_unit=unit)[0]
+    own = distances(part.values[partners], part.values[owners], angle_unit=unit)
     mine = np.where(part.strict[owners], own < part.reach[owners], own <= part.reach[owners])
     return np.asarray(inside & ~mine & (owners != partners), dtype=bool)
 
@@ -194,7 +194,8 @@ def holding(part: Bands, wrong: Ints, numbers: Floats) -> tuple[Ints, list[tuple
     below it less those that end below it, two binary searches in the sorted starts and ends. The bands not
     counted as matches (the student's own, and those of values the student's own band holds) can hold only an
     answer within the student's reach plus the widest reach of the values their band holds: those answers are
-    tested one by one, as are all of a strict bound's; an angle's are counted by :func:`_angle_counts`."""
+    tested one by one (past the values their own band surely holds: :func:`_inner`), as are all of a strict
+    bound's; an angle's are counted by :func:`_angle_counts`."""
     counts = np.zeros(len(wrong), dtype=np.int64)
     ranges = list(_ranges(part, numbers[wrong]))
     tested = np.arange(len(wrong))
@@ -211,11 +212,33 @@ def holding(part: Bands, wrong: Ints, numbers: Floats) -> tuple[Ints, list[tuple
         counts[tested] = 0
     elif BY_ENDS and part.period is not None and len(part.order) and 4 * part.reach[part.order].max() < part.period:
         counts, tested = _angle_counts(part, wrong, numbers, ranges)
+    inner = _inner(part, wrong[tested])
     for starts, ends in ranges:
-        for which, positions in expanded(starts[tested], ends[tested]):
-            ok = accepts(part, wrong[tested[which]], part.order[positions], numbers)
-            counts += np.bincount(tested[which[ok]], minlength=len(wrong))
+        starts, ends = starts[tested], ends[tested]
+        # Past the values the student's own band surely holds (none counts), on either side.
+        for first, last in ((starts, np.minimum(ends, inner[0])), (np.maximum(starts, inner[1]), ends)):
+            for which, positions in expanded(first, last):
+                ok = accepts(part, wrong[tested[which]], part.order[positions], numbers)
+                counts += np.bincount(tested[which[ok]], minlength=len(wrong))
     return counts, ranges
+
+
+def _inner(part: Bands, owners: Ints) -> tuple[Ints, Ints]:
+    """Per owner, sorted positions (from, to) whose values the owner's own band surely holds (:func:`accepts`
+    counts none of them): within a millionth of its reach of its edges, where that is far above the rounding of
+    a difference (empty for an angle, or where the reach is not so)."""
+    count = len(owners)
+    if part.period is not None or not count:
+        return np.zeros(count, dtype=np.int64), np.zeros(count, dtype=np.int64)
+    own, mine = part.values[owners], part.reach[owners]
+    with np.errstate(invalid="ignore"):
+        margin = np.where(part.strict[owners], 1e-6, 0.0) + 1e-6
+        usable = np.isfinite(own) & np.isfinite(mine) & (mine * 1e-6 > 1e-12 * np.abs(own))
+    inside = np.where(usable, mine * (1 - margin), 0.0)
+    low, high = np.where(usable, own - inside, 0.0), np.where(usable, own + inside, 0.0)
+    first = np.searchsorted(part.sorted_values, low, side="left")
+    last = np.searchsorted(part.sorted_values, high, side="right")
+    return np.where(usable, first, 0).astype(np.int64), np.where(usable, last, 0).astype(np.int64)
 
 
 def _angle_counts(part: Bands, wrong: Ints, numbers: Floats, ranges: Sequence[tuple[Ints, Ints]]

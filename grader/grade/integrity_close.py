@@ -109,12 +109,14 @@ def centres_window(part: Bands, spread: Spread, owners: Ints, numbers: Floats, l
     return low, high
 
 
-class Typed:
-    """A part's right answers as typed, sorted (the other centre a closeness is read from; those typed as the
-    value is are found by it), and the students whose typed right answer lies outside their own band (searched
-    whole)."""
+class Searched:
+    """What a part's close search looks up, worked out once a part, not once a window: its right answers as
+    typed, sorted (the other centre a closeness is read from; those typed as the value is are found by it), and
+    the students whose typed right answer lies outside their own band (searched whole); per wrong answer and
+    turn of its range, the widest reach in the range (``reach``) and, for an angle, the widest reach over the
+    band's chance (``spread``)."""
 
-    def __init__(self, part: Bands, right: Floats) -> None:
+    def __init__(self, part: Bands, right: Floats, part_ranges: Sequence[tuple[Ints, Ints]]) -> None:
         have = np.flatnonzero(np.isfinite(right) & np.isfinite(part.values) & np.isfinite(part.reach)
                               & (right != part.values))
         placed = right[have] if part.period is None else np.mod(right[have], part.period)  # as the values
@@ -123,6 +125,15 @@ class Typed:
         unit = part.unit if part.period is not None else None
         distance = errors(right[have], part.values[have], angle_unit=unit)[0]
         self.outside = have[~(distance <= part.reach[have])]
+        reach = -part.reach[part.order]
+        self.reach = [-range_least(reach, starts, ends) for starts, ends in part_ranges]
+        self.spread: list[Floats] = []
+        if part.period is not None:
+            chance = part.chance[part.order]
+            with np.errstate(divide="ignore", invalid="ignore"):
+                spread_out = np.where(chance > 0, part.reach[part.order] / chance, np.inf)
+            spread_out = -np.nan_to_num(spread_out, nan=np.inf)
+            self.spread = [-range_least(spread_out, starts, ends) for starts, ends in part_ranges]
 
 
 class _Source(NamedTuple):
@@ -161,7 +172,7 @@ def close_pairs(parts: Sequence[Bands], spread: Spread, wrong: Mapping[str, Ints
     top = int(levels[owners].max(initial=1))
     compact = np.full(students, -1, dtype=np.int64)
     compact[owners] = np.arange(len(owners))
-    typed = [Typed(part, right[part.label]) for part in parts]  # each part's typed right answers, sorted once
+    lookups = [Searched(part, right[part.label], part_ranges) for part, part_ranges in zip(parts, ranges, strict=True)]
     # Per split and owner, the partners the band search would look at: the parts ranked at the split or later.
     band = np.zeros((top + 2) * len(owners))
     rows_of = [rows[compact[wrong[part.label][rows]] >= 0] for part, rows in zip(parts, searched, strict=True)]
@@ -182,19 +193,19 @@ def close_pairs(parts: Sequence[Bands], spread: Spread, wrong: Mapping[str, Ints
         least = np.full(students, float(bound(examined, kept, np.array([level]))[0]))
         for index, (part, part_ranges, rows) in enumerate(zip(parts, ranges, rows_of, strict=True)):
             use = rows[at[compact[wrong[part.label][rows]]]]
-            for source in _close_sources(part, spread, wrong[part.label][use], numbers[part.label], typed[index],
+            for source in _close_sources(part, spread, wrong[part.label][use], numbers[part.label], lookups[index],
                                          part_ranges, use, least):
                 looked += np.bincount(compact[wrong[part.label][source.rows]], minlength=len(owners),
                                       weights=np.maximum(source.ends - source.starts, 0))
         total = looked + band[level]
         better = at & (total < cost)
         split[better], cost[better] = level, total[better]
-    yield from _formed(parts, spread, wrong, numbers, typed, ranges, rows_of, rank, owners, split, cost,
+    yield from _formed(parts, spread, wrong, numbers, lookups, ranges, rows_of, rank, owners, split, cost,
                        np.maximum(needed, 2), examined, kept, chunk)
 
 
 def _formed(parts: Sequence[Bands], spread: Spread, wrong: Mapping[str, Ints], numbers: Mapping[str, Floats],
-            typed: Sequence[Typed], ranges: Sequence[Sequence[tuple[Ints, Ints]]], rows_of: Sequence[Ints],
+            lookups: Sequence[Searched], ranges: Sequence[Sequence[tuple[Ints, Ints]]], rows_of: Sequence[Ints],
             rank: npt.NDArray[np.int8], owners: Ints, split: Ints, cost: Floats, needed: Ints, examined: int,
             kept: float, chunk: int) -> Iterator[tuple[Ints, Ints]]:
     """:func:`close_pairs`'s searches, each owner (of ``owners``) split at ``split``."""
@@ -216,7 +227,7 @@ def _formed(parts: Sequence[Bands], spread: Spread, wrong: Mapping[str, Ints], n
         close = rows[at[who] >= needed[who]]
         band = rows[rank[who, index] >= at[who]]
         for source, is_close in [*((source, True) for source in _close_sources(
-                                     part, spread, members[close], numbers[part.label], typed[index],
+                                     part, spread, members[close], numbers[part.label], lookups[index],
                                      part_ranges, close, least)),
                                  *((_Source(band, starts[band], ends[band], part.order), False)
                                    for starts, ends in part_ranges)]:
@@ -300,50 +311,46 @@ class Elsewhere:
         return found
 
 
-def _close_sources(part: Bands, spread: Spread, owners: Ints, numbers: Floats, typed: Typed,
+def _close_sources(part: Bands, spread: Spread, owners: Ints, numbers: Floats, lookup: Searched,
                    part_ranges: Sequence[tuple[Ints, Ints]], rows: Ints, least: Floats) -> list[_Source]:
     """The close search's sources for a part's answers ``rows`` (of ``owners``): the values in each answer's
     window within its range, the typed right answers in it, and the students whose typed right answer is
     outside their band; the whole range where no window is read."""
     typed_numbers = numbers[owners]
     if part.period is not None:
-        return _angle_sources(part, owners, typed_numbers, typed, part_ranges, rows, least[owners])
+        return _angle_sources(part, owners, typed_numbers, lookup, part_ranges, rows, least[owners])
     low, high = centres_window(part, spread, owners, typed_numbers, least[owners])
     windowed = np.isfinite(low) | np.isfinite(high)
     sources = []
-    for starts, ends in part_ranges:
+    for (starts, ends), reach in zip(part_ranges, lookup.reach, strict=True):
         sources.append(_within(rows, starts[rows], ends[rows], part.sorted_values, low, high, windowed, part.order))
         # A typed centre is in its band, which holds the answer: within twice the widest reach of the range.
-        widest = 2 * (1 + WIDEN) * -range_least(-part.reach[part.order], starts[rows], ends[rows])
+        widest = 2 * (1 + WIDEN) * reach[rows]
         low, high = np.maximum(low, typed_numbers - widest), np.minimum(high, typed_numbers + widest)
-    sources += _typed_sources(typed, rows, low, high, windowed)
+    sources += _typed_sources(lookup, rows, low, high, windowed)
     return sources
 
 
-def _angle_sources(part: Bands, owners: Ints, numbers: Floats, typed: Typed,
+def _angle_sources(part: Bands, owners: Ints, numbers: Floats, lookup: Searched,
                    part_ranges: Sequence[tuple[Ints, Ints]], rows: Ints, least: Floats) -> list[_Source]:
     """An angle's close search. Its chance is the partner's ``p`` times the narrowed share of their band, at
     least ``p |a - c| / 2r`` (the band narrowed holds all between the answer and the centre): a centre can
     make it under ``least`` only within ``2 least r / p`` of the answer, the widest of that over the range,
     a turn at a time as the range is."""
     period = float(part.period or 0.0)
-    order = part.order
-    with np.errstate(divide="ignore", invalid="ignore"):
-        spread_out = np.where(part.chance[order] > 0, part.reach[order] / part.chance[order], np.inf)
-    spread_out = np.nan_to_num(spread_out, nan=np.inf)
     placed = np.mod(numbers, period)
     sources = []
-    for shift, (starts, ends) in zip((0.0, -period, period), part_ranges, strict=True):
+    for shift, (starts, ends), spread_out, reach_out in zip((0.0, -period, period), part_ranges, lookup.spread,
+                                                            lookup.reach, strict=True):
         starts, ends = starts[rows], ends[rows]
-        widest = -range_least(-spread_out, starts, ends)
         with np.errstate(invalid="ignore"):
-            reach = np.maximum(2 * least * widest * (1 + WIDEN), 0.0) + WIDEN * period
+            reach = np.maximum(2 * least * spread_out[rows] * (1 + WIDEN), 0.0) + WIDEN * period
         windowed = np.isfinite(reach)
         target = placed + shift
-        widest = 2 * (1 + WIDEN) * -range_least(-part.reach[order], starts, ends)
+        widest = 2 * (1 + WIDEN) * reach_out[rows]
         low, high = target - np.minimum(reach, widest), target + np.minimum(reach, widest)
-        sources.append(_within(rows, starts, ends, part.sorted_values, low, high, windowed, order))
-        sources += _typed_sources(typed, rows, low, high, windowed)
+        sources.append(_within(rows, starts, ends, part.sorted_values, low, high, windowed, part.order))
+        sources += _typed_sources(lookup, rows, low, high, windowed)
     return sources
 
 
@@ -356,7 +363,7 @@ def _within(rows: Ints, starts: Ints, ends: Ints, sorted_values: Floats, low: Fl
                    np.where(windowed, np.minimum(ends, highest), ends), order)
 
 
-def _typed_sources(typed: Typed, rows: Ints, low: Floats, high: Floats,
+def _typed_sources(typed: Searched, rows: Ints, low: Floats, high: Floats,
                    windowed: npt.NDArray[np.bool_]) -> list[_Source]:
     """The students whose typed right answer is between ``low`` and ``high``, and those whose typed right
     answer is outside their band, for the answers ``windowed``."""

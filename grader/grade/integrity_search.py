@@ -225,8 +225,8 @@ def holding(part: Bands, wrong: Ints, numbers: Floats) -> tuple[Ints, list[tuple
 
 def _inner(part: Bands, owners: Ints) -> tuple[Ints, Ints]:
     """Per owner, sorted positions (from, to) whose values the owner's own band surely holds (:func:`accepts`
-    counts none of them): within a millionth of its reach of its edges, where that is far above the rounding of
-    a difference (empty for an angle, or where the reach is not so)."""
+    counts none of them): those more than a millionth of its reach inside its edges, where that is far above
+    the rounding of a difference (none for an angle, or where the reach is not so)."""
     count = len(owners)
     if part.period is not None or not count:
         return np.zeros(count, dtype=np.int64), np.zeros(count, dtype=np.int64)

@@ -53,6 +53,7 @@ from grader.assign.key_columns import (
 )
 from grader.base.errors import GraderError, TemplateError, shown
 from grader.base.inputs import CELL_CHARS, decode_text, read_bytes, regular_size
+from grader.base.numbering import numbered, numbered_first, numbered_rows
 from grader.grade.key_parts import KeyPart as KeyPart  # grading's parts, made here
 from grader.grade.key_parts import PartTable, StudentParts
 from grader.grade.notation import ReadError, check_powers
@@ -779,7 +780,7 @@ def _shapes(columns: KeyColumns, layouts: list[tuple[list[tuple[str, list[str]]]
     rows = len(columns.value)
     place = np.repeat((np.cumsum(sizes) - sizes)[columns.shape] - starts, counts) + np.arange(rows)
     first, which = _combinations(columns)
-    distinct, at, inverse = np.unique(place * len(first) + which, return_index=True, return_inverse=True)
+    distinct, inverse, at = numbered_first(place * len(first) + which)
     rests, points = columns.code[first, UNIT:].tolist(), columns.points[first].tolist()
     shapes: list[KeyPart] = []
     found: dict[tuple[Any, ...], int] = {}
@@ -792,7 +793,7 @@ def _shapes(columns: KeyColumns, layouts: list[tuple[list[tuple[str, list[str]]]
             found[key] = len(shapes)
             shapes.append(_part_shape(key, columns.texts, columns.tolerances, symbols, shared))
         number[index] = found[key]
-    return shapes, number[inverse.ravel()]
+    return shapes, number[inverse]
 
 
 def _label_layouts(shape: np.ndarray, layouts: list[tuple[Any, Any, int]], starts: np.ndarray,
@@ -800,9 +801,9 @@ def _label_layouts(shape: np.ndarray, layouts: list[tuple[Any, Any, int]], start
     """Each student's labels in order, as the place of each label among their rows (one mapping for the
     students who share it) and which of them each student has; :class:`_EntryError` where a student has a
     label twice."""
-    numbered: dict[str, int] = {}
-    label_of = np.array([numbered.setdefault(part.label, len(numbered)) for part in shapes], np.int64)
-    labels = list(numbered)
+    label_numbers: dict[str, int] = {}
+    label_of = np.array([label_numbers.setdefault(part.label, len(label_numbers)) for part in shapes], np.int64)
+    labels = list(label_numbers)
     layout_of = np.zeros(len(shape), np.int64)
     offsets: list[dict[str, int]] = []
     for layout, (_, _, size) in enumerate(layouts):
@@ -810,8 +811,8 @@ def _label_layouts(shape: np.ndarray, layouts: list[tuple[Any, Any, int]], start
         if not members.size:
             continue
         grid = label_of[shape_of[starts[members][:, None] + np.arange(size)]] if size else np.zeros((1, 0), np.int64)
-        distinct, inverse = np.unique(grid, axis=0, return_inverse=True)
-        layout_of[members] = len(offsets) + inverse.ravel()
+        distinct, inverse, _ = numbered_rows(grid)
+        layout_of[members] = len(offsets) + inverse
         for found in distinct.tolist():
             offsets.append({labels[number]: place for place, number in enumerate(found)})
             if len(offsets[-1]) != size:
@@ -843,12 +844,12 @@ def _combinations(columns: KeyColumns) -> tuple[np.ndarray, np.ndarray]:
     """
     combined = np.zeros(len(columns.points), np.int64)
     for column in (*columns.code[:, UNIT:].T, columns.points.view(np.int64)):
-        distinct, index = np.unique(column, return_inverse=True)
+        distinct, index = numbered(column)
         if combined.size and int(combined.max()) >= (1 << 62) // len(distinct):
-            combined = np.unique(combined, return_inverse=True)[1].ravel()  # numbered afresh from 0: fits again
-        combined = combined * len(distinct) + index.ravel()
-    _, first, inverse = np.unique(combined, return_index=True, return_inverse=True)
-    return first, inverse.ravel()
+            combined = numbered(combined)[1]  # numbered afresh from 0: fits again
+        combined = combined * len(distinct) + index
+    _, inverse, first = numbered_first(combined)
+    return first, inverse
 
 
 def _layout(shape: list[tuple[str, list[str], list[str]]], shared: dict[Any, Any]

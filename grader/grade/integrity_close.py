@@ -35,7 +35,7 @@ import numpy.typing as npt
 
 from grader.grade.compare import errors
 from grader.grade.integrity_chance import UNRELATED, Spread
-from grader.grade.integrity_search import Bands, Floats, Ints, accepts, blocks, distinct, expanded, range_least
+from grader.grade.integrity_search import Bands, Floats, Ints, accepts, blocks, distinct, expanded, ranges_least
 
 FEW = 1 << 16  # partners looked at in all under which the band search alone is taken (the findings are the same)
 CLOSE = True  # False: the band search alone, as before the close search (for the tests' comparison)
@@ -125,15 +125,14 @@ class Searched:
         unit = part.unit if part.period is not None else None
         distance = errors(right[have], part.values[have], angle_unit=unit)[0]
         self.outside = have[~(distance <= part.reach[have])]
-        reach = -part.reach[part.order]
-        self.reach = [-range_least(reach, starts, ends) for starts, ends in part_ranges]
+        self.reach = [-least for least in ranges_least(-part.reach[part.order], part_ranges)]
         self.spread: list[Floats] = []
         if part.period is not None:
             chance = part.chance[part.order]
             with np.errstate(divide="ignore", invalid="ignore"):
                 spread_out = np.where(chance > 0, part.reach[part.order] / chance, np.inf)
             spread_out = -np.nan_to_num(spread_out, nan=np.inf)
-            self.spread = [-range_least(spread_out, starts, ends) for starts, ends in part_ranges]
+            self.spread = [-least for least in ranges_least(spread_out, part_ranges)]
 
 
 class _Source(NamedTuple):

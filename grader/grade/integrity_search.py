@@ -292,10 +292,29 @@ def range_least(values: Floats, starts: Ints, ends: Ints) -> Floats:
     >>> range_least(np.array([5.0, 3.0, 4.0, 1.0, 2.0]), np.array([0, 0, 2, 4, 3]), np.array([1, 3, 4, 5, 3]))
     array([ 5.,  3.,  1.,  2., inf])
     """
-    found = np.full(len(starts), np.inf)
-    sizes = ends - starts
-    if not len(values) or not (sizes > 0).any():
-        return found
+    return ranges_least(values, [(starts, ends)])[0]
+
+
+def ranges_least(values: Floats, ranges: Sequence[tuple[Ints, Ints]]) -> list[Floats]:
+    """:func:`range_least` of each ``(starts, ends)`` of ``ranges``, the table built once for them all."""
+    levels: list[Floats] = []
+    found = []
+    for starts, ends in ranges:
+        least = np.full(len(starts), np.inf)
+        sizes = ends - starts
+        if len(values) and (sizes > 0).any():
+            if not levels:
+                levels.append(values)
+                while 2 ** len(levels) <= len(values):
+                    run = 2 ** (len(levels) - 1)
+                    levels.append(np.minimum(levels[-1][:-run], levels[-1][run:]))
+            some = np.flatnonzero(sizes > 0)
+            level = np.floor(np.log2(sizes[some])).astype(np.int64)
+            for k in distinct(level).tolist():
+                rows = some[level == k]
+                least[rows] = np.minimum(levels[k][starts[rows]], levels[k][ends[rows] - 2 ** k])
+        found.append(least)
+    return found
     levels = [values]
     while 2 ** len(levels) <= len(values):
         run = 2 ** (len(levels) - 1)

@@ -70,7 +70,7 @@ def numbered_rows(rows: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]
     rows = np.asarray(rows)
     count, width = rows.shape
     base = int(rows.max(initial=0)) + 1
-    if rows.dtype.kind not in "iu" or (count and int(rows.min()) < 0) or base ** max(width, 1) >= 1 << 62:
+    if rows.dtype.kind not in "iu" or int(rows.min(initial=0)) < 0 or base ** max(width, 1) >= 1 << 62:
         distinct, firsts, inverse = np.unique(rows, axis=0, return_index=True, return_inverse=True)
         return distinct, inverse.ravel(), firsts
     combined = np.zeros(count, dtype=np.int64)

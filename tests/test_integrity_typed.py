@@ -24,6 +24,7 @@ PIECES = ["0", "1", "7", "12", "3.41", ".", "-", "+", "e", "E", "e+03", "e-4", "
     ("5.79e+03", (5790.0, 10.0)), ("2.5E-3", (0.0025, 0.0001)), ("165 cm/s", (165.0, 1.0)),
     ("1.06e+03 N·s", (1060.0, 10.0)), ("12 %", (12.0, 1.0)), ("46.2 deg", (46.2, 0.1)), ("3.41m/s", (3.41, 0.01)),
     ("1 234", (1234.0, 1.0)), ("1e99999", None), ("3.4.5", None), ("3.41 m/s or 2", None), ("six", None),
+    ("3.41.", None), ("3.41,", None), ("3..", None),
 ])
 def test_a_typed_number_reads_as_typed_place_reads_it(text: str, expected: tuple[float, float] | None) -> None:
     assert typed_place(text) == expected

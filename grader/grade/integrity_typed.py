@@ -32,8 +32,8 @@ def halves(texts: Sequence[str | None], numbers: Floats) -> list[float]:
     head, unit_after, short = _HEAD.match, _unit_after, SHORT
     found = []
     for text, number in zip(texts, numbers.tolist(), strict=True):
-        if text is not None and len(text) <= short and (plain := head(text)) and unit_after(plain[3],
-                                                                                              text[plain.end():]):
+        if text is not None and len(text) <= short and (plain := head(text)) and unit_after(
+                _shape(plain[2]), plain[3], text[plain.end():]):
             exponent = plain[3][1:] or "0"
             value = float(f"{plain[1]}{plain[2]}e{exponent}")
             if value == 0 or not math.isfinite(value):
@@ -63,7 +63,8 @@ def place(text: str) -> tuple[float, float] | None:
     >>> place("-6.50e-3 kN"), place("12 %"), place("1 234"), place("3.4.5")
     ((-0.0065, 1e-05), (12.0, 1.0), (1234.0, 1.0), None)
     """
-    if len(text) <= SHORT and (head := _HEAD.match(text)) and _unit_after(head[3], text[head.end():]):
+    if len(text) <= SHORT and (head := _HEAD.match(text)) and _unit_after(_shape(head[2]), head[3],
+                                                                            text[head.end():]):
         sign, mantissa, exponent = head[1], head[2], head[3][1:] or "0"
         power = int(exponent) - len(mantissa.partition(".")[2])
         value = float(f"{sign}{mantissa}e{exponent}")
@@ -72,18 +73,24 @@ def place(text: str) -> tuple[float, float] | None:
 
 
 @functools.lru_cache(maxsize=1 << 12)
-def _unit_after(exponent: str, tail: str) -> bool:
-    """Whether ``typed_place`` reads a short text made of a plain number, its ``exponent`` (``e+03``; may be
-    empty) and ``tail`` as the number alone: whether it reads ``1`` with the same exponent and tail as ``1``
-    with the exponent. Its decisions depend on the tail and exponent alone: cleaning changes only the tail
-    (the number is plain ASCII, not at either end's spaces); the unit is looked for at each letter (``°``,
-    ``%``) after a character that is not one, of which the number has only its ``e``, and taken when the text
-    before it ends in a digit or a point (a number's last character, either way) and the rest is a unit; the
-    number then read is the number alone, whatever its digits."""
+def _unit_after(shape: str, exponent: str, tail: str) -> bool:
+    """Whether ``typed_place`` reads a short text made of a plain number of the ``shape`` :func:`_shape` gives,
+    its ``exponent`` (``e+03``; may be empty) and ``tail`` as the number alone: whether it reads the shape with
+    the same exponent and tail as the shape with the exponent. Its decisions depend on the shape, exponent and
+    tail alone: cleaning changes only the tail (the number is plain ASCII, not at either end's spaces); the
+    unit is looked for at each letter (``°``, ``%``) after a character that is not one, of which the number has
+    only its ``e``, and taken when the text before it ends in a digit or a point (a number's last character,
+    either way) and the rest is a unit; a tail that goes on the number (a second point: ``3.41.``) does so as
+    it goes on the shape; the number then read is the number alone, whatever its digits."""
     if not tail and not exponent:
         return True
-    probe = typed_place(f"1{exponent}{tail}")
-    return probe is not None and probe == typed_place(f"1{exponent}")
+    probe = typed_place(f"{shape}{exponent}{tail}")
+    return probe is not None and probe == typed_place(f"{shape}{exponent}")
+
+
+def _shape(mantissa: str) -> str:
+    """A number of the same shape as ``mantissa``: without a point, ending in one, or with digits after it."""
+    return "1" if "." not in mantissa else "1." if mantissa.endswith(".") else "1.0"
 
 
 _typed_place = functools.lru_cache(maxsize=1 << 16)(typed_place)

@@ -315,16 +315,6 @@ def ranges_least(values: Floats, ranges: Sequence[tuple[Ints, Ints]]) -> list[Fl
                 least[rows] = np.minimum(levels[k][starts[rows]], levels[k][ends[rows] - 2 ** k])
         found.append(least)
     return found
-    levels = [values]
-    while 2 ** len(levels) <= len(values):
-        run = 2 ** (len(levels) - 1)
-        levels.append(np.minimum(levels[-1][:-run], levels[-1][run:]))
-    some = np.flatnonzero(sizes > 0)
-    level = np.floor(np.log2(sizes[some])).astype(np.int64)
-    for k in distinct(level).tolist():
-        rows = some[level == k]
-        found[rows] = np.minimum(levels[k][starts[rows]], levels[k][ends[rows] - 2 ** k])
-    return found
 
 
 def nearest(part: Bands, owners: Ints, numbers: Floats, count: int) -> Ints:
